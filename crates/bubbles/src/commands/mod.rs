@@ -1,0 +1,9 @@
+//! One module per subcommand, each with `Args` and `run`.
+
+pub mod bake;
+pub mod bench;
+pub mod chart;
+pub mod color;
+pub mod reflectance;
+pub mod render;
+pub mod simulate;

@@ -1,0 +1,52 @@
+//! `bubbles`: soap bubbles with real thin-film optics.
+
+mod commands;
+mod error;
+
+use clap::{Parser, Subcommand};
+
+/// Soap bubbles with real thin-film optics.
+#[derive(Debug, Parser)]
+#[command(name = "bubbles", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Thin-film reflectance and transmittance, spectral, from CSV on stdin or flags.
+    Reflectance(commands::reflectance::Args),
+    /// CIE colour of a soap film, from CSV `thickness_nm,angle_deg` on stdin.
+    Color(commands::color::Args),
+    /// Draw the interference colour chart (colour against thickness) to a PNG.
+    Chart(commands::chart::Args),
+    /// Bake the (thickness, cos θ) textures to EXR/PNG with a JSON description.
+    Bake(commands::bake::Args),
+    /// Simulate a scene's bubbles and print their state as JSON.
+    Simulate(commands::simulate::Args),
+    /// Simulate, then render a scene to PNG or EXR.
+    Render(commands::render::Args),
+    /// Time the frame and print a breakdown.
+    Bench(commands::bench::Args),
+}
+
+fn main() -> std::process::ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Reflectance(args) => commands::reflectance::run(args),
+        Command::Color(args) => commands::color::run(args),
+        Command::Chart(args) => commands::chart::run(args),
+        Command::Bake(args) => commands::bake::run(args),
+        Command::Simulate(args) => commands::simulate::run(args),
+        Command::Render(args) => commands::render::run(args),
+        Command::Bench(args) => commands::bench::run(args),
+    };
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("error: {err}");
+            std::process::ExitCode::from(err.exit_code())
+        }
+    }
+}

@@ -1,0 +1,2 @@
+//! Criterion benches (filled in by the crate owner).
+fn main() {}

@@ -1,0 +1,18 @@
+//! Exact spectral thin-film optics and CIE colour.
+//!
+//! `thinfilm` knows nothing of meshes or rendering: it turns a film description
+//! (indices, thickness, angle, wavelength) into reflectance and transmittance, and
+//! spectra into colour.
+
+pub mod airy;
+pub mod batch;
+pub mod dispersion;
+pub mod fresnel;
+pub mod tmm;
+
+pub mod cmf;
+pub mod colorspace;
+pub mod illuminant;
+pub mod integrate;
+pub mod lab;
+pub mod spectrum;

@@ -1,0 +1,1 @@
+//! Cross-crate tests: laws that hold end to end across thinfilm, lut, dynamics and raster.
