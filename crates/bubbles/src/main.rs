@@ -2,6 +2,8 @@
 
 mod commands;
 mod error;
+#[allow(dead_code)] // TEMPORARY: wired into simulate/render by the integrator
+mod scene;
 
 use clap::{Parser, Subcommand};
 

@@ -1,0 +1,409 @@
+//! The TOML scene schema: plain serde types, documented in `docs/scene-format.md`.
+//!
+//! Every table uses `deny_unknown_fields`, so a misspelt key is an error with its
+//! line and column rather than a silently ignored setting.
+
+use super::values::{Direction, Finite, NonNegative, Positive, Rgb, Vec3};
+use serde::Deserialize;
+
+/// A whole scene file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Simulated time to advance before rendering, in seconds.
+    #[serde(default = "zero")]
+    pub time_s: NonNegative,
+    /// The viewpoint.
+    pub camera: CameraSpec,
+    /// What surrounds the scene.
+    #[serde(default)]
+    pub environment: EnvironmentSpec,
+    /// Optional ground plane.
+    #[serde(default)]
+    pub ground: Option<GroundSpec>,
+    /// Opaque objects.
+    #[serde(default)]
+    pub objects: Vec<ObjectSpec>,
+    /// Small spherical lights.
+    #[serde(default)]
+    pub lights: Vec<LightSpec>,
+    /// The soap bubbles.
+    #[serde(default)]
+    pub bubbles: Vec<BubbleSpec>,
+    /// Wind acting on the bubbles.
+    #[serde(default)]
+    pub wind: WindSpec,
+    /// Film optics shared by every bubble.
+    #[serde(default)]
+    pub film: FilmSpec,
+    /// Solver settings shared by every bubble.
+    #[serde(default)]
+    pub dynamics: DynamicsSpec,
+    /// Renderer defaults (CLI flags override them).
+    #[serde(default)]
+    pub render: RenderSpec,
+}
+
+fn zero() -> NonNegative {
+    NonNegative::new(0.0).expect("0 is non-negative")
+}
+
+/// A look-at camera.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraSpec {
+    /// Eye position, m.
+    pub eye_m: Vec3,
+    /// Point looked at, m.
+    pub target_m: Vec3,
+    /// Up direction.
+    #[serde(default = "y_up")]
+    pub up: Direction,
+    /// Vertical field of view, degrees.
+    #[serde(default = "default_vfov")]
+    pub vfov_deg: Positive,
+}
+
+fn y_up() -> Direction {
+    Direction::new([0.0, 1.0, 0.0]).expect("y is a direction")
+}
+
+fn default_vfov() -> Positive {
+    Positive::new(40.0).expect("40 > 0")
+}
+
+/// The environment: what a ray that hits nothing sees.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, tag = "kind", rename_all = "kebab-case")]
+pub enum EnvironmentSpec {
+    /// A procedural sky with a sun.
+    Sky {
+        /// Sky radiance straight up.
+        #[serde(default = "zenith")]
+        zenith_rgb: Rgb,
+        /// Sky radiance at the horizon.
+        #[serde(default = "horizon")]
+        horizon_rgb: Rgb,
+        /// Radiance below the horizon.
+        #[serde(default = "below")]
+        ground_rgb: Rgb,
+        /// Direction towards the sun.
+        #[serde(default = "sun_dir")]
+        sun_direction: Direction,
+        /// Sun disc radiance (0 for none).
+        #[serde(default = "sun_rgb")]
+        sun_rgb: Rgb,
+    },
+    /// The same radiance in every direction.
+    Uniform {
+        /// The radiance.
+        rgb: Rgb,
+    },
+    /// An equirectangular (latitude-longitude) image.
+    Equirect {
+        /// Image path, relative to the scene file.
+        path: String,
+        /// Radiance scale applied to the decoded linear values.
+        #[serde(default = "one")]
+        intensity: NonNegative,
+    },
+    /// Six cube-map face images, in the order +x, −x, +y, −y, +z, −z.
+    Cube {
+        /// Face paths, relative to the scene file.
+        faces: [String; 6],
+        /// Radiance scale applied to the decoded linear values.
+        #[serde(default = "one")]
+        intensity: NonNegative,
+    },
+}
+
+impl Default for EnvironmentSpec {
+    fn default() -> Self {
+        Self::Sky {
+            zenith_rgb: zenith(),
+            horizon_rgb: horizon(),
+            ground_rgb: below(),
+            sun_direction: sun_dir(),
+            sun_rgb: sun_rgb(),
+        }
+    }
+}
+
+fn rgb(v: [f64; 3]) -> Rgb {
+    Rgb::new(v).expect("literal colour is valid")
+}
+fn zenith() -> Rgb {
+    rgb([0.25, 0.45, 0.9])
+}
+fn horizon() -> Rgb {
+    rgb([0.85, 0.9, 1.0])
+}
+fn below() -> Rgb {
+    rgb([0.3, 0.28, 0.25])
+}
+fn sun_dir() -> Direction {
+    Direction::new([0.4, 0.8, 0.3]).expect("literal direction is valid")
+}
+fn sun_rgb() -> Rgb {
+    rgb([0.0, 0.0, 0.0])
+}
+fn one() -> NonNegative {
+    NonNegative::new(1.0).expect("1 >= 0")
+}
+
+/// A horizontal ground plane.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GroundSpec {
+    /// Height of the plane, m.
+    #[serde(default = "finite_zero")]
+    pub height_m: Finite,
+    /// Half the side of the drawn square, m.
+    #[serde(default = "ground_extent")]
+    pub half_extent_m: Positive,
+    /// Surface appearance.
+    #[serde(default)]
+    pub material: MaterialSpec,
+}
+
+fn finite_zero() -> Finite {
+    Finite::new(0.0).expect("0 is finite")
+}
+fn ground_extent() -> Positive {
+    Positive::new(10.0).expect("10 > 0")
+}
+
+/// How an opaque surface looks.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, tag = "kind", rename_all = "kebab-case")]
+pub enum MaterialSpec {
+    /// Two alternating colours.
+    Checker {
+        /// First albedo.
+        a: Rgb,
+        /// Second albedo.
+        b: Rgb,
+        /// Side of one square, m.
+        scale_m: Positive,
+    },
+    /// An image repeated every `scale_m`.
+    Image {
+        /// Image path, relative to the scene file.
+        path: String,
+        /// Side of one repeat, m.
+        scale_m: Positive,
+    },
+    /// One colour with a Blinn-Phong highlight.
+    Solid {
+        /// Diffuse albedo.
+        albedo: Rgb,
+        /// Specular colour.
+        #[serde(default = "no_specular")]
+        specular: Rgb,
+        /// Blinn-Phong exponent.
+        #[serde(default = "shininess")]
+        shininess: Positive,
+    },
+}
+
+impl Default for MaterialSpec {
+    fn default() -> Self {
+        Self::Checker {
+            a: rgb([0.8, 0.8, 0.8]),
+            b: rgb([0.15, 0.15, 0.18]),
+            scale_m: Positive::new(0.05).expect("0.05 > 0"),
+        }
+    }
+}
+
+fn no_specular() -> Rgb {
+    rgb([0.0, 0.0, 0.0])
+}
+fn shininess() -> Positive {
+    Positive::new(32.0).expect("32 > 0")
+}
+
+/// An opaque object.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, tag = "kind", rename_all = "kebab-case")]
+pub enum ObjectSpec {
+    /// A sphere.
+    Sphere {
+        /// Centre, m.
+        center_m: Vec3,
+        /// Radius, m.
+        radius_m: Positive,
+        /// Appearance.
+        material: MaterialSpec,
+    },
+    /// An axis-aligned box.
+    Box {
+        /// Lowest corner, m.
+        min_m: Vec3,
+        /// Highest corner, m.
+        max_m: Vec3,
+        /// Appearance.
+        material: MaterialSpec,
+    },
+    /// A Wavefront OBJ mesh.
+    Mesh {
+        /// OBJ path, relative to the scene file.
+        path: String,
+        /// Translation applied to the mesh, m.
+        #[serde(default = "origin")]
+        offset_m: Vec3,
+        /// Uniform scale applied to the mesh.
+        #[serde(default = "unit_scale")]
+        scale: Positive,
+        /// Appearance.
+        material: MaterialSpec,
+    },
+}
+
+fn origin() -> Vec3 {
+    Vec3::new([0.0; 3]).expect("origin is finite")
+}
+fn unit_scale() -> Positive {
+    Positive::new(1.0).expect("1 > 0")
+}
+
+/// A small spherical light.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightSpec {
+    /// Centre, m.
+    pub position_m: Vec3,
+    /// Radius of the emitting sphere, m.
+    pub radius_m: Positive,
+    /// Emission spectrum: an illuminant name (`d65`, `sodium`, …) or a CSV path.
+    #[serde(default = "d65")]
+    pub spectrum: String,
+    /// Luminance of the emitting surface, relative to a white of 1.
+    #[serde(default = "light_luminance")]
+    pub luminance: NonNegative,
+}
+
+fn d65() -> String {
+    "d65".into()
+}
+fn light_luminance() -> NonNegative {
+    NonNegative::new(20.0).expect("20 >= 0")
+}
+
+/// One soap bubble.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BubbleSpec {
+    /// Centre at time 0, m.
+    pub center_m: Vec3,
+    /// Radius at rest, m.
+    pub radius_m: Positive,
+    /// Initial velocity, m/s.
+    #[serde(default = "origin")]
+    pub velocity_m_per_s: Vec3,
+    /// Mean film thickness at rest, nm.
+    #[serde(default = "mean_thickness")]
+    pub mean_thickness_nm: Positive,
+    /// Icosphere subdivision level (3 gives 642 vertices, as in seed 000).
+    #[serde(default = "subdivisions")]
+    pub subdivisions: u32,
+    /// Surface tension, N/m.
+    #[serde(default)]
+    pub sigma_n_per_m: Option<Positive>,
+    /// Velocity damping rate γ/m, 1/s.
+    #[serde(default)]
+    pub damping_per_s: Option<NonNegative>,
+    /// Seed of the thickness perturbation (sloshing).
+    #[serde(default)]
+    pub seed: u64,
+}
+
+fn mean_thickness() -> Positive {
+    Positive::new(500.0).expect("500 > 0")
+}
+fn subdivisions() -> u32 {
+    3
+}
+
+/// Wind: a uniform velocity plus seeded gusts.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WindSpec {
+    /// Uniform air velocity, m/s.
+    #[serde(default)]
+    pub velocity_m_per_s: Option<Vec3>,
+    /// Gust amplitude, m/s.
+    #[serde(default)]
+    pub gust_m_per_s: Option<NonNegative>,
+    /// Gust seed.
+    #[serde(default)]
+    pub seed: u64,
+}
+
+/// Film optics.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FilmSpec {
+    /// Film refractive index (ignored when `dispersion = "water"`).
+    #[serde(default = "n_soap")]
+    pub n_film: Positive,
+    /// `"none"` for a constant index, `"water"` for water's n(λ).
+    #[serde(default = "no_dispersion")]
+    pub dispersion: String,
+    /// White reference illuminant for the environment reflectivity texture.
+    #[serde(default = "d65")]
+    pub illuminant: String,
+}
+
+impl Default for FilmSpec {
+    fn default() -> Self {
+        Self {
+            n_film: n_soap(),
+            dispersion: no_dispersion(),
+            illuminant: d65(),
+        }
+    }
+}
+
+fn n_soap() -> Positive {
+    Positive::new(1.33).expect("1.33 > 0")
+}
+fn no_dispersion() -> String {
+    "none".into()
+}
+
+/// Solver settings.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DynamicsSpec {
+    /// Fixed time step, s.
+    #[serde(default)]
+    pub dt_s: Option<Positive>,
+    /// Gravity, m/s².
+    #[serde(default)]
+    pub gravity_m_per_s2: Option<Vec3>,
+    /// `"verlet"` (default), `"symplectic-euler"` or `"explicit-euler"`.
+    #[serde(default)]
+    pub integrator: Option<String>,
+}
+
+/// Renderer defaults.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderSpec {
+    /// `"dynamic"` cube maps (default), `"static"` environment, or `"sphere-map"`.
+    #[serde(default)]
+    pub reflection: Option<String>,
+    /// Cube-map face size, texels.
+    #[serde(default)]
+    pub cube_map_size: Option<u32>,
+    /// Exposure multiplier before tone mapping.
+    #[serde(default)]
+    pub exposure: Option<Positive>,
+    /// `"aces"`, `"reinhard"` or `"clamp"`.
+    #[serde(default)]
+    pub tonemap: Option<String>,
+    /// Anti-aliasing samples per pixel.
+    #[serde(default)]
+    pub samples: Option<u32>,
+}
