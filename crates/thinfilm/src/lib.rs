@@ -16,3 +16,7 @@ pub mod illuminant;
 pub mod integrate;
 pub mod lab;
 pub mod spectrum;
+
+pub use airy::{Response, ThinFilm};
+pub use dispersion::RefractiveIndex;
+pub use fresnel::OpticsError;

@@ -1,0 +1,112 @@
+//! The error of every fallible optics call: which value was bad, and what it was.
+
+use num_complex::Complex64;
+use std::fmt;
+
+/// A rejected optics input, naming the parameter and its value.
+#[derive(Clone, Debug, PartialEq)]
+pub enum OpticsError {
+    /// A real refractive index that is not finite and positive.
+    Index {
+        /// Which index.
+        what: &'static str,
+        /// The rejected value.
+        value: f64,
+    },
+    /// A complex refractive index that is not finite with `Re > 0` and `Im ≥ 0`.
+    ComplexIndex {
+        /// Which index.
+        what: &'static str,
+        /// The rejected value.
+        value: Complex64,
+    },
+    /// A cosine of an incidence angle outside [0, 1].
+    Cosine {
+        /// Which cosine.
+        what: &'static str,
+        /// The rejected value.
+        value: f64,
+    },
+    /// A wavelength that is not finite and positive.
+    Wavelength {
+        /// The rejected wavelength in nm.
+        wavelength_nm: f64,
+    },
+    /// A thickness that is not finite and non-negative.
+    Thickness {
+        /// The rejected thickness in nm.
+        thickness_nm: f64,
+    },
+    /// A dispersion model whose parameters are invalid (named in `reason`).
+    Dispersion {
+        /// What is wrong.
+        reason: String,
+    },
+    /// A dispersion model that gives no finite positive index at this wavelength.
+    IndexAtWavelength {
+        /// The wavelength in nm.
+        wavelength_nm: f64,
+        /// What the model gave there.
+        value: f64,
+    },
+    /// Slices that must have equal lengths do not.
+    Length {
+        /// Which slice.
+        what: &'static str,
+        /// Its length.
+        len: usize,
+        /// The length it must have.
+        expected: usize,
+    },
+    /// A non-finite weight or sample value in a batch call.
+    NotFinite {
+        /// Which slice.
+        what: &'static str,
+        /// The index of the bad element.
+        index: usize,
+        /// The rejected value.
+        value: f64,
+    },
+}
+
+impl fmt::Display for OpticsError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            OpticsError::Index { what, value } => {
+                write!(f, "{what} = {value} is not a finite refractive index > 0")
+            }
+            OpticsError::ComplexIndex { what, value } => write!(
+                f,
+                "{what} = {value} is not a finite complex index with real part > 0 and \
+                 imaginary part >= 0"
+            ),
+            OpticsError::Cosine { what, value } => {
+                write!(f, "{what} = {value} is not a cosine in [0, 1]")
+            }
+            OpticsError::Wavelength { wavelength_nm } => {
+                write!(f, "wavelength {wavelength_nm} nm is not finite and > 0")
+            }
+            OpticsError::Thickness { thickness_nm } => {
+                write!(f, "thickness {thickness_nm} nm is not finite and >= 0")
+            }
+            OpticsError::Dispersion { reason } => write!(f, "invalid dispersion model: {reason}"),
+            OpticsError::IndexAtWavelength {
+                wavelength_nm,
+                value,
+            } => write!(
+                f,
+                "dispersion model gives n = {value} at {wavelength_nm} nm (not finite and > 0)"
+            ),
+            OpticsError::Length {
+                what,
+                len,
+                expected,
+            } => write!(f, "{what} has {len} elements, expected {expected}"),
+            OpticsError::NotFinite { what, index, value } => {
+                write!(f, "{what}[{index}] = {value} is not a valid value")
+            }
+        }
+    }
+}
+
+impl std::error::Error for OpticsError {}
