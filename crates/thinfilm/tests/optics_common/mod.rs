@@ -40,7 +40,10 @@ pub fn film(n_outside: f64, n_film: f64, n_substrate: Complex64, thickness_nm: f
 pub fn as_stack(film: &ThinFilm, wavelength_nm: f64) -> Stack {
     Stack {
         n_incident: film.n_outside,
-        layers: vec![Layer::lossless(film.n_film.n_at(wavelength_nm), film.thickness_nm)],
+        layers: vec![Layer::lossless(
+            film.n_film.n_at(wavelength_nm),
+            film.thickness_nm,
+        )],
         n_substrate: film.n_substrate,
     }
 }

@@ -1,0 +1,267 @@
+//! The f32 batch path against the f64 reference (`ThinFilm`), and its input checks.
+
+mod optics_common;
+
+use optics_common::{assert_close, film, re};
+use proptest::prelude::*;
+use thinfilm::batch::{
+    reflectance, try_reflectance, try_reflectance_transmittance, try_weighted_reflectance_row,
+    try_weighted_response_row, weighted_reflectance_row,
+};
+use thinfilm::dispersion::RefractiveIndex;
+use thinfilm::fresnel::OpticsError;
+
+/// f64 reference for a symmetric film at f32 inputs.
+fn reference(n0: f32, n1: f32, d: f32, cos: f32, l: f32) -> (f64, f64) {
+    let resp = film(n0 as f64, n1 as f64, re(n0 as f64), d as f64).response(l as f64, cos as f64);
+    (resp.r(), resp.t())
+}
+
+fn sample() -> impl Strategy<Value = (f32, f32, f32)> {
+    (
+        0.0..3000.0f32,
+        prop_oneof![0.0..=1.0f32, 0.0..0.01f32, Just(0.0f32), Just(1.0f32)],
+        360.0..830.0f32,
+    )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+    #[test]
+    fn per_sample_batch_matches_f64(
+        n0 in prop_oneof![Just(1.0f32), 1.0..1.6f32],
+        n1 in prop_oneof![Just(1.33f32), 1.0..2.5f32],
+        samples in prop::collection::vec(sample(), 1..40),
+    ) {
+        let d: Vec<f32> = samples.iter().map(|s| s.0).collect();
+        let c: Vec<f32> = samples.iter().map(|s| s.1).collect();
+        let l: Vec<f32> = samples.iter().map(|s| s.2).collect();
+        let mut r = vec![f32::NAN; d.len()];
+        let mut t = vec![f32::NAN; d.len()];
+        try_reflectance_transmittance(n0, n1, &d, &c, &l, &mut r, &mut t).unwrap();
+        let mut r_only = vec![f32::NAN; d.len()];
+        reflectance(n0, n1, &d, &c, &l, &mut r_only);
+        for i in 0..d.len() {
+            let (r64, t64) = reference(n0, n1, d[i], c[i], l[i]);
+            let label = format!("d={} cos={} λ={}", d[i], c[i], l[i]);
+            assert_close(&format!("R {label}"), r[i] as f64, r64, 1e-5);
+            assert_close(&format!("T {label}"), t[i] as f64, t64, 1e-5);
+            prop_assert_eq!(r[i].to_bits(), r_only[i].to_bits());
+        }
+    }
+
+    #[test]
+    fn weighted_row_matches_f64_sum(
+        n0 in prop_oneof![Just(1.0f32), 1.0..1.6f32],
+        cos in prop_oneof![0.0..=1.0f32, 0.0..0.01f32, Just(1.0f32)],
+        spectrum in prop::collection::vec((360.0..830.0f32, 1.0..2.5f32, 0.0..1.0f32, 0.0..1.0f32, 0.0..1.0f32), 1..12),
+        thickness in prop::collection::vec(0.0..3000.0f32, 1..300),
+    ) {
+        let l: Vec<f32> = spectrum.iter().map(|s| s.0).collect();
+        let n: Vec<f32> = spectrum.iter().map(|s| s.1).collect();
+        let w: Vec<[f32; 3]> = spectrum.iter().map(|s| [s.2, s.3, s.4]).collect();
+        let mut out_r = vec![[f32::NAN; 3]; thickness.len()];
+        let mut out_t = vec![[f32::NAN; 3]; thickness.len()];
+        try_weighted_response_row(n0, cos, &l, &n, &w, &thickness, &mut out_r, &mut out_t).unwrap();
+        let mut r_only = vec![[f32::NAN; 3]; thickness.len()];
+        weighted_reflectance_row(n0, cos, &l, &n, &w, &thickness, &mut r_only);
+        let weight_sum: [f64; 3] = [0, 1, 2].map(|c| w.iter().map(|x| x[c] as f64).sum());
+        for (i, &d) in thickness.iter().enumerate() {
+            let mut r64 = [0.0f64; 3];
+            let mut t64 = [0.0f64; 3];
+            for k in 0..l.len() {
+                let (r, t) = reference(n0, n[k], d, cos, l[k]);
+                for c in 0..3 {
+                    r64[c] += w[k][c] as f64 * r;
+                    t64[c] += w[k][c] as f64 * t;
+                }
+            }
+            for c in 0..3 {
+                let tol = 1e-5 * weight_sum[c].max(1.0);
+                assert_close(&format!("R[{c}] d={d}"), out_r[i][c] as f64, r64[c], tol);
+                assert_close(&format!("T[{c}] d={d}"), out_t[i][c] as f64, t64[c], tol);
+                prop_assert_eq!(out_r[i][c].to_bits(), r_only[i][c].to_bits());
+            }
+        }
+    }
+}
+
+#[test]
+fn row_and_per_sample_paths_agree_bit_for_bit_across_chunks() {
+    // One wavelength with unit weight: the row is the per-sample reflectance exactly.
+    let thickness: Vec<f32> = (0..1000).map(|i| i as f32 * 2.137).collect();
+    for cos in [1.0f32, 0.61, 0.05] {
+        let mut row = vec![[0.0f32; 3]; thickness.len()];
+        weighted_reflectance_row(
+            1.0,
+            cos,
+            &[532.0],
+            &[1.33],
+            &[[1.0; 3]],
+            &thickness,
+            &mut row,
+        );
+        let mut per = vec![0.0f32; thickness.len()];
+        let n = thickness.len();
+        reflectance(
+            1.0,
+            1.33,
+            &thickness,
+            &vec![cos; n],
+            &vec![532.0; n],
+            &mut per,
+        );
+        for i in 0..n {
+            assert_eq!(
+                row[i][0].to_bits(),
+                per[i].to_bits(),
+                "d = {}",
+                thickness[i]
+            );
+            assert_eq!(row[i][0], row[i][2]);
+        }
+    }
+}
+
+#[test]
+fn dispersive_row_uses_each_wavelengths_index() {
+    let l = [400.0f32, 550.0, 700.0];
+    let n = l.map(|x| RefractiveIndex::Water.n_at(x as f64) as f32);
+    let thickness = [0.0f32, 123.0, 456.0, 789.0];
+    let mut out = [[0.0f32; 3]; 4];
+    let w = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    weighted_reflectance_row(1.0, 0.9, &l, &n, &w, &thickness, &mut out);
+    for (i, &d) in thickness.iter().enumerate() {
+        for c in 0..3 {
+            let (r, _) = reference(1.0, n[c], d, 0.9, l[c]);
+            assert_close(&format!("channel {c} d={d}"), out[i][c] as f64, r, 1e-6);
+        }
+    }
+}
+
+#[test]
+fn index_matched_film_is_invisible() {
+    let mut r = [f32::NAN; 3];
+    let mut t = [f32::NAN; 3];
+    let d = [0.0, 100.0, 1e4];
+    try_reflectance_transmittance(1.2, 1.2, &d, &[0.0, 0.5, 1.0], &[400.0; 3], &mut r, &mut t)
+        .unwrap();
+    assert_eq!((r, t), ([0.0; 3], [1.0; 3]));
+}
+
+#[test]
+fn bad_batch_inputs_are_named_and_leave_output_untouched() {
+    let mut out = [[7.0f32; 3]; 2];
+    let err = try_weighted_reflectance_row(
+        1.0,
+        0.5,
+        &[500.0, 600.0],
+        &[1.33],
+        &[[1.0; 3]; 2],
+        &[1.0, 2.0],
+        &mut out,
+    )
+    .unwrap_err();
+    assert!(
+        matches!(
+            err,
+            OpticsError::Length {
+                what: "n_film",
+                len: 1,
+                expected: 2
+            }
+        ),
+        "{err}"
+    );
+    let err = try_weighted_reflectance_row(
+        1.0,
+        0.5,
+        &[500.0],
+        &[1.33],
+        &[[1.0; 3]],
+        &[1.0, -2.0],
+        &mut out,
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("thickness_nm[1] = -2"), "{err}");
+    let err = try_weighted_reflectance_row(
+        1.0,
+        1.5,
+        &[500.0],
+        &[1.33],
+        &[[1.0; 3]],
+        &[1.0, 2.0],
+        &mut out,
+    )
+    .unwrap_err();
+    assert!(matches!(err, OpticsError::Cosine { .. }), "{err}");
+    let err = try_weighted_reflectance_row(
+        1.0,
+        0.5,
+        &[500.0],
+        &[1.33],
+        &[[f32::NAN, 0.0, 0.0]],
+        &[1.0, 2.0],
+        &mut out,
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("weights[0]"), "{err}");
+    let err = try_weighted_reflectance_row(
+        1.0,
+        0.5,
+        &[0.0],
+        &[1.33],
+        &[[1.0; 3]],
+        &[1.0, 2.0],
+        &mut out,
+    )
+    .unwrap_err();
+    assert!(matches!(err, OpticsError::Wavelength { .. }), "{err}");
+    assert_eq!(out, [[7.0; 3]; 2]);
+    let mut r = [7.0f32; 2];
+    let err = try_reflectance(
+        1.0,
+        1.33,
+        &[1.0, 2.0],
+        &[0.5, f32::NAN],
+        &[500.0; 2],
+        &mut r,
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("cos_theta[1]"), "{err}");
+    let err = try_reflectance(1.0, -1.33, &[1.0, 2.0], &[0.5; 2], &[500.0; 2], &mut r).unwrap_err();
+    assert!(
+        matches!(err, OpticsError::Index { what: "n_film", .. }),
+        "{err}"
+    );
+    let err = try_reflectance(
+        1.0,
+        1.33,
+        &[1.0, 2.0],
+        &[0.5; 2],
+        &[500.0; 2],
+        &mut [0.0; 3],
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, OpticsError::Length { what: "out_r", .. }),
+        "{err}"
+    );
+    assert_eq!(r, [7.0; 2]);
+}
+
+#[test]
+#[should_panic(expected = "out has 1 elements, expected 2")]
+fn weighted_row_panics_on_mismatched_output() {
+    let mut out = [[0.0f32; 3]; 1];
+    weighted_reflectance_row(
+        1.0,
+        0.5,
+        &[500.0],
+        &[1.33],
+        &[[1.0; 3]],
+        &[1.0, 2.0],
+        &mut out,
+    );
+}
