@@ -1,0 +1,457 @@
+//! The strip passes: background + opaque triangles, and the bubble blend.
+//!
+//! A strip is `STRIP_ROWS` full image rows; it owns its pixels' samples outright, so strips
+//! run in parallel with no shared writes, and each walks its triangles in one fixed order.
+
+use glam::Vec3;
+use lut::Lut;
+
+use crate::camera::View;
+use crate::raster::{SamplePattern, SetupTri, for_each_covered_in_row};
+use crate::shading::{ground_albedo, lit, object_albedo};
+use crate::{CubeMap, Environment, FilmTables, Ground, Light, Material, SphereMap};
+
+/// Rows per strip (the unit of parallel work).
+pub(crate) const STRIP_ROWS: usize = 8;
+
+/// Tag bit marking an emissive light-sphere triangle (low bits: the light's index).
+pub(crate) const EMISSIVE: u32 = 1 << 31;
+
+/// Triangle indices per strip, in submission order (a counting sort).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Bins {
+    starts: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl Bins {
+    /// Rebuilds the bins of `tris` for `strips` strips.
+    pub fn build(&mut self, tris: &[SetupTri], strips: usize) {
+        let range = |t: &SetupTri| {
+            (
+                t.bbox[1] as usize / STRIP_ROWS,
+                (t.bbox[3] as usize - 1) / STRIP_ROWS,
+            )
+        };
+        self.starts.clear();
+        self.starts.resize(strips + 2, 0);
+        for t in tris {
+            let (a, b) = range(t);
+            for s in a..=b.min(strips - 1) {
+                self.starts[s + 2] += 1;
+            }
+        }
+        for s in 2..self.starts.len() {
+            self.starts[s] += self.starts[s - 1];
+        }
+        self.items.clear();
+        self.items.resize(self.starts[strips + 1] as usize, 0);
+        // starts[s + 1] is now the write cursor of strip s.
+        for (i, t) in tris.iter().enumerate() {
+            let (a, b) = range(t);
+            for s in a..=b.min(strips - 1) {
+                let cursor = &mut self.starts[s + 1];
+                self.items[*cursor as usize] = i as u32;
+                *cursor += 1;
+            }
+        }
+    }
+
+    /// Triangle indices touching strip `s`.
+    pub fn strip(&self, s: usize) -> &[u32] {
+        &self.items[self.starts[s] as usize..self.starts[s + 1] as usize]
+    }
+}
+
+/// The ground plane prepared for one view: its inverse depth is affine in pixel coordinates.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct GroundView<'a> {
+    pub ground: &'a Ground,
+    /// `1/t = c + gx·px + gy·py`; the plane is in front where positive.
+    pub c: f32,
+    pub gx: f32,
+    pub gy: f32,
+    /// Unit normal facing the eye.
+    pub normal: Vec3,
+}
+
+impl<'a> GroundView<'a> {
+    /// `None` when the eye lies in the plane (it is seen edge-on: nothing to draw).
+    pub fn new(ground: &'a Ground, view: &View) -> Option<Self> {
+        let height = ground.height_m - view.eye.y;
+        if height == 0.0 || !height.is_finite() {
+            return None;
+        }
+        let sx = 2.0 * view.tan_half_x / view.width as f32;
+        let sy = 2.0 * view.tan_half_y / view.height as f32;
+        let inv_h = 1.0 / height;
+        Some(Self {
+            ground,
+            c: (view.forward.y - view.tan_half_x * view.right.y + view.tan_half_y * view.up.y)
+                * inv_h,
+            gx: sx * view.right.y * inv_h,
+            gy: -sy * view.up.y * inv_h,
+            normal: if height < 0.0 { Vec3::Y } else { -Vec3::Y },
+        })
+    }
+
+    #[inline]
+    fn inv_depth(&self, px: f32, py: f32) -> f32 {
+        self.c + self.gx * px + self.gy * py
+    }
+}
+
+/// Everything the opaque pass of one view reads.
+pub(crate) struct OpaqueCtx<'a> {
+    pub view: View,
+    pub pattern: SamplePattern,
+    pub env: &'a Environment,
+    pub ground: Option<GroundView<'a>>,
+    pub ambient: [f32; 3],
+    pub lights: &'a [Light],
+    pub materials: &'a [&'a Material],
+    pub tris: &'a [SetupTri],
+    pub bins: &'a Bins,
+}
+
+impl OpaqueCtx<'_> {
+    /// Renders strip `strip` (rows from `strip·STRIP_ROWS`) into its sample buffers.
+    pub fn render_strip(&self, strip: usize, color: &mut [[f32; 3]], depth: &mut [f32]) {
+        let y0 = strip * STRIP_ROWS;
+        let rows = color.len() / (self.view.width * self.pattern.count);
+        self.background(y0, rows, color, depth);
+        for &t in self.bins.strip(strip) {
+            self.triangle(&self.tris[t as usize], y0, rows, color, depth);
+        }
+    }
+
+    fn background(&self, y0: usize, rows: usize, color: &mut [[f32; 3]], depth: &mut [f32]) {
+        let s_count = self.pattern.count;
+        let full = self.pattern.full_mask();
+        let width = self.view.width;
+        for row in 0..rows {
+            let py = (y0 + row) as f32;
+            for x in 0..width {
+                let px = x as f32;
+                let base = (row * width + x) * s_count;
+                let mut ground_mask = 0u32;
+                let mut first_ground = 0usize;
+                if let Some(g) = &self.ground {
+                    for s in (0..s_count).rev() {
+                        let (ox, oy) = self.pattern.offset_f32(s);
+                        let z = g.inv_depth(px + ox, py + oy);
+                        depth[base + s] = z.max(0.0);
+                        if z > 0.0 {
+                            ground_mask |= 1 << s;
+                            first_ground = s;
+                        }
+                    }
+                } else {
+                    depth[base..base + s_count].fill(0.0);
+                }
+                let sky = if ground_mask != full {
+                    self.env.radiance(self.view.ray(px + 0.5, py + 0.5))
+                } else {
+                    [0.0; 3]
+                };
+                let ground = if ground_mask != 0 {
+                    let (ox, oy) = if ground_mask == full {
+                        (0.5, 0.5)
+                    } else {
+                        self.pattern.offset_f32(first_ground)
+                    };
+                    self.shade_ground(px + ox, py + oy)
+                } else {
+                    [0.0; 3]
+                };
+                for s in 0..s_count {
+                    color[base + s] = if ground_mask & (1 << s) != 0 {
+                        ground
+                    } else {
+                        sky
+                    };
+                }
+            }
+        }
+    }
+
+    fn shade_ground(&self, px: f32, py: f32) -> [f32; 3] {
+        let Some(g) = &self.ground else {
+            return [0.0; 3];
+        };
+        let view = &self.view;
+        let inv_t = g.inv_depth(px, py).max(1e-30);
+        let t = 1.0 / inv_t;
+        let d = view.ray(px, py);
+        let p = view.eye + d * t;
+        // Footprint of one pixel on the plane: ∂P/∂px = t·(∂d − d·∂d.y/d.y).
+        let sx = 2.0 * view.tan_half_x / view.width as f32;
+        let sy = 2.0 * view.tan_half_y / view.height as f32;
+        let ddx = view.right * sx;
+        let ddy = -view.up * sy;
+        let inv_dy = if d.y != 0.0 { 1.0 / d.y } else { 0.0 };
+        let dpx = (ddx - d * (ddx.y * inv_dy)) * t;
+        let dpy = (ddy - d * (ddy.y * inv_dy)) * t;
+        let footprint = [dpx.x.abs() + dpy.x.abs(), dpx.z.abs() + dpy.z.abs()];
+        let footprint = footprint.map(|f| if f.is_finite() { f } else { 1e9 });
+        let albedo = ground_albedo(&g.ground.material, p.x, p.z, footprint);
+        let v = d.normalize_or(view.forward);
+        lit(
+            &g.ground.material,
+            albedo,
+            p,
+            g.normal,
+            v,
+            self.ambient,
+            self.lights,
+        )
+    }
+
+    fn triangle(
+        &self,
+        tri: &SetupTri,
+        y0: usize,
+        rows: usize,
+        color: &mut [[f32; 3]],
+        depth: &mut [f32],
+    ) {
+        let s_count = self.pattern.count;
+        let width = self.view.width;
+        let ya = (tri.bbox[1] as usize).max(y0);
+        let yb = (tri.bbox[3] as usize).min(y0 + rows);
+        for py in ya..yb {
+            for_each_covered_in_row(tri, &self.pattern, py as i32, |px, mask| {
+                let base = ((py - y0) * width + px as usize) * s_count;
+                let (pxf, pyf) = (px as f32 - tri.ox, py as f32 - tri.oy);
+                let mut pass = 0u32;
+                let mut first = 0usize;
+                for s in (0..s_count).rev() {
+                    if mask & (1 << s) != 0 {
+                        let (ox, oy) = self.pattern.offset_f32(s);
+                        if tri.inv_w.at(pxf + ox, pyf + oy) > depth[base + s] {
+                            pass |= 1 << s;
+                            first = s;
+                        }
+                    }
+                }
+                if pass == 0 {
+                    return;
+                }
+                let (ox, oy) = if mask == self.pattern.full_mask() {
+                    (0.5, 0.5)
+                } else {
+                    self.pattern.offset_f32(first)
+                };
+                let c = self.shade(tri, px as f32 + ox, py as f32 + oy);
+                for s in 0..s_count {
+                    if pass & (1 << s) != 0 {
+                        let (ox, oy) = self.pattern.offset_f32(s);
+                        color[base + s] = c;
+                        depth[base + s] = tri.inv_w.at(pxf + ox, pyf + oy);
+                    }
+                }
+            });
+        }
+    }
+
+    fn shade(&self, tri: &SetupTri, px: f32, py: f32) -> [f32; 3] {
+        if tri.tag & EMISSIVE != 0 {
+            return self.lights[(tri.tag & !EMISSIVE) as usize].radiance;
+        }
+        let (inv_w, a) = tri.interpolate(px, py);
+        let d = self.view.ray(px, py);
+        let p = self.view.eye + d / inv_w;
+        let v = d.normalize_or(self.view.forward);
+        let n = Vec3::new(a[0], a[1], a[2]).normalize_or(-v);
+        let material = self.materials[tri.tag as usize];
+        let albedo = object_albedo(material, p, [a[3], a[4]]);
+        lit(material, albedo, p, n, v, self.ambient, self.lights)
+    }
+}
+
+/// Where one bubble's reflections come from.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Reflection<'a> {
+    Cube(&'a CubeMap),
+    Env(&'a Environment),
+    Sphere(&'a SphereMap),
+}
+
+impl Reflection<'_> {
+    #[inline]
+    fn sample(&self, dir: Vec3) -> [f32; 3] {
+        match self {
+            Self::Cube(c) => c.sample(dir),
+            Self::Env(e) => e.radiance(dir),
+            Self::Sphere(s) => s.sample(dir),
+        }
+    }
+}
+
+/// Everything the bubble pass reads.
+pub(crate) struct BubbleCtx<'a> {
+    pub view: View,
+    pub pattern: SamplePattern,
+    pub tables: &'a FilmTables,
+    pub lights: &'a [Light],
+    /// Per light: its highlight table (its own, or the reflectivity).
+    pub light_tables: &'a [&'a Lut],
+    /// Per bubble (by original index).
+    pub reflections: &'a [Reflection<'a>],
+    pub tris: &'a [SetupTri],
+    pub bins: &'a Bins,
+}
+
+impl BubbleCtx<'_> {
+    /// Blends every bubble triangle touching strip `strip` over its samples, in order.
+    pub fn render_strip(&self, strip: usize, color: &mut [[f32; 3]], depth: &[f32]) {
+        let y0 = strip * STRIP_ROWS;
+        let s_count = self.pattern.count;
+        let width = self.view.width;
+        let rows = color.len() / (width * s_count);
+        let full = self.pattern.full_mask();
+        for &t in self.bins.strip(strip) {
+            let tri = &self.tris[t as usize];
+            let ya = (tri.bbox[1] as usize).max(y0);
+            let yb = (tri.bbox[3] as usize).min(y0 + rows);
+            for py in ya..yb {
+                for_each_covered_in_row(tri, &self.pattern, py as i32, |px, mask| {
+                    let base = ((py - y0) * width + px as usize) * s_count;
+                    let (rx, ry) = (px as f32 - tri.ox, py as f32 - tri.oy);
+                    let mut pass = 0u32;
+                    let mut first = 0usize;
+                    for s in (0..s_count).rev() {
+                        if mask & (1 << s) != 0 {
+                            let (ox, oy) = self.pattern.offset_f32(s);
+                            if tri.inv_w.at(rx + ox, ry + oy) > depth[base + s] {
+                                pass |= 1 << s;
+                                first = s;
+                            }
+                        }
+                    }
+                    if pass == 0 {
+                        return;
+                    }
+                    let (ox, oy) = if mask == full {
+                        (0.5, 0.5)
+                    } else {
+                        self.pattern.offset_f32(first)
+                    };
+                    let (t_rgb, add) = self.shade(tri, px as f32 + ox, py as f32 + oy);
+                    for s in 0..s_count {
+                        if pass & (1 << s) != 0 {
+                            let c = &mut color[base + s];
+                            for k in 0..3 {
+                                c[k] = c[k] * t_rgb[k] + add[k];
+                            }
+                        }
+                    }
+                });
+            }
+        }
+    }
+
+    /// Transmittance and added radiance of the film at pixel-space point `(px, py)`.
+    #[inline]
+    fn shade(&self, tri: &SetupTri, px: f32, py: f32) -> ([f32; 3], [f32; 3]) {
+        let (inv_w, a) = tri.interpolate(px, py);
+        let thickness_nm = a[3].max(0.0);
+        let d = self.view.ray(px, py);
+        let v = d.normalize_or(self.view.forward);
+        let mut n = Vec3::new(a[0], a[1], a[2]).normalize_or(-v);
+        let mut c = v.dot(n);
+        // Face the film towards the viewer: back faces show the film from inside.
+        if c > 0.0 {
+            n = -n;
+            c = -c;
+        }
+        let cos_theta = (-c).min(1.0);
+        let r_rgb = self.tables.reflectivity.sample(thickness_nm, cos_theta);
+        let t_rgb = match &self.tables.transmittance {
+            Some(t) => t.sample(thickness_nm, cos_theta),
+            None => r_rgb.map(|r| 1.0 - r),
+        };
+        let reflected = v - n * (2.0 * c);
+        let env = self.reflections[tri.tag as usize].sample(reflected);
+        let mut add = [r_rgb[0] * env[0], r_rgb[1] * env[1], r_rgb[2] * env[2]];
+        if !self.lights.is_empty() {
+            let p = self.view.eye + d / inv_w;
+            for (light, table) in self.lights.iter().zip(self.light_tables) {
+                let vis = light_visibility(light, p, reflected, tri.extra);
+                if vis > 0.0 {
+                    let l = table.sample(thickness_nm, cos_theta);
+                    for k in 0..3 {
+                        add[k] += l[k] * light.radiance[k] * vis;
+                    }
+                }
+            }
+        }
+        (t_rgb, add)
+    }
+}
+
+/// Fraction of a pixel whose reflected rays hit `light`: a linear ramp one pixel wide
+/// (`pixel_angle_rad`) across the edge of the light's disc, so highlights are anti-aliased.
+#[inline]
+pub(crate) fn light_visibility(
+    light: &Light,
+    p: Vec3,
+    reflected: Vec3,
+    pixel_angle_rad: f32,
+) -> f32 {
+    let to_light = light.position - p;
+    let dist = to_light.length();
+    if dist <= light.radius_m {
+        return 1.0;
+    }
+    let r = reflected.normalize_or_zero();
+    let cos_gamma = r.dot(to_light / dist);
+    let alpha = (light.radius_m / dist).asin();
+    let w = pixel_angle_rad.max(1e-5);
+    let reach = alpha + 0.5 * w;
+    // 1 − cos γ ≤ γ²/2, so this rejects only rays with γ > reach.
+    if 1.0 - cos_gamma > 0.5 * reach * reach {
+        return 0.0;
+    }
+    let gamma = cos_gamma.clamp(-1.0, 1.0).acos();
+    ((alpha - gamma) / w + 0.5).clamp(0.0, 1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn light_visibility_is_one_inside_zero_outside_and_half_on_the_rim() {
+        let light = Light {
+            position: Vec3::new(0.0, 0.0, -10.0),
+            radius_m: 0.5,
+            radiance: [1.0; 3],
+            light_lut: None,
+        };
+        let w = 0.001;
+        assert_eq!(light_visibility(&light, Vec3::ZERO, -Vec3::Z, w), 1.0);
+        assert_eq!(light_visibility(&light, Vec3::ZERO, Vec3::X, w), 0.0);
+        let alpha = (0.5f32 / 10.0).asin();
+        let rim = Vec3::new(alpha.sin(), 0.0, -alpha.cos());
+        let v = light_visibility(&light, Vec3::ZERO, rim, w);
+        assert!((v - 0.5).abs() < 0.05, "rim visibility {v}");
+        // Inside the light everything is visible.
+        assert_eq!(light_visibility(&light, light.position, Vec3::X, w), 1.0);
+    }
+
+    #[test]
+    fn bins_list_each_triangle_in_every_strip_it_touches_in_order() {
+        let tri = |y0: i32, y1: i32| SetupTri {
+            bbox: [0, y0, 4, y1],
+            ..SetupTri::default()
+        };
+        let tris = [tri(0, 3), tri(5, 20), tri(8, 9), tri(30, 32)];
+        let mut bins = Bins::default();
+        bins.build(&tris, 4);
+        assert_eq!(bins.strip(0), &[0, 1]);
+        assert_eq!(bins.strip(1), &[1, 2]);
+        assert_eq!(bins.strip(2), &[1]);
+        assert_eq!(bins.strip(3), &[3]);
+    }
+}

@@ -1,0 +1,419 @@
+//! [`Renderer`]: runs the passes of a frame and keeps their buffers between frames.
+
+use std::time::Instant;
+
+use glam::Vec3;
+use lut::Lut;
+use rayon::prelude::*;
+
+use crate::camera::View;
+use crate::cubemap::FACE_BASES;
+use crate::passes::{Bins, BubbleCtx, EMISSIVE, GroundView, OpaqueCtx, Reflection, STRIP_ROWS};
+use crate::raster::{ATTRS, ClipVertex, SamplePattern, SetupTri, setup_triangle};
+use crate::{
+    BubbleMesh, CubeMap, FilmTables, Frame, Material, Object, ReflectionMode, RenderError,
+    RenderScene, RenderSettings, TriMesh,
+};
+
+/// Slices and stacks of a tessellated [`Object::Sphere`].
+const SPHERE_SEGMENTS: (usize, usize) = (48, 24);
+/// Slices and stacks of a drawn light sphere.
+const LIGHT_SEGMENTS: (usize, usize) = (16, 8);
+
+/// World-space opaque triangles with a material tag each.
+#[derive(Debug, Clone, Default)]
+struct Geometry {
+    positions: Vec<Vec3>,
+    attrs: Vec<[f32; ATTRS]>,
+    triangles: Vec<[u32; 3]>,
+    tags: Vec<u32>,
+}
+
+impl Geometry {
+    fn clear(&mut self) {
+        self.positions.clear();
+        self.attrs.clear();
+        self.triangles.clear();
+        self.tags.clear();
+    }
+
+    fn push(&mut self, mesh: &TriMesh, tag: u32) {
+        let base = self.positions.len() as u32;
+        self.positions.extend_from_slice(&mesh.positions);
+        for (k, n) in mesh.normals.iter().enumerate() {
+            let uv = mesh.uvs.get(k).copied().unwrap_or([0.0; 2]);
+            self.attrs.push([n.x, n.y, n.z, uv[0], uv[1]]);
+        }
+        for t in &mesh.triangles {
+            self.triangles.push(t.map(|i| i + base));
+            self.tags.push(tag);
+        }
+    }
+
+    /// Clips and sets up every triangle for `view`, appending to `out` in order.
+    fn setup(&self, view: &View, out: &mut Vec<SetupTri>) {
+        for (t, &tag) in self.triangles.iter().zip(&self.tags) {
+            let tri =
+                t.map(|i| clip_vertex(view, self.positions[i as usize], self.attrs[i as usize]));
+            setup_triangle(view, tri, tag, 0.0, |s| out.push(s));
+        }
+    }
+}
+
+fn clip_vertex(view: &View, p: Vec3, attrs: [f32; ATTRS]) -> ClipVertex {
+    let [x, y, w] = view.clip(p);
+    ClipVertex { x, y, w, attrs }
+}
+
+/// Per cube face: its triangles and depth buffer, reused across frames.
+#[derive(Debug, Clone, Default)]
+struct FaceScratch {
+    tris: Vec<SetupTri>,
+    bins: Bins,
+    depth: Vec<f32>,
+}
+
+/// Renders [`RenderScene`]s, reusing every buffer from one frame to the next.
+///
+/// Output is bit-identical at any rayon thread count: strips of rows own their pixels and
+/// walk their triangles in a fixed order. Run it inside `ThreadPool::install` to choose
+/// the pool.
+#[derive(Debug, Default)]
+pub struct Renderer {
+    frame: Frame,
+    color: Vec<[f32; 3]>,
+    depth: Vec<f32>,
+    cube_maps: Vec<CubeMap>,
+    faces: Vec<FaceScratch>,
+    objects: Geometry,
+    light_spheres: Geometry,
+    opaque_tris: Vec<SetupTri>,
+    opaque_bins: Bins,
+    bubble_tris: Vec<SetupTri>,
+    bubble_bins: Bins,
+}
+
+impl Renderer {
+    /// A renderer with empty buffers (they grow on the first frame).
+    pub fn new() -> Renderer {
+        Renderer::default()
+    }
+
+    /// The last rendered frame.
+    pub fn frame(&self) -> &Frame {
+        &self.frame
+    }
+
+    /// The dynamic cube map rendered for bubble `index` in the last frame, if any.
+    pub fn cube_map(&self, index: usize) -> Option<&CubeMap> {
+        self.cube_maps.get(index)
+    }
+
+    /// Renders one frame: opaque scene, per-bubble cube maps, sorted bubble blend, resolve.
+    pub fn render(
+        &mut self,
+        scene: &RenderScene,
+        tables: &FilmTables,
+        settings: &RenderSettings,
+    ) -> Result<&Frame, RenderError> {
+        settings.validate()?;
+        scene.validate(tables)?;
+        let start = Instant::now();
+        let view = scene.camera.view(settings.width, settings.height);
+        let pattern = SamplePattern::new(settings.samples);
+        let materials = self.tessellate(scene);
+        let strips = settings.height.div_ceil(STRIP_ROWS);
+
+        self.opaque_tris.clear();
+        self.objects.setup(&view, &mut self.opaque_tris);
+        if settings.draw_lights {
+            self.light_spheres.setup(&view, &mut self.opaque_tris);
+        }
+        self.opaque_bins.build(&self.opaque_tris, strips);
+        self.setup_bubbles(scene, &view);
+        self.bubble_bins.build(&self.bubble_tris, strips);
+        let setup_s = start.elapsed().as_secs_f64();
+
+        let t = Instant::now();
+        if let ReflectionMode::DynamicCubeMap { face_size } = settings.reflection {
+            self.render_cube_maps(scene, &materials, face_size);
+        }
+        let cube_maps_s = t.elapsed().as_secs_f64();
+
+        let t = Instant::now();
+        let samples_per_strip = STRIP_ROWS * settings.width * pattern.count;
+        let total = settings.width * settings.height * pattern.count;
+        self.color.resize(total, [0.0; 3]);
+        self.depth.resize(total, 0.0);
+        let ground = scene
+            .ground
+            .as_ref()
+            .and_then(|g| GroundView::new(g, &view));
+        let opaque = OpaqueCtx {
+            view,
+            pattern,
+            env: &scene.environment,
+            ground,
+            ambient: scene.ambient_rgb,
+            lights: &scene.lights,
+            materials: &materials,
+            tris: &self.opaque_tris,
+            bins: &self.opaque_bins,
+        };
+        self.color
+            .par_chunks_mut(samples_per_strip)
+            .zip(self.depth.par_chunks_mut(samples_per_strip))
+            .enumerate()
+            .for_each(|(s, (color, depth))| opaque.render_strip(s, color, depth));
+        let opaque_s = t.elapsed().as_secs_f64();
+
+        let t = Instant::now();
+        let reflections: Vec<Reflection<'_>> = (0..scene.bubbles.len())
+            .map(|b| match &settings.reflection {
+                ReflectionMode::DynamicCubeMap { .. } => Reflection::Cube(&self.cube_maps[b]),
+                ReflectionMode::StaticEnvironment => Reflection::Env(&scene.environment),
+                ReflectionMode::SphereMap(map) => Reflection::Sphere(map),
+            })
+            .collect();
+        let light_tables: Vec<&Lut> = scene
+            .lights
+            .iter()
+            .map(|l| {
+                l.light_lut
+                    .map_or(&tables.reflectivity, |i| &tables.lights[i])
+            })
+            .collect();
+        let bubbles = BubbleCtx {
+            view,
+            pattern,
+            tables,
+            lights: &scene.lights,
+            light_tables: &light_tables,
+            reflections: &reflections,
+            tris: &self.bubble_tris,
+            bins: &self.bubble_bins,
+        };
+        if !self.bubble_tris.is_empty() {
+            self.color
+                .par_chunks_mut(samples_per_strip)
+                .zip(self.depth.par_chunks(samples_per_strip))
+                .enumerate()
+                .for_each(|(s, (color, depth))| bubbles.render_strip(s, color, depth));
+        }
+        let bubbles_s = t.elapsed().as_secs_f64();
+
+        let t = Instant::now();
+        self.resolve(settings, pattern.count);
+        let resolve_s = t.elapsed().as_secs_f64();
+        self.frame.timings = crate::FrameTimings {
+            setup_s,
+            cube_maps_s,
+            opaque_s,
+            bubbles_s,
+            resolve_s,
+        };
+        Ok(&self.frame)
+    }
+
+    /// Fills the world-space object and light-sphere geometry; returns the material table.
+    fn tessellate<'s>(&mut self, scene: &'s RenderScene) -> Vec<&'s Material> {
+        self.objects.clear();
+        self.light_spheres.clear();
+        let mut materials = Vec::with_capacity(scene.objects.len());
+        for (k, object) in scene.objects.iter().enumerate() {
+            materials.push(object.material());
+            let tag = k as u32;
+            match object {
+                Object::Sphere {
+                    center, radius_m, ..
+                } => {
+                    let (s, r) = SPHERE_SEGMENTS;
+                    self.objects
+                        .push(&TriMesh::uv_sphere(*center, *radius_m, s, r), tag);
+                }
+                Object::Box {
+                    center,
+                    half_extents_m,
+                    ..
+                } => {
+                    self.objects
+                        .push(&TriMesh::cuboid(*center, *half_extents_m), tag);
+                }
+                Object::Mesh { mesh, .. } => self.objects.push(mesh, tag),
+            }
+        }
+        for (k, light) in scene.lights.iter().enumerate() {
+            let (s, r) = LIGHT_SEGMENTS;
+            let mesh = TriMesh::uv_sphere(light.position, light.radius_m, s, r);
+            self.light_spheres.push(&mesh, EMISSIVE | k as u32);
+        }
+        materials
+    }
+
+    /// Sets up bubble triangles: bubbles far to near, each bubble's back faces then front faces.
+    fn setup_bubbles(&mut self, scene: &RenderScene, view: &View) {
+        self.bubble_tris.clear();
+        let mut order: Vec<(f32, usize)> = scene
+            .bubbles
+            .iter()
+            .enumerate()
+            .map(|(k, b)| ((b.center() - view.eye).length(), k))
+            .collect();
+        // Stable, far first; NaN-free because the scene was validated.
+        order.sort_by(|a, b| b.0.total_cmp(&a.0));
+        for &(_, k) in &order {
+            let bubble = &scene.bubbles[k];
+            for front in [false, true] {
+                for t in &bubble.triangles {
+                    if is_front_facing(bubble, *t, view.eye) == front {
+                        let tri = t.map(|i| {
+                            let i = i as usize;
+                            let n = bubble.normals[i];
+                            clip_vertex(
+                                view,
+                                bubble.positions[i],
+                                [n.x, n.y, n.z, bubble.thickness_nm[i], 0.0],
+                            )
+                        });
+                        let extra = reflection_rate(view, bubble, *t);
+                        setup_triangle(view, tri, k as u32, extra, |s| self.bubble_tris.push(s));
+                    }
+                }
+            }
+        }
+    }
+
+    /// Renders each bubble's six cube faces (the scene without bubbles or light spheres).
+    fn render_cube_maps(&mut self, scene: &RenderScene, materials: &[&Material], face_size: usize) {
+        let n = scene.bubbles.len();
+        self.cube_maps.truncate(n);
+        for c in &mut self.cube_maps {
+            if c.face_size() != face_size {
+                *c = CubeMap::black(face_size);
+            }
+        }
+        self.cube_maps.resize_with(n, || CubeMap::black(face_size));
+        self.faces.resize_with(6 * n, FaceScratch::default);
+        let m = face_size + 2;
+        let centers: Vec<Vec3> = scene.bubbles.iter().map(BubbleMesh::center).collect();
+        let objects = &self.objects;
+        let jobs: Vec<_> = self
+            .cube_maps
+            .iter_mut()
+            .flat_map(|c| c.faces_mut())
+            .zip(self.faces.iter_mut())
+            .enumerate()
+            .collect();
+        jobs.into_par_iter().for_each(|(j, (texels, scratch))| {
+            let (major, s_axis, t_axis) = FACE_BASES[j % 6];
+            let wide = m as f32 / face_size as f32;
+            let view = View {
+                eye: centers[j / 6],
+                forward: major,
+                right: s_axis,
+                up: -t_axis,
+                tan_half_x: wide,
+                tan_half_y: wide,
+                width: m,
+                height: m,
+                near_m: scene.camera.near_m(),
+            };
+            scratch.tris.clear();
+            objects.setup(&view, &mut scratch.tris);
+            let strips = m.div_ceil(STRIP_ROWS);
+            scratch.bins.build(&scratch.tris, strips);
+            scratch.depth.resize(m * m, 0.0);
+            let ctx = OpaqueCtx {
+                view,
+                pattern: SamplePattern::new(1),
+                env: &scene.environment,
+                ground: scene
+                    .ground
+                    .as_ref()
+                    .and_then(|g| GroundView::new(g, &view)),
+                ambient: scene.ambient_rgb,
+                lights: &scene.lights,
+                materials,
+                tris: &scratch.tris,
+                bins: &scratch.bins,
+            };
+            let rows = STRIP_ROWS * m;
+            for (s, (color, depth)) in texels
+                .chunks_mut(rows)
+                .zip(scratch.depth.chunks_mut(rows))
+                .enumerate()
+            {
+                ctx.render_strip(s, color, depth);
+            }
+        });
+    }
+
+    /// Averages each pixel's samples into the frame.
+    fn resolve(&mut self, settings: &RenderSettings, samples: usize) {
+        let (w, h) = (settings.width, settings.height);
+        self.frame.width = w;
+        self.frame.height = h;
+        self.frame.rgb.resize(w * h, [0.0; 3]);
+        let scale = 1.0 / samples as f32;
+        self.frame
+            .rgb
+            .par_chunks_mut(STRIP_ROWS * w)
+            .zip(self.color.par_chunks(STRIP_ROWS * w * samples))
+            .for_each(|(out, color)| {
+                for (o, px) in out.iter_mut().zip(color.chunks_exact(samples)) {
+                    let mut sum = [0.0f32; 3];
+                    for c in px {
+                        for k in 0..3 {
+                            sum[k] += c[k];
+                        }
+                    }
+                    *o = sum.map(|s| s * scale);
+                }
+            });
+    }
+}
+
+/// Whether triangle `t` faces the eye, its outward side taken from the vertex normals
+/// (so the mesh's winding does not matter).
+fn is_front_facing(bubble: &BubbleMesh, t: [u32; 3], eye: Vec3) -> bool {
+    let [a, b, c] = t.map(|i| bubble.positions[i as usize]);
+    let geometric = (b - a).cross(c - a);
+    let normals: Vec3 = t.iter().map(|&i| bubble.normals[i as usize]).sum();
+    let outward = if geometric.dot(normals) < 0.0 {
+        -geometric
+    } else {
+        geometric
+    };
+    outward.dot(eye - a) > 0.0
+}
+
+/// Angle swept by the reflected direction per pixel across triangle `t` (radians), for
+/// anti-aliasing light highlights; clamped to `[1e-4, 0.5]`.
+fn reflection_rate(view: &View, bubble: &BubbleMesh, t: [u32; 3]) -> f32 {
+    let mut reflected = [Vec3::ZERO; 3];
+    let mut pixels = [(0.0f32, 0.0f32); 3];
+    for (k, &i) in t.iter().enumerate() {
+        let p = bubble.positions[i as usize];
+        let [x, y, w] = view.clip(p);
+        if w <= view.near_m {
+            return 0.5;
+        }
+        pixels[k] = view.pixel_of_clip(x, y, w);
+        let v = (p - view.eye).normalize_or_zero();
+        let mut n = bubble.normals[i as usize].normalize_or_zero();
+        if v.dot(n) > 0.0 {
+            n = -n;
+        }
+        reflected[k] = v - n * (2.0 * v.dot(n));
+    }
+    let mut rate = 1e-4f32;
+    for k in 0..3 {
+        let j = (k + 1) % 3;
+        let (dx, dy) = (pixels[j].0 - pixels[k].0, pixels[j].1 - pixels[k].1);
+        let len_px = (dx * dx + dy * dy).sqrt();
+        if len_px > 1e-3 {
+            rate = rate.max((reflected[j] - reflected[k]).length() / len_px);
+        }
+    }
+    if rate.is_finite() { rate.min(0.5) } else { 0.5 }
+}
