@@ -1,0 +1,161 @@
+//! Shared test scenes: an icosphere bubble builder, synthetic film tables, the paper scene.
+#![allow(dead_code)]
+
+use std::collections::HashMap;
+
+use raster::Vec3;
+use raster::{
+    BubbleMesh, Camera, Environment, FilmTables, Ground, Light, Lut, Material, RenderScene, Sky,
+};
+
+/// A unit icosphere subdivided `level` times, outward-wound.
+pub fn icosphere(level: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let t = (1.0 + 5f32.sqrt()) / 2.0;
+    let mut v: Vec<Vec3> = [
+        (-1.0, t, 0.0),
+        (1.0, t, 0.0),
+        (-1.0, -t, 0.0),
+        (1.0, -t, 0.0),
+        (0.0, -1.0, t),
+        (0.0, 1.0, t),
+        (0.0, -1.0, -t),
+        (0.0, 1.0, -t),
+        (t, 0.0, -1.0),
+        (t, 0.0, 1.0),
+        (-t, 0.0, -1.0),
+        (-t, 0.0, 1.0),
+    ]
+    .iter()
+    .map(|&(x, y, z)| Vec3::new(x, y, z).normalize())
+    .collect();
+    let mut f: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..level {
+        let mut mid = HashMap::new();
+        let mut next = Vec::with_capacity(f.len() * 4);
+        let mut midpoint = |a: u32, b: u32, v: &mut Vec<Vec3>| {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                v.push(((v[a as usize] + v[b as usize]) * 0.5).normalize());
+                v.len() as u32 - 1
+            })
+        };
+        for [a, b, c] in f {
+            let ab = midpoint(a, b, &mut v);
+            let bc = midpoint(b, c, &mut v);
+            let ca = midpoint(c, a, &mut v);
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        f = next;
+    }
+    (v, f)
+}
+
+/// A spherical bubble with thickness given by `thickness(unit normal)`.
+pub fn bubble(
+    center: Vec3,
+    radius_m: f32,
+    level: u32,
+    thickness: impl Fn(Vec3) -> f32,
+) -> BubbleMesh {
+    let (unit, triangles) = icosphere(level);
+    BubbleMesh {
+        positions: unit.iter().map(|n| center + *n * radius_m).collect(),
+        normals: unit.clone(),
+        thickness_nm: unit.iter().map(|n| thickness(*n)).collect(),
+        triangles,
+    }
+}
+
+/// Draining film: thin on top, thick at the bottom (nm).
+pub fn draining(n: Vec3) -> f32 {
+    300.0 + 500.0 * (1.0 - n.y)
+}
+
+/// A smooth, colourful synthetic reflectivity (not physics; just distinct per channel).
+pub fn synthetic_reflectivity() -> Lut {
+    Lut::try_from_fn(64, 16, 1000.0, |d, c| {
+        let base = 0.04 + 0.5 * (1.0 - c).powi(5);
+        let phase = d / 1000.0 * std::f32::consts::TAU;
+        [
+            base * (1.0 + phase.sin()) * 0.5,
+            base * (1.0 + (phase * 1.3).cos()) * 0.5,
+            base * (1.0 + (phase * 1.7).sin()) * 0.5,
+        ]
+    })
+    .unwrap()
+}
+
+/// Synthetic tables with R arbitrary in [0, 1] and T = 1 − R explicitly.
+pub fn lossless_tables() -> FilmTables {
+    let r = Lut::try_from_fn(32, 8, 1000.0, |d, c| {
+        let x = d / 1000.0;
+        [
+            (x * 7.0 + c).fract(),
+            (x * 3.0 + 0.5 * c).fract(),
+            (1.0 - x) * c,
+        ]
+    })
+    .unwrap();
+    let t = Lut::try_new(
+        r.width(),
+        r.height(),
+        r.thickness_max_nm(),
+        r.texels().iter().map(|t| t.map(|v| 1.0 - v)).collect(),
+    )
+    .unwrap();
+    FilmTables {
+        reflectivity: r,
+        transmittance: Some(t),
+        lights: Vec::new(),
+    }
+}
+
+/// The paper-like scene: two level-3 bubbles of radius 0.5 m, one above a checker ground,
+/// a sky and one small light.
+pub fn paper_scene() -> RenderScene {
+    let camera = Camera::look_at(
+        Vec3::new(0.0, 1.2, 3.2),
+        Vec3::new(0.0, 0.7, 0.0),
+        Vec3::Y,
+        45.0,
+    );
+    let mut scene = RenderScene::new(camera, Environment::Sky(Sky::default()));
+    scene.ambient_rgb = [0.5, 0.55, 0.65];
+    scene.ground = Some(Ground {
+        height_m: 0.0,
+        material: Material::checker([0.8; 3], [0.1; 3], 0.5),
+    });
+    scene.lights.push(Light {
+        position: Vec3::new(-1.5, 3.0, 2.0),
+        radius_m: 0.08,
+        radiance: [400.0, 380.0, 350.0],
+        light_lut: None,
+    });
+    scene
+        .bubbles
+        .push(bubble(Vec3::new(-0.55, 0.6, 0.0), 0.5, 3, draining));
+    scene
+        .bubbles
+        .push(bubble(Vec3::new(0.6, 1.1, -0.6), 0.5, 3, draining));
+    scene
+}
