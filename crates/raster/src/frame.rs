@@ -130,11 +130,12 @@ fn write_atomically(
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".raster-")
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .map_err(|e| err(e.to_string()))?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".raster-").suffix(".tmp");
+    // Temporary files are private (0600); the finished image should be readable like any other.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
+    let mut tmp = builder.tempfile_in(dir).map_err(|e| err(e.to_string()))?;
     write(tmp.as_file_mut()).map_err(err)?;
     tmp.as_file_mut()
         .sync_all()
