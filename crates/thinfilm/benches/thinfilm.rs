@@ -1,2 +1,118 @@
-//! Criterion benches (filled in by the crate owner).
-fn main() {}
+//! Throughput of the optics: the f64 reference (`ThinFilm::response`, the transfer matrix)
+//! and the f32 batch kernels, in (thickness, wavelength) samples per second on one core.
+
+use criterion::{BenchmarkId, Criterion, Throughput, black_box, criterion_group, criterion_main};
+use thinfilm::airy::ThinFilm;
+use thinfilm::batch;
+use thinfilm::dispersion::RefractiveIndex;
+
+/// The LUT baker's shape: one row of thicknesses, many wavelengths.
+const THICKNESSES: usize = 1024;
+const WAVELENGTHS: usize = 95; // 360..=830 nm every 5 nm
+
+fn thicknesses() -> Vec<f32> {
+    (0..THICKNESSES)
+        .map(|i| i as f32 * 2000.0 / (THICKNESSES - 1) as f32)
+        .collect()
+}
+
+fn wavelengths() -> Vec<f32> {
+    (0..WAVELENGTHS).map(|k| 360.0 + 5.0 * k as f32).collect()
+}
+
+fn bench_reference(c: &mut Criterion) {
+    let mut group = c.benchmark_group("f64_reference");
+    let d = thicknesses();
+    let l = wavelengths();
+    let samples = (d.len() / 8) * l.len();
+    group.throughput(Throughput::Elements(samples as u64));
+    group.bench_function("ThinFilm::response", |b| {
+        b.iter(|| {
+            let mut sum = 0.0;
+            for &d in d.iter().step_by(8) {
+                let film = ThinFilm::soap(d as f64);
+                for &l in &l {
+                    sum += film.response(l as f64, black_box(0.8)).r();
+                }
+            }
+            sum
+        })
+    });
+    group.bench_function("Stack::response (TMM, one layer)", |b| {
+        b.iter(|| {
+            let mut sum = 0.0;
+            for &d in d.iter().step_by(8) {
+                let stack = ThinFilm::soap(d as f64).try_stack(550.0).unwrap();
+                for &l in &l {
+                    sum += stack.response(l as f64, black_box(0.8)).r();
+                }
+            }
+            sum
+        })
+    });
+    group.finish();
+}
+
+fn bench_batch(c: &mut Criterion) {
+    let mut group = c.benchmark_group("f32_batch");
+    let d = thicknesses();
+    let l = wavelengths();
+    let n: Vec<f32> = l
+        .iter()
+        .map(|&x| RefractiveIndex::Water.n_at(x as f64) as f32)
+        .collect();
+    let w: Vec<[f32; 3]> = l
+        .iter()
+        .map(|&x| [x / 830.0, 0.5, 1.0 - x / 830.0])
+        .collect();
+    let samples = (d.len() * l.len()) as u64;
+
+    group.throughput(Throughput::Elements(samples));
+    for cos in [1.0f32, 0.3] {
+        group.bench_with_input(
+            BenchmarkId::new("weighted_reflectance_row", cos),
+            &cos,
+            |b, &cos| {
+                let mut out = vec![[0.0f32; 3]; d.len()];
+                b.iter(|| {
+                    batch::weighted_reflectance_row(1.0, black_box(cos), &l, &n, &w, &d, &mut out)
+                })
+            },
+        );
+    }
+    group.bench_function("try_weighted_response_row (R and T)", |b| {
+        let mut out_r = vec![[0.0f32; 3]; d.len()];
+        let mut out_t = vec![[0.0f32; 3]; d.len()];
+        b.iter(|| {
+            batch::try_weighted_response_row(
+                1.0,
+                black_box(0.8),
+                &l,
+                &n,
+                &w,
+                &d,
+                &mut out_r,
+                &mut out_t,
+            )
+            .unwrap()
+        })
+    });
+
+    let count = 4096;
+    let sd: Vec<f32> = (0..count).map(|i| (i * 7919 % 2000) as f32).collect();
+    let sc: Vec<f32> = (0..count)
+        .map(|i| ((i * 104_729) % 1000) as f32 / 1000.0)
+        .collect();
+    let sl: Vec<f32> = (0..count)
+        .map(|i| 360.0 + ((i * 31) % 470) as f32)
+        .collect();
+    group.throughput(Throughput::Elements(count as u64));
+    group.bench_function("reflectance (per sample)", |b| {
+        let mut out = vec![0.0f32; count];
+        b.iter(|| batch::reflectance(1.0, 1.33, &sd, &sc, &sl, &mut out))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench_reference, bench_batch);
+criterion_main!(benches);

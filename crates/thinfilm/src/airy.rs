@@ -39,10 +39,16 @@ pub struct ThinFilm {
 impl ThinFilm {
     /// A soap film in air: `1.0 | 1.33 | 1.0`. The thickness is checked when it is used.
     pub fn soap(thickness_nm: f64) -> ThinFilm {
+        ThinFilm::symmetric(1.0, RefractiveIndex::SOAP, thickness_nm)
+    }
+
+    /// A free-standing film `n_outside | n_film | n_outside` (a bubble's wall in any medium).
+    /// The values are checked when it is used.
+    pub fn symmetric(n_outside: f64, n_film: RefractiveIndex, thickness_nm: f64) -> ThinFilm {
         ThinFilm {
-            n_outside: 1.0,
-            n_film: RefractiveIndex::SOAP,
-            n_substrate: Complex64::new(1.0, 0.0),
+            n_outside,
+            n_film,
+            n_substrate: Complex64::new(n_outside, 0.0),
             thickness_nm,
         }
     }
