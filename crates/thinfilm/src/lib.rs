@@ -20,3 +20,9 @@ pub mod spectrum;
 pub use airy::{Response, ThinFilm};
 pub use dispersion::RefractiveIndex;
 pub use fresnel::OpticsError;
+
+pub use cmf::Observer;
+pub use illuminant::{Illuminant, UnknownIlluminant};
+pub use integrate::{DEFAULT_STEP_NM, IntegrateError, Quadrature, SpectralIntegrator};
+pub use lab::{Lab, ciede2000, lab_from_xyz};
+pub use spectrum::{Spectrum, SpectrumError};
