@@ -3,13 +3,15 @@
 //! time, with the portable build as fallback. Both perform the same IEEE operations in
 //! the same order (no fused multiply-adds), so they give bit-identical results.
 
-use super::term::{MAX_PERIODS, MIN_COS_OUTSIDE, MIN_COS2_IN_FILM, Term, Wave, a_and_b, term};
+use super::term::{
+    MAX_PERIODS, MIN_COS_OUTSIDE, MIN_COS2_IN_FILM, Split, Term, Wave, a_and_b, term,
+};
 
 /// Thicknesses processed together: accumulators for one chunk stay in L1.
 pub(crate) const CHUNK: usize = 256;
 
-/// `1.5 · 2^52`: adding and subtracting it rounds an f64 below `2^51` to an integer.
-const ROUND_MAGIC: f64 = 6_755_399_441_055_744.0;
+/// `1.5 · 2^23`: adding and subtracting it rounds an f32 below `2^22` to an integer.
+const ROUND_MAGIC: f32 = 12_582_912.0;
 
 /// Odd minimax polynomial for `sin(π f)` on `f ∈ [−½, ½]`: `f (c1 + f²(c3 + f²(c5 + f²(c7 + f² c9))))`,
 /// max absolute error 4.6e-9 before f32 rounding.
@@ -21,13 +23,21 @@ const SIN_PI: [f32; 5] = [
     0.077_505_276,
 ];
 
-/// `sin²(π · periods)`: the phase is reduced to `[−½, ½]` periods in f64 (exact for the
-/// phases the f32 path accepts), then the polynomial runs in f32. `sin²` has period 1 in
-/// `periods`, so no quadrant bookkeeping is needed.
+/// The round-trip phase `q · d` in periods, reduced to `[−½, ½]` (up to rounding), all in
+/// f32: `d.hi · q.hi` is exact, so the whole periods cancel exactly and the fraction keeps
+/// an absolute error of about `q·d · 2^-36` periods (1e-9 for a 3 µm film).
+/// Requires `q · d < 2^21`.
 #[inline(always)]
-pub(crate) fn sin2_pi_periods(periods: f64) -> f32 {
-    let nearest = (periods + ROUND_MAGIC) - ROUND_MAGIC;
-    let f = (periods - nearest) as f32;
+pub(crate) fn reduced_periods(q: &Split, d: &Split) -> f32 {
+    let exact = d.hi * q.hi;
+    let rest = d.hi * q.lo + d.lo * q.full;
+    let nearest = ((exact + rest) + ROUND_MAGIC) - ROUND_MAGIC;
+    (exact - nearest) + rest
+}
+
+/// `sin²(π f)` for a reduced phase `f`. `sin²` has period 1, so no quadrant bookkeeping.
+#[inline(always)]
+pub(crate) fn sin2_pi(f: f32) -> f32 {
     let f2 = f * f;
     let [c1, c3, c5, c7, c9] = SIN_PI;
     let s = f * (c1 + f2 * (c3 + f2 * (c5 + f2 * (c7 + f2 * c9))));
@@ -35,7 +45,7 @@ pub(crate) fn sin2_pi_periods(periods: f64) -> f32 {
 }
 
 /// Keeps a denominator off zero: it is zero only when its numerator is too (a lossless
-/// film at an exact resonance of a total reflector), where the reflectance is 0.
+/// film at an exact resonance of a total reflector), where the answer is 0.
 #[inline(always)]
 fn nonzero(den: f32) -> f32 {
     if den > f32::MIN_POSITIVE {
@@ -45,24 +55,33 @@ fn nonzero(den: f32) -> f32 {
     }
 }
 
-/// `(R_s + R_p, T_s + T_p)` (sums, not means) for `s2 = sin²(δ/2)`.
+/// `(4ρ_s² s², 4ρ_p² s², (1 − ρ_s²)² + 4ρ_s² s², (1 − ρ_p²)² + 4ρ_p² s²)` for `s2 = sin²(δ/2)`.
 #[inline(always)]
-fn sum_r_t(wave: &Wave, s2: f32) -> (f32, f32) {
+fn parts(wave: &Wave, s2: f32) -> (f32, f32, f32, f32) {
     let num_s = wave.a_s * s2;
     let num_p = wave.a_p * s2;
-    let den_s = nonzero(wave.b_s + num_s);
-    let den_p = nonzero(wave.b_p + num_p);
-    (
-        num_s / den_s + num_p / den_p,
-        wave.b_s / den_s + wave.b_p / den_p,
-    )
+    (num_s, num_p, wave.b_s + num_s, wave.b_p + num_p)
 }
 
-/// Unpolarised `(R, T)` for `s2 = sin²(δ/2)`.
+/// `R_s + R_p` (a sum, not the mean) over one common denominator: one division.
 #[inline(always)]
-pub(crate) fn mean_r_t(wave: &Wave, s2: f32) -> (f32, f32) {
-    let (r, t) = sum_r_t(wave, s2);
-    (0.5 * r, 0.5 * t)
+fn sum_r(wave: &Wave, s2: f32) -> f32 {
+    let (num_s, num_p, den_s, den_p) = parts(wave, s2);
+    (num_s * den_p + num_p * den_s) / nonzero(den_s * den_p)
+}
+
+/// `T_s + T_p` (a sum, not the mean), from its own numerator `(1 − ρ²)²`, not `1 − R`.
+#[inline(always)]
+fn sum_t(wave: &Wave, s2: f32) -> f32 {
+    let (_, _, den_s, den_p) = parts(wave, s2);
+    (wave.b_s * den_p + wave.b_p * den_s) / nonzero(den_s * den_p)
+}
+
+/// Unpolarised `(R, T)` of one wave at one thickness.
+#[inline(always)]
+pub(crate) fn mean_r_t(wave: &Wave, thickness_nm: Split) -> (f32, f32) {
+    let s2 = sin2_pi(reduced_periods(&wave.periods_per_nm, &thickness_nm));
+    (0.5 * sum_r(wave, s2), 0.5 * sum_t(wave, s2))
 }
 
 /// Output rows for [`weighted_row`]: reflectance, and transmittance when `WITH_T`.
@@ -112,11 +131,13 @@ pub(crate) fn weighted_row_body<const WITH_T: bool>(
     thickness_nm: &[f32],
     out: RowOut<'_>,
 ) {
-    let mut d64 = [0.0f64; CHUNK];
+    let mut d_hi = [0.0f32; CHUNK];
+    let mut d_lo = [0.0f32; CHUNK];
     for (chunk_index, d_chunk) in thickness_nm.chunks(CHUNK).enumerate() {
         let n = d_chunk.len();
-        for (dst, &d) in d64.iter_mut().zip(d_chunk) {
-            *dst = d as f64;
+        for ((hi, lo), &d) in d_hi.iter_mut().zip(&mut d_lo).zip(d_chunk) {
+            let split = Split::of_f32(d);
+            (*hi, *lo) = (split.hi, split.lo);
         }
         let mut acc = Acc {
             r: [[0.0; CHUNK]; 3],
@@ -124,7 +145,9 @@ pub(crate) fn weighted_row_body<const WITH_T: bool>(
         };
         for (term, &w) in terms.iter().zip(half_weights) {
             match term {
-                Term::Wave(wave) => accumulate_wave::<WITH_T>(wave, w, &d64[..n], &mut acc),
+                Term::Wave(wave) => {
+                    accumulate_wave::<WITH_T>(wave, w, (&d_hi[..n], &d_lo[..n]), &mut acc)
+                }
                 other => accumulate_scalar::<WITH_T>(other, w, d_chunk, &mut acc),
             }
         }
@@ -142,21 +165,27 @@ fn write_chunk(acc: &[[f32; CHUNK]; 3], out: &mut [[f32; 3]]) {
     }
 }
 
-/// The hot loop: one wavelength over a chunk of thicknesses.
+/// The hot loop: one wavelength over a chunk of thicknesses (split as `hi + lo`).
 #[inline(always)]
-fn accumulate_wave<const WITH_T: bool>(wave: &Wave, w: [f32; 3], d64: &[f64], acc: &mut Acc) {
-    let n = d64.len();
+fn accumulate_wave<const WITH_T: bool>(
+    wave: &Wave,
+    w: [f32; 3],
+    (d_hi, d_lo): (&[f32], &[f32]),
+    acc: &mut Acc,
+) {
+    let n = d_hi.len();
+    let q = wave.periods_per_nm;
     let [r0, r1, r2] = &mut acc.r;
     let [t0, t1, t2] = &mut acc.t;
-    let rows = d64
-        .iter()
-        .zip(&mut r0[..n])
-        .zip(&mut r1[..n])
-        .zip(&mut r2[..n]);
+    let d = d_hi.iter().zip(&d_lo[..n]);
+    let rows = d.zip(&mut r0[..n]).zip(&mut r1[..n]).zip(&mut r2[..n]);
+    let phase =
+        |(&hi, &lo): (&f32, &f32)| sin2_pi(reduced_periods(&q, &Split { hi, lo, full: 0.0 }));
     if WITH_T {
         let t_rows = t0[..n].iter_mut().zip(&mut t1[..n]).zip(&mut t2[..n]);
         for ((((d, a0), a1), a2), ((b0, b1), b2)) in rows.zip(t_rows) {
-            let (r, t) = sum_r_t(wave, sin2_pi_periods(wave.periods_per_nm * d));
+            let s2 = phase(d);
+            let (r, t) = (sum_r(wave, s2), sum_t(wave, s2));
             *a0 += w[0] * r;
             *a1 += w[1] * r;
             *a2 += w[2] * r;
@@ -166,7 +195,7 @@ fn accumulate_wave<const WITH_T: bool>(wave: &Wave, w: [f32; 3], d64: &[f64], ac
         }
     } else {
         for (((d, a0), a1), a2) in rows {
-            let (r, _) = sum_r_t(wave, sin2_pi_periods(wave.periods_per_nm * d));
+            let r = sum_r(wave, phase(d));
             *a0 += w[0] * r;
             *a1 += w[1] * r;
             *a2 += w[2] * r;
@@ -240,16 +269,14 @@ pub(crate) fn samples_body<const WITH_T: bool>(
         let cos1 = cos2_film.max(MIN_COS2_IN_FILM).sqrt();
         let (a_s, b_s) = a_and_b(n0 * cos0, n1 * cos1);
         let (a_p, b_p) = a_and_b(n0 * cos1, n1 * cos0);
-        let periods_per_nm = 2.0 * n1 * cos1 / wavelength_nm[i] as f64;
         let wave = Wave {
             a_s,
             b_s,
             a_p,
             b_p,
-            periods_per_nm,
+            periods_per_nm: Split::of_f64(2.0 * n1 * cos1 / wavelength_nm[i] as f64),
         };
-        let s2 = sin2_pi_periods(periods_per_nm * thickness_nm[i] as f64);
-        let (r, t) = mean_r_t(&wave, s2);
+        let (r, t) = mean_r_t(&wave, Split::of_f32(thickness_nm[i]));
         out_r[i] = r;
         if WITH_T {
             out_t[i] = t;
@@ -284,12 +311,27 @@ mod tests {
     fn sin2_polynomial_matches_libm() {
         let mut worst = 0.0f64;
         for k in 0..=20_000 {
-            let periods = k as f64 * 0.000_731 + 0.013;
-            let exact = (std::f64::consts::PI * periods).sin().powi(2);
-            worst = worst.max((sin2_pi_periods(periods) as f64 - exact).abs());
+            let f = -0.5 + k as f32 / 20_000.0;
+            let exact = (std::f64::consts::PI * f as f64).sin().powi(2);
+            worst = worst.max((sin2_pi(f) as f64 - exact).abs());
         }
         // A few f32 ulps of 1.0 from the Horner steps; the polynomial itself is good to 5e-9.
         assert!(worst < 5e-7, "worst |sin² error| = {worst:e}");
+    }
+
+    #[test]
+    fn phase_reduction_keeps_the_fraction_exact() {
+        let mut worst = 0.0f64;
+        for i in 0..4000 {
+            let q = 0.001 + 0.017 * (i as f64 * 0.618_034).fract();
+            let d = (i as f32 * 97.31) % 200_000.0;
+            let exact = q * d as f64;
+            let f = reduced_periods(&Split::of_f64(q), &Split::of_f32(d)) as f64;
+            assert!(f.abs() <= 0.5 + 1e-6, "q {q} d {d}: fraction {f}");
+            let off = (f - (exact - exact.round())).abs();
+            worst = worst.max(off.min(1.0 - off));
+        }
+        assert!(worst < 2e-7, "worst phase error {worst:e} periods");
     }
 
     #[test]
@@ -334,8 +376,10 @@ mod tests {
 
     #[test]
     fn sin2_reduction_is_exact_at_whole_periods() {
-        for m in [0.0, 1.0, 17.0, 123_456.0, 1e9] {
-            assert_eq!(sin2_pi_periods(m), 0.0, "periods {m}");
+        for m in [0.0, 1.0, 17.0, 123_456.0, 2_000_000.0] {
+            let d = Split::of_f32(m);
+            let q = Split::of_f64(1.0);
+            assert_eq!(sin2_pi(reduced_periods(&q, &d)), 0.0, "periods {m}");
         }
     }
 }

@@ -9,11 +9,11 @@ use num_complex::Complex64;
 /// f32 form (its `1 − ρ²` and `sin(δ/2)` vanish together); the f64 reference is used.
 pub(crate) const MIN_COS2_IN_FILM: f64 = 1e-4;
 
-/// Below this (non-zero) `cos θ_outside` the f32 terms could underflow.
-pub(crate) const MIN_COS_OUTSIDE: f64 = 1e-9;
+/// Below this (non-zero) `cos θ_outside` the product of the f32 denominators could underflow.
+pub(crate) const MIN_COS_OUTSIDE: f64 = 1e-6;
 
-/// Largest phase, in periods, that the f32 path reduces exactly (rounding via `2^52`).
-pub(crate) const MAX_PERIODS: f64 = (1u64 << 40) as f64;
+/// Largest phase, in periods, that the f32 path reduces (it rounds via `1.5 · 2^23`).
+pub(crate) const MAX_PERIODS: f64 = (1u64 << 21) as f64;
 
 /// How one (angle, wavelength, index) is evaluated across thicknesses.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -33,7 +33,7 @@ pub(crate) enum Term {
 }
 
 /// The thickness-independent part of `R_pol = a s² / (b + a s²)`, `T_pol = b / (b + a s²)`,
-/// `s = sin(π · periods_per_nm · d)`, with `a = 4ρ²`, `b = (1 − ρ²)²` for one interface's
+/// `s = sin(π · q · d)`, with `a = 4ρ²`, `b = (1 − ρ²)²` for one interface's
 /// amplitude reflectance `ρ` (symmetric lossless film, Airy sum of all orders).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Wave {
@@ -41,17 +41,51 @@ pub(crate) struct Wave {
     pub b_s: f32,
     pub a_p: f32,
     pub b_p: f32,
-    /// `2 n_film cos θ_t / λ`: round-trip phase `δ = 2π · periods_per_nm · d`.
-    pub periods_per_nm: f64,
+    /// `q = 2 n_film cos θ_t / λ` periods per nm: round-trip phase `δ = 2π q d`.
+    pub periods_per_nm: Split,
+}
+
+/// An f32 split `hi + lo` of a value: `hi` has 12 significant bits, so its product with
+/// another 12-bit `hi` is exact in f32. `full` is the value rounded to f32.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Split {
+    pub hi: f32,
+    pub lo: f32,
+    pub full: f32,
+}
+
+impl Split {
+    /// Splits an f32 exactly: `hi + lo == x`.
+    #[inline(always)]
+    pub(crate) fn of_f32(x: f32) -> Split {
+        let hi = f32::from_bits(x.to_bits() & 0xFFFF_F000);
+        Split {
+            hi,
+            lo: x - hi,
+            full: x,
+        }
+    }
+
+    /// Splits an f64: `hi + lo` equals `x` to about 2^-36 relative.
+    #[inline(always)]
+    pub(crate) fn of_f64(x: f64) -> Split {
+        let full = x as f32;
+        let hi = f32::from_bits(full.to_bits() & 0xFFFF_F000);
+        Split {
+            hi,
+            lo: (x - hi as f64) as f32,
+            full,
+        }
+    }
 }
 
 /// `(4ρ², (1 − ρ²)²)` for `ρ = (x − y)/(x + y)`, with `1 − ρ² = 4xy/(x + y)²` so that
 /// near-total reflection keeps its relative precision.
 #[inline(always)]
 pub(crate) fn a_and_b(x: f64, y: f64) -> (f32, f32) {
-    let sum = x + y;
-    let rho = (x - y) / sum;
-    let one_minus_rho2 = 4.0 * x * y / (sum * sum);
+    let inv_sum = 1.0 / (x + y);
+    let rho = (x - y) * inv_sum;
+    let one_minus_rho2 = 4.0 * x * y * inv_sum * inv_sum;
     (
         (4.0 * rho * rho) as f32,
         (one_minus_rho2 * one_minus_rho2) as f32,
@@ -96,7 +130,7 @@ pub(crate) fn term(
         b_s,
         a_p,
         b_p,
-        periods_per_nm,
+        periods_per_nm: Split::of_f64(periods_per_nm),
     })
 }
 
@@ -105,10 +139,7 @@ impl Term {
     pub(crate) fn evaluate(&self, thickness_nm: f32) -> (f32, f32) {
         match *self {
             Term::Uniform { r, t } => (r, t),
-            Term::Wave(wave) => {
-                let s2 = super::kernel::sin2_pi_periods(wave.periods_per_nm * thickness_nm as f64);
-                super::kernel::mean_r_t(&wave, s2)
-            }
+            Term::Wave(wave) => super::kernel::mean_r_t(&wave, Split::of_f32(thickness_nm)),
             Term::Exact(film, cos_outside, wavelength_nm) => {
                 let film = ThinFilm {
                     thickness_nm: thickness_nm as f64,
