@@ -265,3 +265,41 @@ fn weighted_row_panics_on_mismatched_output() {
         &mut out,
     );
 }
+
+/// Prints the worst |f32 − f64| over a dense sweep (run with `--ignored --nocapture`).
+#[test]
+#[ignore = "measurement, not a check: prints the batch path's worst error"]
+fn report_worst_batch_error() {
+    let thickness: Vec<f32> = (0..=3000).map(|i| i as f32).collect();
+    let (mut worst_r, mut worst_t, mut at) = (0.0f64, 0.0f64, (0.0, 0.0, 0.0));
+    for c in 0..=50 {
+        let cos = c as f32 / 50.0;
+        for l in (360..=830).step_by(10) {
+            let l = l as f32;
+            let mut r = vec![[0.0f32; 3]; thickness.len()];
+            let mut t = vec![[0.0f32; 3]; thickness.len()];
+            try_weighted_response_row(
+                1.0,
+                cos,
+                &[l],
+                &[1.33],
+                &[[1.0; 3]],
+                &thickness,
+                &mut r,
+                &mut t,
+            )
+            .unwrap();
+            for (i, &d) in thickness.iter().enumerate() {
+                let (r64, t64) = reference(1.0, 1.33, d, cos, l);
+                let er = (r[i][0] as f64 - r64).abs();
+                if er > worst_r {
+                    (worst_r, at) = (er, (d, cos, l));
+                }
+                worst_t = worst_t.max((t[i][0] as f64 - t64).abs());
+            }
+        }
+    }
+    println!(
+        "soap film, d 0..3000 nm, cos 0..1, λ 360..830: worst |ΔR| = {worst_r:e} at {at:?}, worst |ΔT| = {worst_t:e}"
+    );
+}
