@@ -1,0 +1,212 @@
+//! Film transport along the mesh: gravity drainage (lubrication theory), seeded swirling
+//! (seed 001's "sloshing"), evaporation. Mass moves along edges with antisymmetric
+//! fluxes, so drainage and sloshing conserve film mass exactly and momentum with it.
+
+use std::f64::consts::TAU;
+
+use glam::DVec3;
+
+use crate::bubble::Bubble;
+use crate::geometry::barycentric_vertex_areas_m2;
+use crate::params::BubbleParams;
+use crate::rng::SplitMix64;
+
+/// Number of travelling waves in the swirl stream function.
+const SLOSH_WAVES: usize = 6;
+/// Largest fraction of a vertex's film that may leave it in one step (keeps masses
+/// positive and the upwind scheme monotone).
+const MAX_OUTFLOW_FRACTION: f64 = 0.5;
+
+/// A seeded stream function ψ on the film, fixed to material points (face centroids of
+/// the rest mesh) so the swirl pattern rides with the surface; its flow n × ∇ψ is
+/// divergence-free, so on a uniform film it moves nothing and on a patterned one it
+/// stirs the pattern.
+#[derive(Clone, Debug)]
+pub(crate) struct Slosh {
+    omega_per_s: [f64; SLOSH_WAVES],
+    /// Per face and wave: amplitude × (sin θ, cos θ) of the material phase θ, m²/s.
+    basis: Vec<[[f64; 2]; SLOSH_WAVES]>,
+}
+
+impl Slosh {
+    pub(crate) fn new(
+        params: &BubbleParams,
+        triangles: &[[u32; 3]],
+        unit_positions: &[DVec3],
+    ) -> Self {
+        let mut rng = SplitMix64::new(params.seed ^ 0x51_05_11);
+        let omega_0 = TAU / params.slosh_period_s;
+        let mut omega_per_s = [0.0; SLOSH_WAVES];
+        // A wave sin(κ d·u) has RMS surface-gradient κ/(R√3); equal shares of the
+        // requested RMS speed U give amplitudes U R √(3/K)/κ.
+        let waves: Vec<(DVec3, f64, f64, f64)> = (0..SLOSH_WAVES)
+            .map(|k| {
+                let direction = rng.unit_vector();
+                let wavenumber = rng.range(1.5, 4.0);
+                let phase = rng.range(0.0, TAU);
+                omega_per_s[k] =
+                    omega_0 * rng.range(0.5, 1.5) * if rng.next_f64() < 0.5 { -1.0 } else { 1.0 };
+                let amplitude = params.slosh_speed_m_per_s
+                    * params.radius_m
+                    * (3.0 / SLOSH_WAVES as f64).sqrt()
+                    / wavenumber;
+                (direction, wavenumber, phase, amplitude)
+            })
+            .collect();
+        let basis = triangles
+            .iter()
+            .map(|t| {
+                let u = t
+                    .iter()
+                    .map(|&i| unit_positions[i as usize])
+                    .sum::<DVec3>()
+                    .normalize();
+                std::array::from_fn(|k| {
+                    let (d, kappa, phase, amp) = waves[k];
+                    let (s, c) = (kappa * d.dot(u) + phase).sin_cos();
+                    [amp * s, amp * c]
+                })
+            })
+            .collect();
+        Self { omega_per_s, basis }
+    }
+
+    /// ψ at every face at time `t_s`, m²/s: Σ_k a_k sin(θ_fk + ω_k t).
+    fn stream_m2_per_s(&self, t_s: f64) -> Vec<f64> {
+        let rot: [(f64, f64); SLOSH_WAVES] =
+            std::array::from_fn(|k| (self.omega_per_s[k] * t_s).sin_cos());
+        self.basis
+            .iter()
+            .map(|waves| {
+                waves
+                    .iter()
+                    .zip(&rot)
+                    .map(|(b, (s, c))| b[0] * c + b[1] * s)
+                    .sum()
+            })
+            .collect()
+    }
+}
+
+impl Bubble {
+    /// Moves film mass for one step of `dt_s` under effective gravity `g_eff` (gravity
+    /// minus the bubble's acceleration) and the swirl at time `t_s`, then evaporates.
+    pub(crate) fn transport_film(&mut self, g_eff: DVec3, dt_s: f64, t_s: f64) {
+        let areas = barycentric_vertex_areas_m2(&self.positions_m, self.topology.triangles());
+        self.transport_film_with_areas(g_eff, dt_s, t_s, &areas);
+        self.update_thickness_with_areas(&areas);
+    }
+
+    fn transport_film_with_areas(&mut self, g_eff: DVec3, dt_s: f64, t_s: f64, areas: &[f64]) {
+        let rho = self.film.density_kg_per_m3;
+        let h: Vec<f64> = self
+            .film_mass_kg
+            .iter()
+            .zip(areas)
+            .map(|(m, a)| if *a > 0.0 { m / (rho * a) } else { 0.0 })
+            .collect();
+        let flux = self.edge_fluxes_kg_per_s(g_eff, t_s, &h);
+        self.apply_fluxes(&flux, dt_s);
+        self.evaporate(areas, dt_s);
+        self.refresh_inertial_mass();
+    }
+
+    /// Signed mass flux along every edge, kg/s, positive from `vertices[0]` to `vertices[1]`.
+    ///
+    /// Drainage: q = ρ g_t h³/(3μ) per unit width (a film draining under gravity with
+    /// lubrication theory), times the dual-edge width, upwind thickness. Swirl: film
+    /// volume ψ_left − ψ_right per unit time across the dual edge, upwind thickness.
+    fn edge_fluxes_kg_per_s(&self, g_eff: DVec3, t_s: f64, h: &[f64]) -> Vec<f64> {
+        let x = &self.positions_m;
+        let tri = self.topology.triangles();
+        let rho = self.film.density_kg_per_m3;
+        let mobility = rho * rho / (3.0 * self.film.drainage_viscosity_pa_s);
+        let centroids: Vec<DVec3> = tri
+            .iter()
+            .map(|t| (x[t[0] as usize] + x[t[1] as usize] + x[t[2] as usize]) * (1.0 / 3.0))
+            .collect();
+        let centroid = |f: u32| centroids[f as usize];
+        let psi = self.slosh.as_ref().map(|s| s.stream_m2_per_s(t_s));
+        self.topology
+            .edges()
+            .iter()
+            .map(|e| {
+                let [i, j] = e.vertices.map(|v| v as usize);
+                let upwind = |q: f64| if q > 0.0 { h[i] } else { h[j] };
+                let mid = 0.5 * (x[i] + x[j]);
+                let width =
+                    (centroid(e.faces[0]) - mid).length() + (centroid(e.faces[1]) - mid).length();
+                let g_t = g_eff.dot((x[j] - x[i]).normalize_or_zero());
+                let mut q = mobility * g_t * upwind(g_t).powi(3) * width;
+                if let Some(psi) = &psi {
+                    let volume_rate = psi[e.faces[0] as usize] - psi[e.faces[1] as usize];
+                    q += rho * volume_rate * upwind(volume_rate);
+                }
+                q
+            })
+            .collect()
+    }
+
+    /// Moves `flux·dt` along the edges, each donor limited so it keeps at least half its
+    /// film; the moved mass carries the donor's velocity (momentum is conserved).
+    fn apply_fluxes(&mut self, flux: &[f64], dt_s: f64) {
+        let edges = self.topology.edges();
+        let n = self.film_mass_kg.len();
+        let mut outflow = vec![0.0; n];
+        for (e, q) in edges.iter().zip(flux) {
+            let donor = if *q > 0.0 {
+                e.vertices[0]
+            } else {
+                e.vertices[1]
+            } as usize;
+            outflow[donor] += q.abs() * dt_s;
+        }
+        let limit: Vec<f64> = outflow
+            .iter()
+            .zip(&self.film_mass_kg)
+            .map(|(out, m)| {
+                if *out > MAX_OUTFLOW_FRACTION * m {
+                    MAX_OUTFLOW_FRACTION * m / out
+                } else {
+                    1.0
+                }
+            })
+            .collect();
+        let mut momentum: Vec<DVec3> = self
+            .velocities_m_per_s
+            .iter()
+            .zip(&self.inertial_mass_kg)
+            .map(|(v, m)| *v * *m)
+            .collect();
+        for (e, q) in edges.iter().zip(flux) {
+            let [a, b] = e.vertices.map(|v| v as usize);
+            let (donor, receiver) = if *q > 0.0 { (a, b) } else { (b, a) };
+            let dm = q.abs() * dt_s * limit[donor];
+            self.film_mass_kg[donor] -= dm;
+            self.film_mass_kg[receiver] += dm;
+            let dp = self.velocities_m_per_s[donor] * dm;
+            momentum[donor] -= dp;
+            momentum[receiver] += dp;
+        }
+        self.refresh_inertial_mass();
+        for ((v, p), m) in self
+            .velocities_m_per_s
+            .iter_mut()
+            .zip(&momentum)
+            .zip(&self.inertial_mass_kg)
+        {
+            *v = *p / *m;
+        }
+    }
+
+    /// Removes ρ·rate·area·dt of film per vertex (vapour leaves with the film's velocity).
+    fn evaporate(&mut self, areas: &[f64], dt_s: f64) {
+        let rate = self.film.evaporation_nm_per_s * 1e-9 * self.film.density_kg_per_m3;
+        if rate == 0.0 {
+            return;
+        }
+        for (m, a) in self.film_mass_kg.iter_mut().zip(areas) {
+            *m = (*m - rate * a * dt_s).max(0.0);
+        }
+    }
+}

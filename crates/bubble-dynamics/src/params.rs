@@ -1,0 +1,261 @@
+//! World and bubble parameters, SI units with the unit in every name, and their validation.
+
+use glam::DVec3;
+
+use crate::collider::Collider;
+use crate::error::ParamError;
+use crate::icosphere::MAX_SUBDIVISIONS;
+use crate::validate::{finite_vec, non_negative, nonzero_vec, positive, unit_interval};
+use crate::wind::Wind;
+
+/// Standard gravity, m/s².
+pub const STANDARD_GRAVITY_M_PER_S2: f64 = 9.806_65;
+/// Standard atmosphere, Pa.
+pub const STANDARD_PRESSURE_PA: f64 = 101_325.0;
+/// Molar gas constant, J/(mol·K).
+pub const GAS_CONSTANT_J_PER_MOL_K: f64 = 8.314_462_618;
+/// Molar mass of dry air, kg/mol.
+pub const AIR_MOLAR_MASS_KG_PER_MOL: f64 = 0.028_964_7;
+
+/// How the time step is integrated.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Integrator {
+    /// Seed 000's scheme: every force explicit, positions advanced with the old velocity.
+    /// Unconditionally unstable for undamped oscillation; kept for comparison.
+    ExplicitEuler,
+    /// Symplectic (semi-implicit) Euler: velocities first, then positions with the new
+    /// velocity; the stiff ideal-gas mode and the drag are implicit (see docs/dynamics.md).
+    #[default]
+    SymplecticEuler,
+}
+
+/// How the film mass is first shared among the vertices.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MassDistribution {
+    /// Each vertex carries the film of its barycentric area: uniform rest thickness.
+    #[default]
+    AreaWeighted,
+    /// Seed 000: every particle has the same mass; the rest thickness then varies with
+    /// the icosphere's uneven vertex areas (its area-weighted mean is still the target).
+    Equal,
+}
+
+/// Parameters shared by the whole world.
+#[derive(Debug)]
+pub struct WorldParams {
+    /// Gravitational acceleration, m/s² (default −9.80665 ŷ: y is up).
+    pub gravity_m_per_s2: DVec3,
+    /// Ambient air pressure, Pa.
+    pub p_out_pa: f64,
+    /// Ambient air density, kg/m³ (drag, buoyancy, added mass).
+    pub air_density_kg_per_m3: f64,
+    /// Ambient air dynamic viscosity, Pa·s (the linear, Stokes-like drag).
+    pub air_viscosity_pa_s: f64,
+    /// Quadratic (form) drag coefficient C_d of a sphere, dimensionless.
+    pub drag_coefficient: f64,
+    /// Multiplier on the linear drag 6πμR (1 = Stokes' law, 0 = off), dimensionless.
+    pub linear_drag_factor: f64,
+    /// Added mass of the entrained air as a fraction of the displaced air (½ for a sphere
+    /// in potential flow), dimensionless.
+    pub added_mass_coefficient: f64,
+    /// Whether the air's buoyancy and the gas's weight act (hydrostatic pressures).
+    pub buoyancy: bool,
+    /// Fixed time step, s (each step is split into automatic substeps).
+    pub dt_s: f64,
+    /// Time integrator.
+    pub integrator: Integrator,
+    /// Largest number of substeps one step may take before it is an error.
+    pub max_substeps: u32,
+    /// Vertex speed judged to be an energy blow-up, m/s (default: speed of sound in air).
+    pub max_speed_m_per_s: f64,
+    /// Restitution of bubble–bubble contacts, in [0, 1].
+    pub bubble_restitution: f64,
+    /// Coulomb friction coefficient of bubble–bubble contacts.
+    pub bubble_friction: f64,
+    /// The air's motion.
+    pub wind: Wind,
+    /// Static obstacles.
+    pub colliders: Vec<Collider>,
+}
+
+impl Default for WorldParams {
+    fn default() -> Self {
+        Self {
+            gravity_m_per_s2: DVec3::new(0.0, -STANDARD_GRAVITY_M_PER_S2, 0.0),
+            p_out_pa: STANDARD_PRESSURE_PA,
+            air_density_kg_per_m3: 1.204,
+            air_viscosity_pa_s: 1.81e-5,
+            drag_coefficient: 0.47,
+            linear_drag_factor: 1.0,
+            added_mass_coefficient: 0.5,
+            buoyancy: true,
+            dt_s: 1.0 / 240.0,
+            integrator: Integrator::SymplecticEuler,
+            max_substeps: 2000,
+            max_speed_m_per_s: 343.0,
+            bubble_restitution: 0.5,
+            bubble_friction: 0.1,
+            wind: Wind::default(),
+            colliders: Vec::new(),
+        }
+    }
+}
+
+impl WorldParams {
+    pub(crate) fn validate(&self) -> Result<(), ParamError> {
+        finite_vec("gravity_m_per_s2", self.gravity_m_per_s2)?;
+        positive("p_out_pa", self.p_out_pa)?;
+        non_negative("air_density_kg_per_m3", self.air_density_kg_per_m3)?;
+        non_negative("air_viscosity_pa_s", self.air_viscosity_pa_s)?;
+        non_negative("drag_coefficient", self.drag_coefficient)?;
+        non_negative("linear_drag_factor", self.linear_drag_factor)?;
+        non_negative("added_mass_coefficient", self.added_mass_coefficient)?;
+        positive("dt_s", self.dt_s)?;
+        if self.max_substeps == 0 {
+            return Err(ParamError::new(
+                "max_substeps",
+                self.max_substeps,
+                "must be at least 1",
+            ));
+        }
+        positive("max_speed_m_per_s", self.max_speed_m_per_s)?;
+        unit_interval("bubble_restitution", self.bubble_restitution)?;
+        non_negative("bubble_friction", self.bubble_friction)?;
+        self.wind.validate().map_err(|e| e.within("wind"))?;
+        for (i, c) in self.colliders.iter().enumerate() {
+            c.validate()
+                .map_err(|e| e.within(&format!("colliders[{i}]")))?;
+        }
+        Ok(())
+    }
+}
+
+/// Parameters of one bubble.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BubbleParams {
+    /// Initial centre, m.
+    pub center_m: DVec3,
+    /// Initial velocity of every vertex, m/s.
+    pub velocity_m_per_s: DVec3,
+    /// Rest radius (volume-equivalent), m.
+    pub radius_m: f64,
+    /// Rest mean film thickness (area-weighted), nm.
+    pub mean_thickness_nm: f64,
+    /// Icosphere subdivision level (3 = 642 vertices, 1280 triangles as in seed 000).
+    pub subdivisions: u32,
+    /// Surface tension of one film surface, N/m (the film has two).
+    pub sigma_n_per_m: f64,
+    /// Gibbs film elasticity E = dT/d ln A of the film tension T, N/m (0 = pure tension).
+    pub gibbs_elasticity_n_per_m: f64,
+    /// Seed 000's damping −γẋ per unit mass (γ/m), 1/s: slows the bubble through the air.
+    pub damping_per_s: f64,
+    /// Viscous damping of deformation only (motion relative to the rigid-body motion), 1/s.
+    pub deformation_damping_per_s: f64,
+    /// Density of the film liquid, kg/m³.
+    pub film_density_kg_per_m3: f64,
+    /// Effective viscosity of the lubrication drainage flux, Pa·s (see docs/dynamics.md).
+    pub drainage_viscosity_pa_s: f64,
+    /// Thickness below which the film ruptures, nm.
+    pub rupture_thickness_nm: f64,
+    /// Relative amplitude of the initial smooth random thickness variation, in [0, 1).
+    pub thickness_variation: f64,
+    /// Typical speed of the seeded swirling (sloshing) film flow, m/s (0 = none).
+    pub slosh_speed_m_per_s: f64,
+    /// Typical period over which the swirl pattern changes, s.
+    pub slosh_period_s: f64,
+    /// Evaporative thinning rate, nm/s (0 = none; removes film mass).
+    pub evaporation_nm_per_s: f64,
+    /// Molar mass of the gas inside, kg/mol (air 0.02896, helium 0.004).
+    pub gas_molar_mass_kg_per_mol: f64,
+    /// Temperature of the gas inside (isothermal), K.
+    pub gas_temperature_k: f64,
+    /// Initial per-axis stretch of the rest sphere; the gas amount is the rest sphere's,
+    /// so a non-unit stretch starts the bubble wobbling.
+    pub initial_scale: DVec3,
+    /// How the film mass is first shared among the vertices.
+    pub mass_distribution: MassDistribution,
+    /// Seed of the initial thickness pattern and of the sloshing.
+    pub seed: u64,
+}
+
+impl Default for BubbleParams {
+    fn default() -> Self {
+        Self {
+            center_m: DVec3::ZERO,
+            velocity_m_per_s: DVec3::ZERO,
+            radius_m: 0.05,
+            mean_thickness_nm: 500.0,
+            subdivisions: 3,
+            sigma_n_per_m: 0.025,
+            gibbs_elasticity_n_per_m: 0.05,
+            damping_per_s: 0.0,
+            deformation_damping_per_s: 10.0,
+            film_density_kg_per_m3: 1000.0,
+            drainage_viscosity_pa_s: 5.0e-8,
+            rupture_thickness_nm: 10.0,
+            thickness_variation: 0.2,
+            slosh_speed_m_per_s: 0.002,
+            slosh_period_s: 4.0,
+            evaporation_nm_per_s: 0.0,
+            gas_molar_mass_kg_per_mol: AIR_MOLAR_MASS_KG_PER_MOL,
+            gas_temperature_k: 293.15,
+            initial_scale: DVec3::ONE,
+            mass_distribution: MassDistribution::AreaWeighted,
+            seed: 0,
+        }
+    }
+}
+
+impl BubbleParams {
+    pub(crate) fn validate(&self) -> Result<(), ParamError> {
+        finite_vec("center_m", self.center_m)?;
+        finite_vec("velocity_m_per_s", self.velocity_m_per_s)?;
+        positive("radius_m", self.radius_m)?;
+        positive("mean_thickness_nm", self.mean_thickness_nm)?;
+        if self.subdivisions > MAX_SUBDIVISIONS {
+            return Err(ParamError::new(
+                "subdivisions",
+                self.subdivisions,
+                format!("must be at most {MAX_SUBDIVISIONS}"),
+            ));
+        }
+        positive("sigma_n_per_m", self.sigma_n_per_m)?;
+        non_negative("gibbs_elasticity_n_per_m", self.gibbs_elasticity_n_per_m)?;
+        non_negative("damping_per_s", self.damping_per_s)?;
+        non_negative("deformation_damping_per_s", self.deformation_damping_per_s)?;
+        positive("film_density_kg_per_m3", self.film_density_kg_per_m3)?;
+        positive("drainage_viscosity_pa_s", self.drainage_viscosity_pa_s)?;
+        non_negative("rupture_thickness_nm", self.rupture_thickness_nm)?;
+        if self.rupture_thickness_nm >= self.mean_thickness_nm {
+            return Err(ParamError::new(
+                "rupture_thickness_nm",
+                self.rupture_thickness_nm,
+                format!(
+                    "must be below mean_thickness_nm = {}",
+                    self.mean_thickness_nm
+                ),
+            ));
+        }
+        if !(0.0..1.0).contains(&self.thickness_variation) {
+            return Err(ParamError::new(
+                "thickness_variation",
+                self.thickness_variation,
+                "must lie in [0, 1)",
+            ));
+        }
+        non_negative("slosh_speed_m_per_s", self.slosh_speed_m_per_s)?;
+        positive("slosh_period_s", self.slosh_period_s)?;
+        non_negative("evaporation_nm_per_s", self.evaporation_nm_per_s)?;
+        positive("gas_molar_mass_kg_per_mol", self.gas_molar_mass_kg_per_mol)?;
+        positive("gas_temperature_k", self.gas_temperature_k)?;
+        nonzero_vec("initial_scale", self.initial_scale)?;
+        if self.initial_scale.min_element() <= 0.0 {
+            return Err(ParamError::new(
+                "initial_scale",
+                self.initial_scale,
+                "must have positive components",
+            ));
+        }
+        Ok(())
+    }
+}
