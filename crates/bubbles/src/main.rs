@@ -1,7 +1,9 @@
 //! `bubbles`: soap bubbles with real thin-film optics.
 
 mod commands;
+mod csv_table;
 mod error;
+mod frame;
 #[allow(dead_code)] // TEMPORARY: wired into simulate/render by the integrator
 mod scene;
 

@@ -1,12 +1,216 @@
-//! `bubbles reflectance` (being built; see the open issue).
+//! `bubbles reflectance`: spectral reflectance and transmittance of a film
+//! `outside | film | outside`, exact (Airy sum of all orders, f64), from CSV on stdin or
+//! from flags for one query.
+//!
+//! Input columns: `thickness_nm,angle_deg,wavelength_nm[,n_film]`, in any order.
+//! Output: `thickness_nm,angle_deg,wavelength_nm,n_film,r_s,r_p,r,t` with full f64
+//! precision (shortest round-trip decimal); `r` is the unpolarised mean and `t` the
+//! unpolarised transmittance, computed from the transmitted amplitudes (not `1 − r`).
 
+use std::fmt::Write as _;
+use std::io::{Read as _, Write as _};
+
+use thinfilm::airy::ThinFilm;
+use thinfilm::dispersion::RefractiveIndex;
+
+use crate::csv_table::{CsvRow, CsvTable};
 use crate::error::{CliError, CliResult};
+
+/// The film index used when neither a column nor `--n-film` gives one.
+const DEFAULT_N_FILM: f64 = 1.33;
+/// Wavelengths accepted, in nm: the range of the colour data.
+const WAVELENGTH_RANGE_NM: [f64; 2] = [360.0, 830.0];
+const HEADER: &str = "thickness_nm,angle_deg,wavelength_nm,n_film,r_s,r_p,r,t";
 
 /// Arguments of `bubbles reflectance`.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Refractive index of the medium on both sides of the film.
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 1.0,
+        allow_negative_numbers = true
+    )]
+    n_outside: f64,
+    /// Film thickness in nm (single query; with --angle-deg and --wavelength-nm).
+    #[arg(long, value_name = "NM", allow_negative_numbers = true)]
+    thickness_nm: Option<f64>,
+    /// Angle of incidence in degrees, in [0, 90) (single query).
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    angle_deg: Option<f64>,
+    /// Vacuum wavelength in nm, in [360, 830] (single query).
+    #[arg(long, value_name = "NM", allow_negative_numbers = true)]
+    wavelength_nm: Option<f64>,
+    /// Film refractive index [default: 1.33]; on stdin, used for rows when the CSV has no
+    /// n_film column.
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    n_film: Option<f64>,
+}
+
+/// One validated query, with the input line it came from (0 for flags).
+#[derive(Debug, Clone, Copy)]
+struct Query {
+    line: usize,
+    thickness_nm: f64,
+    angle_deg: f64,
+    wavelength_nm: f64,
+    n_film: f64,
+}
 
 /// Runs `bubbles reflectance`.
-pub fn run(_args: Args) -> CliResult {
-    Err(CliError::runtime("`bubbles reflectance` is not built yet"))
+pub fn run(args: Args) -> CliResult {
+    check_index(args.n_outside)
+        .map_err(|what| CliError::input(format!("--n-outside {} {what}", args.n_outside)))?;
+    let n_film_default = args.n_film.unwrap_or(DEFAULT_N_FILM);
+    check_index(n_film_default)
+        .map_err(|what| CliError::input(format!("--n-film {n_film_default} {what}")))?;
+    let queries = match (args.thickness_nm, args.angle_deg, args.wavelength_nm) {
+        (None, None, None) => queries_from_stdin(n_film_default)?,
+        (Some(thickness_nm), Some(angle_deg), Some(wavelength_nm)) => {
+            vec![query_from_flags(
+                thickness_nm,
+                angle_deg,
+                wavelength_nm,
+                n_film_default,
+            )?]
+        }
+        _ => {
+            return Err(CliError::input(
+                "a single query needs all of --thickness-nm, --angle-deg and --wavelength-nm \
+                 (or give none of them and pipe CSV on stdin)",
+            ));
+        }
+    };
+    let table = render(args.n_outside, &queries)?;
+    let mut stdout = std::io::stdout().lock();
+    stdout
+        .write_all(table.as_bytes())
+        .and_then(|()| stdout.flush())
+        .map_err(|e| CliError::runtime(format!("cannot write to stdout: {e}")))
+}
+
+fn queries_from_stdin(n_film_default: f64) -> Result<Vec<Query>, CliError> {
+    let mut text = String::new();
+    std::io::stdin()
+        .read_to_string(&mut text)
+        .map_err(|e| CliError::input(format!("cannot read CSV from stdin: {e}")))?;
+    let table = CsvTable::parse(
+        &text,
+        &["thickness_nm", "angle_deg", "wavelength_nm"],
+        &["n_film"],
+    )?;
+    table
+        .rows()
+        .map(|row| query_from_row(&row, n_film_default))
+        .collect()
+}
+
+fn query_from_row(row: &CsvRow<'_>, n_film_default: f64) -> Result<Query, CliError> {
+    let checked = |column: &str, value: f64, check: fn(f64) -> Result<(), &'static str>| {
+        check(value).map_err(|what| row.bad(column, row.get(column).unwrap_or_default(), what))?;
+        Ok::<f64, CliError>(value)
+    };
+    let n_film = checked(
+        "n_film",
+        row.number_or("n_film", n_film_default)?,
+        check_index,
+    )?;
+    Ok(Query {
+        line: row.line(),
+        thickness_nm: checked("thickness_nm", row.number("thickness_nm")?, check_thickness)?,
+        angle_deg: checked("angle_deg", row.number("angle_deg")?, check_angle)?,
+        wavelength_nm: checked(
+            "wavelength_nm",
+            row.number("wavelength_nm")?,
+            check_wavelength,
+        )?,
+        n_film,
+    })
+}
+
+fn query_from_flags(
+    thickness_nm: f64,
+    angle_deg: f64,
+    wavelength_nm: f64,
+    n_film: f64,
+) -> Result<Query, CliError> {
+    let flag = |name: &str, value: f64, check: fn(f64) -> Result<(), &'static str>| {
+        check(value).map_err(|what| CliError::input(format!("{name} {value} {what}")))
+    };
+    flag("--thickness-nm", thickness_nm, check_thickness)?;
+    flag("--angle-deg", angle_deg, check_angle)?;
+    flag("--wavelength-nm", wavelength_nm, check_wavelength)?;
+    flag("--n-film", n_film, check_index)?;
+    Ok(Query {
+        line: 0,
+        thickness_nm,
+        angle_deg,
+        wavelength_nm,
+        n_film,
+    })
+}
+
+fn check_thickness(thickness_nm: f64) -> Result<(), &'static str> {
+    if thickness_nm.is_finite() && thickness_nm >= 0.0 {
+        Ok(())
+    } else {
+        Err("is not a thickness >= 0 nm")
+    }
+}
+
+fn check_angle(angle_deg: f64) -> Result<(), &'static str> {
+    if (0.0..90.0).contains(&angle_deg) {
+        Ok(())
+    } else {
+        Err("is not an angle in [0, 90) degrees")
+    }
+}
+
+fn check_wavelength(wavelength_nm: f64) -> Result<(), &'static str> {
+    let [lo, hi] = WAVELENGTH_RANGE_NM;
+    if (lo..=hi).contains(&wavelength_nm) {
+        Ok(())
+    } else {
+        Err("is not a wavelength in [360, 830] nm")
+    }
+}
+
+fn check_index(n: f64) -> Result<(), &'static str> {
+    if n.is_finite() && n > 0.0 {
+        Ok(())
+    } else {
+        Err("is not a refractive index > 0")
+    }
+}
+
+/// The whole output CSV, built before anything is printed.
+fn render(n_outside: f64, queries: &[Query]) -> Result<String, CliError> {
+    let mut out = String::with_capacity(64 * (queries.len() + 1));
+    out.push_str(HEADER);
+    out.push('\n');
+    for q in queries {
+        let film = ThinFilm::symmetric(
+            n_outside,
+            RefractiveIndex::Constant(q.n_film),
+            q.thickness_nm,
+        );
+        let resp = film
+            .try_response(q.wavelength_nm, q.angle_deg.to_radians().cos())
+            .map_err(|e| CliError::input(format!("line {}: {e}", q.line)))?;
+        // Writing to a String cannot fail.
+        let _ = writeln!(
+            out,
+            "{},{},{},{},{},{},{},{}",
+            q.thickness_nm,
+            q.angle_deg,
+            q.wavelength_nm,
+            q.n_film,
+            resp.r_s,
+            resp.r_p,
+            resp.r(),
+            resp.t()
+        );
+    }
+    Ok(out)
 }

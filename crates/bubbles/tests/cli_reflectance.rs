@@ -1,0 +1,275 @@
+//! `bubbles reflectance` run as a process: values against the library, and every class of
+//! bad input rejected with exit code 2 and nothing on stdout.
+
+use std::io::Write;
+use std::process::{Command, Output, Stdio};
+
+use thinfilm::airy::ThinFilm;
+use thinfilm::dispersion::RefractiveIndex;
+
+const HEADER: &str = "thickness_nm,angle_deg,wavelength_nm,n_film,r_s,r_p,r,t";
+
+fn run(args: &[&str], stdin: &str) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bubbles"))
+        .arg("reflectance")
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn bubbles");
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(stdin.as_bytes())
+        .unwrap();
+    child.wait_with_output().unwrap()
+}
+
+fn stdout(output: &Output) -> String {
+    assert!(
+        output.status.success(),
+        "exit {:?}, stderr: {}",
+        output.status.code(),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    String::from_utf8(output.stdout.clone()).unwrap()
+}
+
+/// Parses output rows into numbers, checking the header.
+fn rows(text: &str) -> Vec<Vec<f64>> {
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some(HEADER));
+    lines
+        .map(|l| l.split(',').map(|f| f.parse::<f64>().unwrap()).collect())
+        .collect()
+}
+
+fn expected(n_outside: f64, d: f64, angle: f64, l: f64, n: f64) -> [f64; 4] {
+    let film = ThinFilm::symmetric(n_outside, RefractiveIndex::Constant(n), d);
+    let resp = film.response(l, angle.to_radians().cos());
+    [resp.r_s, resp.r_p, resp.r(), resp.t()]
+}
+
+#[test]
+fn stdin_rows_match_the_library_exactly() {
+    let input = "wavelength_nm,n_film,thickness_nm,angle_deg\n550,1.33,500,30\n400,1.45,0,0\n\n830,1.2,2500.5,89.9\n";
+    let out = rows(&stdout(&run(&[], input)));
+    let queries = [
+        (500.0, 30.0, 550.0, 1.33),
+        (0.0, 0.0, 400.0, 1.45),
+        (2500.5, 89.9, 830.0, 1.2),
+    ];
+    assert_eq!(out.len(), queries.len());
+    for (row, &(d, a, l, n)) in out.iter().zip(&queries) {
+        assert_eq!(&row[..4], &[d, a, l, n]);
+        // Shortest round-trip formatting: bit-for-bit the library's values.
+        assert_eq!(&row[4..], &expected(1.0, d, a, l, n));
+    }
+    assert_eq!(out[1][6], 0.0, "a vanishing film reflects nothing");
+}
+
+#[test]
+fn n_film_column_is_optional_and_n_outside_applies() {
+    let out = rows(&stdout(&run(
+        &["--n-outside", "1.1"],
+        "thickness_nm,angle_deg,wavelength_nm\n300,45,600\n",
+    )));
+    assert_eq!(out[0][3], 1.33);
+    assert_eq!(&out[0][4..], &expected(1.1, 300.0, 45.0, 600.0, 1.33));
+    let out = rows(&stdout(&run(
+        &["--n-film", "1.4"],
+        "thickness_nm,angle_deg,wavelength_nm\n300,45,600\n",
+    )));
+    assert_eq!(out[0][3], 1.4);
+    assert_eq!(&out[0][4..], &expected(1.0, 300.0, 45.0, 600.0, 1.4));
+}
+
+#[test]
+fn transmittance_is_reported_and_conserves_energy() {
+    let out = rows(&stdout(&run(
+        &[],
+        "thickness_nm,angle_deg,wavelength_nm\n123,10,450\n777,70,700\n",
+    )));
+    for row in out {
+        assert!(
+            (row[6] + row[7] - 1.0).abs() < 1e-12,
+            "r + t = {}",
+            row[6] + row[7]
+        );
+        assert_eq!(row[6], (row[4] + row[5]) / 2.0);
+    }
+}
+
+#[test]
+fn single_query_flags_print_header_and_one_row() {
+    let text = stdout(&run(
+        &[
+            "--thickness-nm",
+            "500",
+            "--angle-deg",
+            "30",
+            "--wavelength-nm",
+            "550",
+        ],
+        "",
+    ));
+    let out = rows(&text);
+    assert_eq!(out.len(), 1);
+    assert_eq!(&out[0][..4], &[500.0, 30.0, 550.0, 1.33]);
+    assert_eq!(&out[0][4..], &expected(1.0, 500.0, 30.0, 550.0, 1.33));
+    let text = stdout(&run(
+        &[
+            "--thickness-nm",
+            "500",
+            "--angle-deg",
+            "30",
+            "--wavelength-nm",
+            "550",
+            "--n-film",
+            "1.5",
+        ],
+        "",
+    ));
+    assert_eq!(rows(&text)[0][3], 1.5);
+}
+
+#[test]
+fn header_only_gives_header_only() {
+    assert_eq!(
+        stdout(&run(&[], "thickness_nm,angle_deg,wavelength_nm\n")),
+        format!("{HEADER}\n")
+    );
+}
+
+/// Runs with bad input and checks: exit code 2, empty stdout, stderr naming `needles`.
+#[track_caller]
+fn rejects(args: &[&str], stdin: &str, needles: &[&str]) {
+    let output = run(args, stdin);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "stderr: {stderr}");
+    assert!(
+        output.stdout.is_empty(),
+        "stdout: {}",
+        String::from_utf8_lossy(&output.stdout)
+    );
+    for needle in needles {
+        assert!(
+            stderr.contains(needle),
+            "stderr {stderr:?} lacks {needle:?}"
+        );
+    }
+}
+
+const GOOD: &str = "thickness_nm,angle_deg,wavelength_nm\n100,10,500\n";
+
+#[test]
+fn non_numeric_field_is_rejected_with_line_and_value() {
+    rejects(
+        &[],
+        &format!("{GOOD}abc,10,500\n"),
+        &["line 3", "thickness_nm", "'abc'"],
+    );
+    rejects(
+        &[],
+        &format!("{GOOD}100,NaN,500\n"),
+        &["line 3", "angle_deg", "'NaN'"],
+    );
+}
+
+#[test]
+fn missing_or_unknown_columns_are_rejected() {
+    rejects(
+        &[],
+        "thickness_nm,angle_deg\n1,2\n",
+        &["line 1", "wavelength_nm"],
+    );
+    rejects(
+        &[],
+        "thickness_nm,angle_deg,wavelength_nm,colour\n1,2,500,red\n",
+        &["unknown column 'colour'"],
+    );
+    rejects(&[], &format!("{GOOD}100,10\n"), &["line 3", "2 fields"]);
+    rejects(&[], "", &["empty input"]);
+}
+
+#[test]
+fn negative_thickness_is_rejected() {
+    rejects(
+        &[],
+        &format!("{GOOD}-5,10,500\n"),
+        &["line 3", "thickness_nm", "'-5'"],
+    );
+    rejects(
+        &[
+            "--thickness-nm",
+            "-5",
+            "--angle-deg",
+            "0",
+            "--wavelength-nm",
+            "500",
+        ],
+        "",
+        &["--thickness-nm -5"],
+    );
+}
+
+#[test]
+fn angle_outside_0_to_90_is_rejected() {
+    rejects(
+        &[],
+        &format!("{GOOD}100,90,500\n"),
+        &["line 3", "angle_deg", "'90'"],
+    );
+    rejects(&[], &format!("{GOOD}100,-1,500\n"), &["line 3", "'-1'"]);
+    rejects(
+        &[
+            "--thickness-nm",
+            "5",
+            "--angle-deg",
+            "95",
+            "--wavelength-nm",
+            "500",
+        ],
+        "",
+        &["--angle-deg 95"],
+    );
+}
+
+#[test]
+fn wavelength_outside_colour_range_is_rejected() {
+    rejects(
+        &[],
+        &format!("{GOOD}100,10,359.9\n"),
+        &["line 3", "wavelength_nm", "'359.9'"],
+    );
+    rejects(&[], &format!("{GOOD}100,10,831\n"), &["line 3", "'831'"]);
+}
+
+#[test]
+fn bad_refractive_index_is_rejected() {
+    let header = "thickness_nm,angle_deg,wavelength_nm,n_film\n";
+    rejects(
+        &[],
+        &format!("{header}100,10,500,0\n"),
+        &["line 2", "n_film", "'0'"],
+    );
+    rejects(
+        &[],
+        &format!("{header}100,10,500,-1.3\n"),
+        &["line 2", "'-1.3'"],
+    );
+    rejects(
+        &[],
+        &format!("{header}100,10,500,inf\n"),
+        &["line 2", "'inf'"],
+    );
+    rejects(&["--n-outside", "0"], GOOD, &["--n-outside 0"]);
+    rejects(&["--n-film", "-2"], GOOD, &["--n-film -2"]);
+}
+
+#[test]
+fn partial_single_query_flags_are_rejected() {
+    rejects(&["--thickness-nm", "5"], "", &["--angle-deg"]);
+}
