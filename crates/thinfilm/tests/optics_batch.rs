@@ -303,3 +303,45 @@ fn report_worst_batch_error() {
         "soap film, d 0..3000 nm, cos 0..1, λ 360..830: worst |ΔR| = {worst_r:e} at {at:?}, worst |ΔT| = {worst_t:e}"
     );
 }
+
+/// This thread's CPU time in ns (Linux `schedstat`), immune to other processes' load.
+fn thread_cpu_ns() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    text.split_whitespace().next()?.parse().ok()
+}
+
+/// Prints CPU ns per (thickness, wavelength) sample of the row kernel, by thread CPU time
+/// rather than wall time so a loaded machine does not inflate it. Run in release:
+/// `cargo test --release -p thinfilm --test optics_batch -- --ignored --nocapture`.
+#[test]
+#[ignore = "measurement, not a check: prints CPU time per sample"]
+fn report_row_cpu_ns_per_sample() {
+    let thickness: Vec<f32> = (0..1024).map(|i| i as f32 * 2000.0 / 1023.0).collect();
+    let l: Vec<f32> = (0..95).map(|k| 360.0 + 5.0 * k as f32).collect();
+    let n: Vec<f32> = l
+        .iter()
+        .map(|&x| RefractiveIndex::Water.n_at(x as f64) as f32)
+        .collect();
+    let w: Vec<[f32; 3]> = l
+        .iter()
+        .map(|&x| [x / 830.0, 0.5, 1.0 - x / 830.0])
+        .collect();
+    let mut out = vec![[0.0f32; 3]; thickness.len()];
+    let Some(start) = thread_cpu_ns() else {
+        println!("no /proc/thread-self/schedstat here");
+        return;
+    };
+    let rounds = 300;
+    for round in 0..rounds {
+        let cos = 0.3 + 0.7 * round as f32 / rounds as f32;
+        weighted_reflectance_row(1.0, cos, &l, &n, &w, &thickness, &mut out);
+    }
+    let ns = (thread_cpu_ns().unwrap() - start) as f64;
+    let samples = (rounds * l.len() * thickness.len()) as f64;
+    println!(
+        "weighted_reflectance_row: {:.3} CPU ns per sample ({} samples), checksum {}",
+        ns / samples,
+        samples,
+        out[500][1]
+    );
+}
