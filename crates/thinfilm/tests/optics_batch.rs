@@ -310,12 +310,12 @@ fn thread_cpu_ns() -> Option<u64> {
     text.split_whitespace().next()?.parse().ok()
 }
 
-/// Prints CPU ns per (thickness, wavelength) sample of the row kernel, by thread CPU time
+/// Prints CPU ns per (thickness, wavelength) sample of the batch kernels and per f64 call, by thread CPU time
 /// rather than wall time so a loaded machine does not inflate it. Run in release:
 /// `cargo test --release -p thinfilm --test optics_batch -- --ignored --nocapture`.
 #[test]
 #[ignore = "measurement, not a check: prints CPU time per sample"]
-fn report_row_cpu_ns_per_sample() {
+fn report_cpu_ns_per_sample() {
     let thickness: Vec<f32> = (0..1024).map(|i| i as f32 * 2000.0 / 1023.0).collect();
     let l: Vec<f32> = (0..95).map(|k| 360.0 + 5.0 * k as f32).collect();
     let n: Vec<f32> = l
@@ -343,5 +343,37 @@ fn report_row_cpu_ns_per_sample() {
         ns / samples,
         samples,
         out[500][1]
+    );
+    let start = thread_cpu_ns().unwrap();
+    let mut sum = 0.0;
+    for &d in thickness.iter().step_by(16) {
+        let f = thinfilm::airy::ThinFilm::soap(d as f64);
+        for &x in &l {
+            sum += f.response(x as f64, 0.8).r();
+        }
+    }
+    let calls = (thickness.len() / 16 * l.len()) as f64;
+    let ns = (thread_cpu_ns().unwrap() - start) as f64;
+    println!(
+        "ThinFilm::response: {:.1} CPU ns per call, checksum {sum}",
+        ns / calls
+    );
+    let count = 1 << 16;
+    let d: Vec<f32> = (0..count).map(|i| (i * 7919 % 2000) as f32).collect();
+    let c: Vec<f32> = (0..count)
+        .map(|i| ((i * 104_729) % 1000) as f32 / 1000.0)
+        .collect();
+    let x: Vec<f32> = (0..count)
+        .map(|i| 360.0 + ((i * 31) % 470) as f32)
+        .collect();
+    let mut r = vec![0.0f32; count];
+    let start = thread_cpu_ns().unwrap();
+    for _ in 0..20 {
+        reflectance(1.0, 1.33, &d, &c, &x, &mut r);
+    }
+    let ns = (thread_cpu_ns().unwrap() - start) as f64;
+    println!(
+        "reflectance (per sample): {:.2} CPU ns per sample",
+        ns / (20 * count) as f64
     );
 }
