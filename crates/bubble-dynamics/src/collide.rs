@@ -109,7 +109,11 @@ pub(crate) fn candidate_pairs(bounds: &[Bounds]) -> Vec<(usize, usize)> {
     pairs
 }
 
-/// Resolves all bubble–bubble contacts once.
+/// Gauss–Seidel sweeps over each touching pair: a second sweep settles the vertices that
+/// the other bubble's correction pushed back in.
+const CONTACT_SWEEPS: usize = 2;
+
+/// Resolves all bubble–bubble contacts.
 pub(crate) fn resolve_bubbles(bubbles: &mut [Bubble], restitution: f64, friction: f64) {
     if bubbles.len() < 2 {
         return;
@@ -119,9 +123,10 @@ pub(crate) fn resolve_bubbles(bubbles: &mut [Bubble], restitution: f64, friction
         let (head, tail) = bubbles.split_at_mut(j);
         let (a, b) = (&mut head[i], &mut tail[0]);
         let material = (restitution, friction);
-        push_vertices_out(a, b, bounds[j], material);
-        let bounds_a = Bounds::of(&a.positions_m);
-        push_vertices_out(b, a, bounds_a, material);
+        for _ in 0..CONTACT_SWEEPS {
+            push_vertices_out(a, b, Bounds::of(&b.positions_m), material);
+            push_vertices_out(b, a, Bounds::of(&a.positions_m), material);
+        }
     }
 }
 
@@ -206,9 +211,10 @@ fn locate_on_surface(b: &Bubble, center: DVec3, p: DVec3, hint: &mut usize) -> O
         (best, best_score) = next;
     }
     *hint = best;
-    let tri = topo.triangles();
-    topo.faces_of(best).iter().find_map(|&f| {
-        let corners = tri[f as usize].map(|k| k as usize);
+    // The best-aligned vertex is almost always a corner of the face the ray crosses;
+    // when it is not (obtuse or sheared triangles), the face is one ring further out.
+    let hit_face = |f: u32| {
+        let corners = topo.triangles()[f as usize].map(|k| k as usize);
         let [q0, q1, q2] = corners.map(|k| x[k]);
         let (u, v) = ray_triangle(center, dir, q0, q1, q2)?;
         let normal = (q1 - q0).cross(q2 - q0).try_normalize()?;
@@ -218,7 +224,15 @@ fn locate_on_surface(b: &Bubble, center: DVec3, p: DVec3, hint: &mut usize) -> O
             normal,
             depth_m: (q0 - p).dot(normal),
         })
-    })
+    };
+    topo.faces_of(best)
+        .iter()
+        .find_map(|&f| hit_face(f))
+        .or_else(|| {
+            topo.neighbors_of(best)
+                .iter()
+                .find_map(|&n| topo.faces_of(n as usize).iter().find_map(|&f| hit_face(f)))
+        })
 }
 
 /// Möller–Trumbore: barycentric (u, v) of the hit of ray o + t·d (t > 0) on triangle
