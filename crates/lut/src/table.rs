@@ -150,7 +150,10 @@ impl Lut {
     /// # Panics
     /// Panics if `i >= width` or `j >= height`.
     pub fn texel(&self, i: usize, j: usize) -> [f32; 3] {
-        assert!(i < self.width && j < self.height, "texel ({i}, {j}) out of range");
+        assert!(
+            i < self.width && j < self.height,
+            "texel ({i}, {j}) out of range"
+        );
         self.texels[j * self.width + i]
     }
 
@@ -170,7 +173,7 @@ impl Lut {
 }
 
 /// Value held by sample `k` of an axis of `n` samples spanning `0..=max`.
-fn axis_value(k: usize, n: usize, max: f32) -> f32 {
+pub(crate) fn axis_value(k: usize, n: usize, max: f32) -> f32 {
     if k + 1 == n {
         max
     } else {
@@ -242,7 +245,11 @@ mod tests {
         let [d, c, dc] = lut.sample(1234.5, 0.37);
         assert!((d - 1234.5).abs() < 1e-3, "d off by {}", d - 1234.5);
         assert!((c - 0.37).abs() < 1e-6, "c off by {}", c - 0.37);
-        assert!((dc - 1234.5 * 0.37).abs() < 1e-2, "dc off by {}", dc - 1234.5 * 0.37);
+        assert!(
+            (dc - 1234.5 * 0.37).abs() < 1e-2,
+            "dc off by {}",
+            dc - 1234.5 * 0.37
+        );
     }
 
     #[test]

@@ -1,0 +1,151 @@
+//! [`bake`]: every table of a [`BakeConfig`], in parallel rows on the fused f32 kernel.
+
+use rayon::prelude::*;
+use thinfilm::batch::{try_weighted_response_row, weighted_reflectance_row};
+use thinfilm::cmf::Observer;
+
+use crate::config::N_OUTSIDE;
+use crate::meta::COLOR_SPACE;
+use crate::table::axis_value;
+use crate::weights::{Pass, light_pass, reflectivity_pass};
+use crate::{BakeConfig, Lut, LutMeta, LutSet};
+
+/// Bakes the reflectivity, transmittance and light-source tables of `config`.
+///
+/// Rows are baked in parallel; each row is computed the same way on any thread, so the
+/// result is bit-identical at any thread count.
+pub fn bake(config: &BakeConfig) -> LutSet {
+    bake_with_progress(config, &|| {})
+}
+
+/// Number of kernel rows [`bake_with_progress`] reports: one per row for the
+/// reflectivity-and-transmittance pass and one per row per light.
+pub fn progress_rows(config: &BakeConfig) -> usize {
+    config.height * (1 + config.lights.len())
+}
+
+/// Number of (texel, wavelength) reflectance evaluations a bake of `config` makes:
+/// texels × wavelengths of the reflectivity pass (which also yields transmittance) plus
+/// texels × wavelengths of each light (a line light costs only its lines).
+pub fn spectral_samples(config: &BakeConfig) -> u64 {
+    let texels = (config.width * config.height) as u64;
+    let wavelengths: usize = reflectivity_pass(config).wavelength_nm.len()
+        + (0..config.lights.len())
+            .map(|k| light_pass(config, k).wavelength_nm.len())
+            .sum::<usize>();
+    texels * wavelengths as u64
+}
+
+/// Like [`bake`], calling `on_row` (from any thread) after each of the
+/// [`progress_rows`] kernel rows.
+pub fn bake_with_progress(config: &BakeConfig, on_row: &(dyn Fn() + Sync)) -> LutSet {
+    let thickness_nm: Vec<f32> = (0..config.width)
+        .map(|i| axis_value(i, config.width, config.thickness_max_nm))
+        .collect();
+    let reflectivity_pass = reflectivity_pass(config);
+    let (reflectivity, transmittance) =
+        bake_response_pass(config, &reflectivity_pass, &thickness_nm, on_row);
+    let mut passes = vec![reflectivity_pass];
+    let mut lights = Vec::with_capacity(config.lights.len());
+    for (k, light) in config.lights.iter().enumerate() {
+        let pass = light_pass(config, k);
+        let texels = bake_pass(config, &pass, &thickness_nm, on_row);
+        lights.push((light.name().to_owned(), table(config, texels)));
+        passes.push(pass);
+    }
+    LutSet {
+        reflectivity: table(config, reflectivity),
+        transmittance: table(config, transmittance),
+        lights,
+        meta: meta(config, &passes),
+    }
+}
+
+/// Runs the fused reflectance-and-transmittance kernel on every row of two tables.
+fn bake_response_pass(
+    config: &BakeConfig,
+    pass: &Pass,
+    thickness_nm: &[f32],
+    on_row: &(dyn Fn() + Sync),
+) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+    let mut r = vec![[0.0f32; 3]; config.width * config.height];
+    let mut t = r.clone();
+    r.par_chunks_mut(config.width)
+        .zip(t.par_chunks_mut(config.width))
+        .enumerate()
+        .for_each(|(j, (row_r, row_t))| {
+            try_weighted_response_row(
+                N_OUTSIDE as f32,
+                axis_value(j, config.height, 1.0),
+                &pass.wavelength_nm,
+                &pass.n_film,
+                &pass.weights,
+                thickness_nm,
+                row_r,
+                row_t,
+            )
+            .expect("a validated BakeConfig gives valid kernel inputs");
+            on_row();
+        });
+    (r, t)
+}
+
+/// Runs the fused reflectance kernel on every row of one table.
+fn bake_pass(
+    config: &BakeConfig,
+    pass: &Pass,
+    thickness_nm: &[f32],
+    on_row: &(dyn Fn() + Sync),
+) -> Vec<[f32; 3]> {
+    let mut texels = vec![[0.0f32; 3]; config.width * config.height];
+    texels
+        .par_chunks_mut(config.width)
+        .enumerate()
+        .for_each(|(j, row)| {
+            weighted_reflectance_row(
+                N_OUTSIDE as f32,
+                axis_value(j, config.height, 1.0),
+                &pass.wavelength_nm,
+                &pass.n_film,
+                &pass.weights,
+                thickness_nm,
+                row,
+            );
+            on_row();
+        });
+    texels
+}
+
+fn table(config: &BakeConfig, texels: Vec<[f32; 3]>) -> Lut {
+    Lut::try_new(config.width, config.height, config.thickness_max_nm, texels)
+        .expect("a validated BakeConfig bakes finite texels of the right count")
+}
+
+fn meta(config: &BakeConfig, passes: &[Pass]) -> LutMeta {
+    let mut wavelengths: Vec<f64> = passes
+        .iter()
+        .flat_map(|p| p.wavelength_nm_f64.iter().copied())
+        .collect();
+    wavelengths.sort_by(f64::total_cmp);
+    wavelengths.dedup();
+    LutMeta {
+        thickness_max_nm: config.thickness_max_nm,
+        n_outside: N_OUTSIDE,
+        film_index: format!("{:?}", config.film_index),
+        film_index_samples: wavelengths
+            .into_iter()
+            .map(|w| [w, config.film_index.n_at(w)])
+            .collect(),
+        observer: observer_name(config.observer).into(),
+        step_nm: config.step_nm,
+        reference_illuminant: config.reference.name().into(),
+        color_space: COLOR_SPACE.into(),
+    }
+}
+
+fn observer_name(observer: Observer) -> &'static str {
+    match observer {
+        Observer::Cie1931 => "CIE 1931 2-degree",
+        Observer::Cie1964 => "CIE 1964 10-degree",
+    }
+}

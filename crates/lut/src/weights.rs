@@ -1,0 +1,79 @@
+//! Spectral weights for the fused bake kernel: one `(λ_k, n_film(λ_k), W_k)` list per
+//! table, so that a texel is `Σ_k W_k · R(d, cos θ, λ_k)` in one pass.
+
+use thinfilm::colorspace::{SRGB_FROM_XYZ, apply};
+use thinfilm::integrate::SpectralIntegrator;
+
+use crate::BakeConfig;
+
+/// The inputs of one table's kernel call, in f32 as the kernel takes them.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Pass {
+    /// The integration wavelengths in full precision, for the record in `lut.json`.
+    pub wavelength_nm_f64: Vec<f64>,
+    pub wavelength_nm: Vec<f32>,
+    pub n_film: Vec<f32>,
+    pub weights: Vec<[f32; 3]>,
+}
+
+/// The wavelengths at which `integrator` weighs anything (zero-weight samples, e.g. the
+/// whole grid for a pure line spectrum, would only cost time).
+pub(crate) fn sample_wavelengths(
+    integrator: &SpectralIntegrator,
+) -> impl Iterator<Item = f64> + '_ {
+    integrator
+        .wavelengths_nm()
+        .iter()
+        .zip(integrator.weights())
+        .filter(|(_, w)| w.iter().any(|&c| c != 0.0))
+        .map(|(&wavelength_nm, _)| wavelength_nm)
+}
+
+/// Linear-sRGB colour of a perfect reflector under the integrator's light (its Y is 1).
+pub(crate) fn linear_srgb_white(integrator: &SpectralIntegrator) -> [f64; 3] {
+    let xyz = integrator.weights().iter().fold([0.0; 3], |acc, w| {
+        [acc[0] + w[0], acc[1] + w[1], acc[2] + w[2]]
+    });
+    apply(&SRGB_FROM_XYZ, xyz)
+}
+
+/// Builds a pass from per-sample linear-sRGB weights, dropping zero-weight samples.
+fn pass(config: &BakeConfig, integrator: &SpectralIntegrator, scale: [f64; 3]) -> Pass {
+    let mut out = Pass {
+        wavelength_nm_f64: Vec::new(),
+        wavelength_nm: Vec::new(),
+        n_film: Vec::new(),
+        weights: Vec::new(),
+    };
+    for (&wavelength_nm, w) in integrator.wavelengths_nm().iter().zip(integrator.weights()) {
+        if w.iter().all(|&c| c == 0.0) {
+            continue;
+        }
+        let rgb = apply(&SRGB_FROM_XYZ, *w);
+        out.wavelength_nm_f64.push(wavelength_nm);
+        out.wavelength_nm.push(wavelength_nm as f32);
+        out.n_film
+            .push(config.film_index.n_at(wavelength_nm) as f32);
+        out.weights
+            .push(std::array::from_fn(|c| (rgb[c] * scale[c]) as f32));
+    }
+    out
+}
+
+/// The reflectivity pass: weights divided channel by channel by the reference white, so
+/// that `R ≡ 1` gives exactly (1, 1, 1) in exact arithmetic.
+pub(crate) fn reflectivity_pass(config: &BakeConfig) -> Pass {
+    let integrator = config
+        .integrator(&config.reference)
+        .expect("BakeConfig guarantees the reference integrates");
+    let white = linear_srgb_white(&integrator);
+    pass(config, &integrator, white.map(|c| 1.0 / c))
+}
+
+/// The light-source pass of `config.lights[k]`: linear sRGB, the light itself at Y = 1.
+pub(crate) fn light_pass(config: &BakeConfig, k: usize) -> Pass {
+    let integrator = config
+        .integrator(&config.lights[k])
+        .expect("BakeConfig guarantees every light integrates");
+    pass(config, &integrator, [1.0; 3])
+}
