@@ -1,12 +1,118 @@
-//! `bubbles bench` (being built; see the open issue).
+//! `bubbles bench`: time whole frames (simulation + render) and print a breakdown.
 
-use crate::error::{CliError, CliResult};
+use crate::error::CliResult;
+use crate::frame::{FrameJob, Options};
+use std::time::Instant;
 
 /// Arguments of `bubbles bench`.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// A scene file (.toml) or a built-in scene (default `paper`).
+    pub scene: Option<String>,
+    /// Frames timed at each size (after two warm-up frames).
+    #[arg(long, default_value_t = 50)]
+    pub frames: u32,
+    /// Image sizes to time, as WxH (repeatable; default 400x400 and 1920x1080).
+    #[arg(long = "size", value_parser = parse_size)]
+    pub sizes: Vec<(usize, usize)>,
+    #[command(flatten)]
+    pub options: Options,
+}
+
+/// Mean seconds per frame of each stage.
+#[derive(Debug, Default, Clone, Copy)]
+struct Breakdown {
+    simulation_s: f64,
+    cube_maps_s: f64,
+    opaque_s: f64,
+    bubbles_s: f64,
+    other_s: f64,
+    total_s: f64,
+}
 
 /// Runs `bubbles bench`.
-pub fn run(_args: Args) -> CliResult {
-    Err(CliError::runtime("`bubbles bench` is not built yet"))
+pub fn run(args: Args) -> CliResult {
+    let sizes = if args.sizes.is_empty() {
+        vec![(400, 400), (1920, 1080)]
+    } else {
+        args.sizes.clone()
+    };
+    let frames = args.frames.max(1);
+    let mut job = FrameJob::prepare(args.scene.as_deref(), &args.options)?;
+    let mut report = String::new();
+    report.push_str(&format!(
+        "threads: {}, samples: {}, reflection: {:?}, one solver step (dt = {:.6} s) per frame\n",
+        rayon::current_num_threads(),
+        job.settings().samples,
+        job.settings().reflection,
+        job.dt_s()
+    ));
+    report.push_str(
+        "size        sim_ms  cube_ms  opaque_ms  bubbles_ms  other_ms  frame_ms     fps\n",
+    );
+    for (w, h) in sizes {
+        job.set_size(w, h);
+        let b = time_frames(&mut job, frames)?;
+        report.push_str(&format!(
+            "{:<10} {:>7.3} {:>8.3} {:>10.3} {:>11.3} {:>9.3} {:>9.3} {:>7.1}\n",
+            format!("{w}x{h}"),
+            b.simulation_s * 1e3,
+            b.cube_maps_s * 1e3,
+            b.opaque_s * 1e3,
+            b.bubbles_s * 1e3,
+            b.other_s * 1e3,
+            b.total_s * 1e3,
+            1.0 / b.total_s
+        ));
+    }
+    print!("{report}");
+    Ok(())
+}
+
+fn time_frames(job: &mut FrameJob, frames: u32) -> Result<Breakdown, crate::error::CliError> {
+    for _ in 0..2 {
+        job.step()?;
+        job.render()?;
+    }
+    let mut sum = Breakdown::default();
+    for _ in 0..frames {
+        let start = Instant::now();
+        job.step()?;
+        let sim = start.elapsed().as_secs_f64();
+        let t = job.render()?.timings;
+        let total = start.elapsed().as_secs_f64();
+        sum.simulation_s += sim;
+        sum.cube_maps_s += t.cube_maps_s;
+        sum.opaque_s += t.opaque_s;
+        sum.bubbles_s += t.bubbles_s;
+        sum.other_s += total - sim - t.cube_maps_s - t.opaque_s - t.bubbles_s;
+        sum.total_s += total;
+    }
+    let n = f64::from(frames);
+    Ok(Breakdown {
+        simulation_s: sum.simulation_s / n,
+        cube_maps_s: sum.cube_maps_s / n,
+        opaque_s: sum.opaque_s / n,
+        bubbles_s: sum.bubbles_s / n,
+        other_s: sum.other_s / n,
+        total_s: sum.total_s / n,
+    })
+}
+
+fn parse_size(s: &str) -> Result<(usize, usize), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("{s:?}: expected WxH, e.g. 400x400"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<usize>()
+            .ok()
+            .filter(|n| (1..=16384).contains(n))
+    };
+    match (parse(w), parse(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => Err(format!(
+            "{s:?}: width and height must be whole numbers in 1..=16384"
+        )),
+    }
 }

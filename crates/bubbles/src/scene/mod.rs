@@ -1,12 +1,16 @@
 //! Scenes: the TOML format (`schema`), its validated values (`values`), the built-in
 //! scenes, and the conversions to the solver and the renderer.
 
+mod film;
 pub mod schema;
+mod to_dynamics;
+mod to_raster;
 pub mod values;
 
 use crate::error::CliError;
 use schema::SceneFile;
 use std::path::{Path, PathBuf};
+pub use to_raster::bubble_meshes;
 
 /// Built-in scenes, by name, with their TOML source.
 pub const BUILTINS: [(&str, &str); 2] = [

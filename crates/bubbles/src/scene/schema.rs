@@ -382,7 +382,7 @@ pub struct DynamicsSpec {
     /// Gravity, m/s².
     #[serde(default)]
     pub gravity_m_per_s2: Option<Vec3>,
-    /// `"verlet"` (default), `"symplectic-euler"` or `"explicit-euler"`.
+    /// `"symplectic-euler"` (default) or `"explicit-euler"` (seed 000).
     #[serde(default)]
     pub integrator: Option<String>,
 }
