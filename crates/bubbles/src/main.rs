@@ -3,6 +3,7 @@
 mod commands;
 mod csv_table;
 mod error;
+mod frame;
 #[allow(dead_code)] // TEMPORARY: wired into simulate/render by the integrator
 mod scene;
 
