@@ -25,7 +25,6 @@ const VOLUME_BLOWUP: f64 = 100.0;
 
 /// Something that happened during a step.
 #[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
 pub enum Event {
     /// A bubble's film fell below its rupture thickness; the bubble was removed.
     Burst {
