@@ -1,2 +1,71 @@
-//! Criterion benches (filled in by the crate owner).
-fn main() {}
+//! Criterion benches: the paper-like scene (2 level-3 bubbles, checker ground, sky, one
+//! light, dynamic 128² cube maps) at 400×400 and 1920×1080, plus the other reflection modes.
+//!
+//! `CARGO_TARGET_DIR=/work/targets/raster cargo bench -p raster -- --warm-up-time 1 --measurement-time 3`
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use raster::{FilmTables, ReflectionMode, RenderSettings, Renderer};
+
+fn bench_paper(c: &mut Criterion) {
+    let scene = common::paper_scene();
+    let tables = FilmTables::from_reflectivity(common::synthetic_reflectivity());
+    let cases = [
+        (
+            "paper_400x400_dynamic128_1spp",
+            400,
+            400,
+            1,
+            ReflectionMode::DynamicCubeMap { face_size: 128 },
+        ),
+        (
+            "paper_400x400_dynamic128_4spp",
+            400,
+            400,
+            4,
+            ReflectionMode::DynamicCubeMap { face_size: 128 },
+        ),
+        (
+            "paper_400x400_static_4spp",
+            400,
+            400,
+            4,
+            ReflectionMode::StaticEnvironment,
+        ),
+        (
+            "paper_1920x1080_dynamic128_4spp",
+            1920,
+            1080,
+            4,
+            ReflectionMode::DynamicCubeMap { face_size: 128 },
+        ),
+    ];
+    for (name, width, height, samples, reflection) in cases {
+        let settings = RenderSettings {
+            width,
+            height,
+            samples,
+            reflection,
+            ..RenderSettings::default()
+        };
+        let mut renderer = Renderer::new();
+        renderer.render(&scene, &tables, &settings).unwrap();
+        c.bench_function(name, |b| {
+            b.iter(|| renderer.render(&scene, &tables, &settings).unwrap().width())
+        });
+        let t = renderer.frame().timings;
+        eprintln!(
+            "{name}: last frame setup {:.2} ms, cube maps {:.2} ms, opaque {:.2} ms, bubbles {:.2} ms, resolve {:.2} ms",
+            t.setup_s * 1e3,
+            t.cube_maps_s * 1e3,
+            t.opaque_s * 1e3,
+            t.bubbles_s * 1e3,
+            t.resolve_s * 1e3
+        );
+    }
+}
+
+criterion_group!(benches, bench_paper);
+criterion_main!(benches);

@@ -1,4 +1,5 @@
-//! Renders the paper-like scene to `paper.png` (or the path given) for a visual check.
+//! Renders the paper-like scene to `paper.png` (or the path given) for a visual check;
+//! a second argument renders that many extra frames (for profiling).
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -6,13 +7,16 @@ mod common;
 use raster::{FilmTables, RenderSettings, Renderer};
 
 fn main() {
-    let out = std::env::args()
-        .nth(1)
-        .unwrap_or_else(|| "paper.png".into());
+    let mut args = std::env::args().skip(1);
+    let out = args.next().unwrap_or_else(|| "paper.png".into());
+    let repeat: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(0);
     let scene = common::paper_scene();
     let tables = FilmTables::from_reflectivity(common::synthetic_reflectivity());
     let settings = RenderSettings::default();
     let mut renderer = Renderer::new();
+    for _ in 0..repeat {
+        renderer.render(&scene, &tables, &settings).expect("render");
+    }
     let frame = renderer.render(&scene, &tables, &settings).expect("render");
     println!("{:?}", frame.timings);
     frame

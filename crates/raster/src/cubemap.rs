@@ -173,6 +173,12 @@ impl CubeMap {
         }
     }
 
+    /// Bordered face `face` as an `(N + 2)²` slice.
+    pub(crate) fn face(&self, face: usize) -> &[[f32; 3]] {
+        let m = self.face_size + 2;
+        &self.texels[face * m * m..(face + 1) * m * m]
+    }
+
     /// The six bordered faces as mutable `(N + 2)²` slices, for rendering into.
     pub(crate) fn faces_mut(&mut self) -> std::slice::ChunksExactMut<'_, [f32; 3]> {
         let m = self.face_size + 2;

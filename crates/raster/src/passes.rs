@@ -73,6 +73,11 @@ pub(crate) struct GroundView<'a> {
     pub gy: f32,
     /// Unit normal facing the eye.
     pub normal: Vec3,
+    /// `1 / (height − eye.y)`.
+    inv_height: f32,
+    /// Change of the (unnormalised) view ray per pixel along x and y.
+    ddx: Vec3,
+    ddy: Vec3,
 }
 
 impl<'a> GroundView<'a> {
@@ -92,6 +97,9 @@ impl<'a> GroundView<'a> {
             gx: sx * view.right.y * inv_h,
             gy: -sy * view.up.y * inv_h,
             normal: if height < 0.0 { Vec3::Y } else { -Vec3::Y },
+            inv_height: inv_h,
+            ddx: view.right * sx,
+            ddy: -view.up * sy,
         })
     }
 
@@ -106,6 +114,8 @@ pub(crate) struct OpaqueCtx<'a> {
     pub view: View,
     pub pattern: SamplePattern,
     pub env: &'a Environment,
+    /// Precomputed environment radiance per pixel (single-sample views only).
+    pub sky_texels: Option<&'a [[f32; 3]]>,
     pub ground: Option<GroundView<'a>>,
     pub ambient: [f32; 3],
     pub lights: &'a [Light],
@@ -130,7 +140,25 @@ impl OpaqueCtx<'_> {
         let full = self.pattern.full_mask();
         let width = self.view.width;
         for row in 0..rows {
-            let py = (y0 + row) as f32;
+            let y = y0 + row;
+            let py = y as f32;
+            if s_count == 1 {
+                // One sample at the pixel centre: the cube-face path, kept branch-light.
+                let span = row * width..(row + 1) * width;
+                let (color, depth) = (&mut color[span.clone()], &mut depth[span]);
+                for (x, (c, z)) in color.iter_mut().zip(depth.iter_mut()).enumerate() {
+                    let (cx, cy) = (x as f32 + 0.5, py + 0.5);
+                    let g = self.ground.as_ref().map_or(0.0, |g| g.inv_depth(cx, cy));
+                    if g > 0.0 {
+                        *z = g;
+                        *c = self.shade_ground(cx, cy, g);
+                    } else {
+                        *z = 0.0;
+                        *c = self.sky(x, y);
+                    }
+                }
+                continue;
+            }
             for x in 0..width {
                 let px = x as f32;
                 let base = (row * width + x) * s_count;
@@ -150,7 +178,7 @@ impl OpaqueCtx<'_> {
                     depth[base..base + s_count].fill(0.0);
                 }
                 let sky = if ground_mask != full {
-                    self.env.radiance(self.view.ray(px + 0.5, py + 0.5))
+                    self.sky(x, y)
                 } else {
                     [0.0; 3]
                 };
@@ -160,7 +188,11 @@ impl OpaqueCtx<'_> {
                     } else {
                         self.pattern.offset_f32(first_ground)
                     };
-                    self.shade_ground(px + ox, py + oy)
+                    let g = self
+                        .ground
+                        .as_ref()
+                        .map_or(0.0, |g| g.inv_depth(px + ox, py + oy));
+                    self.shade_ground(px + ox, py + oy, g)
                 } else {
                     [0.0; 3]
                 };
@@ -175,33 +207,41 @@ impl OpaqueCtx<'_> {
         }
     }
 
-    fn shade_ground(&self, px: f32, py: f32) -> [f32; 3] {
+    /// Environment radiance behind pixel `(x, y)`: from the precomputed texels when given.
+    #[inline]
+    fn sky(&self, x: usize, y: usize) -> [f32; 3] {
+        match self.sky_texels {
+            Some(t) => t[y * self.view.width + x],
+            None => self
+                .env
+                .radiance(self.view.ray(x as f32 + 0.5, y as f32 + 0.5)),
+        }
+    }
+
+    /// Lit ground at pixel-space point `(px, py)`, whose inverse depth `inv_t` is positive.
+    #[inline]
+    fn shade_ground(&self, px: f32, py: f32, inv_t: f32) -> [f32; 3] {
         let Some(g) = &self.ground else {
             return [0.0; 3];
         };
         let view = &self.view;
-        let inv_t = g.inv_depth(px, py).max(1e-30);
         let t = 1.0 / inv_t;
         let d = view.ray(px, py);
         let p = view.eye + d * t;
         // Footprint of one pixel on the plane: ∂P/∂px = t·(∂d − d·∂d.y/d.y).
-        let sx = 2.0 * view.tan_half_x / view.width as f32;
-        let sy = 2.0 * view.tan_half_y / view.height as f32;
-        let ddx = view.right * sx;
-        let ddy = -view.up * sy;
-        let inv_dy = if d.y != 0.0 { 1.0 / d.y } else { 0.0 };
-        let dpx = (ddx - d * (ddx.y * inv_dy)) * t;
-        let dpy = (ddy - d * (ddy.y * inv_dy)) * t;
+        // d.y = inv_t · (h − eye.y), so 1/d.y needs no division of its own.
+        let inv_dy = t * g.inv_height;
+        let dpx = (g.ddx - d * (g.ddx.y * inv_dy)) * t;
+        let dpy = (g.ddy - d * (g.ddy.y * inv_dy)) * t;
         let footprint = [dpx.x.abs() + dpy.x.abs(), dpx.z.abs() + dpy.z.abs()];
-        let footprint = footprint.map(|f| if f.is_finite() { f } else { 1e9 });
+        let footprint = footprint.map(|f| if f < 1e9 { f } else { 1e9 });
         let albedo = ground_albedo(&g.ground.material, p.x, p.z, footprint);
-        let v = d.normalize_or(view.forward);
         lit(
             &g.ground.material,
             albedo,
             p,
             g.normal,
-            v,
+            d,
             self.ambient,
             self.lights,
         )
@@ -390,7 +430,7 @@ impl BubbleCtx<'_> {
     }
 }
 
-/// Fraction of a pixel whose reflected rays hit `light`: a linear ramp one pixel wide
+/// Fraction of a pixel whose reflected rays (unit `reflected`) hit `light`: a linear ramp one pixel wide
 /// (`pixel_angle_rad`) across the edge of the light's disc, so highlights are anti-aliased.
 #[inline]
 pub(crate) fn light_visibility(
@@ -404,15 +444,16 @@ pub(crate) fn light_visibility(
     if dist <= light.radius_m {
         return 1.0;
     }
-    let r = reflected.normalize_or_zero();
-    let cos_gamma = r.dot(to_light / dist);
-    let alpha = (light.radius_m / dist).asin();
+    let cos_gamma = reflected.dot(to_light) / dist;
+    let sin_alpha = light.radius_m / dist;
     let w = pixel_angle_rad.max(1e-5);
-    let reach = alpha + 0.5 * w;
-    // 1 − cos γ ≤ γ²/2, so this rejects only rays with γ > reach.
+    // asin x ≤ πx/2 bounds the disc's angular radius; and 1 − cos γ ≤ γ²/2, so this
+    // rejects only rays with γ beyond the disc plus half a pixel (most of them, cheaply).
+    let reach = std::f32::consts::FRAC_PI_2 * sin_alpha + 0.5 * w;
     if 1.0 - cos_gamma > 0.5 * reach * reach {
         return 0.0;
     }
+    let alpha = sin_alpha.asin();
     let gamma = cos_gamma.clamp(-1.0, 1.0).acos();
     ((alpha - gamma) / w + 0.5).clamp(0.0, 1.0)
 }

@@ -107,6 +107,8 @@ impl SetupTri {
 pub(crate) struct SamplePattern {
     pub count: usize,
     pub offsets: [(i64, i64); 16],
+    /// The same offsets in pixels.
+    pub offsets_px: [(f32, f32); 16],
 }
 
 impl SamplePattern {
@@ -164,17 +166,18 @@ impl SamplePattern {
                 );
             }
         }
+        let s = 1.0 / SUBPIXEL as f32;
         SamplePattern {
             count: count as usize,
             offsets,
+            offsets_px: offsets.map(|(x, y)| (x as f32 * s, y as f32 * s)),
         }
     }
 
     /// Pixel-space offset of sample `s` from the pixel's top-left corner.
     #[inline]
     pub fn offset_f32(&self, s: usize) -> (f32, f32) {
-        let (x, y) = self.offsets[s];
-        (x as f32 / SUBPIXEL as f32, y as f32 / SUBPIXEL as f32)
+        self.offsets_px[s]
     }
 
     /// Bit mask with one bit per sample.

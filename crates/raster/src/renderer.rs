@@ -1,5 +1,6 @@
 //! [`Renderer`]: runs the passes of a frame and keeps their buffers between frames.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 use glam::Vec3;
@@ -11,8 +12,8 @@ use crate::cubemap::FACE_BASES;
 use crate::passes::{Bins, BubbleCtx, EMISSIVE, GroundView, OpaqueCtx, Reflection, STRIP_ROWS};
 use crate::raster::{ATTRS, ClipVertex, SamplePattern, SetupTri, setup_triangle};
 use crate::{
-    BubbleMesh, CubeMap, FilmTables, Frame, Material, Object, ReflectionMode, RenderError,
-    RenderScene, RenderSettings, TriMesh,
+    BubbleMesh, CubeMap, Environment, FilmTables, Frame, Material, Object, ReflectionMode,
+    RenderError, RenderScene, RenderSettings, TriMesh,
 };
 
 /// Slices and stacks of a tessellated [`Object::Sphere`].
@@ -81,8 +82,6 @@ struct FaceScratch {
 #[derive(Debug, Default)]
 pub struct Renderer {
     frame: Frame,
-    color: Vec<[f32; 3]>,
-    depth: Vec<f32>,
     cube_maps: Vec<CubeMap>,
     faces: Vec<FaceScratch>,
     objects: Geometry,
@@ -91,6 +90,9 @@ pub struct Renderer {
     opaque_bins: Bins,
     bubble_tris: Vec<SetupTri>,
     bubble_bins: Bins,
+    /// The environment rendered into cube faces, reused while the environment is unchanged
+    /// (kept only for the cheap-to-compare procedural kinds).
+    env_cube: Option<(Environment, CubeMap)>,
 }
 
 impl Renderer {
@@ -141,10 +143,6 @@ impl Renderer {
         let cube_maps_s = t.elapsed().as_secs_f64();
 
         let t = Instant::now();
-        let samples_per_strip = STRIP_ROWS * settings.width * pattern.count;
-        let total = settings.width * settings.height * pattern.count;
-        self.color.resize(total, [0.0; 3]);
-        self.depth.resize(total, 0.0);
         let ground = scene
             .ground
             .as_ref()
@@ -153,6 +151,7 @@ impl Renderer {
             view,
             pattern,
             env: &scene.environment,
+            sky_texels: None,
             ground,
             ambient: scene.ambient_rgb,
             lights: &scene.lights,
@@ -160,14 +159,6 @@ impl Renderer {
             tris: &self.opaque_tris,
             bins: &self.opaque_bins,
         };
-        self.color
-            .par_chunks_mut(samples_per_strip)
-            .zip(self.depth.par_chunks_mut(samples_per_strip))
-            .enumerate()
-            .for_each(|(s, (color, depth))| opaque.render_strip(s, color, depth));
-        let opaque_s = t.elapsed().as_secs_f64();
-
-        let t = Instant::now();
         let reflections: Vec<Reflection<'_>> = (0..scene.bubbles.len())
             .map(|b| match &settings.reflection {
                 ReflectionMode::DynamicCubeMap { .. } => Reflection::Cube(&self.cube_maps[b]),
@@ -193,18 +184,40 @@ impl Renderer {
             tris: &self.bubble_tris,
             bins: &self.bubble_bins,
         };
-        if !self.bubble_tris.is_empty() {
-            self.color
-                .par_chunks_mut(samples_per_strip)
-                .zip(self.depth.par_chunks(samples_per_strip))
-                .enumerate()
-                .for_each(|(s, (color, depth))| bubbles.render_strip(s, color, depth));
-        }
-        let bubbles_s = t.elapsed().as_secs_f64();
-
-        let t = Instant::now();
-        self.resolve(settings, pattern.count);
-        let resolve_s = t.elapsed().as_secs_f64();
+        let (w, h) = (settings.width, settings.height);
+        self.frame.width = w;
+        self.frame.height = h;
+        self.frame.rgb.resize(w * h, [0.0; 3]);
+        let phase_ns = [(); 3].map(|_| AtomicU64::new(0));
+        // Each strip runs opaque → bubbles → resolve on a per-thread sample buffer, so its
+        // samples stay in cache and never travel to memory.
+        self.frame
+            .rgb
+            .par_chunks_mut(STRIP_ROWS * w)
+            .enumerate()
+            .for_each(|(s, out)| {
+                STRIP_SCRATCH.with_borrow_mut(|(color, depth)| {
+                    let n = out.len() * pattern.count;
+                    color.resize(n, [0.0; 3]);
+                    depth.resize(n, 0.0);
+                    let (color, depth) = (&mut color[..n], &mut depth[..n]);
+                    let t0 = Instant::now();
+                    opaque.render_strip(s, color, depth);
+                    let t1 = Instant::now();
+                    bubbles.render_strip(s, color, depth);
+                    let t2 = Instant::now();
+                    resolve(out, color, pattern.count);
+                    let t3 = Instant::now();
+                    for (acc, d) in phase_ns.iter().zip([t1 - t0, t2 - t1, t3 - t2]) {
+                        acc.fetch_add(d.as_nanos() as u64, Ordering::Relaxed);
+                    }
+                });
+            });
+        // Apportion the fused pass's wall time by each phase's share of the CPU time.
+        let wall_s = t.elapsed().as_secs_f64();
+        let cpu = phase_ns.map(|a| a.into_inner() as f64);
+        let total: f64 = cpu.iter().sum::<f64>().max(1.0);
+        let [opaque_s, bubbles_s, resolve_s] = cpu.map(|c| wall_s * c / total);
         self.frame.timings = crate::FrameTimings {
             setup_s,
             cube_maps_s,
@@ -294,6 +307,8 @@ impl Renderer {
         }
         self.cube_maps.resize_with(n, || CubeMap::black(face_size));
         self.faces.resize_with(6 * n, FaceScratch::default);
+        self.update_env_cube(&scene.environment, face_size);
+        let env_cube = self.env_cube.as_ref().map(|(_, c)| c);
         let m = face_size + 2;
         let centers: Vec<Vec3> = scene.bubbles.iter().map(BubbleMesh::center).collect();
         let objects = &self.objects;
@@ -327,6 +342,7 @@ impl Renderer {
                 view,
                 pattern: SamplePattern::new(1),
                 env: &scene.environment,
+                sky_texels: env_cube.map(|c| c.face(j % 6)),
                 ground: scene
                     .ground
                     .as_ref()
@@ -348,28 +364,42 @@ impl Renderer {
         });
     }
 
-    /// Averages each pixel's samples into the frame.
-    fn resolve(&mut self, settings: &RenderSettings, samples: usize) {
-        let (w, h) = (settings.width, settings.height);
-        self.frame.width = w;
-        self.frame.height = h;
-        self.frame.rgb.resize(w * h, [0.0; 3]);
-        let scale = 1.0 / samples as f32;
-        self.frame
-            .rgb
-            .par_chunks_mut(STRIP_ROWS * w)
-            .zip(self.color.par_chunks(STRIP_ROWS * w * samples))
-            .for_each(|(out, color)| {
-                for (o, px) in out.iter_mut().zip(color.chunks_exact(samples)) {
-                    let mut sum = [0.0f32; 3];
-                    for c in px {
-                        for k in 0..3 {
-                            sum[k] += c[k];
-                        }
-                    }
-                    *o = sum.map(|s| s * scale);
-                }
-            });
+    /// Caches the environment's cube faces when it is procedural (cheap to compare);
+    /// their texel directions are the same for every bubble, so they can be copied.
+    fn update_env_cube(&mut self, env: &Environment, face_size: usize) {
+        if !matches!(env, Environment::Sky(_) | Environment::Uniform(_)) {
+            self.env_cube = None;
+            return;
+        }
+        let fresh = self
+            .env_cube
+            .as_ref()
+            .is_some_and(|(e, c)| e == env && c.face_size() == face_size);
+        if !fresh {
+            self.env_cube = CubeMap::from_environment(env, face_size)
+                .ok()
+                .map(|c| (env.clone(), c));
+        }
+    }
+}
+
+thread_local! {
+    /// Per-thread sample colour and depth of the strip being rendered, reused across frames.
+    static STRIP_SCRATCH: std::cell::RefCell<(Vec<[f32; 3]>, Vec<f32>)> =
+        const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
+}
+
+/// Averages each pixel's samples (in sample order, so the sum is deterministic).
+fn resolve(out: &mut [[f32; 3]], color: &[[f32; 3]], samples: usize) {
+    let scale = 1.0 / samples as f32;
+    for (o, px) in out.iter_mut().zip(color.chunks_exact(samples)) {
+        let mut sum = [0.0f32; 3];
+        for c in px {
+            for k in 0..3 {
+                sum[k] += c[k];
+            }
+        }
+        *o = sum.map(|s| s * scale);
     }
 }
 

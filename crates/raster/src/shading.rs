@@ -5,11 +5,23 @@ use glam::Vec3;
 
 use crate::{Light, Material, Pattern};
 
+/// `x.floor()` without a libm call (baseline x86-64 has no rounding instruction);
+/// exact for |x| < 2²³, where every f32 beyond is already an integer.
+#[inline]
+pub(crate) fn fast_floor(x: f32) -> f32 {
+    if x.abs() < 8_388_608.0 {
+        let t = x as i32 as f32;
+        if t > x { t - 1.0 } else { t }
+    } else {
+        x
+    }
+}
+
 /// Box-filtered checker weight of cell colour `b` for unit cells (0 → `a`, 1 → `b`), given
 /// the pattern-space position and its footprint per pixel (Quilez's closed form).
 #[inline]
 pub(crate) fn filtered_checker(p: [f32; 2], footprint: [f32; 2]) -> f32 {
-    let tri = |x: f32| (x - x.floor() - 0.5).abs();
+    let tri = |x: f32| (x - fast_floor(x) - 0.5).abs();
     let mut i = [0.0; 2];
     for k in 0..2 {
         let w = footprint[k] + 1e-3;
@@ -24,8 +36,9 @@ pub(crate) fn object_albedo(material: &Material, p: Vec3, uv: [f32; 2]) -> [f32;
     match &material.pattern {
         Pattern::Solid(c) => *c,
         Pattern::Checker { a, b, scale_m } => {
-            let q = (p / *scale_m).floor();
-            let parity = (q.x as i64 + q.y as i64 + q.z as i64).rem_euclid(2);
+            let q = p / *scale_m;
+            let cell = |c: f32| fast_floor(c) as i64;
+            let parity = (cell(q.x) + cell(q.y) + cell(q.z)).rem_euclid(2);
             if parity == 0 { *a } else { *b }
         }
         Pattern::Textured { texture, .. } => texture.sample_repeat(uv[0], uv[1]),
@@ -46,7 +59,8 @@ pub(crate) fn ground_albedo(material: &Material, x: f32, z: f32, footprint: [f32
     }
 }
 
-/// Radiance leaving point `p` with unit normal `n` towards a viewer looking along unit `v`.
+/// Radiance leaving point `p` with unit normal `n` towards a viewer looking along `v`
+/// (any positive length: it is normalised only when the material has a specular lobe).
 ///
 /// A sphere of radius ρ and radiance L at distance D gives irradiance `π L (ρ/D)² cos θ`,
 /// exact for a uniformly bright sphere; diffuse radiance is then `albedo · L (ρ/D)² cos θ`.
@@ -84,7 +98,7 @@ pub(crate) fn lit(
         let solid = (light.radius_m * light.radius_m / dist2).min(1.0) * n_dot_l;
         let mut weight = [albedo[0] * solid, albedo[1] * solid, albedo[2] * solid];
         if has_specular {
-            let h = (l - v).normalize_or_zero();
+            let h = (l - v.normalize_or_zero()).normalize_or_zero();
             let s = spec_norm * n.dot(h).max(0.0).powf(material.shininess) * solid;
             for (w, k) in weight.iter_mut().zip(material.specular) {
                 *w += k * s;
@@ -100,6 +114,27 @@ pub(crate) fn lit(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fast_floor_matches_floor() {
+        for x in [
+            -3.5f32,
+            -3.0,
+            -0.0,
+            0.0,
+            0.3,
+            2.999_999_8,
+            -1e-30,
+            1e7,
+            -8_388_607.5,
+            3e9,
+            -3e9,
+            f32::INFINITY,
+        ] {
+            assert_eq!(fast_floor(x), x.floor(), "floor({x})");
+        }
+        assert!(fast_floor(f32::NAN).is_nan());
+    }
 
     #[test]
     fn filtered_checker_is_the_checker_when_sharp_and_grey_when_wide() {

@@ -185,12 +185,13 @@ fn golden_sphere_map_over_equirect_with_light_table() {
         16,
         (0..512)
             .map(|k| {
-                let (x, y) = ((k % 32) as f32 / 32.0, (k / 32) as f32 / 16.0);
-                [
-                    0.2 + 0.8 * x,
-                    0.3 + 0.7 * (1.0 - y),
-                    0.5 + 0.5 * (x * 12.0).sin().abs(),
-                ]
+                // 16 × 8 checker cells of 2 × 2 texels: sharp features to reflect.
+                let (x, y) = (k % 32 / 2, k / 32 / 2);
+                if (x + y) % 2 == 0 {
+                    [1.2, 0.6, 0.2]
+                } else {
+                    [0.05, 0.1, 0.4]
+                }
             })
             .collect(),
     )

@@ -94,7 +94,7 @@ pub fn draining(n: Vec3) -> f32 {
 /// A smooth, colourful synthetic reflectivity (not physics; just distinct per channel).
 pub fn synthetic_reflectivity() -> Lut {
     Lut::try_from_fn(64, 16, 1000.0, |d, c| {
-        let base = 0.04 + 0.5 * (1.0 - c).powi(5);
+        let base = 0.1 + 0.6 * (1.0 - c).powi(5);
         let phase = d / 1000.0 * std::f32::consts::TAU;
         [
             base * (1.0 + phase.sin()) * 0.5,
