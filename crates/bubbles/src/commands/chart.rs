@@ -145,16 +145,14 @@ impl Layout {
 
 /// Linear sRGB of each row (angle), one colour per pixel column (at its centre's thickness).
 fn row_colours(colour: &FilmColour, columns: u32) -> Result<Vec<Vec<[f64; 3]>>, CliError> {
+    let thickness_nm: Vec<f32> = (0..columns)
+        .map(|x| (MAX_THICKNESS_NM * (f64::from(x) + 0.5) / f64::from(columns)) as f32)
+        .collect();
     ANGLES_DEG
-        .iter()
+        .par_iter()
         .map(|&angle| {
-            (0..columns)
-                .into_par_iter()
-                .map(|x| {
-                    let d = MAX_THICKNESS_NM * (f64::from(x) + 0.5) / f64::from(columns);
-                    colour.xyz(d, angle).map(|xyz| apply(&SRGB_FROM_XYZ, xyz))
-                })
-                .collect()
+            let xyz = colour.xyz_row_f32(angle, &thickness_nm)?;
+            Ok(xyz.into_iter().map(|v| apply(&SRGB_FROM_XYZ, v)).collect())
         })
         .collect()
 }
