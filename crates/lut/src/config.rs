@@ -62,7 +62,8 @@ impl Light {
         })
     }
 
-    /// Reads a CSV spectrum (`wavelength_nm,value` per line) and names it after the file
+    /// Reads a CSV spectrum (header `wavelength_nm,value`, then one sample per line; see
+    /// `Spectrum::from_csv_str`) and names it after the file
     /// stem, with characters unsafe in file names replaced by `_`.
     pub fn try_from_csv_path(path: &Path) -> Result<Self, ConfigError> {
         let spectrum = Spectrum::from_csv_path(path).map_err(|e| ConfigError::Spectrum {

@@ -22,9 +22,10 @@ pub const DESCRIPTION_FILE: &str = "lut.json";
 pub enum SaveError {
     /// No format was asked for.
     NoFormats,
-    /// A table's resolution or thickness range differs from the reflectivity table's.
+    /// A table's resolution or thickness range differs from the reflectivity table's
+    /// (or `meta.thickness_max_nm` does).
     Inconsistent {
-        /// File stem of the odd table.
+        /// File stem of the odd table, or `meta`.
         table: String,
     },
     /// A light name is empty, too long, or holds characters unsafe in a file name.
@@ -128,6 +129,11 @@ impl LutSet {
             return Err(SaveError::NoFormats);
         }
         let reference = &self.reflectivity;
+        if self.meta.thickness_max_nm != reference.thickness_max_nm() {
+            return Err(SaveError::Inconsistent {
+                table: "meta".into(),
+            });
+        }
         for (stem, lut) in self.named_tables() {
             if lut.width() != reference.width()
                 || lut.height() != reference.height()
@@ -181,7 +187,11 @@ impl LutSet {
                     entry.exr = Some(file);
                 }
                 Format::Png16 => {
-                    let (image, offset, scale) = png16_image(lut);
+                    let (image, offset, scale) =
+                        png16_image(lut).ok_or_else(|| SaveError::Encode {
+                            path: path.clone(),
+                            message: "values span too wide a range for 16-bit codes".into(),
+                        })?;
                     staged.push(stage(dir, &path, |w| {
                         write_image(&image, w, ImageFormat::Png)
                     })?);
@@ -292,17 +302,24 @@ fn exr_image(lut: &Lut) -> ImageBuffer<Rgb<f32>, Vec<f32>> {
         .expect("a Lut holds width × height texels")
 }
 
+/// A 16-bit RGB image.
+type Png16Image = ImageBuffer<Rgb<u16>, Vec<u16>>;
+
 /// The 16-bit codes of `lut` and their decoding `value = offset + scale · code / 65535`.
 ///
 /// The range always covers 0..1, so tables inside it decode as plain `code / 65535`;
-/// values outside (out-of-gamut negatives, bright lights) widen it.
-pub(crate) fn png16_image(lut: &Lut) -> (ImageBuffer<Rgb<u16>, Vec<u16>>, f32, f32) {
+/// values outside (out-of-gamut negatives, bright lights) widen it. `None` if the range
+/// overflows f32.
+pub(crate) fn png16_image(lut: &Lut) -> Option<(Png16Image, f32, f32)> {
     let (lo, hi) = lut
         .texels()
         .iter()
         .flatten()
         .fold((0.0f32, 1.0f32), |(lo, hi), &v| (lo.min(v), hi.max(v)));
     let scale = hi - lo;
+    if !scale.is_finite() {
+        return None;
+    }
     let codes = lut
         .texels()
         .iter()
@@ -311,7 +328,7 @@ pub(crate) fn png16_image(lut: &Lut) -> (ImageBuffer<Rgb<u16>, Vec<u16>>, f32, f
         .collect();
     let image = ImageBuffer::from_raw(lut.width() as u32, lut.height() as u32, codes)
         .expect("a Lut holds width × height texels");
-    (image, lo, scale)
+    Some((image, lo, scale))
 }
 
 fn png8_preview_image(lut: &Lut) -> ImageBuffer<Rgb<u8>, Vec<u8>> {

@@ -77,3 +77,68 @@ pub(crate) fn light_pass(config: &BakeConfig, k: usize) -> Pass {
         .expect("BakeConfig guarantees every light integrates");
     pass(config, &integrator, [1.0; 3])
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Light;
+    use thinfilm::colorspace::XYZ_FROM_SRGB;
+    use thinfilm::illuminant::Illuminant;
+
+    fn flat(pass: &Pass, reflectance: f32) -> [f32; 3] {
+        pass.weights.iter().fold([0.0; 3], |acc, w| {
+            std::array::from_fn(|c| acc[c] + w[c] * reflectance)
+        })
+    }
+
+    #[test]
+    fn flat_reflectors_map_to_grey_of_their_reflectance_under_any_reference() {
+        for reference in [
+            Illuminant::D65,
+            Illuminant::A,
+            Illuminant::F11,
+            Illuminant::E,
+        ] {
+            let config = BakeConfig::builder()
+                .reference(Light::illuminant(reference))
+                .build()
+                .unwrap();
+            let pass = reflectivity_pass(&config);
+            for reflectance in [1.0f32, 0.04] {
+                let rgb = flat(&pass, reflectance);
+                for c in rgb {
+                    let diff = c - reflectance;
+                    assert!(
+                        diff.abs() < 2e-6 * 1f32.max(reflectance),
+                        "{reference:?}: {c} vs {reflectance}, off by {diff:e}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_perfect_mirror_shows_each_light_at_luminance_one() {
+        let lights = [Illuminant::Sodium, Illuminant::A, Illuminant::F11]
+            .map(Light::illuminant)
+            .to_vec();
+        let config = BakeConfig::builder().lights(lights).build().unwrap();
+        for k in 0..3 {
+            let rgb = flat(&light_pass(&config, k), 1.0).map(f64::from);
+            let y = apply(&XYZ_FROM_SRGB, rgb)[1];
+            assert!(
+                (y - 1.0).abs() < 1e-6,
+                "light {k}: Y = {y}, off by {:e}",
+                y - 1.0
+            );
+        }
+    }
+
+    #[test]
+    fn a_line_light_keeps_only_its_lines() {
+        let config = BakeConfig::default();
+        let pass = light_pass(&config, 0);
+        assert_eq!(pass.wavelength_nm, [589.0, 589.6]);
+        assert_eq!(pass.n_film, [1.33, 1.33]);
+    }
+}

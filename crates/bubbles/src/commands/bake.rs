@@ -27,8 +27,8 @@ pub struct Args {
     /// Thickness of the last column, in nm (the first is 0).
     #[arg(long, value_name = "N", default_value_t = lut::config::DEFAULT_THICKNESS_MAX_NM, allow_negative_numbers = true)]
     thickness_max_nm: f32,
-    /// Lights to bake a light-source table for: a built-in name or a CSV spectrum file
-    /// (`wavelength_nm,value` lines). Repeatable.
+    /// Lights to bake a light-source table for: a built-in name (d65, d50, a, e, f2, f11,
+    /// sodium) or a CSV spectrum file (header `wavelength_nm,value`). Repeatable.
     #[arg(long = "illuminant", value_name = "NAME|PATH.csv", num_args = 1.., default_value = "sodium")]
     illuminants: Vec<String>,
     /// White light the reflectivity and transmittance tables are normalised to.

@@ -1,0 +1,279 @@
+//! The baked tables against independent truth: the f64 Airy path of `thinfilm`, a
+//! closed-form Airy reflectance written out here, energy conservation, and the limits
+//! of grazing incidence and vanishing thickness.
+
+use lut::{BakeConfig, Light, LutSet};
+use num_complex::Complex64;
+use proptest::prelude::*;
+use thinfilm::airy::ThinFilm;
+use thinfilm::cmf::Observer;
+use thinfilm::colorspace::{SRGB_FROM_XYZ, XYZ_FROM_SRGB, apply};
+use thinfilm::dispersion::RefractiveIndex;
+use thinfilm::illuminant::Illuminant;
+use thinfilm::integrate::SpectralIntegrator;
+use thinfilm::spectrum::Spectrum;
+
+fn assert_close(what: &str, got: f64, want: f64, tol: f64) {
+    assert!(
+        (got - want).abs() <= tol,
+        "{what}: got {got}, want {want}, difference {:e} > {tol:e}",
+        got - want
+    );
+}
+
+fn small(builder: lut::BakeConfigBuilder) -> BakeConfig {
+    builder.resolution(48, 12).build().expect("valid config")
+}
+
+fn film(config: &BakeConfig, thickness_nm: f32) -> ThinFilm {
+    ThinFilm {
+        n_outside: 1.0,
+        n_film: *config.film_index(),
+        n_substrate: Complex64::new(1.0, 0.0),
+        thickness_nm: f64::from(thickness_nm),
+    }
+}
+
+/// Linear sRGB of the film under `light` by the f64 path, `reflect` choosing R or T.
+fn direct_rgb(config: &BakeConfig, light: &Light, d: f32, c: f32, reflect: bool) -> [f64; 3] {
+    let integrator = SpectralIntegrator::new(config.observer(), light.spectrum(), config.step_nm())
+        .expect("valid light");
+    let film = film(config, d);
+    let xyz = integrator.xyz(|l| {
+        let response = film.response(l, f64::from(c));
+        if reflect { response.r() } else { response.t() }
+    });
+    apply(&SRGB_FROM_XYZ, xyz)
+}
+
+fn reference_white_rgb(config: &BakeConfig) -> [f64; 3] {
+    let integrator = SpectralIntegrator::new(
+        config.observer(),
+        config.reference().spectrum(),
+        config.step_nm(),
+    )
+    .expect("valid light");
+    apply(&SRGB_FROM_XYZ, integrator.white_xyz())
+}
+
+/// Every texel of every table against the f64 Airy path at the texel's (d, cos θ).
+fn check_against_airy(config: &BakeConfig, set: &LutSet, tol: f64) {
+    let white = reference_white_rgb(config);
+    let lut = &set.reflectivity;
+    for j in 0..lut.height() {
+        for i in 0..lut.width() {
+            let (d, c) = (lut.thickness_nm_at(i), lut.cos_theta_at(j));
+            let r = direct_rgb(config, config.reference(), d, c, true);
+            let t = direct_rgb(config, config.reference(), d, c, false);
+            for k in 0..3 {
+                let at = format!("texel ({i}, {j}) d={d} cos={c} channel {k}");
+                let got = f64::from(set.reflectivity.texel(i, j)[k]);
+                assert_close(&format!("R {at}"), got, r[k] / white[k], tol);
+                let got = f64::from(set.transmittance.texel(i, j)[k]);
+                assert_close(&format!("T {at}"), got, t[k] / white[k], tol);
+            }
+            for (light, (name, table)) in config.lights().iter().zip(&set.lights) {
+                let want = direct_rgb(config, light, d, c, true);
+                for (k, (got, want)) in table.texel(i, j).into_iter().zip(want).enumerate() {
+                    let what = format!("light {name} texel ({i}, {j}) ch {k}");
+                    assert_close(&what, f64::from(got), want, tol);
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn default_settings_match_the_f64_airy_path_at_every_texel() {
+    let config = small(BakeConfig::builder());
+    check_against_airy(&config, &lut::bake(&config), 2e-5);
+}
+
+#[test]
+fn dispersive_film_other_observer_and_lights_match_the_f64_airy_path() {
+    let config = small(
+        BakeConfig::builder()
+            .film_index(RefractiveIndex::Water)
+            .observer(Observer::Cie1964)
+            .step_nm(10.0)
+            .thickness_max_nm(1200.0)
+            .reference(Light::illuminant(Illuminant::D50))
+            .lights(
+                [Illuminant::A, Illuminant::F11, Illuminant::Sodium]
+                    .map(Light::illuminant)
+                    .to_vec(),
+            ),
+    );
+    check_against_airy(&config, &lut::bake(&config), 2e-5);
+}
+
+/// Unpolarised reflectance of a free film `1 | n | 1`, Airy's sum of all orders written
+/// from the Fresnel coefficients: `R = F sin²(δ/2) / (1 + F sin²(δ/2))`, `F = 4ρ²/(1 − ρ²)²`.
+fn airy_closed_form(n: f64, thickness_nm: f64, cos_theta: f64, wavelength_nm: f64) -> f64 {
+    let sin2 = 1.0 - cos_theta * cos_theta;
+    let n_cos_t = (n * n - sin2).sqrt();
+    let rho_s = (cos_theta - n_cos_t) / (cos_theta + n_cos_t);
+    let rho_p = (n * n * cos_theta - n_cos_t) / (n * n * cos_theta + n_cos_t);
+    let half_delta = 2.0 * std::f64::consts::PI * n_cos_t * thickness_nm / wavelength_nm;
+    let s2 = half_delta.sin().powi(2);
+    let r = |rho: f64| {
+        let f = 4.0 * rho * rho / (1.0 - rho * rho).powi(2);
+        f * s2 / (1.0 + f * s2)
+    };
+    0.5 * (r(rho_s) + r(rho_p))
+}
+
+#[test]
+fn a_single_line_light_gives_the_closed_form_airy_reflectance_as_luminance() {
+    let wavelength_nm = 532.0;
+    let line = Spectrum::from_lines(vec![(wavelength_nm, 1.0)]).expect("valid line");
+    let config = BakeConfig::builder()
+        .resolution(97, 23)
+        .film_index(RefractiveIndex::Constant(1.38))
+        .lights(vec![Light::try_new("laser", line).expect("valid name")])
+        .build()
+        .expect("valid config");
+    let set = lut::bake(&config);
+    let table = set.light("laser").expect("baked");
+    for j in 1..table.height() {
+        for i in 0..table.width() {
+            let (d, c) = (table.thickness_nm_at(i), table.cos_theta_at(j));
+            let y = apply(&XYZ_FROM_SRGB, table.texel(i, j).map(f64::from))[1];
+            let want = airy_closed_form(1.38, f64::from(d), f64::from(c), wavelength_nm);
+            assert_close(&format!("Y at d={d} cos={c}"), y, want, 2e-6);
+        }
+    }
+}
+
+#[test]
+fn transmittance_from_its_own_formula_is_one_minus_reflectivity() {
+    let config = BakeConfig::builder()
+        .resolution(256, 64)
+        .film_index(RefractiveIndex::Water)
+        .build()
+        .expect("valid config");
+    let set = lut::bake(&config);
+    let worst = set
+        .reflectivity
+        .texels()
+        .iter()
+        .zip(set.transmittance.texels())
+        .flat_map(|(r, t)| (0..3).map(move |k| (r[k] + t[k] - 1.0).abs()))
+        .fold(0.0f32, f32::max);
+    assert!(worst < 4e-6, "R + T - 1 reaches {worst:e}");
+}
+
+#[test]
+fn grazing_row_is_a_perfect_mirror_and_zero_thickness_column_is_invisible() {
+    let config = small(
+        BakeConfig::builder().lights(
+            [Illuminant::Sodium, Illuminant::F11, Illuminant::A]
+                .map(Light::illuminant)
+                .to_vec(),
+        ),
+    );
+    let set = lut::bake(&config);
+    for i in 0..set.reflectivity.width() {
+        for k in 0..3 {
+            assert_close(
+                "R at grazing",
+                f64::from(set.reflectivity.texel(i, 0)[k]),
+                1.0,
+                2e-6,
+            );
+            assert_close(
+                "T at grazing",
+                f64::from(set.transmittance.texel(i, 0)[k]),
+                0.0,
+                2e-6,
+            );
+        }
+        // Each light reflected by a perfect mirror is the light itself: Y = 1.
+        for (name, table) in &set.lights {
+            let y = apply(&XYZ_FROM_SRGB, table.texel(i, 0).map(f64::from))[1];
+            assert_close(&format!("Y of {name} at grazing"), y, 1.0, 2e-6);
+        }
+    }
+    for j in 1..set.reflectivity.height() {
+        for k in 0..3 {
+            assert_close(
+                "R at d = 0",
+                f64::from(set.reflectivity.texel(0, j)[k]),
+                0.0,
+                1e-7,
+            );
+            assert_close(
+                "T at d = 0",
+                f64::from(set.transmittance.texel(0, j)[k]),
+                1.0,
+                2e-6,
+            );
+        }
+    }
+}
+
+#[test]
+fn bake_is_bit_identical_at_any_thread_count() {
+    let config = BakeConfig::builder()
+        .resolution(300, 40)
+        .build()
+        .expect("valid config");
+    let bake_on = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool")
+            .install(|| lut::bake(&config))
+    };
+    let one = bake_on(1);
+    assert_eq!(one, bake_on(2));
+    assert_eq!(one, bake_on(5));
+}
+
+#[test]
+fn progress_reports_every_kernel_row() {
+    let config = small(BakeConfig::builder());
+    let rows = std::sync::atomic::AtomicUsize::new(0);
+    let set = lut::bake_with_progress(&config, &|| {
+        rows.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    });
+    assert_eq!(rows.into_inner(), lut::progress_rows(&config));
+    assert_eq!(set, lut::bake(&config));
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Whatever the settings: finite texels, luminance of the reflection within [0, 1]
+    /// (each R(λ) is, and the weights of Y are non-negative), and R + T = 1.
+    #[test]
+    fn any_valid_bake_is_finite_bounded_and_conserves_energy(
+        width in 2usize..40,
+        height in 2usize..12,
+        thickness_max_nm in 1.0f32..20_000.0,
+        step_nm in 1.0f64..50.0,
+        n in 1.0f64..2.5,
+        observer in prop::sample::select(Observer::ALL.to_vec()),
+        reference in prop::sample::select(vec![Illuminant::D65, Illuminant::D50, Illuminant::E, Illuminant::F2]),
+    ) {
+        let config = BakeConfig::builder()
+            .resolution(width, height)
+            .thickness_max_nm(thickness_max_nm)
+            .step_nm(step_nm)
+            .film_index(RefractiveIndex::Constant(n))
+            .observer(observer)
+            .reference(Light::illuminant(reference))
+            .build()
+            .expect("valid config");
+        let set = lut::bake(&config);
+        let white = reference_white_rgb(&config);
+        for (r, t) in set.reflectivity.texels().iter().zip(set.transmittance.texels()) {
+            let absolute = std::array::from_fn(|k| f64::from(r[k]) * white[k]);
+            let y = apply(&XYZ_FROM_SRGB, absolute)[1];
+            prop_assert!((-1e-6..=1.0 + 1e-6).contains(&y), "Y = {y}");
+            for k in 0..3 {
+                prop_assert!((r[k] + t[k] - 1.0).abs() < 1e-5, "R + T = {}", r[k] + t[k]);
+            }
+        }
+    }
+}
