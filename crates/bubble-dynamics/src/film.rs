@@ -7,7 +7,7 @@ use std::f64::consts::TAU;
 use glam::DVec3;
 
 use crate::bubble::Bubble;
-use crate::geometry::barycentric_vertex_areas_m2;
+use crate::bubble::face_areas_m2;
 use crate::params::BubbleParams;
 use crate::rng::SplitMix64;
 
@@ -90,42 +90,46 @@ impl Slosh {
 
 impl Bubble {
     /// Moves film mass for one step of `dt_s` under effective gravity `g_eff` (gravity
-    /// minus the bubble's acceleration) and the swirl at time `t_s`, then evaporates.
+    /// minus the bubble's acceleration) and the swirl at time `t_s`, evaporates, and
+    /// refreshes the thickness.
     pub(crate) fn transport_film(&mut self, g_eff: DVec3, dt_s: f64, t_s: f64) {
-        let areas = barycentric_vertex_areas_m2(&self.positions_m, self.topology.triangles());
-        self.transport_film_with_areas(g_eff, dt_s, t_s, &areas);
-        self.update_thickness_with_areas(&areas);
-    }
-
-    fn transport_film_with_areas(&mut self, g_eff: DVec3, dt_s: f64, t_s: f64, areas: &[f64]) {
+        let face_areas = face_areas_m2(&self.positions_m, self.topology.triangles());
+        let areas = vertex_areas_m2(
+            self.topology.triangles(),
+            &face_areas,
+            self.positions_m.len(),
+        );
         let rho = self.film.density_kg_per_m3;
         let h: Vec<f64> = self
             .film_mass_kg
             .iter()
-            .zip(areas)
+            .zip(&areas)
             .map(|(m, a)| if *a > 0.0 { m / (rho * a) } else { 0.0 })
             .collect();
-        let flux = self.edge_fluxes_kg_per_s(g_eff, t_s, &h);
+        let flux = self.edge_fluxes_kg_per_s(g_eff, t_s, &h, &face_areas);
         self.apply_fluxes(&flux, dt_s);
-        self.evaporate(areas, dt_s);
+        self.evaporate(&areas, dt_s);
         self.refresh_inertial_mass();
+        self.update_thickness_with_areas(&areas);
     }
 
     /// Signed mass flux along every edge, kg/s, positive from `vertices[0]` to `vertices[1]`.
     ///
     /// Drainage: q = ρ g_t h³/(3μ) per unit width (a film draining under gravity with
-    /// lubrication theory), times the dual-edge width, upwind thickness. Swirl: film
+    /// lubrication theory), upwind thickness, times the width of the dual cell boundary
+    /// across the edge, (h_left + h_right)/3 = 2(A_left + A_right)/(3|e|) from the two
+    /// faces' heights. With g_t = g·e/|e| the flux needs no square root. Swirl: film
     /// volume ψ_left − ψ_right per unit time across the dual edge, upwind thickness.
-    fn edge_fluxes_kg_per_s(&self, g_eff: DVec3, t_s: f64, h: &[f64]) -> Vec<f64> {
+    fn edge_fluxes_kg_per_s(
+        &self,
+        g_eff: DVec3,
+        t_s: f64,
+        h: &[f64],
+        face_areas: &[f64],
+    ) -> Vec<f64> {
         let x = &self.positions_m;
-        let tri = self.topology.triangles();
         let rho = self.film.density_kg_per_m3;
         let mobility = rho * rho / (3.0 * self.film.drainage_viscosity_pa_s);
-        let centroids: Vec<DVec3> = tri
-            .iter()
-            .map(|t| (x[t[0] as usize] + x[t[1] as usize] + x[t[2] as usize]) * (1.0 / 3.0))
-            .collect();
-        let centroid = |f: u32| centroids[f as usize];
         let psi = self.slosh.as_ref().map(|s| s.stream_m2_per_s(t_s));
         self.topology
             .edges()
@@ -133,13 +137,14 @@ impl Bubble {
             .map(|e| {
                 let [i, j] = e.vertices.map(|v| v as usize);
                 let upwind = |q: f64| if q > 0.0 { h[i] } else { h[j] };
-                let mid = 0.5 * (x[i] + x[j]);
-                let width =
-                    (centroid(e.faces[0]) - mid).length() + (centroid(e.faces[1]) - mid).length();
-                let g_t = g_eff.dot((x[j] - x[i]).normalize_or_zero());
-                let mut q = mobility * g_t * upwind(g_t).powi(3) * width;
+                let [fa, fb] = e.faces.map(|f| f as usize);
+                let edge = x[j] - x[i];
+                let g_dot_e = g_eff.dot(edge);
+                let width_over_len =
+                    2.0 * (face_areas[fa] + face_areas[fb]) / (3.0 * edge.length_squared());
+                let mut q = mobility * g_dot_e * width_over_len * upwind(g_dot_e).powi(3);
                 if let Some(psi) = &psi {
-                    let volume_rate = psi[e.faces[0] as usize] - psi[e.faces[1] as usize];
+                    let volume_rate = psi[fa] - psi[fb];
                     q += rho * volume_rate * upwind(volume_rate);
                 }
                 q
@@ -209,4 +214,15 @@ impl Bubble {
             *m = (*m - rate * a * dt_s).max(0.0);
         }
     }
+}
+
+/// Barycentric vertex areas from face areas: a third of each face to each corner.
+fn vertex_areas_m2(triangles: &[[u32; 3]], face_areas: &[f64], vertex_count: usize) -> Vec<f64> {
+    let mut areas = vec![0.0; vertex_count];
+    for (t, a) in triangles.iter().zip(face_areas) {
+        for &i in t {
+            areas[i as usize] += a / 3.0;
+        }
+    }
+    areas
 }

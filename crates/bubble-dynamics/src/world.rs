@@ -353,11 +353,10 @@ impl Bubble {
             if !(x.is_finite() && v.is_finite()) {
                 return Some(Divergence::NonFinite { vertex });
             }
-            let speed = v.length();
-            if speed > max_speed_m_per_s {
+            if v.length_squared() > max_speed_m_per_s * max_speed_m_per_s {
                 return Some(Divergence::Speed {
                     vertex,
-                    speed_m_per_s: speed,
+                    speed_m_per_s: v.length(),
                     limit_m_per_s: max_speed_m_per_s,
                 });
             }
