@@ -41,7 +41,7 @@ impl Observer {
         let i = (t.floor() as usize).min(ROWS - 2);
         let f = t - i as f64;
         let (a, b) = (table[i], table[i + 1]);
-        std::array::from_fn(|c| a[c] + f * (b[c] - a[c]))
+        std::array::from_fn(|c| (1.0 - f) * a[c] + f * b[c])
     }
 
     /// The observer named `"1931"` or `"1964"` (also `"cie1931"`, `"2"`, `"cie1964"`, `"10"`).

@@ -142,24 +142,18 @@ impl SpectralIntegrator {
     /// Sorts, merges coincident wavelengths, drops zero weights and normalises.
     fn from_samples(mut samples: Vec<(f64, [f64; 3])>, norm: f64) -> SpectralIntegrator {
         samples.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut wavelength_nm: Vec<f64> = Vec::with_capacity(samples.len());
-        let mut weight: Vec<[f64; 3]> = Vec::with_capacity(samples.len());
+        let mut merged: Vec<(f64, [f64; 3])> = Vec::with_capacity(samples.len());
         for (w, v) in samples {
-            match (wavelength_nm.last(), weight.last_mut()) {
-                (Some(&last), Some(acc)) if last == w => {
-                    (0..3).for_each(|c| acc[c] += v[c] / norm);
-                }
-                _ => {
-                    wavelength_nm.push(w);
-                    weight.push(v.map(|c| c / norm));
-                }
+            match merged.last_mut() {
+                Some((last, acc)) if *last == w => (0..3).for_each(|c| acc[c] += v[c]),
+                _ => merged.push((w, v)),
             }
         }
-        let keep: Vec<bool> = weight.iter().map(|v| v.iter().any(|&c| c != 0.0)).collect();
-        let mut k = keep.iter();
-        wavelength_nm.retain(|_| *k.next().unwrap_or(&false));
-        let mut k = keep.iter();
-        weight.retain(|_| *k.next().unwrap_or(&false));
+        let (wavelength_nm, weight): (Vec<f64>, Vec<[f64; 3]>) = merged
+            .into_iter()
+            .filter(|(_, v)| v.iter().any(|&c| c != 0.0))
+            .map(|(w, v)| (w, v.map(|c| c / norm)))
+            .unzip();
         let white_xyz = weight.iter().fold([0.0; 3], |acc, v| {
             [acc[0] + v[0], acc[1] + v[1], acc[2] + v[2]]
         });
@@ -213,8 +207,8 @@ impl SpectralIntegrator {
     }
 }
 
-/// ∫E ȳ dλ by the CIE 1 nm summation, plus the lines' delta terms excluded
-/// (they are added with the samples).
+/// ∫E ȳ dλ: the CIE 1 nm summation of the continuous part plus the lines'
+/// delta terms.
 fn reference_norm(observer: Observer, illuminant: &Spectrum) -> f64 {
     let continuous: f64 = observer
         .table_1nm()

@@ -266,7 +266,8 @@ impl Spectrum {
         let (w0, w1) = (w[upper - 1], w[upper]);
         let (v0, v1) = (self.value[upper - 1], self.value[upper]);
         let t = (wavelength_nm - w0) / (w1 - w0);
-        v0 + t * (v1 - v0)
+        // This form is exact at both ends (t = 0 and t = 1).
+        (1.0 - t) * v0 + t * v1
     }
 
     /// The emission lines `(wavelength_nm, power)`, sorted by wavelength.
