@@ -22,6 +22,7 @@ mod cubemap;
 mod environment;
 mod error;
 mod frame;
+mod ground;
 mod mesh;
 mod obj;
 mod passes;

@@ -7,6 +7,7 @@ use glam::Vec3;
 use lut::Lut;
 
 use crate::camera::View;
+use crate::ground::{SPAN, ground_span, span_supported};
 use crate::raster::{SamplePattern, SetupTri, for_each_covered_in_row};
 use crate::shading::{ground_albedo, lit, object_albedo};
 use crate::{CubeMap, Environment, FilmTables, Ground, Light, Material, SphereMap};
@@ -74,10 +75,10 @@ pub(crate) struct GroundView<'a> {
     /// Unit normal facing the eye.
     pub normal: Vec3,
     /// `1 / (height − eye.y)`.
-    inv_height: f32,
+    pub inv_height: f32,
     /// Change of the (unnormalised) view ray per pixel along x and y.
-    ddx: Vec3,
-    ddy: Vec3,
+    pub ddx: Vec3,
+    pub ddy: Vec3,
 }
 
 impl<'a> GroundView<'a> {
@@ -104,7 +105,7 @@ impl<'a> GroundView<'a> {
     }
 
     #[inline]
-    fn inv_depth(&self, px: f32, py: f32) -> f32 {
+    pub fn inv_depth(&self, px: f32, py: f32) -> f32 {
         self.c + self.gx * px + self.gy * py
     }
 }
@@ -137,73 +138,103 @@ impl OpaqueCtx<'_> {
 
     fn background(&self, y0: usize, rows: usize, color: &mut [[f32; 3]], depth: &mut [f32]) {
         let s_count = self.pattern.count;
-        let full = self.pattern.full_mask();
         let width = self.view.width;
+        let fast = self.ground.as_ref().filter(|g| span_supported(g));
+        let mut centre = [[0.0f32; 3]; SPAN];
         for row in 0..rows {
             let y = y0 + row;
-            let py = y as f32;
-            if s_count == 1 {
-                // One sample at the pixel centre: the cube-face path, kept branch-light.
-                let span = row * width..(row + 1) * width;
-                let (color, depth) = (&mut color[span.clone()], &mut depth[span]);
-                for (x, (c, z)) in color.iter_mut().zip(depth.iter_mut()).enumerate() {
-                    let (cx, cy) = (x as f32 + 0.5, py + 0.5);
-                    let g = self.ground.as_ref().map_or(0.0, |g| g.inv_depth(cx, cy));
-                    if g > 0.0 {
-                        *z = g;
-                        *c = self.shade_ground(cx, cy, g);
-                    } else {
-                        *z = 0.0;
-                        *c = self.sky(x, y);
-                    }
+            for x0 in (0..width).step_by(SPAN) {
+                let n = SPAN.min(width - x0);
+                // Centres seeing the ground form one contiguous run (inverse depth is affine).
+                let run = self.ground_run(y, x0, n);
+                if let (Some(g), Some((a, b))) = (fast, run) {
+                    ground_span(self, g, y, x0 + a, &mut centre[a..b]);
                 }
-                continue;
-            }
-            for x in 0..width {
-                let px = x as f32;
-                let base = (row * width + x) * s_count;
-                let mut ground_mask = 0u32;
-                let mut first_ground = 0usize;
-                if let Some(g) = &self.ground {
-                    for s in (0..s_count).rev() {
-                        let (ox, oy) = self.pattern.offset_f32(s);
-                        let z = g.inv_depth(px + ox, py + oy);
-                        depth[base + s] = z.max(0.0);
-                        if z > 0.0 {
-                            ground_mask |= 1 << s;
-                            first_ground = s;
-                        }
-                    }
-                } else {
-                    depth[base..base + s_count].fill(0.0);
-                }
-                let sky = if ground_mask != full {
-                    self.sky(x, y)
-                } else {
-                    [0.0; 3]
-                };
-                let ground = if ground_mask != 0 {
-                    let (ox, oy) = if ground_mask == full {
-                        (0.5, 0.5)
-                    } else {
-                        self.pattern.offset_f32(first_ground)
+                for (i, c) in centre.iter().enumerate().take(n) {
+                    let x = x0 + i;
+                    let base = (row * width + x) * s_count;
+                    let precomputed = match (fast, run) {
+                        (Some(_), Some((a, b))) if (a..b).contains(&i) => Some(*c),
+                        _ => None,
                     };
-                    let g = self
-                        .ground
-                        .as_ref()
-                        .map_or(0.0, |g| g.inv_depth(px + ox, py + oy));
-                    self.shade_ground(px + ox, py + oy, g)
-                } else {
-                    [0.0; 3]
-                };
-                for s in 0..s_count {
-                    color[base + s] = if ground_mask & (1 << s) != 0 {
-                        ground
-                    } else {
-                        sky
-                    };
+                    self.background_pixel(
+                        x,
+                        y,
+                        precomputed,
+                        &mut color[base..base + s_count],
+                        &mut depth[base..base + s_count],
+                    );
                 }
             }
+        }
+    }
+
+    /// The pixels `i` of `x0 .. x0 + n` on row `y` whose centres see the ground, as `a..b`.
+    fn ground_run(&self, y: usize, x0: usize, n: usize) -> Option<(usize, usize)> {
+        let g = self.ground.as_ref()?;
+        let cy = y as f32 + 0.5;
+        let sees = |i: usize| g.inv_depth((x0 + i) as f32 + 0.5, cy) > 0.0;
+        let a = (0..n).find(|&i| sees(i))?;
+        let b = (a..n).find(|&i| !sees(i)).unwrap_or(n);
+        Some((a, b))
+    }
+
+    /// Fills one pixel's samples with ground or environment; `centre` is the ground radiance
+    /// at the pixel centre when already computed.
+    #[inline]
+    fn background_pixel(
+        &self,
+        x: usize,
+        y: usize,
+        centre: Option<[f32; 3]>,
+        color: &mut [[f32; 3]],
+        depth: &mut [f32],
+    ) {
+        let s_count = self.pattern.count;
+        let full = self.pattern.full_mask();
+        let (px, py) = (x as f32, y as f32);
+        let mut ground_mask = 0u32;
+        let mut first_ground = 0usize;
+        if let Some(g) = &self.ground {
+            for s in (0..s_count).rev() {
+                let (ox, oy) = self.pattern.offset_f32(s);
+                let z = g.inv_depth(px + ox, py + oy);
+                depth[s] = z.max(0.0);
+                if z > 0.0 {
+                    ground_mask |= 1 << s;
+                    first_ground = s;
+                }
+            }
+        } else {
+            depth.fill(0.0);
+        }
+        let sky = if ground_mask != full {
+            self.sky(x, y)
+        } else {
+            [0.0; 3]
+        };
+        let ground = if ground_mask == 0 {
+            [0.0; 3]
+        } else if let (true, Some(c)) = (ground_mask == full, centre) {
+            c
+        } else {
+            let (ox, oy) = if ground_mask == full {
+                (0.5, 0.5)
+            } else {
+                self.pattern.offset_f32(first_ground)
+            };
+            let g = self
+                .ground
+                .as_ref()
+                .map_or(0.0, |g| g.inv_depth(px + ox, py + oy));
+            self.shade_ground(px + ox, py + oy, g)
+        };
+        for (s, c) in color.iter_mut().enumerate() {
+            *c = if ground_mask & (1 << s) != 0 {
+                ground
+            } else {
+                sky
+            };
         }
     }
 

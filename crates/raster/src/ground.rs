@@ -1,0 +1,129 @@
+//! The ground plane's span kernel: lit, box-filtered checker (or solid) ground for a run of
+//! pixel centres along one row, written as straight-line f32 code over small arrays so the
+//! compiler can keep it in SIMD registers. Other ground materials use the scalar path.
+
+use crate::passes::{GroundView, OpaqueCtx};
+use crate::{Light, Pattern};
+
+/// Pixels per kernel call.
+pub(crate) const SPAN: usize = 64;
+
+/// Whether [`ground_span`] handles this ground (solid or checker albedo, no specular lobe).
+pub(crate) fn span_supported(g: &GroundView<'_>) -> bool {
+    let m = &g.ground.material;
+    m.specular == [0.0; 3] && matches!(m.pattern, Pattern::Solid(_) | Pattern::Checker { .. })
+}
+
+/// `x.floor()` for |x| ≤ 2²⁴ without branches (callers clamp larger values first).
+#[inline(always)]
+fn floor_small(x: f32) -> f32 {
+    let t = x as i32 as f32;
+    t - f32::from(u8::from(t > x))
+}
+
+/// Box-filtered checker weight, as [`crate::shading`]'s scalar version, clamped for range.
+#[inline(always)]
+fn checker_weight(p: [f32; 2], footprint: [f32; 2]) -> f32 {
+    let tri = |x: f32| (x - floor_small(x) - 0.5).abs();
+    let mut i = [0.0; 2];
+    for k in 0..2 {
+        let w = footprint[k].min(1e6) + 1e-3;
+        let x = p[k].clamp(-1e6, 1e6);
+        i[k] = 2.0 * (tri((x - 0.5 * w) * 0.5) - tri((x + 0.5 * w) * 0.5)) / w;
+    }
+    0.5 - 0.5 * i[0] * i[1]
+}
+
+/// Ground radiance at the centres of pixels `x0 .. x0 + out.len()` of row `y` (all of whose
+/// centres must see the ground: inverse depth > 0), written to `out`.
+///
+/// # Panics
+/// Panics if `out.len() > SPAN`.
+pub(crate) fn ground_span(
+    ctx: &OpaqueCtx<'_>,
+    g: &GroundView<'_>,
+    y: usize,
+    x0: usize,
+    out: &mut [[f32; 3]],
+) {
+    let n = out.len();
+    assert!(n <= SPAN, "span of {n} pixels exceeds {SPAN}");
+    let view = &ctx.view;
+    let cy = y as f32 + 0.5;
+    let (_, ay) = view.ray_coefficients(0.0, cy);
+    let sx = 2.0 * view.tan_half_x / view.width as f32;
+    let (a, b, scale) = match g.ground.material.pattern {
+        Pattern::Checker { a, b, scale_m } => (a, b, scale_m),
+        Pattern::Solid(c) => (c, c, 1.0),
+        Pattern::Textured { .. } => unreachable!("span_supported excludes textures"),
+    };
+    let inv_scale = 1.0 / scale;
+    // Row constants: d(x) = d0 + x·ddx.
+    let d0 = view.forward + view.up * ay + view.right * (0.5 * sx - view.tan_half_x);
+    let (ddx, ddy, eye) = (g.ddx, g.ddy, view.eye);
+    let mut weight = [0.0f32; SPAN];
+    let mut px = [0.0f32; SPAN];
+    let mut pz = [0.0f32; SPAN];
+    for i in 0..n {
+        let x = (x0 + i) as f32;
+        let (dx, dz) = (d0.x + ddx.x * x, d0.z + ddx.z * x);
+        let inv_t = (g.c + g.gx * (x + 0.5) + g.gy * cy).max(1e-30);
+        let t = 1.0 / inv_t;
+        px[i] = eye.x + dx * t;
+        pz[i] = eye.z + dz * t;
+        // ∂P/∂px = t·(∂d − d·∂d.y/d.y) with 1/d.y = t/(h − eye.y).
+        let inv_dy = t * g.inv_height;
+        let (kx, ky) = (ddx.y * inv_dy, ddy.y * inv_dy);
+        let fx = ((ddx.x - dx * kx) * t).abs() + ((ddy.x - dx * ky) * t).abs();
+        let fz = ((ddx.z - dz * kx) * t).abs() + ((ddy.z - dz * ky) * t).abs();
+        weight[i] = checker_weight(
+            [px[i] * inv_scale, pz[i] * inv_scale],
+            [fx * inv_scale, fz * inv_scale],
+        );
+    }
+    let mut irradiance = [[0.0f32; SPAN]; 3];
+    for (k, irr) in irradiance.iter_mut().enumerate() {
+        irr[..n].fill(ctx.ambient[k]);
+    }
+    let height = g.ground.height_m;
+    for light in ctx.lights {
+        add_light(
+            light,
+            height,
+            g.normal.y,
+            &px[..n],
+            &pz[..n],
+            &mut irradiance,
+        );
+    }
+    for (i, o) in out.iter_mut().enumerate() {
+        let w = weight[i];
+        for k in 0..3 {
+            o[k] = (a[k] * (1.0 - w) + b[k] * w) * irradiance[k][i];
+        }
+    }
+}
+
+/// Adds one light's `L (ρ/D)² cos θ` to each point's irradiance term.
+#[inline(always)]
+fn add_light(
+    light: &Light,
+    height: f32,
+    normal_y: f32,
+    px: &[f32],
+    pz: &[f32],
+    irr: &mut [[f32; SPAN]; 3],
+) {
+    let ly = light.position.y - height;
+    let r2 = light.radius_m * light.radius_m;
+    for i in 0..px.len() {
+        let (lx, lz) = (light.position.x - px[i], light.position.z - pz[i]);
+        let dist2 = lx * lx + ly * ly + lz * lz;
+        let inv_dist = 1.0 / dist2.sqrt();
+        let cos = (normal_y * ly * inv_dist).max(0.0);
+        let solid = (r2 / dist2).min(1.0) * cos;
+        for (channel, radiance) in irr.iter_mut().zip(light.radiance) {
+            channel[i] += solid * radiance;
+        }
+    }
+}
