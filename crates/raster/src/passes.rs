@@ -492,6 +492,7 @@ pub(crate) fn light_visibility(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::raster::SamplePattern;
 
     #[test]
     fn light_visibility_is_one_inside_zero_outside_and_half_on_the_rim() {
@@ -510,6 +511,78 @@ mod tests {
         assert!((v - 0.5).abs() < 0.05, "rim visibility {v}");
         // Inside the light everything is visible.
         assert_eq!(light_visibility(&light, light.position, Vec3::X, w), 1.0);
+    }
+
+    #[test]
+    fn ground_span_kernel_matches_the_scalar_ground() {
+        use crate::{Camera, Ground, Material};
+        let camera = Camera::look_at(
+            Vec3::new(0.3, 1.3, 3.0),
+            Vec3::new(0.0, 0.2, 0.0),
+            Vec3::Y,
+            60.0,
+        );
+        let view = camera.view(150, 100);
+        let ground = Ground {
+            height_m: 0.1,
+            material: Material::checker([0.8, 0.7, 0.6], [0.1, 0.2, 0.3], 0.4),
+        };
+        let g = GroundView::new(&ground, &view).unwrap();
+        let lights = [
+            Light {
+                position: Vec3::new(-1.0, 2.0, 1.0),
+                radius_m: 0.1,
+                radiance: [50.0, 40.0, 30.0],
+                light_lut: None,
+            },
+            Light {
+                position: Vec3::new(2.0, 0.5, -1.0),
+                radius_m: 0.3,
+                radiance: [5.0; 3],
+                light_lut: None,
+            },
+        ];
+        let env = Environment::Uniform([1.0; 3]);
+        let bins = Bins::default();
+        let ctx = OpaqueCtx {
+            view,
+            pattern: SamplePattern::new(1),
+            env: &env,
+            sky_texels: None,
+            ground: Some(g),
+            ambient: [0.2, 0.3, 0.4],
+            lights: &lights,
+            materials: &[],
+            tris: &[],
+            bins: &bins,
+        };
+        let mut checked = 0;
+        for y in (0..100).step_by(7) {
+            for x0 in (0..150).step_by(SPAN) {
+                let n = SPAN.min(150 - x0);
+                let Some((a, b)) = ctx.ground_run(y, x0, n) else {
+                    continue;
+                };
+                let mut out = [[0.0; 3]; SPAN];
+                ground_span(&ctx, &g, y, x0 + a, &mut out[..b - a]);
+                for (i, got) in out[..b - a].iter().enumerate() {
+                    let (cx, cy) = ((x0 + a + i) as f32 + 0.5, y as f32 + 0.5);
+                    let want = ctx.shade_ground(cx, cy, g.inv_depth(cx, cy));
+                    for k in 0..3 {
+                        let tol = 1e-4 * want[k].abs().max(1e-2);
+                        assert!(
+                            (got[k] - want[k]).abs() <= tol,
+                            "({},{y}) channel {k}: {} vs {}",
+                            x0 + a + i,
+                            got[k],
+                            want[k]
+                        );
+                    }
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 500, "only {checked} ground pixels compared");
     }
 
     #[test]
