@@ -4,7 +4,6 @@ mod commands;
 mod csv_table;
 mod error;
 mod frame;
-#[allow(dead_code)] // TEMPORARY: wired into simulate/render by the integrator
 mod scene;
 
 use clap::{Parser, Subcommand};

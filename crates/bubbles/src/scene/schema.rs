@@ -151,16 +151,13 @@ fn one() -> NonNegative {
     NonNegative::new(1.0).expect("1 >= 0")
 }
 
-/// A horizontal ground plane.
+/// An infinite horizontal ground plane (drawn and collided with).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GroundSpec {
     /// Height of the plane, m.
     #[serde(default = "finite_zero")]
     pub height_m: Finite,
-    /// Half the side of the drawn square, m.
-    #[serde(default = "ground_extent")]
-    pub half_extent_m: Positive,
     /// Surface appearance.
     #[serde(default)]
     pub material: MaterialSpec,
@@ -168,9 +165,6 @@ pub struct GroundSpec {
 
 fn finite_zero() -> Finite {
     Finite::new(0.0).expect("0 is finite")
-}
-fn ground_extent() -> Positive {
-    Positive::new(10.0).expect("10 > 0")
 }
 
 /// How an opaque surface looks.
@@ -316,6 +310,27 @@ pub struct BubbleSpec {
     /// Seed of the thickness perturbation (sloshing).
     #[serde(default)]
     pub seed: u64,
+    /// Gibbs film elasticity, N/m.
+    #[serde(default)]
+    pub gibbs_elasticity_n_per_m: Option<NonNegative>,
+    /// Effective drainage viscosity, Pa·s.
+    #[serde(default)]
+    pub drainage_viscosity_pa_s: Option<Positive>,
+    /// Thickness below which the film bursts, nm.
+    #[serde(default)]
+    pub rupture_thickness_nm: Option<NonNegative>,
+    /// Relative amplitude of the initial random thickness variation, in [0, 1).
+    #[serde(default)]
+    pub thickness_variation: Option<NonNegative>,
+    /// Typical speed of the swirling film flow (sloshing), m/s.
+    #[serde(default)]
+    pub slosh_speed_m_per_s: Option<NonNegative>,
+    /// Evaporative thinning rate, nm/s.
+    #[serde(default)]
+    pub evaporation_nm_per_s: Option<NonNegative>,
+    /// Molar mass of the gas inside, kg/mol (air 0.02896, helium 0.004).
+    #[serde(default)]
+    pub gas_molar_mass_kg_per_mol: Option<Positive>,
 }
 
 fn mean_thickness() -> Positive {

@@ -84,8 +84,40 @@ fn bubble_params(spec: &BubbleSpec) -> BubbleParams {
             .damping_per_s
             .map_or(defaults.damping_per_s, |v| v.get()),
         seed: spec.seed,
+        gibbs_elasticity_n_per_m: or(
+            spec.gibbs_elasticity_n_per_m.map(|v| v.get()),
+            defaults.gibbs_elasticity_n_per_m,
+        ),
+        drainage_viscosity_pa_s: or(
+            spec.drainage_viscosity_pa_s.map(|v| v.get()),
+            defaults.drainage_viscosity_pa_s,
+        ),
+        rupture_thickness_nm: or(
+            spec.rupture_thickness_nm.map(|v| v.get()),
+            defaults.rupture_thickness_nm,
+        ),
+        thickness_variation: or(
+            spec.thickness_variation.map(|v| v.get()),
+            defaults.thickness_variation,
+        ),
+        slosh_speed_m_per_s: or(
+            spec.slosh_speed_m_per_s.map(|v| v.get()),
+            defaults.slosh_speed_m_per_s,
+        ),
+        evaporation_nm_per_s: or(
+            spec.evaporation_nm_per_s.map(|v| v.get()),
+            defaults.evaporation_nm_per_s,
+        ),
+        gas_molar_mass_kg_per_mol: or(
+            spec.gas_molar_mass_kg_per_mol.map(|v| v.get()),
+            defaults.gas_molar_mass_kg_per_mol,
+        ),
         ..defaults
     }
+}
+
+fn or(value: Option<f64>, default: f64) -> f64 {
+    value.unwrap_or(default)
 }
 
 fn dvec(v: [f64; 3]) -> DVec3 {
