@@ -138,7 +138,7 @@ impl CubeMap {
     }
 
     /// Seamless bilinear lookup of the radiance along `dir` (any length; zero reads +X).
-    #[inline]
+    #[inline(always)]
     pub fn sample(&self, dir: Vec3) -> [f32; 3] {
         let (face, s, t) = face_coordinates(dir);
         let n = self.face_size as f32;

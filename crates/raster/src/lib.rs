@@ -23,6 +23,7 @@ mod environment;
 mod error;
 mod frame;
 mod ground;
+mod lut_sampler;
 mod mesh;
 mod obj;
 mod passes;

@@ -4,13 +4,13 @@
 //! run in parallel with no shared writes, and each walks its triangles in one fixed order.
 
 use glam::Vec3;
-use lut::Lut;
 
 use crate::camera::View;
 use crate::ground::{SPAN, ground_span, span_supported};
+use crate::lut_sampler::LutSampler;
 use crate::raster::{SamplePattern, SetupTri, for_each_covered_in_row};
 use crate::shading::{ground_albedo, lit, object_albedo};
-use crate::{CubeMap, Environment, FilmTables, Ground, Light, Material, SphereMap};
+use crate::{CubeMap, Environment, Ground, Light, Material, SphereMap};
 
 /// Rows per strip (the unit of parallel work).
 pub(crate) const STRIP_ROWS: usize = 8;
@@ -363,10 +363,12 @@ impl Reflection<'_> {
 pub(crate) struct BubbleCtx<'a> {
     pub view: View,
     pub pattern: SamplePattern,
-    pub tables: &'a FilmTables,
+    pub reflectivity: LutSampler<'a>,
+    /// `None` means `T = 1 − R`.
+    pub transmittance: Option<LutSampler<'a>>,
     pub lights: &'a [Light],
     /// Per light: its highlight table (its own, or the reflectivity).
-    pub light_tables: &'a [&'a Lut],
+    pub light_tables: &'a [LutSampler<'a>],
     /// Per bubble (by original index).
     pub reflections: &'a [Reflection<'a>],
     pub tris: &'a [SetupTri],
@@ -437,8 +439,8 @@ impl BubbleCtx<'_> {
             c = -c;
         }
         let cos_theta = (-c).min(1.0);
-        let r_rgb = self.tables.reflectivity.sample(thickness_nm, cos_theta);
-        let t_rgb = match &self.tables.transmittance {
+        let r_rgb = self.reflectivity.sample(thickness_nm, cos_theta);
+        let t_rgb = match &self.transmittance {
             Some(t) => t.sample(thickness_nm, cos_theta),
             None => r_rgb.map(|r| 1.0 - r),
         };

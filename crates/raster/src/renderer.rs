@@ -3,8 +3,8 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
+use crate::lut_sampler::LutSampler;
 use glam::Vec3;
-use lut::Lut;
 use rayon::prelude::*;
 
 use crate::camera::View;
@@ -166,18 +166,21 @@ impl Renderer {
                 ReflectionMode::SphereMap(map) => Reflection::Sphere(map),
             })
             .collect();
-        let light_tables: Vec<&Lut> = scene
+        let light_tables: Vec<LutSampler<'_>> = scene
             .lights
             .iter()
             .map(|l| {
-                l.light_lut
-                    .map_or(&tables.reflectivity, |i| &tables.lights[i])
+                LutSampler::new(
+                    l.light_lut
+                        .map_or(&tables.reflectivity, |i| &tables.lights[i]),
+                )
             })
             .collect();
         let bubbles = BubbleCtx {
             view,
             pattern,
-            tables,
+            reflectivity: LutSampler::new(&tables.reflectivity),
+            transmittance: tables.transmittance.as_ref().map(LutSampler::new),
             lights: &scene.lights,
             light_tables: &light_tables,
             reflections: &reflections,
