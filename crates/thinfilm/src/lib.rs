@@ -3,6 +3,24 @@
 //! `thinfilm` knows nothing of meshes or rendering: it turns a film description
 //! (indices, thickness, angle, wavelength) into reflectance and transmittance, and
 //! spectra into colour.
+//!
+//! It depends on nothing but `num-complex`, so it can be added alone:
+//!
+//! ```
+//! use thinfilm::{Illuminant, Observer, SpectralIntegrator, ThinFilm, DEFAULT_STEP_NM};
+//! use thinfilm::colorspace::{SRGB_FROM_XYZ, apply, hex, srgb8_from_linear};
+//!
+//! let film = ThinFilm::soap(300.0); // air | 1.33 | air, 300 nm thick
+//! let d65 = SpectralIntegrator::new(Observer::Cie1931, &Illuminant::D65.spectrum(), DEFAULT_STEP_NM).unwrap();
+//! let xyz = d65.xyz(|wavelength_nm| film.response(wavelength_nm, 1.0).r()); // head-on
+//! let rgb = apply(&SRGB_FROM_XYZ, xyz);
+//! println!("reflected colour {}", hex(srgb8_from_linear(rgb)));
+//! assert!(xyz[1] > 0.0 && xyz[1] < 0.2);
+//! ```
+//!
+//! Optics: [`fresnel`], [`airy`] (exact single film), [`tmm`] (N-layer stacks),
+//! [`dispersion`], and the f32 fast path [`batch`]. Colour, split pbrt-style:
+//! [`spectrum`], [`cmf`], [`illuminant`], [`integrate`], [`colorspace`], [`lab`].
 
 pub mod airy;
 pub mod batch;
