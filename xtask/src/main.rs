@@ -40,6 +40,57 @@ fn ci() -> bool {
 }
 
 fn figures() -> bool {
-    std::fs::create_dir_all("docs/figures").is_ok()
-        && cargo(&["run", "--release", "-p", "bubbles", "--", "chart", "--out", "docs/figures/chart.png"])
+    /// Seed 000, Fig. 2: (a) the sodium light-source texture and (b) the RGB reflectivity
+    /// texture, as 8-bit sRGB previews of a 512 × 512 bake (thickness 0–2000 nm left to
+    /// right, cos θ 0–1 top to bottom: the texture's own layout, the paper's upside down).
+    fn seed000_fig2(root: &std::path::Path) -> bool {
+        let bake_dir = root.join("target").join("fig2-bake");
+        let Some(bake_arg) = bake_dir.to_str() else {
+            return false;
+        };
+        let baked = cargo(&[
+            "run",
+            "--release",
+            "-p",
+            "bubbles",
+            "--",
+            "bake",
+            "--out",
+            bake_arg,
+            "--resolution",
+            "512x512",
+            "--illuminant",
+            "sodium",
+            "--format",
+            "png8",
+        ]);
+        let copied = baked
+            && [
+                ("light_sodium.preview.png", "fig2a_sodium_light_texture.png"),
+                ("reflectivity.preview.png", "fig2b_reflectivity_texture.png"),
+            ]
+            .iter()
+            .all(|(from, to)| {
+                std::fs::copy(bake_dir.join(from), root.join("docs/figures").join(to)).is_ok()
+            });
+        let _ = std::fs::remove_dir_all(&bake_dir);
+        copied
+    }
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    if std::fs::create_dir_all(root.join("docs/figures")).is_err() {
+        return false;
+    }
+    // Both run even if one fails, so one broken figure does not hide the others.
+    let fig2 = seed000_fig2(&root);
+    let chart = cargo(&[
+        "run",
+        "--release",
+        "-p",
+        "bubbles",
+        "--",
+        "chart",
+        "--out",
+        "docs/figures/chart.png",
+    ]);
+    fig2 && chart
 }

@@ -40,6 +40,8 @@ fn configs() -> Vec<(&'static str, BakeConfig)> {
 
 fn bench_bake(c: &mut Criterion) {
     let mut group = c.benchmark_group("bake");
+    // Bakes take tens to hundreds of ms; ten samples keep the whole bench under a minute.
+    group.sample_size(10);
     for (name, config) in configs() {
         let samples = lut::spectral_samples(&config);
         eprintln!("{name}: {samples} spectral samples");

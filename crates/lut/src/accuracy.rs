@@ -17,6 +17,17 @@ use crate::config::N_OUTSIDE;
 use crate::weights::linear_srgb_white;
 use crate::{BakeConfig, LutSet};
 
+/// The published accuracy of the default reflectivity table (2048 × 128): a bilinear
+/// lookup stays within this CIEDE2000 of direct evaluation for every thickness in
+/// `0..=2000` nm and every `cos θ >= BOUND_COS_THETA_MIN` (tested in `tests/error_bound.rs`;
+/// docs/lut.md has the table against resolution).
+pub const BOUND_DELTA_E: f64 = 0.5;
+
+/// Smallest cos θ covered by [`BOUND_DELTA_E`] (θ ≤ 84.3°). Nearer grazing the film's
+/// fringes sharpen without limit (their finesse grows as 1/cos²θ) and reflectance jumps
+/// from 0 at d = 0 to 1 at cos θ = 0, which no uniform table resolves.
+pub const BOUND_COS_THETA_MIN: f32 = 0.1;
+
 /// Which table of a [`LutSet`] to check.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Table {

@@ -1,7 +1,7 @@
 //! [`bake`]: every table of a [`BakeConfig`], in parallel rows on the fused f32 kernel.
 
 use rayon::prelude::*;
-use thinfilm::batch::{try_weighted_response_row, weighted_reflectance_row};
+use thinfilm::batch::weighted_reflectance_row;
 use thinfilm::cmf::Observer;
 
 use crate::config::N_OUTSIDE;
@@ -19,13 +19,13 @@ pub fn bake(config: &BakeConfig) -> LutSet {
 }
 
 /// Number of kernel rows [`bake_with_progress`] reports: one per row for the
-/// reflectivity-and-transmittance pass and one per row per light.
+/// reflectivity pass (transmittance is derived from it) and one per row per light.
 pub fn progress_rows(config: &BakeConfig) -> usize {
     config.height * (1 + config.lights.len())
 }
 
 /// Number of (texel, wavelength) reflectance evaluations a bake of `config` makes:
-/// texels × wavelengths of the reflectivity pass (which also yields transmittance) plus
+/// texels × wavelengths of the reflectivity pass (transmittance is `1 − R`) plus
 /// texels × wavelengths of each light (a line light costs only its lines).
 pub fn spectral_samples(config: &BakeConfig) -> u64 {
     let texels = (config.width * config.height) as u64;
@@ -43,8 +43,16 @@ pub fn bake_with_progress(config: &BakeConfig, on_row: &(dyn Fn() + Sync)) -> Lu
         .map(|i| axis_value(i, config.width, config.thickness_max_nm))
         .collect();
     let reflectivity_pass = reflectivity_pass(config);
-    let (reflectivity, transmittance) =
-        bake_response_pass(config, &reflectivity_pass, &thickness_nm, on_row);
+    let reflectivity = bake_pass(config, &reflectivity_pass, &thickness_nm, on_row);
+    // The film is lossless (real index, the same real medium on both sides), so
+    // T(λ) = 1 − R(λ) exactly, and the weights sum to 1 per channel, so
+    // Σ W_k (1 − R_k) = 1 − Σ W_k R_k: one subtraction instead of a second spectral sum,
+    // which would nearly double the bake. tests/bake_physics.rs checks this table against
+    // the f64 path's own transmittance formula.
+    let transmittance = reflectivity
+        .par_iter()
+        .map(|rgb| rgb.map(|c| 1.0 - c))
+        .collect();
     let mut passes = vec![reflectivity_pass];
     let mut lights = Vec::with_capacity(config.lights.len());
     for (k, light) in config.lights.iter().enumerate() {
@@ -59,35 +67,6 @@ pub fn bake_with_progress(config: &BakeConfig, on_row: &(dyn Fn() + Sync)) -> Lu
         lights,
         meta: meta(config, &passes),
     }
-}
-
-/// Runs the fused reflectance-and-transmittance kernel on every row of two tables.
-fn bake_response_pass(
-    config: &BakeConfig,
-    pass: &Pass,
-    thickness_nm: &[f32],
-    on_row: &(dyn Fn() + Sync),
-) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
-    let mut r = vec![[0.0f32; 3]; config.width * config.height];
-    let mut t = r.clone();
-    r.par_chunks_mut(config.width)
-        .zip(t.par_chunks_mut(config.width))
-        .enumerate()
-        .for_each(|(j, (row_r, row_t))| {
-            try_weighted_response_row(
-                N_OUTSIDE as f32,
-                axis_value(j, config.height, 1.0),
-                &pass.wavelength_nm,
-                &pass.n_film,
-                &pass.weights,
-                thickness_nm,
-                row_r,
-                row_t,
-            )
-            .expect("a validated BakeConfig gives valid kernel inputs");
-            on_row();
-        });
-    (r, t)
 }
 
 /// Runs the fused reflectance kernel on every row of one table.

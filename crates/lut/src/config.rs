@@ -14,7 +14,7 @@ use crate::set::is_valid_light_name;
 use crate::weights::{linear_srgb_white, sample_wavelengths};
 
 /// Default number of thickness columns.
-pub const DEFAULT_WIDTH: usize = 1024;
+pub const DEFAULT_WIDTH: usize = 2048;
 /// Default number of cos θ rows.
 pub const DEFAULT_HEIGHT: usize = 128;
 /// Default thickness of the last column, in nm (seed 000, Fig. 2).
@@ -210,7 +210,7 @@ pub struct BakeConfig {
 }
 
 impl Default for BakeConfig {
-    /// 1024 × 128 texels over 0–2000 nm, soap film index, CIE 1931 observer, 5 nm step,
+    /// 2048 × 128 texels over 0–2000 nm, soap film index, CIE 1931 observer, 5 nm step,
     /// D65 reference white, one light-source table for the sodium lamp.
     fn default() -> Self {
         Self::builder()

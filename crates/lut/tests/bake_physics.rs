@@ -145,22 +145,65 @@ fn a_single_line_light_gives_the_closed_form_airy_reflectance_as_luminance() {
     }
 }
 
+/// The reflectivity weights rebuilt here from the integrator: linear sRGB per sample,
+/// divided by the reference white, as f32 for the kernel.
+fn reflectivity_weights(config: &BakeConfig) -> (Vec<f32>, Vec<f32>, Vec<[f32; 3]>) {
+    let integrator = SpectralIntegrator::new(
+        config.observer(),
+        config.reference().spectrum(),
+        config.step_nm(),
+    )
+    .expect("valid light");
+    let white = reference_white_rgb(config);
+    let mut out = (Vec::new(), Vec::new(), Vec::new());
+    for (&l, w) in integrator.wavelengths_nm().iter().zip(integrator.weights()) {
+        let rgb = apply(&SRGB_FROM_XYZ, *w);
+        out.0.push(l as f32);
+        out.1.push(config.film_index().n_at(l) as f32);
+        out.2
+            .push(std::array::from_fn(|k| (rgb[k] / white[k]) as f32));
+    }
+    out
+}
+
 #[test]
-fn transmittance_from_its_own_formula_is_one_minus_reflectivity() {
+fn transmittance_table_matches_the_transmittance_formula_of_the_f32_kernel() {
     let config = BakeConfig::builder()
         .resolution(256, 64)
         .film_index(RefractiveIndex::Water)
         .build()
         .expect("valid config");
     let set = lut::bake(&config);
-    let worst = set
-        .reflectivity
-        .texels()
-        .iter()
-        .zip(set.transmittance.texels())
-        .flat_map(|(r, t)| (0..3).map(move |k| (r[k] + t[k] - 1.0).abs()))
-        .fold(0.0f32, f32::max);
-    assert!(worst < 4e-6, "R + T - 1 reaches {worst:e}");
+    let (wavelength_nm, n_film, weights) = reflectivity_weights(&config);
+    let thickness_nm: Vec<f32> = (0..256)
+        .map(|i| set.transmittance.thickness_nm_at(i))
+        .collect();
+    let mut worst = 0.0f32;
+    for j in 0..64 {
+        let mut r = vec![[0.0f32; 3]; 256];
+        let mut t = vec![[0.0f32; 3]; 256];
+        thinfilm::batch::try_weighted_response_row(
+            1.0,
+            set.transmittance.cos_theta_at(j),
+            &wavelength_nm,
+            &n_film,
+            &weights,
+            &thickness_nm,
+            &mut r,
+            &mut t,
+        )
+        .expect("valid row");
+        for (i, own) in t.iter().enumerate() {
+            let baked = set.transmittance.texel(i, j);
+            for k in 0..3 {
+                worst = worst.max((own[k] - baked[k]).abs());
+            }
+        }
+    }
+    assert!(
+        worst < 4e-6,
+        "baked T differs from the kernel's own T formula by {worst:e}"
+    );
 }
 
 #[test]

@@ -1,17 +1,15 @@
 //! The published accuracy of the default table (docs/lut.md): a bilinear lookup of the
 //! reflectivity stays within CIEDE2000 0.5 of direct f64 evaluation for
-//! d ∈ [0, 2000] nm and cos θ ∈ [0.15, 1].
+//! d ∈ [0, 2000] nm and cos θ ∈ [0.1, 1].
 //!
 //! The full table of error against resolution comes from
 //! `cargo run --release -p lut --example error_table`.
 
 use lut::BakeConfig;
-use lut::accuracy::{Table, cell_centre_points, delta_e_report, random_points};
-
-/// Smallest cos θ the published bound covers (θ ≤ 81.4°).
-const BOUND_COS_MIN: f32 = 0.15;
-/// The published bound.
-const BOUND_DELTA_E: f64 = 0.5;
+use lut::accuracy::{
+    BOUND_COS_THETA_MIN as BOUND_COS_MIN, BOUND_DELTA_E, Table, cell_centre_points, delta_e_report,
+    random_points,
+};
 
 /// Random points over the bounded domain, plus points packed into the first two columns,
 /// where the d² onset of reflectance meets CIELAB's steep dark end, plus cell centres.
