@@ -6,13 +6,16 @@ use std::path::Path;
 use crate::{RenderError, ToneMap};
 
 /// Wall-clock seconds spent in each phase of a frame.
+///
+/// The opaque, bubble and resolve phases run fused, strip by strip (so each strip's samples
+/// stay in cache); their wall time is split between them by their shares of CPU time.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct FrameTimings {
     /// Validation, tessellation, triangle setup and binning.
     pub setup_s: f64,
-    /// Rendering the dynamic cube maps (or nothing in the other modes).
+    /// Rendering the dynamic cube maps (zero in the other reflection modes).
     pub cube_maps_s: f64,
-    /// Environment, ground and opaque objects.
+    /// Environment, ground and opaque objects of the main view.
     pub opaque_s: f64,
     /// The bubble blend pass.
     pub bubbles_s: f64,

@@ -357,13 +357,12 @@ impl Renderer {
                 bins: &scratch.bins,
             };
             let rows = STRIP_ROWS * m;
-            for (s, (color, depth)) in texels
-                .chunks_mut(rows)
-                .zip(scratch.depth.chunks_mut(rows))
+            // Strips of a face run in parallel too: twelve faces alone balance poorly.
+            texels
+                .par_chunks_mut(rows)
+                .zip(scratch.depth.par_chunks_mut(rows))
                 .enumerate()
-            {
-                ctx.render_strip(s, color, depth);
-            }
+                .for_each(|(s, (color, depth))| ctx.render_strip(s, color, depth));
         });
     }
 
