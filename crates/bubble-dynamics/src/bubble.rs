@@ -24,14 +24,34 @@ pub(crate) struct Film {
     pub(crate) evaporation_nm_per_s: f64,
 }
 
-/// Per-vertex work buffers, kept to avoid allocating every substep.
+/// What the triangle pass sums at each vertex (one cache line per vertex).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct VertexSums {
+    /// Tension, hydrostatic and drag forces, N.
+    pub(crate) force_n: DVec3,
+    /// ∂V/∂x, m².
+    pub(crate) volume_gradient_m2: DVec3,
+    /// Bound on the drag force's derivative with respect to this vertex's velocity, N·s/m.
+    pub(crate) drag_n_s_per_m: f64,
+    /// Gershgorin row sum of the tension/elasticity Hessian, N/m (first substep only).
+    pub(crate) stiffness_n_per_m: f64,
+}
+
+/// Work buffers, kept to avoid allocating every substep.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Scratch {
-    pub(crate) force_n: Vec<DVec3>,
-    pub(crate) volume_gradient_m2: Vec<DVec3>,
-    pub(crate) drag_n_s_per_m: Vec<f64>,
-    pub(crate) wind_m_per_s: Vec<DVec3>,
+    pub(crate) sums: Vec<VertexSums>,
+    /// Enclosed volume at the state the sums were taken at, m³.
+    pub(crate) volume_m3: f64,
+    pub(crate) relative_velocity_m_per_s: Vec<DVec3>,
     pub(crate) solve: Vec<DVec3>,
+    pub(crate) face_area_m2: Vec<f64>,
+    pub(crate) vertex_area_m2: Vec<f64>,
+    pub(crate) film_thickness_m: Vec<f64>,
+    pub(crate) stream_m2_per_s: Vec<f64>,
+    pub(crate) flux_kg_per_s: Vec<f64>,
+    pub(crate) outflow_kg: Vec<f64>,
+    pub(crate) momentum_kg_m_per_s: Vec<DVec3>,
 }
 
 /// A soap bubble: a closed triangle mesh whose vertices are particles carrying film
@@ -48,8 +68,7 @@ pub struct Bubble {
     pub(crate) carried_fraction: Vec<f64>,
     pub(crate) gas_mass_kg: f64,
     pub(crate) added_mass_kg: f64,
-    pub(crate) rest_face_area_m2: Vec<f64>,
-    /// 1 / rest_face_area_m2 (the elasticity needs the ratio every substep).
+    /// 1 / rest face area, 1/m² (the elasticity needs the ratio every substep).
     pub(crate) inv_rest_face_area: Vec<f64>,
     pub(crate) rest_radius_m: f64,
     pub(crate) rest_volume_m3: f64,
@@ -106,7 +125,6 @@ impl Bubble {
                 * world.air_density_kg_per_m3
                 * rest_volume_m3,
             inv_rest_face_area: rest_face_area_m2.iter().map(|a| 1.0 / a).collect(),
-            rest_face_area_m2,
             rest_radius_m: params.radius_m,
             rest_volume_m3,
             gas_pv_j: p_in_pa * rest_volume_m3,

@@ -21,10 +21,12 @@ pub(crate) struct Bounds {
 impl Bounds {
     pub(crate) fn of(positions: &[DVec3]) -> Self {
         let center_m = positions.iter().copied().sum::<DVec3>() / positions.len() as f64;
+        // √ is monotone: one root of the largest square, not one per vertex.
         let radius_m = positions
             .iter()
-            .map(|x| x.distance(center_m))
-            .fold(0.0, f64::max);
+            .map(|x| x.distance_squared(center_m))
+            .fold(0.0, f64::max)
+            .sqrt();
         Self { center_m, radius_m }
     }
 }

@@ -2,77 +2,41 @@
 //!
 //! m_i ẍ_i = −T ∂A/∂x_i + Δp ∂V/∂x_i + m_i g + F_buoyancy + F_drag − γ m_i ẋ_i, with the
 //! film tension T = 2σ + E(A_f/A_f⁰ − 1) per triangle and Δp from the isothermal gas.
+//!
+//! A substep is two halves: [`Bubble::accumulate_forces`] (one pass over the triangles
+//! that yields every per-vertex sum the update needs, and on a step's first substep the
+//! stiffness bound that sets the substep count) and [`Bubble::advance`] (three passes
+//! over the vertices: implicit solve, rigid-motion fit, damping and positions).
 
 use glam::{DMat3, DVec3};
 
-use crate::bubble::Bubble;
+use crate::bubble::{Bubble, VertexSums};
 use crate::params::{Integrator, WorldParams};
 use crate::wind::WindField;
 
-/// What one substep of one bubble needs from the world.
-pub(crate) struct Substep<'a> {
-    pub(crate) params: &'a WorldParams,
-    pub(crate) wind: &'a WindField,
-    pub(crate) dt_s: f64,
-    pub(crate) t_s: f64,
-}
-
 impl Bubble {
-    /// Advances velocities and positions by one substep (collisions come after).
-    pub(crate) fn integrate(&mut self, ctx: &Substep<'_>) {
-        self.prepare_scratch();
-        self.sample_wind(ctx);
-        let p_in_pa = self.accumulate_forces(ctx.params);
-        match ctx.params.integrator {
-            Integrator::SymplecticEuler => {
-                self.symplectic_velocities(ctx.dt_s, p_in_pa);
-                self.damp_deformation(ctx.dt_s);
-                for (x, v) in self.positions_m.iter_mut().zip(&self.velocities_m_per_s) {
-                    *x += *v * ctx.dt_s;
-                }
-            }
-            Integrator::ExplicitEuler => {
-                self.explicit_step(ctx.dt_s, p_in_pa);
-                self.damp_deformation(ctx.dt_s);
-            }
-        }
-    }
-
-    fn prepare_scratch(&mut self) {
+    /// Samples the wind and fills the per-vertex force, volume-gradient and drag sums at
+    /// the current state and time `t_s`. With `STIFFNESS` also returns an upper bound on
+    /// the angular frequency of the explicit (film) forces, rad/s; else 0.
+    ///
+    /// The bound: row sums of the tension/elasticity Hessian (Gershgorin). Each triangle
+    /// contributes at most (|T| + E)·Σ|e|²/(4A) to the stiffness of each corner, divided
+    /// by the corner's mass. The gas mode is implicit and does not appear.
+    pub(crate) fn accumulate_forces<const STIFFNESS: bool>(
+        &mut self,
+        params: &WorldParams,
+        wind: &WindField,
+        t_s: f64,
+    ) -> f64 {
         let n = self.positions_m.len();
         let s = &mut self.scratch;
-        for buf in [
-            &mut s.force_n,
-            &mut s.volume_gradient_m2,
-            &mut s.wind_m_per_s,
-            &mut s.solve,
-        ] {
-            buf.clear();
-            buf.resize(n, DVec3::ZERO);
+        s.sums.clear();
+        s.sums.resize(n, VertexSums::default());
+        let still = wind.is_still();
+        if !still {
+            self.sample_relative_velocity(wind, t_s);
         }
-        s.drag_n_s_per_m.clear();
-        s.drag_n_s_per_m.resize(n, 0.0);
-    }
-
-    fn sample_wind(&mut self, ctx: &Substep<'_>) {
-        if ctx.wind.is_still() {
-            return;
-        }
-        // Gusts are metres across, a bubble centimetres: a first-order expansion about the
-        // centre is exact to (R/L)², and saves trigonometry at every vertex.
-        let c = self.center_m();
-        let (w0, jacobian) = ctx.wind.smooth_part(c, ctx.t_s);
-        let user = ctx.wind.user_field();
-        for (w, x) in self.scratch.wind_m_per_s.iter_mut().zip(&self.positions_m) {
-            *w = w0 + jacobian * (*x - c) + user.map_or(DVec3::ZERO, |f| f(*x, ctx.t_s));
-        }
-    }
-
-    /// Fills the explicit forces, the volume gradient and the drag coefficients; updates
-    /// the volume; returns the gas pressure.
-    fn accumulate_forces(&mut self, params: &WorldParams) -> f64 {
-        let o = self.positions_m.iter().copied().sum::<DVec3>() / self.positions_m.len() as f64;
-        let drag = DragModel::new(params, self.rest_radius_m);
+        let o = self.positions_m.iter().copied().sum::<DVec3>() / n as f64;
         // Air density outside minus gas density inside: the hydrostatic pressure gradients
         // carry both the air's buoyancy and the gas's weight to the film, along normals.
         let hydro = if params.buoyancy {
@@ -80,76 +44,76 @@ impl Bubble {
         } else {
             0.0
         };
-        let tension_0 = 2.0 * self.film.sigma_n_per_m;
-        let elasticity = self.film.gibbs_elasticity_n_per_m;
-        let s = &mut self.scratch;
-        for (t, inv_rest_area) in self
-            .topology
-            .triangles()
-            .iter()
-            .zip(&self.inv_rest_face_area)
-        {
-            let [ia, ib, ic] = t.map(|i| i as usize);
-            let (a, b, c) = (
-                self.positions_m[ia],
-                self.positions_m[ib],
-                self.positions_m[ic],
-            );
-            let n2 = (b - a).cross(c - a);
-            let share = n2 * (1.0 / 6.0);
-            s.volume_gradient_m2[ia] += share;
-            s.volume_gradient_m2[ib] += share;
-            s.volume_gradient_m2[ic] += share;
-            let len = n2.length();
-            if len == 0.0 {
-                continue;
-            }
-            // −T ∂A/∂x with ∂A/∂a = ½ n̂ × (c − b) = n2 × (c − b) / (2|n2|), cyclically.
-            let area = 0.5 * len;
-            let tension = tension_0 + elasticity * (area * inv_rest_area - 1.0);
-            let coef = 0.5 * tension / len;
-            s.force_n[ia] -= coef * n2.cross(c - b);
-            s.force_n[ib] -= coef * n2.cross(a - c);
-            s.force_n[ic] -= coef * n2.cross(b - a);
-            if hydro != 0.0 {
-                // Pressures vary with height as ρ g·x outside and inside: the net push
-                // −(ρ_air − ρ_gas)(g·(x̄ − o)) A n̂ per face sums to exactly
-                // (ρ_gas − ρ_air) V g (divergence theorem on the polyhedron).
-                let depth = params.gravity_m_per_s2.dot((a + b + c) * (1.0 / 3.0) - o);
-                let f = share * (-hydro * depth);
-                s.force_n[ia] += f;
-                s.force_n[ib] += f;
-                s.force_n[ic] += f;
-            }
-            if drag.active {
-                let v = &self.velocities_m_per_s;
-                let w = &s.wind_m_per_s;
-                let v_face = ((v[ia] + v[ib] + v[ic]) - (w[ia] + w[ib] + w[ic])) * (1.0 / 3.0);
-                let (force, stiffness) = drag.face_force(n2, v_face);
-                for i in [ia, ib, ic] {
-                    s.force_n[i] += force;
-                    s.drag_n_s_per_m[i] += stiffness;
-                }
-            }
+        let faces = FaceForces {
+            tension_0: 2.0 * self.film.sigma_n_per_m,
+            elasticity: self.film.gibbs_elasticity_n_per_m,
+            hydro_g: params.gravity_m_per_s2 * -hydro,
+            origin: o,
+            drag: DragModel::new(params, self.rest_radius_m),
+        };
+        let relative = if still {
+            &self.velocities_m_per_s
+        } else {
+            &self.scratch.relative_velocity_m_per_s
+        };
+        let six_volume = faces.accumulate::<STIFFNESS>(
+            &self.positions_m,
+            relative,
+            self.topology.triangles(),
+            &self.inv_rest_face_area,
+            &mut self.scratch.sums,
+        );
+        self.scratch.volume_m3 = six_volume / 6.0;
+        if STIFFNESS {
+            self.frequency_from_stiffness()
+        } else {
+            0.0
         }
-        // Euler's theorem for the degree-3 homogeneous volume: Σ (x_i − o)·∂V/∂x_i = 3V.
-        let three_volume: f64 = self
-            .positions_m
-            .iter()
-            .zip(&s.volume_gradient_m2)
-            .map(|(x, g)| (*x - o).dot(*g))
-            .sum();
-        self.volume_m3 = three_volume / 3.0;
-        self.add_gravity(params);
-        self.gas_pv_j / self.volume_m3
     }
 
-    /// The film's own weight, a body force. The gas's weight is not here: it reaches the
-    /// film as the hydrostatic pressure gradient above (pulling the gas share of each
-    /// vertex down would shear the film along its own plane).
-    fn add_gravity(&mut self, params: &WorldParams) {
-        for (f, m) in self.scratch.force_n.iter_mut().zip(&self.film_mass_kg) {
-            *f += params.gravity_m_per_s2 * *m;
+    /// Vertex velocities relative to the air. Gusts are metres across, a bubble
+    /// centimetres: a first-order expansion about the centre is exact to (R/L)², and
+    /// saves trigonometry at every vertex.
+    fn sample_relative_velocity(&mut self, wind: &WindField, t_s: f64) {
+        let c = self.center_m();
+        let (w0, jacobian) = wind.smooth_part(c, t_s);
+        let user = wind.user_field();
+        let out = &mut self.scratch.relative_velocity_m_per_s;
+        out.clear();
+        out.extend(
+            self.positions_m
+                .iter()
+                .zip(&self.velocities_m_per_s)
+                .map(|(x, v)| {
+                    let w = w0 + jacobian * (*x - c) + user.map_or(DVec3::ZERO, |f| f(*x, t_s));
+                    *v - w
+                }),
+        );
+    }
+
+    /// ω_max from the per-vertex stiffness row sums: max_i √(k_i / m_i); infinite when a
+    /// row sum is not finite (a degenerate triangle), so the substep count reports it.
+    fn frequency_from_stiffness(&self) -> f64 {
+        let mut worst = 0.0_f64;
+        let mut finite = true;
+        for (s, m) in self.scratch.sums.iter().zip(&self.inertial_mass_kg) {
+            finite &= s.stiffness_n_per_m.is_finite();
+            worst = worst.max(s.stiffness_n_per_m / m);
+        }
+        if finite { worst.sqrt() } else { f64::INFINITY }
+    }
+
+    /// Advances velocities and positions by `dt_s` with the sums of the last
+    /// [`Bubble::accumulate_forces`] (collisions come after).
+    pub(crate) fn advance(&mut self, params: &WorldParams, dt_s: f64) {
+        self.volume_m3 = self.scratch.volume_m3;
+        let p_in_pa = self.gas_pv_j / self.volume_m3;
+        match params.integrator {
+            Integrator::SymplecticEuler => self.symplectic_step(params, dt_s, p_in_pa),
+            Integrator::ExplicitEuler => {
+                self.explicit_step(params, dt_s, p_in_pa);
+                self.damp_deformation(dt_s);
+            }
         }
     }
 
@@ -157,43 +121,90 @@ impl Bubble {
     /// stabilised: (D + dt²(p/V) g gᵀ) v⁺ = M v + dt (F + Δp g + k v), D = M + dt(k + γM),
     /// solved in O(n) by Sherman–Morrison because the gas stiffness (p/V) g gᵀ has rank
     /// one. F holds the drag at the current velocity and k ≥ ‖∂F_drag/∂v‖ per vertex, so
-    /// the drag part is a contraction at any dt and exact at steady state.
-    fn symplectic_velocities(&mut self, dt: f64, p_in_pa: f64) {
+    /// the drag part is a contraction at any dt and exact at steady state. Then the
+    /// deformation damping and the position update x⁺ = x + dt v⁺.
+    fn symplectic_step(&mut self, params: &WorldParams, dt: f64, p_in_pa: f64) {
         let dp = p_in_pa - self.p_out_pa;
         let beta = dt * dt * p_in_pa / self.volume_m3;
         let gamma = self.film.damping_per_s;
+        let gravity = params.gravity_m_per_s2;
         let s = &mut self.scratch;
+        s.solve.clear();
+        s.solve.resize(self.positions_m.len(), DVec3::ZERO);
         let (mut gu, mut gz) = (0.0, 0.0);
-        for i in 0..self.positions_m.len() {
-            let m = self.inertial_mass_kg[i];
-            let k = s.drag_n_s_per_m[i];
-            let d = m + dt * (k + gamma * m);
-            let g = s.volume_gradient_m2[i];
-            let v = self.velocities_m_per_s[i];
-            let u = (v * m + (s.force_n[i] + g * dp + v * k) * dt) / d;
-            let z = g / d;
+        // The mass moments feed the rigid-motion fit of the damping below.
+        let (mut mass, mut first) = (0.0, DVec3::ZERO);
+        for ((((v, z), sum), x), (&m, &film)) in self
+            .velocities_m_per_s
+            .iter_mut()
+            .zip(&mut s.solve)
+            .zip(&s.sums)
+            .zip(&self.positions_m)
+            .zip(self.inertial_mass_kg.iter().zip(&self.film_mass_kg))
+        {
+            let k = sum.drag_n_s_per_m;
+            let inv_d = 1.0 / (m + dt * (k + gamma * m));
+            let g = sum.volume_gradient_m2;
+            let force = sum.force_n + gravity * film + g * dp + *v * k;
+            let u = (*v * m + force * dt) * inv_d;
+            *z = g * inv_d;
             gu += g.dot(u);
-            gz += g.dot(z);
-            self.velocities_m_per_s[i] = u;
-            s.solve[i] = z;
+            gz += g.dot(*z);
+            *v = u;
+            mass += m;
+            first += *x * m;
         }
         let correction = beta * gu / (1.0 + beta * gz);
-        for (v, z) in self.velocities_m_per_s.iter_mut().zip(&s.solve) {
-            *v -= *z * correction;
+        let rate = self.film.deformation_damping_per_s;
+        if rate == 0.0 {
+            for ((x, v), z) in self
+                .positions_m
+                .iter_mut()
+                .zip(&mut self.velocities_m_per_s)
+                .zip(&s.solve)
+            {
+                *v -= *z * correction;
+                *x += *v * dt;
+            }
+            return;
         }
+        let com = first / mass;
+        let mut moments = RigidMoments::default();
+        for (((x, v), z), &m) in self
+            .positions_m
+            .iter()
+            .zip(&mut self.velocities_m_per_s)
+            .zip(&s.solve)
+            .zip(&self.inertial_mass_kg)
+        {
+            *v -= *z * correction;
+            moments.add(*x - com, *v, m);
+        }
+        let (v_cm, omega) = moments.motion(mass);
+        damp_and_move(
+            &mut self.positions_m,
+            &mut self.velocities_m_per_s,
+            (com, v_cm, omega),
+            (-rate * dt).exp(),
+            dt,
+        );
     }
 
     /// Seed 000: x⁺ = x + dt v, v⁺ = v + dt a(x, v), everything explicit.
-    fn explicit_step(&mut self, dt: f64, p_in_pa: f64) {
+    fn explicit_step(&mut self, params: &WorldParams, dt: f64, p_in_pa: f64) {
         let dp = p_in_pa - self.p_out_pa;
         let gamma = self.film.damping_per_s;
-        let s = &self.scratch;
-        for i in 0..self.positions_m.len() {
-            let m = self.inertial_mass_kg[i];
-            let v = self.velocities_m_per_s[i];
-            let f = s.force_n[i] + s.volume_gradient_m2[i] * dp - v * (gamma * m);
-            self.positions_m[i] += v * dt;
-            self.velocities_m_per_s[i] = v + f * (dt / m);
+        for (((x, v), sum), (&m, &film)) in self
+            .positions_m
+            .iter_mut()
+            .zip(&mut self.velocities_m_per_s)
+            .zip(&self.scratch.sums)
+            .zip(self.inertial_mass_kg.iter().zip(&self.film_mass_kg))
+        {
+            let f = sum.force_n + params.gravity_m_per_s2 * film + sum.volume_gradient_m2 * dp
+                - *v * (gamma * m);
+            *x += *v * dt;
+            *v += f * (dt / m);
         }
     }
 
@@ -214,44 +225,162 @@ impl Bubble {
 
     /// Centre of mass, its velocity, and the angular velocity I⁻¹L about it.
     pub(crate) fn rigid_motion(&self) -> (DVec3, DVec3, DVec3) {
-        let (mut mass, mut first, mut momentum) = (0.0, DVec3::ZERO, DVec3::ZERO);
-        for ((x, v), m) in self
-            .positions_m
-            .iter()
-            .zip(&self.velocities_m_per_s)
-            .zip(&self.inertial_mass_kg)
-        {
+        let (mut mass, mut first) = (0.0, DVec3::ZERO);
+        for (x, m) in self.positions_m.iter().zip(&self.inertial_mass_kg) {
             mass += m;
             first += *x * *m;
-            momentum += *v * *m;
         }
-        let (com, v_cm) = (first / mass, momentum / mass);
-        let mut l = DVec3::ZERO;
-        let mut second = DMat3::ZERO;
-        for ((x, v), m) in self
+        let com = first / mass;
+        let mut moments = RigidMoments::default();
+        for ((x, v), &m) in self
             .positions_m
             .iter()
             .zip(&self.velocities_m_per_s)
             .zip(&self.inertial_mass_kg)
         {
-            let r = *x - com;
-            l += r.cross(*v) * *m;
-            second += outer(r, r * *m);
+            moments.add(*x - com, *v, m);
         }
-        // I = tr(S)·1 − S for the second moment S = Σ m r rᵀ.
-        let trace = second.col(0).x + second.col(1).y + second.col(2).z;
-        let inertia = DMat3::from_diagonal(DVec3::splat(trace)) - second;
-        let omega = if inertia.determinant() > 0.0 {
-            inertia.inverse() * l
-        } else {
-            DVec3::ZERO
-        };
+        let (v_cm, omega) = moments.motion(mass);
         (com, v_cm, omega)
     }
 }
 
-fn outer(a: DVec3, b: DVec3) -> DMat3 {
-    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
+/// v ← rigid + (v − rigid)·keep with rigid = v_cm + ω × (x − com), then x ← x + dt v.
+fn damp_and_move(
+    positions: &mut [DVec3],
+    velocities: &mut [DVec3],
+    (com, v_cm, omega): (DVec3, DVec3, DVec3),
+    keep: f64,
+    dt: f64,
+) {
+    for (x, v) in positions.iter_mut().zip(velocities) {
+        let rigid = v_cm + omega.cross(*x - com);
+        *v = rigid + (*v - rigid) * keep;
+        *x += *v * dt;
+    }
+}
+
+/// Momentum, angular momentum and the second mass moment about the centre of mass.
+#[derive(Default)]
+struct RigidMoments {
+    momentum: DVec3,
+    angular: DVec3,
+    /// Σ m r rᵀ: diagonal (xx, yy, zz) and off-diagonal (xy, xz, yz).
+    diagonal: DVec3,
+    off_diagonal: DVec3,
+}
+
+impl RigidMoments {
+    #[inline(always)]
+    fn add(&mut self, r: DVec3, v: DVec3, m: f64) {
+        self.momentum += v * m;
+        self.angular += r.cross(v) * m;
+        let mr = r * m;
+        self.diagonal += mr * r;
+        self.off_diagonal += DVec3::new(mr.x * r.y, mr.x * r.z, mr.y * r.z);
+    }
+
+    /// Centre-of-mass velocity and the angular velocity I⁻¹L (zero for a degenerate I).
+    fn motion(&self, mass: f64) -> (DVec3, DVec3) {
+        // I = tr(S)·1 − S for the second moment S = Σ m r rᵀ.
+        let (d, o) = (self.diagonal, self.off_diagonal);
+        let trace = d.x + d.y + d.z;
+        let inertia = DMat3::from_cols(
+            DVec3::new(trace - d.x, -o.x, -o.y),
+            DVec3::new(-o.x, trace - d.y, -o.z),
+            DVec3::new(-o.y, -o.z, trace - d.z),
+        );
+        let omega = if inertia.determinant() > 0.0 {
+            inertia.inverse() * self.angular
+        } else {
+            DVec3::ZERO
+        };
+        (self.momentum / mass, omega)
+    }
+}
+
+/// Everything the triangle pass needs besides the mesh.
+struct FaceForces {
+    tension_0: f64,
+    elasticity: f64,
+    /// −(ρ_air − ρ_gas)·g: the hydrostatic pressure per unit height, vector form.
+    hydro_g: DVec3,
+    origin: DVec3,
+    drag: DragModel,
+}
+
+impl FaceForces {
+    /// One pass over the triangles: tension, hydrostatics and drag into the forces, the
+    /// volume gradient, the drag stiffness and (with `STIFFNESS`) the Gershgorin row sums
+    /// of the tension Hessian. Returns six times the enclosed volume.
+    fn accumulate<const STIFFNESS: bool>(
+        &self,
+        positions: &[DVec3],
+        relative_velocities: &[DVec3],
+        triangles: &[[u32; 3]],
+        inv_rest_face_area: &[f64],
+        sums: &mut [VertexSums],
+    ) -> f64 {
+        let mut six_volume = 0.0;
+        for (t, inv_rest_area) in triangles.iter().zip(inv_rest_face_area) {
+            let [ia, ib, ic] = t.map(|i| i as usize);
+            let (a, b, c) = (positions[ia], positions[ib], positions[ic]);
+            let (ab, bc, ca) = (b - a, c - b, a - c);
+            // n2 = (b − a) × (c − a) = 2A n̂.
+            let n2 = ca.cross(ab);
+            // ∂V/∂x = A n̂ / 3 per corner; V = Σ (a − o)·n2 / 6 (tetrahedra from o).
+            let share = n2 * (1.0 / 6.0);
+            six_volume += (a - self.origin).dot(n2);
+            let len = n2.length();
+            if len == 0.0 {
+                // No area gradient exists; the stiffness bound turns infinite and the
+                // substep count reports the broken mesh.
+                for i in [ia, ib, ic] {
+                    sums[i].volume_gradient_m2 += share;
+                    if STIFFNESS {
+                        sums[i].stiffness_n_per_m = f64::INFINITY;
+                    }
+                }
+                continue;
+            }
+            let inv_len = 1.0 / len;
+            let tension = self.tension_0 + self.elasticity * (0.5 * len * inv_rest_area - 1.0);
+            // −T ∂A/∂x with ∂A/∂a = ½ n̂ × (c − b) = n2 × (c − b) / (2|n2|), cyclically.
+            let coef = -0.5 * tension * inv_len;
+            // Pressures vary with height as ρ g·x outside and inside: the net push
+            // −(ρ_air − ρ_gas)(g·(x̄ − o)) A n̂ per face sums to exactly
+            // (ρ_gas − ρ_air) V g (divergence theorem on the polyhedron).
+            let centroid = (a + b + c) * (1.0 / 3.0) - self.origin;
+            let mut common = share * self.hydro_g.dot(centroid);
+            let mut drag_k = 0.0;
+            if self.drag.active {
+                let v_face =
+                    (relative_velocities[ia] + relative_velocities[ib] + relative_velocities[ic])
+                        * (1.0 / 3.0);
+                let (force, stiffness) = self.drag.face_force(n2, len, inv_len, v_face);
+                common += force;
+                drag_k = stiffness;
+            }
+            let stiffness = if STIFFNESS {
+                // Gershgorin: (|T| + E)·Σ|e|²/(4A) bounds the row sums of this triangle's
+                // tension/elasticity Hessian at each corner.
+                let edges2 = ab.length_squared() + bc.length_squared() + ca.length_squared();
+                (tension.abs() + self.elasticity) * edges2 * 0.5 * inv_len
+            } else {
+                0.0
+            };
+            for (i, opposite) in [(ia, bc), (ib, ca), (ic, ab)] {
+                let sum = &mut sums[i];
+                sum.force_n += n2.cross(opposite) * coef + common;
+                sum.volume_gradient_m2 += share;
+                sum.drag_n_s_per_m += drag_k;
+                if STIFFNESS {
+                    sum.stiffness_n_per_m += stiffness;
+                }
+            }
+        }
+        six_volume
+    }
 }
 
 /// Air drag as a pressure on the leading faces (n̂·v > 0, v relative to the wind):
@@ -277,21 +406,22 @@ impl DragModel {
     }
 
     /// Each corner's share of the drag force (N) on a face with double-area vector `n2`
-    /// (= 2A n̂) moving at `v_rel`, and a bound (N·s/m) on that share's derivative with
-    /// respect to a corner's velocity.
-    fn face_force(&self, n2: DVec3, v_rel: DVec3) -> (DVec3, f64) {
+    /// (= 2A n̂, of length `len`) moving at `v_rel`, and a bound (N·s/m) on that share's
+    /// derivative with respect to a corner's velocity.
+    #[inline]
+    fn face_force(&self, n2: DVec3, len: f64, inv_len: f64, v_rel: DVec3) -> (DVec3, f64) {
         let lead2 = n2.dot(v_rel);
         if lead2 <= 0.0 {
             return (DVec3::ZERO, 0.0);
         }
-        let inv_len = 1.0 / n2.length();
         let normal_speed = lead2 * inv_len;
         let pressure =
             (self.linear_pa_s_per_m + self.quadratic_kg_per_m3 * normal_speed) * normal_speed;
         // Force −p·A·n̂ = −p·n2/2, a third per corner.
-        let force = n2 * (-pressure / 6.0);
+        let force = n2 * (pressure * (-1.0 / 6.0));
         let stiffness = (self.linear_pa_s_per_m + 2.0 * self.quadratic_kg_per_m3 * normal_speed)
-            / (6.0 * inv_len);
+            * len
+            * (1.0 / 6.0);
         (force, stiffness)
     }
 }

@@ -6,8 +6,8 @@ use std::f64::consts::TAU;
 
 use glam::DVec3;
 
-use crate::bubble::Bubble;
-use crate::bubble::face_areas_m2;
+use crate::bubble::{Bubble, Scratch};
+use crate::geometry::double_area_vector;
 use crate::params::BubbleParams;
 use crate::rng::SplitMix64;
 
@@ -71,20 +71,18 @@ impl Slosh {
         Self { omega_per_s, basis }
     }
 
-    /// ψ at every face at time `t_s`, m²/s: Σ_k a_k sin(θ_fk + ω_k t).
-    fn stream_m2_per_s(&self, t_s: f64) -> Vec<f64> {
+    /// ψ at every face at time `t_s` into `out`, m²/s: Σ_k a_k sin(θ_fk + ω_k t).
+    fn stream_m2_per_s(&self, t_s: f64, out: &mut Vec<f64>) {
         let rot: [(f64, f64); SLOSH_WAVES] =
             std::array::from_fn(|k| (self.omega_per_s[k] * t_s).sin_cos());
-        self.basis
-            .iter()
-            .map(|waves| {
-                waves
-                    .iter()
-                    .zip(&rot)
-                    .map(|(b, (s, c))| b[0] * c + b[1] * s)
-                    .sum()
-            })
-            .collect()
+        out.clear();
+        out.extend(self.basis.iter().map(|waves| {
+            waves
+                .iter()
+                .zip(&rot)
+                .map(|(b, (s, c))| b[0] * c + b[1] * s)
+                .sum::<f64>()
+        }));
     }
 }
 
@@ -93,99 +91,119 @@ impl Bubble {
     /// minus the bubble's acceleration) and the swirl at time `t_s`, evaporates, and
     /// refreshes the thickness.
     pub(crate) fn transport_film(&mut self, g_eff: DVec3, dt_s: f64, t_s: f64) {
-        let face_areas = face_areas_m2(&self.positions_m, self.topology.triangles());
-        let areas = vertex_areas_m2(
-            self.topology.triangles(),
-            &face_areas,
+        // The work buffers live in the bubble; take them so the bubble can be borrowed.
+        let mut s = std::mem::take(&mut self.scratch);
+        let triangles = self.topology.triangles();
+        face_areas_into(&self.positions_m, triangles, &mut s.face_area_m2);
+        vertex_areas_into(
+            triangles,
+            &s.face_area_m2,
             self.positions_m.len(),
+            &mut s.vertex_area_m2,
         );
         let rho = self.film.density_kg_per_m3;
-        let h: Vec<f64> = self
-            .film_mass_kg
-            .iter()
-            .zip(&areas)
-            .map(|(m, a)| if *a > 0.0 { m / (rho * a) } else { 0.0 })
-            .collect();
-        let flux = self.edge_fluxes_kg_per_s(g_eff, t_s, &h, &face_areas);
-        self.apply_fluxes(&flux, dt_s);
-        self.evaporate(&areas, dt_s);
+        s.film_thickness_m.clear();
+        s.film_thickness_m.extend(
+            self.film_mass_kg
+                .iter()
+                .zip(&s.vertex_area_m2)
+                .map(|(m, a)| if *a > 0.0 { m / (rho * a) } else { 0.0 }),
+        );
+        let swirl = self.slosh.as_ref().map(|slosh| {
+            slosh.stream_m2_per_s(t_s, &mut s.stream_m2_per_s);
+            &s.stream_m2_per_s[..]
+        });
+        let mut flux = std::mem::take(&mut s.flux_kg_per_s);
+        self.edge_fluxes_kg_per_s(
+            g_eff,
+            swirl,
+            &s.film_thickness_m,
+            &s.face_area_m2,
+            &mut flux,
+        );
+        s.flux_kg_per_s = flux;
+        self.apply_fluxes(&mut s, dt_s);
+        self.evaporate(&s.vertex_area_m2, dt_s);
         self.refresh_inertial_mass();
-        self.update_thickness_with_areas(&areas);
+        self.update_thickness_with_areas(&s.vertex_area_m2);
+        self.scratch = s;
     }
 
-    /// Signed mass flux along every edge, kg/s, positive from `vertices[0]` to `vertices[1]`.
+    /// Signed mass flux along every edge into `out`, kg/s, positive from `vertices[0]`
+    /// to `vertices[1]`.
     ///
     /// Drainage: q = ρ g_t h³/(3μ) per unit width (a film draining under gravity with
     /// lubrication theory), upwind thickness, times the width of the dual cell boundary
     /// across the edge, (h_left + h_right)/3 = 2(A_left + A_right)/(3|e|) from the two
     /// faces' heights. With g_t = g·e/|e| the flux needs no square root. Swirl: film
-    /// volume ψ_left − ψ_right per unit time across the dual edge, upwind thickness.
+    /// volume ψ_left − ψ_right per unit time across the dual edge (`swirl` holds ψ per
+    /// face), upwind thickness.
     fn edge_fluxes_kg_per_s(
         &self,
         g_eff: DVec3,
-        t_s: f64,
+        swirl: Option<&[f64]>,
         h: &[f64],
         face_areas: &[f64],
-    ) -> Vec<f64> {
+        out: &mut Vec<f64>,
+    ) {
         let x = &self.positions_m;
         let rho = self.film.density_kg_per_m3;
-        let mobility = rho * rho / (3.0 * self.film.drainage_viscosity_pa_s);
-        let psi = self.slosh.as_ref().map(|s| s.stream_m2_per_s(t_s));
-        self.topology
-            .edges()
-            .iter()
-            .map(|e| {
-                let [i, j] = e.vertices.map(|v| v as usize);
-                let upwind = |q: f64| if q > 0.0 { h[i] } else { h[j] };
-                let [fa, fb] = e.faces.map(|f| f as usize);
-                let edge = x[j] - x[i];
-                let g_dot_e = g_eff.dot(edge);
-                let width_over_len =
-                    2.0 * (face_areas[fa] + face_areas[fb]) / (3.0 * edge.length_squared());
-                let mut q = mobility * g_dot_e * width_over_len * upwind(g_dot_e).powi(3);
-                if let Some(psi) = &psi {
-                    let volume_rate = psi[fa] - psi[fb];
-                    q += rho * volume_rate * upwind(volume_rate);
-                }
-                q
-            })
-            .collect()
+        // ρ/(3μ)·ρ h³ g_t·width, with width/|e| = 2(A_l + A_r)/(3|e|²).
+        let mobility = 2.0 * rho * rho / (9.0 * self.film.drainage_viscosity_pa_s);
+        out.clear();
+        out.extend(self.topology.edges().iter().map(|e| {
+            let [i, j] = e.vertices.map(|v| v as usize);
+            // The sign of a flux is as good as random: select the index, not the branch.
+            let upwind = |q: f64| h[if q > 0.0 { i } else { j }];
+            let [fa, fb] = e.faces.map(|f| f as usize);
+            let edge = x[j] - x[i];
+            let g_dot_e = g_eff.dot(edge);
+            let hu = upwind(g_dot_e);
+            let mut q = mobility * g_dot_e * (face_areas[fa] + face_areas[fb]) * (hu * hu * hu)
+                / edge.length_squared();
+            if let Some(psi) = swirl {
+                let volume_rate = psi[fa] - psi[fb];
+                q += rho * volume_rate * upwind(volume_rate);
+            }
+            q
+        }));
     }
 
     /// Moves `flux·dt` along the edges, each donor limited so it keeps at least half its
     /// film; the moved mass carries the donor's velocity (momentum is conserved).
-    fn apply_fluxes(&mut self, flux: &[f64], dt_s: f64) {
+    fn apply_fluxes(&mut self, s: &mut Scratch, dt_s: f64) {
         let edges = self.topology.edges();
-        let n = self.film_mass_kg.len();
-        let mut outflow = vec![0.0; n];
+        let flux = &s.flux_kg_per_s;
+        // Outflow per donor, then turned in place into the donor's limiting factor.
+        let limit = &mut s.outflow_kg;
+        limit.clear();
+        limit.resize(self.film_mass_kg.len(), 0.0);
         for (e, q) in edges.iter().zip(flux) {
-            let donor = if *q > 0.0 {
-                e.vertices[0]
-            } else {
-                e.vertices[1]
-            } as usize;
-            outflow[donor] += q.abs() * dt_s;
+            let donor = e.vertices[usize::from(*q <= 0.0)] as usize;
+            limit[donor] += q.abs() * dt_s;
         }
-        let limit: Vec<f64> = outflow
-            .iter()
-            .zip(&self.film_mass_kg)
-            .map(|(out, m)| {
-                if *out > MAX_OUTFLOW_FRACTION * m {
-                    MAX_OUTFLOW_FRACTION * m / out
-                } else {
-                    1.0
-                }
-            })
-            .collect();
-        let mut momentum: Vec<DVec3> = self
-            .velocities_m_per_s
-            .iter()
-            .zip(&self.inertial_mass_kg)
-            .map(|(v, m)| *v * *m)
-            .collect();
+        for (l, m) in limit.iter_mut().zip(&self.film_mass_kg) {
+            let out = *l;
+            *l = if out > MAX_OUTFLOW_FRACTION * m {
+                MAX_OUTFLOW_FRACTION * m / out
+            } else {
+                1.0
+            };
+        }
+        let momentum = &mut s.momentum_kg_m_per_s;
+        momentum.clear();
+        momentum.extend(
+            self.velocities_m_per_s
+                .iter()
+                .zip(&self.inertial_mass_kg)
+                .map(|(v, m)| *v * *m),
+        );
         for (e, q) in edges.iter().zip(flux) {
-            let [a, b] = e.vertices.map(|v| v as usize);
-            let (donor, receiver) = if *q > 0.0 { (a, b) } else { (b, a) };
+            let forward = usize::from(*q <= 0.0);
+            let (donor, receiver) = (
+                e.vertices[forward] as usize,
+                e.vertices[1 - forward] as usize,
+            );
             let dm = q.abs() * dt_s * limit[donor];
             self.film_mass_kg[donor] -= dm;
             self.film_mass_kg[receiver] += dm;
@@ -197,7 +215,7 @@ impl Bubble {
         for ((v, p), m) in self
             .velocities_m_per_s
             .iter_mut()
-            .zip(&momentum)
+            .zip(momentum.iter())
             .zip(&self.inertial_mass_kg)
         {
             *v = *p / *m;
@@ -216,13 +234,29 @@ impl Bubble {
     }
 }
 
-/// Barycentric vertex areas from face areas: a third of each face to each corner.
-fn vertex_areas_m2(triangles: &[[u32; 3]], face_areas: &[f64], vertex_count: usize) -> Vec<f64> {
-    let mut areas = vec![0.0; vertex_count];
+/// Face areas, m², into `out`.
+fn face_areas_into(positions: &[DVec3], triangles: &[[u32; 3]], out: &mut Vec<f64>) {
+    out.clear();
+    out.extend(triangles.iter().map(|t| {
+        let [a, b, c] = t.map(|i| positions[i as usize]);
+        0.5 * double_area_vector(a, b, c).length()
+    }));
+}
+
+/// Barycentric vertex areas from face areas into `out`: a third of each face to each
+/// corner.
+fn vertex_areas_into(
+    triangles: &[[u32; 3]],
+    face_areas: &[f64],
+    vertex_count: usize,
+    out: &mut Vec<f64>,
+) {
+    out.clear();
+    out.resize(vertex_count, 0.0);
     for (t, a) in triangles.iter().zip(face_areas) {
+        let third = a / 3.0;
         for &i in t {
-            areas[i as usize] += a / 3.0;
+            out[i as usize] += third;
         }
     }
-    areas
 }

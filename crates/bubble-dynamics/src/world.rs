@@ -8,7 +8,6 @@ use glam::DVec3;
 use crate::bubble::Bubble;
 use crate::collide;
 use crate::collider::Collider;
-use crate::dynamics::Substep;
 use crate::error::{Divergence, ParamError, SimError};
 use crate::geometry::enclosed_volume_m3;
 use crate::icosphere::equilibrium_icosphere;
@@ -208,19 +207,27 @@ impl World {
     fn try_step(&mut self) -> Result<Vec<Event>, SimError> {
         let step = self.steps + 1;
         let dt = self.params.dt_s;
-        let substeps = self.substeps_needed(step)?;
-        let h = dt / f64::from(substeps);
         let t0 = self.time_s();
         let v_start: Vec<DVec3> = self.bubbles.iter().map(Bubble::velocity_m_per_s).collect();
+        // The first substep's forces do not depend on its length, so the pass that
+        // computes them also gives the stiffness bound that sets the substep count.
+        let mut worst = (0.0_f64, 0);
+        for b in &mut self.bubbles {
+            let omega = b.accumulate_forces::<true>(&self.params, &self.wind, t0);
+            // NaN wins, so a broken mesh is reported rather than stepped.
+            if omega.is_nan() || omega > worst.0 {
+                worst = (omega, b.id);
+            }
+        }
+        let substeps = self.substeps_needed(step, worst)?;
+        let h = dt / f64::from(substeps);
         for k in 0..substeps {
-            let ctx = Substep {
-                params: &self.params,
-                wind: &self.wind,
-                dt_s: h,
-                t_s: t0 + f64::from(k) * h,
-            };
+            let t_s = t0 + f64::from(k) * h;
             for b in &mut self.bubbles {
-                b.integrate(&ctx);
+                if k > 0 {
+                    b.accumulate_forces::<false>(&self.params, &self.wind, t_s);
+                }
+                b.advance(&self.params, h);
             }
             collide::resolve_bubbles(
                 &mut self.bubbles,
@@ -230,7 +237,7 @@ impl World {
             for b in &mut self.bubbles {
                 collide::resolve_static(b, &self.params.colliders);
             }
-            self.check_divergence(step, k, ctx.t_s)?;
+            self.check_divergence(step, k, t_s)?;
         }
         self.steps = step;
         self.last_substeps = substeps;
@@ -241,15 +248,8 @@ impl World {
         Ok(self.remove_burst(step))
     }
 
-    fn substeps_needed(&self, step: u64) -> Result<u32, SimError> {
-        let mut worst = (0.0_f64, 0);
-        for b in &self.bubbles {
-            let omega = b.max_frequency_per_s();
-            // NaN wins, so a broken mesh is reported rather than stepped.
-            if omega.is_nan() || omega > worst.0 {
-                worst = (omega, b.id);
-            }
-        }
+    /// Substeps for the stiffest bubble `(ω_max, id)`: symplectic Euler needs ω·h < 2.
+    fn substeps_needed(&self, step: u64, worst: (f64, u64)) -> Result<u32, SimError> {
         let needed = (self.params.dt_s * worst.0 / (2.0 * STABILITY_FRACTION))
             .ceil()
             .max(1.0);
@@ -306,44 +306,21 @@ impl World {
 }
 
 impl Bubble {
-    /// Upper bound on the angular frequency of the explicit (film) forces, rad/s.
-    ///
-    /// Row sums of the tension/elasticity Hessian (Gershgorin): each triangle contributes
-    /// at most (|T| + E)·Σ|e|²/(4A) to the stiffness of each corner, divided by the
-    /// corner's mass. The gas mode is implicit and does not appear.
-    pub(crate) fn max_frequency_per_s(&self) -> f64 {
-        let mut stiffness = vec![0.0; self.positions_m.len()];
-        let sigma2 = 2.0 * self.film.sigma_n_per_m;
-        let e = self.film.gibbs_elasticity_n_per_m;
-        for (t, rest) in self
-            .topology
-            .triangles()
-            .iter()
-            .zip(&self.rest_face_area_m2)
-        {
-            let [a, b, c] = t.map(|i| self.positions_m[i as usize]);
-            let area = 0.5 * (b - a).cross(c - a).length();
-            let tension = (sigma2 + e * (area / rest - 1.0)).abs() + e;
-            let k = tension
-                * ((b - a).length_squared() + (c - b).length_squared() + (a - c).length_squared())
-                / (4.0 * area);
-            for &i in t {
-                stiffness[i as usize] += k;
-            }
-        }
-        let mut worst = stiffness
-            .iter()
-            .zip(&self.inertial_mass_kg)
-            .map(|(k, m)| k / m)
-            .fold(0.0, f64::max);
-        if stiffness.iter().any(|k| !k.is_finite()) {
-            worst = f64::INFINITY;
-        }
-        worst.sqrt()
-    }
-
     /// Why this bubble's state is judged diverged, if it is.
     pub(crate) fn divergence(&self, max_speed_m_per_s: f64) -> Option<Divergence> {
+        let ratio = self.volume_m3 / self.rest_volume_m3;
+        let volume_ok = (1.0 / VOLUME_BLOWUP..=VOLUME_BLOWUP).contains(&ratio);
+        // Fast screen: a speed within the limit is finite, and a finite sum of finite
+        // coordinates clears the position; anything else is judged by the loop below.
+        let limit2 = max_speed_m_per_s * max_speed_m_per_s;
+        let clear = self
+            .positions_m
+            .iter()
+            .zip(&self.velocities_m_per_s)
+            .all(|(x, v)| (x.x + x.y + x.z).is_finite() & (v.length_squared() <= limit2));
+        if clear && volume_ok {
+            return None;
+        }
         for (vertex, (x, v)) in self
             .positions_m
             .iter()
@@ -361,11 +338,7 @@ impl Bubble {
                 });
             }
         }
-        let ratio = self.volume_m3 / self.rest_volume_m3;
-        if !(1.0 / VOLUME_BLOWUP..=VOLUME_BLOWUP).contains(&ratio) {
-            return Some(Divergence::Volume { ratio });
-        }
-        None
+        (!volume_ok).then_some(Divergence::Volume { ratio })
     }
 }
 
