@@ -320,3 +320,25 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn an_index_matched_film_is_invisible_and_thick_films_stay_finite() {
+    let config = small(BakeConfig::builder().film_index(RefractiveIndex::Constant(1.0)));
+    let set = lut::bake(&config);
+    for (r, t) in set
+        .reflectivity
+        .texels()
+        .iter()
+        .zip(set.transmittance.texels())
+    {
+        for k in 0..3 {
+            assert_close("R of an index-matched film", f64::from(r[k]), 0.0, 1e-7);
+            assert_close("T of an index-matched film", f64::from(t[k]), 1.0, 1e-7);
+        }
+    }
+    let thick = small(BakeConfig::builder().thickness_max_nm(lut::config::MAX_THICKNESS_NM));
+    let set = lut::bake(&thick);
+    // 100 µm is ~450 periods of phase, and the kernel takes wavelengths in f32 (589.6 nm
+    // is off by 2e-5 nm): ~2e-5 periods of phase, amplified near grazing by sharp fringes.
+    check_against_airy(&thick, &set, 5e-4);
+}
