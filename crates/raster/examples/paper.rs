@@ -1,5 +1,6 @@
 //! Renders the paper-like scene to `paper.png` (or the path given) for a visual check;
-//! a second argument renders that many extra frames (for profiling).
+//! a second argument renders that many extra frames (for profiling), a third sets the
+//! samples per pixel.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -12,7 +13,11 @@ fn main() {
     let repeat: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(0);
     let scene = common::paper_scene();
     let tables = FilmTables::from_reflectivity(common::synthetic_reflectivity());
-    let settings = RenderSettings::default();
+    let samples = args.next().and_then(|s| s.parse().ok()).unwrap_or(4);
+    let settings = RenderSettings {
+        samples,
+        ..RenderSettings::default()
+    };
     let mut renderer = Renderer::new();
     for _ in 0..repeat {
         renderer.render(&scene, &tables, &settings).expect("render");

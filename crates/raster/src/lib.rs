@@ -17,6 +17,8 @@
 //! strips rendered in parallel with rayon; output is bit-identical at any thread count.
 //! A GPU backend could sit behind a cargo feature and reuse the scene types unchanged.
 
+#![warn(missing_docs)]
+
 mod camera;
 mod cubemap;
 mod environment;
