@@ -13,9 +13,10 @@ use crate::MAX_SIDE;
 use crate::set::is_valid_light_name;
 use crate::weights::{linear_srgb_white, sample_wavelengths};
 
-/// Default number of thickness columns.
+/// Default number of thickness columns: the thickness axis sets the lookup error, and
+/// 2048 keeps the reflectivity within the published ΔE00 bound (docs/lut.md).
 pub const DEFAULT_WIDTH: usize = 2048;
-/// Default number of cos θ rows.
+/// Default number of cos θ rows: more rows barely change the error above grazing.
 pub const DEFAULT_HEIGHT: usize = 128;
 /// Default thickness of the last column, in nm (seed 000, Fig. 2).
 pub const DEFAULT_THICKNESS_MAX_NM: f32 = 2000.0;
