@@ -18,7 +18,11 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    if ok { ExitCode::SUCCESS } else { ExitCode::FAILURE }
+    if ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    }
 }
 
 /// Runs cargo with `args` from the workspace root, returning whether it succeeded.
@@ -35,7 +39,14 @@ fn cargo(args: &[&str]) -> bool {
 
 fn ci() -> bool {
     cargo(&["fmt", "--all", "--check"])
-        && cargo(&["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"])
+        && cargo(&[
+            "clippy",
+            "--workspace",
+            "--all-targets",
+            "--",
+            "-D",
+            "warnings",
+        ])
         && cargo(&["test", "--workspace"])
 }
 
