@@ -140,9 +140,20 @@ impl OpaqueCtx<'_> {
         let s_count = self.pattern.count;
         let width = self.view.width;
         let fast = self.ground.as_ref().filter(|g| span_supported(g));
+        // Inverse depth is affine: each sample's differs from the centre's by a constant.
+        let mut dz = [0.0f32; 16];
+        if let Some(g) = &self.ground {
+            for (d, &(ox, oy)) in dz.iter_mut().zip(&self.pattern.offsets_px).take(s_count) {
+                *d = g.gx * (ox - 0.5) + g.gy * (oy - 0.5);
+            }
+        }
+        let dz = &dz[..s_count];
+        let min_dz = dz.iter().copied().fold(f32::INFINITY, f32::min);
+        let max_dz = dz.iter().copied().fold(f32::NEG_INFINITY, f32::max);
         let mut centre = [[0.0f32; 3]; SPAN];
         for row in 0..rows {
             let y = y0 + row;
+            let cy = y as f32 + 0.5;
             for x0 in (0..width).step_by(SPAN) {
                 let n = SPAN.min(width - x0);
                 // Centres seeing the ground form one contiguous run (inverse depth is affine).
@@ -153,17 +164,29 @@ impl OpaqueCtx<'_> {
                 for (i, c) in centre.iter().enumerate().take(n) {
                     let x = x0 + i;
                     let base = (row * width + x) * s_count;
-                    let precomputed = match (fast, run) {
-                        (Some(_), Some((a, b))) if (a..b).contains(&i) => Some(*c),
-                        _ => None,
-                    };
-                    self.background_pixel(
-                        x,
-                        y,
-                        precomputed,
+                    let (color, depth) = (
                         &mut color[base..base + s_count],
                         &mut depth[base..base + s_count],
                     );
+                    let z = self
+                        .ground
+                        .as_ref()
+                        .map_or(-1.0, |g| g.inv_depth(x as f32 + 0.5, cy));
+                    let in_run =
+                        matches!((fast, run), (Some(_), Some((a, b))) if (a..b).contains(&i));
+                    if in_run && z + min_dz > 0.0 {
+                        // Every sample on the ground, shaded at the centre by the span kernel.
+                        color.fill(*c);
+                        for (d, o) in depth.iter_mut().zip(dz) {
+                            *d = z + o;
+                        }
+                    } else if z + max_dz <= 0.0 {
+                        // Every sample sees the environment.
+                        color.fill(self.sky(x, y));
+                        depth.fill(0.0);
+                    } else {
+                        self.background_pixel(x, y, in_run.then_some(*c), color, depth);
+                    }
                 }
             }
         }
