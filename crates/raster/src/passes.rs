@@ -408,35 +408,38 @@ impl BubbleCtx<'_> {
         let full = self.pattern.full_mask();
         for &t in self.bins.strip(strip) {
             let tri = &self.tris[t as usize];
+            // Inverse depth is affine: each sample's differs from the centre's by a constant.
+            let mut dz = [0.0f32; 16];
+            for (d, &(ox, oy)) in dz.iter_mut().zip(&self.pattern.offsets_px).take(s_count) {
+                *d = tri.inv_w.dx * (ox - 0.5) + tri.inv_w.dy * (oy - 0.5);
+            }
+            let dz = &dz[..s_count];
             let ya = (tri.bbox[1] as usize).max(y0);
             let yb = (tri.bbox[3] as usize).min(y0 + rows);
             for py in ya..yb {
                 for_each_covered_in_row(tri, &self.pattern, py as i32, |px, mask| {
                     let base = ((py - y0) * width + px as usize) * s_count;
-                    let (rx, ry) = (px as f32 - tri.ox, py as f32 - tri.oy);
+                    let z = tri
+                        .inv_w
+                        .at(px as f32 + 0.5 - tri.ox, py as f32 + 0.5 - tri.oy);
                     let mut pass = 0u32;
-                    let mut first = 0usize;
-                    for s in (0..s_count).rev() {
-                        if mask & (1 << s) != 0 {
-                            let (ox, oy) = self.pattern.offset_f32(s);
-                            if tri.inv_w.at(rx + ox, ry + oy) > depth[base + s] {
-                                pass |= 1 << s;
-                                first = s;
-                            }
-                        }
+                    for (s, (&opaque, &o)) in depth[base..base + s_count].iter().zip(dz).enumerate()
+                    {
+                        pass |= u32::from(z + o > opaque) << s;
                     }
+                    pass &= mask;
                     if pass == 0 {
                         return;
                     }
+                    // Shade at the centre when the triangle covers the pixel, else at a covered sample.
                     let (ox, oy) = if mask == full {
                         (0.5, 0.5)
                     } else {
-                        self.pattern.offset_f32(first)
+                        self.pattern.offset_f32(pass.trailing_zeros() as usize)
                     };
                     let (t_rgb, add) = self.shade(tri, px as f32 + ox, py as f32 + oy);
-                    for s in 0..s_count {
+                    for (s, c) in color[base..base + s_count].iter_mut().enumerate() {
                         if pass & (1 << s) != 0 {
-                            let c = &mut color[base + s];
                             for k in 0..3 {
                                 c[k] = c[k] * t_rgb[k] + add[k];
                             }
