@@ -26,6 +26,7 @@ pub(crate) struct Film {
 
 /// What the triangle pass sums at each vertex (one cache line per vertex).
 #[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(64))]
 pub(crate) struct VertexSums {
     /// Tension, hydrostatic and drag forces, N.
     pub(crate) force_n: DVec3,

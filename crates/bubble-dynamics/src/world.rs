@@ -4,6 +4,7 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use crate::bubble::Bubble;
 use crate::collide;
@@ -44,8 +45,9 @@ pub enum Event {
 
 /// Bubbles in air: advance with [`World::step`] or [`World::advance`].
 ///
-/// Deterministic: identical inputs give bit-identical states (no hash-map iteration, no
-/// parallel reductions).
+/// Deterministic: identical inputs give bit-identical states at any thread count (no
+/// hash-map iteration, no parallel reductions; bubbles are integrated in parallel, each
+/// on its own, and contacts are resolved in a fixed order).
 #[derive(Debug)]
 pub struct World {
     params: WorldParams,
@@ -209,26 +211,24 @@ impl World {
         let dt = self.params.dt_s;
         let t0 = self.time_s();
         let v_start: Vec<DVec3> = self.bubbles.iter().map(Bubble::velocity_m_per_s).collect();
+        let (params, wind) = (&self.params, &self.wind);
+        let parallel = worth_threads(&self.bubbles);
         // The first substep's forces do not depend on its length, so the pass that
         // computes them also gives the stiffness bound that sets the substep count.
-        let mut worst = (0.0_f64, 0);
-        for b in &mut self.bubbles {
-            let omega = b.accumulate_forces::<true>(&self.params, &self.wind, t0);
-            // NaN wins, so a broken mesh is reported rather than stepped.
-            if omega.is_nan() || omega > worst.0 {
-                worst = (omega, b.id);
-            }
-        }
-        let substeps = self.substeps_needed(step, worst)?;
+        let mut omegas = vec![0.0; self.bubbles.len()];
+        for_each_bubble(&mut self.bubbles, &mut omegas, parallel, |b, omega| {
+            *omega = b.accumulate_forces::<true>(params, wind, t0);
+        });
+        let substeps = self.substeps_needed(step, &omegas)?;
         let h = dt / f64::from(substeps);
         for k in 0..substeps {
             let t_s = t0 + f64::from(k) * h;
-            for b in &mut self.bubbles {
+            for_each_bubble(&mut self.bubbles, &mut omegas, parallel, |b, _| {
                 if k > 0 {
-                    b.accumulate_forces::<false>(&self.params, &self.wind, t_s);
+                    b.accumulate_forces::<false>(params, wind, t_s);
                 }
-                b.advance(&self.params, h);
-            }
+                b.advance(params, h);
+            });
             collide::resolve_bubbles(
                 &mut self.bubbles,
                 self.params.bubble_restitution,
@@ -241,15 +241,25 @@ impl World {
         }
         self.steps = step;
         self.last_substeps = substeps;
-        for (b, v0) in self.bubbles.iter_mut().zip(v_start) {
-            let acceleration = (b.velocity_m_per_s() - v0) / dt;
-            b.transport_film(self.params.gravity_m_per_s2 - acceleration, dt, t0);
-        }
+        let gravity = self.params.gravity_m_per_s2;
+        let mut v_start = v_start;
+        for_each_bubble(&mut self.bubbles, &mut v_start, parallel, |b, v0| {
+            let acceleration = (b.velocity_m_per_s() - *v0) / dt;
+            b.transport_film(gravity - acceleration, dt, t0);
+        });
         Ok(self.remove_burst(step))
     }
 
-    /// Substeps for the stiffest bubble `(ω_max, id)`: symplectic Euler needs ω·h < 2.
-    fn substeps_needed(&self, step: u64, worst: (f64, u64)) -> Result<u32, SimError> {
+    /// Substeps for the stiffest bubble (the largest ω_max in `omegas`, one per bubble):
+    /// symplectic Euler needs ω·h < 2.
+    fn substeps_needed(&self, step: u64, omegas: &[f64]) -> Result<u32, SimError> {
+        let mut worst = (0.0_f64, 0);
+        for (b, &omega) in self.bubbles.iter().zip(omegas) {
+            // NaN wins, so a broken mesh is reported rather than stepped.
+            if omega.is_nan() || omega > worst.0 {
+                worst = (omega, b.id);
+            }
+        }
         let needed = (self.params.dt_s * worst.0 / (2.0 * STABILITY_FRACTION))
             .ceil()
             .max(1.0);
@@ -339,6 +349,39 @@ impl Bubble {
             }
         }
         (!volume_ok).then_some(Divergence::Volume { ratio })
+    }
+}
+
+/// Triangles below which a step is too little work to share among threads.
+const PARALLEL_MIN_TRIANGLES: usize = 2048;
+
+/// Whether the bubbles' independent work is worth spreading over threads (the results
+/// are the same either way).
+fn worth_threads(bubbles: &[Bubble]) -> bool {
+    bubbles.len() > 1
+        && bubbles
+            .iter()
+            .map(|b| b.topology.triangles().len())
+            .sum::<usize>()
+            >= PARALLEL_MIN_TRIANGLES
+}
+
+/// Runs `f` on every bubble with its slot of `data`, on the rayon pool when `parallel`.
+/// Each call touches only its own bubble and slot, so the outcome does not depend on
+/// the thread count or the scheduling.
+fn for_each_bubble<T: Send>(
+    bubbles: &mut [Bubble],
+    data: &mut [T],
+    parallel: bool,
+    f: impl Fn(&mut Bubble, &mut T) + Send + Sync,
+) {
+    if parallel {
+        bubbles
+            .par_iter_mut()
+            .zip(data.par_iter_mut())
+            .for_each(|(b, d)| f(b, d));
+    } else {
+        bubbles.iter_mut().zip(data).for_each(|(b, d)| f(b, d));
     }
 }
 
