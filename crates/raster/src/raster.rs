@@ -495,9 +495,8 @@ mod tests {
             }
         }
         let counts = coverage(&view, &pattern, &tris);
-        // Pixel centres 0.5 .. 7.5 inside [0.5, 8.5): the top row and left column of squares
-        // own their top/left edges, so every centre x,y in 0.5..=6.5 is covered once; the last
-        // row/column (centre 7.5) lies on the excluded right/bottom edges... except 7.5 < 8.5.
+        // The squares tile [0.5, 8.5)²: every pixel centre (0.5 .. 7.5) lies on some edge or
+        // corner, and the top-left rule must give each to exactly one triangle.
         for py in 0..8 {
             for px in 0..8 {
                 assert_eq!(counts[py * 8 + px], 1, "pixel ({px},{py})");
