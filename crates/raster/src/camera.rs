@@ -124,17 +124,13 @@ impl Camera {
     pub(crate) fn view(&self, width: usize, height: usize) -> View {
         let tan_half_y = (self.vfov_deg.to_radians() * 0.5).tan();
         let tan_half_x = tan_half_y * width as f32 / height as f32;
-        View {
-            eye: self.eye,
-            forward: self.forward,
-            right: self.right,
-            up: self.up,
-            tan_half_x,
-            tan_half_y,
-            width,
-            height,
-            near_m: self.near_m,
-        }
+        View::new(
+            self.eye,
+            [self.forward, self.right, self.up],
+            (tan_half_x, tan_half_y),
+            (width, height),
+            self.near_m,
+        )
     }
 }
 
@@ -154,9 +150,37 @@ pub(crate) struct View {
     pub width: usize,
     pub height: usize,
     pub near_m: f32,
+    /// Screen-plane step per pixel, `2·tan_half / size`, along x and y.
+    pub x_per_px: f32,
+    pub y_per_px: f32,
 }
 
 impl View {
+    /// A view from its frame (`[forward, right, up]`, unit and orthogonal), half-angle
+    /// tangents, pixel size and near distance.
+    pub fn new(
+        eye: Vec3,
+        axes: [Vec3; 3],
+        tan_half: (f32, f32),
+        size: (usize, usize),
+        near_m: f32,
+    ) -> View {
+        let [forward, right, up] = axes;
+        View {
+            eye,
+            forward,
+            right,
+            up,
+            tan_half_x: tan_half.0,
+            tan_half_y: tan_half.1,
+            width: size.0,
+            height: size.1,
+            near_m,
+            x_per_px: 2.0 * tan_half.0 / size.0 as f32,
+            y_per_px: 2.0 * tan_half.1 / size.1 as f32,
+        }
+    }
+
     /// Unnormalised ray direction through pixel-space point `(px, py)`; its forward component is 1.
     #[inline]
     pub fn ray(&self, px: f32, py: f32) -> Vec3 {
@@ -167,9 +191,10 @@ impl View {
     /// Screen-plane coordinates `(x·tan_half_x, y·tan_half_y)` of pixel-space point `(px, py)`.
     #[inline]
     pub fn ray_coefficients(&self, px: f32, py: f32) -> (f32, f32) {
-        let sx = 2.0 * self.tan_half_x / self.width as f32;
-        let sy = 2.0 * self.tan_half_y / self.height as f32;
-        (px * sx - self.tan_half_x, self.tan_half_y - py * sy)
+        (
+            px * self.x_per_px - self.tan_half_x,
+            self.tan_half_y - py * self.y_per_px,
+        )
     }
 
     /// Clip coordinates `(x, y, w)` of a world point; `w` is the view depth.

@@ -51,7 +51,7 @@ pub(crate) fn ground_span(
     let view = &ctx.view;
     let cy = y as f32 + 0.5;
     let (_, ay) = view.ray_coefficients(0.0, cy);
-    let sx = 2.0 * view.tan_half_x / view.width as f32;
+    let sx = view.x_per_px;
     let (a, b, scale) = match g.ground.material.pattern {
         Pattern::Checker { a, b, scale_m } => (a, b, scale_m),
         Pattern::Solid(c) => (c, c, 1.0),

@@ -88,8 +88,7 @@ impl<'a> GroundView<'a> {
         if height == 0.0 || !height.is_finite() {
             return None;
         }
-        let sx = 2.0 * view.tan_half_x / view.width as f32;
-        let sy = 2.0 * view.tan_half_y / view.height as f32;
+        let (sx, sy) = (view.x_per_px, view.y_per_px);
         let inv_h = 1.0 / height;
         Some(Self {
             ground,

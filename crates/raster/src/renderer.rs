@@ -325,17 +325,13 @@ impl Renderer {
         jobs.into_par_iter().for_each(|(j, (texels, scratch))| {
             let (major, s_axis, t_axis) = FACE_BASES[j % 6];
             let wide = m as f32 / face_size as f32;
-            let view = View {
-                eye: centers[j / 6],
-                forward: major,
-                right: s_axis,
-                up: -t_axis,
-                tan_half_x: wide,
-                tan_half_y: wide,
-                width: m,
-                height: m,
-                near_m: scene.camera.near_m(),
-            };
+            let view = View::new(
+                centers[j / 6],
+                [major, s_axis, -t_axis],
+                (wide, wide),
+                (m, m),
+                scene.camera.near_m(),
+            );
             scratch.tris.clear();
             objects.setup(&view, &mut scratch.tris);
             let strips = m.div_ceil(STRIP_ROWS);
