@@ -103,5 +103,29 @@ fn figures() -> bool {
         "--out",
         "docs/figures/chart.png",
     ]);
-    fig2 && chart
+    let render = |scene: &str, out: &str, size: [&str; 2]| {
+        cargo(&[
+            "run",
+            "--release",
+            "-p",
+            "bubbles",
+            "--",
+            "render",
+            scene,
+            "--out",
+            out,
+            "--width",
+            size[0],
+            "--height",
+            size[1],
+        ])
+    };
+    // The README's main job (seed 000 Fig. 4 at its 400 × 400) and the furnace invariant.
+    let paper = render("paper", "docs/figures/paper.png", ["400", "400"]);
+    let furnace = render(
+        "white-furnace",
+        "docs/figures/white-furnace.png",
+        ["200", "200"],
+    );
+    fig2 && chart && paper && furnace
 }
