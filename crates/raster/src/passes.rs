@@ -478,8 +478,9 @@ impl BubbleCtx<'_> {
                 let vis = light_visibility(light, p, reflected, tri.extra);
                 if vis > 0.0 {
                     let l = table.sample(thickness_nm, cos_theta);
+                    let gain = light.highlight_gain();
                     for k in 0..3 {
-                        add[k] += l[k] * light.radiance[k] * vis;
+                        add[k] += l[k] * gain[k] * vis;
                     }
                 }
             }

@@ -154,9 +154,28 @@ pub struct Light {
     pub radiance: [f32; 3],
     /// Index into [`FilmTables::lights`] of this light's source table, if it has one.
     ///
-    /// Its highlight on a bubble is `table(d, cos θ) ⊙ radiance`; without a table it is
+    /// A source table already holds the light's colour, scaled so the light itself has
+    /// luminance 1 (seed 000's light-source texture), so its highlight on a bubble is
+    /// `table(d, cos θ) × Y`, with `Y` the luminance of `radiance`. Without a table it is
     /// `reflectivity(d, cos θ) ⊙ radiance`.
     pub light_lut: Option<usize>,
+}
+
+impl Light {
+    /// What the highlight table is multiplied by: the luminance of `radiance` when the
+    /// light has its own (already coloured) table, else `radiance` itself.
+    #[inline]
+    pub fn highlight_gain(&self) -> [f32; 3] {
+        match self.light_lut {
+            Some(_) => [luminance(self.radiance); 3],
+            None => self.radiance,
+        }
+    }
+}
+
+/// Luminance Y of a linear sRGB colour (Rec. 709 / sRGB primaries, D65 white).
+fn luminance(rgb: [f32; 3]) -> f32 {
+    0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
 }
 
 /// A bubble film: a closed triangle mesh with outward vertex normals and per-vertex thickness.
