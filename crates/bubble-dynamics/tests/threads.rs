@@ -3,7 +3,7 @@
 
 use bubble_dynamics::{BubbleParams, Collider, DVec3, Gusts, Wind, World, WorldParams};
 
-/// Three level-3 bubbles (enough triangles to take the parallel path) thrown at each
+/// Three level-4 bubbles (enough triangles to take the parallel path) thrown at each
 /// other just above the ground in gusts, with swirl and drainage.
 fn scene() -> World {
     let params = WorldParams {
@@ -20,7 +20,7 @@ fn scene() -> World {
             center_m: DVec3::new(0.11 * i as f64, 0.07, 0.01 * i as f64),
             velocity_m_per_s: DVec3::new(0.5 - 0.5 * i as f64, -0.3, 0.0),
             radius_m: 0.05,
-            subdivisions: 3,
+            subdivisions: 4,
             seed: i,
             ..BubbleParams::default()
         })
@@ -28,7 +28,7 @@ fn scene() -> World {
     World::try_new(params, bubbles).expect("valid scene")
 }
 
-/// Every bit of every bubble's state after 30 steps, plus the substeps of each step.
+/// Every bit of every bubble's state after 16 steps, plus the substeps of each step.
 fn run_on(threads: usize) -> (Vec<u64>, Vec<u32>) {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -37,7 +37,7 @@ fn run_on(threads: usize) -> (Vec<u64>, Vec<u32>) {
     pool.install(|| {
         let mut world = scene();
         let mut substeps = Vec::new();
-        for _ in 0..30 {
+        for _ in 0..16 {
             world.step().expect("stable");
             substeps.push(world.last_substeps());
         }
@@ -60,7 +60,7 @@ fn parallel_bubbles_give_bit_identical_states_on_1_2_and_3_threads() {
     // The scene must exercise contacts: bubbles 0 and 1 are pressed together by now.
     let world_check = {
         let mut w = scene();
-        w.advance(30.0 / 240.0).expect("stable");
+        w.advance(16.0 / 240.0).expect("stable");
         w
     };
     let [a, b, ..] = world_check.bubbles() else {
