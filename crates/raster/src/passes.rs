@@ -129,14 +129,28 @@ impl OpaqueCtx<'_> {
     pub fn render_strip(&self, strip: usize, color: &mut [[f32; 3]], depth: &mut [f32]) {
         let y0 = strip * STRIP_ROWS;
         let rows = color.len() / (self.view.width * self.pattern.count);
-        self.background(y0, rows, color, depth);
+        // Fixed sample counts let the per-pixel fills and loops unroll (same arithmetic).
+        match self.pattern.count {
+            1 => self.background::<1>(y0, rows, color, depth),
+            4 => self.background::<4>(y0, rows, color, depth),
+            _ => self.background::<0>(y0, rows, color, depth),
+        }
         for &t in self.bins.strip(strip) {
             self.triangle(&self.tris[t as usize], y0, rows, color, depth);
         }
     }
 
-    fn background(&self, y0: usize, rows: usize, color: &mut [[f32; 3]], depth: &mut [f32]) {
-        let s_count = self.pattern.count;
+    /// Ground and environment behind every sample of the strip; `N` is the sample count,
+    /// or 0 for the pattern's own.
+    #[inline(always)]
+    fn background<const N: usize>(
+        &self,
+        y0: usize,
+        rows: usize,
+        color: &mut [[f32; 3]],
+        depth: &mut [f32],
+    ) {
+        let s_count = if N == 0 { self.pattern.count } else { N };
         let width = self.view.width;
         let fast = self.ground.as_ref().filter(|g| span_supported(g));
         // Inverse depth is affine: each sample's differs from the centre's by a constant.
@@ -401,51 +415,69 @@ impl BubbleCtx<'_> {
     /// Blends every bubble triangle touching strip `strip` over its samples, in order.
     pub fn render_strip(&self, strip: usize, color: &mut [[f32; 3]], depth: &[f32]) {
         let y0 = strip * STRIP_ROWS;
-        let s_count = self.pattern.count;
-        let width = self.view.width;
-        let rows = color.len() / (width * s_count);
-        let full = self.pattern.full_mask();
+        let rows = color.len() / (self.view.width * self.pattern.count);
         for &t in self.bins.strip(strip) {
             let tri = &self.tris[t as usize];
-            // Inverse depth is affine: each sample's differs from the centre's by a constant.
-            let mut dz = [0.0f32; 16];
-            for (d, &(ox, oy)) in dz.iter_mut().zip(&self.pattern.offsets_px).take(s_count) {
-                *d = tri.inv_w.dx * (ox - 0.5) + tri.inv_w.dy * (oy - 0.5);
+            // The default 4-sample pattern gets fixed-length sample loops (same arithmetic).
+            if self.pattern.count == 4 {
+                self.blend_triangle::<4>(tri, y0, rows, color, depth);
+            } else {
+                self.blend_triangle::<0>(tri, y0, rows, color, depth);
             }
-            let dz = &dz[..s_count];
-            let ya = (tri.bbox[1] as usize).max(y0);
-            let yb = (tri.bbox[3] as usize).min(y0 + rows);
-            for py in ya..yb {
-                for_each_covered_in_row(tri, &self.pattern, py as i32, |px, mask| {
-                    let base = ((py - y0) * width + px as usize) * s_count;
-                    let z = tri
-                        .inv_w
-                        .at(px as f32 + 0.5 - tri.ox, py as f32 + 0.5 - tri.oy);
-                    let mut pass = 0u32;
-                    for (s, (&opaque, &o)) in depth[base..base + s_count].iter().zip(dz).enumerate()
-                    {
-                        pass |= u32::from(z + o > opaque) << s;
-                    }
-                    pass &= mask;
-                    if pass == 0 {
-                        return;
-                    }
-                    // Shade at the centre when the triangle covers the pixel, else at a covered sample.
-                    let (ox, oy) = if mask == full {
-                        (0.5, 0.5)
-                    } else {
-                        self.pattern.offset_f32(pass.trailing_zeros() as usize)
-                    };
-                    let (t_rgb, add) = self.shade(tri, px as f32 + ox, py as f32 + oy);
-                    for (s, c) in color[base..base + s_count].iter_mut().enumerate() {
-                        if pass & (1 << s) != 0 {
-                            for k in 0..3 {
-                                c[k] = c[k] * t_rgb[k] + add[k];
-                            }
+        }
+    }
+
+    /// Blends one triangle over rows `y0 .. y0 + rows`; `N` is the sample count, or 0 for
+    /// the pattern's own.
+    #[inline(always)]
+    fn blend_triangle<const N: usize>(
+        &self,
+        tri: &SetupTri,
+        y0: usize,
+        rows: usize,
+        color: &mut [[f32; 3]],
+        depth: &[f32],
+    ) {
+        let s_count = if N == 0 { self.pattern.count } else { N };
+        let width = self.view.width;
+        let full = self.pattern.full_mask();
+        // Inverse depth is affine: each sample's differs from the centre's by a constant.
+        let mut dz = [0.0f32; 16];
+        for (d, &(ox, oy)) in dz.iter_mut().zip(&self.pattern.offsets_px).take(s_count) {
+            *d = tri.inv_w.dx * (ox - 0.5) + tri.inv_w.dy * (oy - 0.5);
+        }
+        let dz = &dz[..s_count];
+        let ya = (tri.bbox[1] as usize).max(y0);
+        let yb = (tri.bbox[3] as usize).min(y0 + rows);
+        for py in ya..yb {
+            for_each_covered_in_row(tri, &self.pattern, py as i32, |px, mask| {
+                let base = ((py - y0) * width + px as usize) * s_count;
+                let z = tri
+                    .inv_w
+                    .at(px as f32 + 0.5 - tri.ox, py as f32 + 0.5 - tri.oy);
+                let mut pass = 0u32;
+                for (s, (&opaque, &o)) in depth[base..base + s_count].iter().zip(dz).enumerate() {
+                    pass |= u32::from(z + o > opaque) << s;
+                }
+                pass &= mask;
+                if pass == 0 {
+                    return;
+                }
+                // Shade at the centre when the triangle covers the pixel, else at a covered sample.
+                let (ox, oy) = if mask == full {
+                    (0.5, 0.5)
+                } else {
+                    self.pattern.offset_f32(pass.trailing_zeros() as usize)
+                };
+                let (t_rgb, add) = self.shade(tri, px as f32 + ox, py as f32 + oy);
+                for (s, c) in color[base..base + s_count].iter_mut().enumerate() {
+                    if pass & (1 << s) != 0 {
+                        for k in 0..3 {
+                            c[k] = c[k] * t_rgb[k] + add[k];
                         }
                     }
-                });
-            }
+                }
+            });
         }
     }
 

@@ -378,7 +378,25 @@ pub(crate) fn for_each_covered_in_row(
     for (s, o) in offs.iter_mut().take(pattern.count).enumerate() {
         *o = tri.edges.map(|e| sample_offsets(&e, s));
     }
-    let offs = &offs[..pattern.count];
+    // The common 4-sample pattern gets a fixed-length copy so the sample loop unrolls.
+    if pattern.count == 4 {
+        let offs4: [[i64; 3]; 4] = [offs[0], offs[1], offs[2], offs[3]];
+        covered_in_row(x0, x1, row, step, &offs4, f);
+    } else {
+        covered_in_row(x0, x1, row, step, &offs[..pattern.count], f);
+    }
+}
+
+/// The multi-sample row walk of [`for_each_covered_in_row`], for sample edge offsets `offs`.
+#[inline(always)]
+fn covered_in_row(
+    x0: i32,
+    x1: i32,
+    mut row: [i64; 3],
+    step: [i64; 3],
+    offs: &[[i64; 3]],
+    mut f: impl FnMut(i32, u32),
+) {
     for px in x0..x1 {
         let mut mask = 0u32;
         for (s, o) in offs.iter().enumerate() {
