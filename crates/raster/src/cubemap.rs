@@ -146,8 +146,10 @@ impl CubeMap {
         // Interior texel i has its centre at s = (2i + 1)/N − 1 and is stored at i + 1.
         let fx = ((s + 1.0) * 0.5 * n + 0.5).clamp(0.0, (m - 1) as f32);
         let fy = ((t + 1.0) * 0.5 * n + 0.5).clamp(0.0, (m - 1) as f32);
-        let x0 = (fx as usize).min(m - 2);
-        let y0 = (fy as usize).min(m - 2);
+        // fx, fy are in [0, m − 1] (m ≤ 8194) or NaN (→ 0 either way): i32 conversion is exact
+        // and cheaper than usize's.
+        let x0 = (fx as i32 as usize).min(m - 2);
+        let y0 = (fy as i32 as usize).min(m - 2);
         let tx = fx - x0 as f32;
         let ty = fy - y0 as f32;
         let base = self.face_offset(face) + y0 * m + x0;

@@ -47,7 +47,8 @@ impl<'a> LutSampler<'a> {
 fn split(x: f32, n: usize) -> (usize, f32) {
     let x = x.clamp(0.0, (n - 1) as f32);
     let x = if x.is_nan() { 0.0 } else { x };
-    let i0 = (x as usize).min(n - 2);
+    // x is in [0, n − 1] and n indexes memory, so the cheaper i32 conversion is exact.
+    let i0 = (x as i32 as usize).min(n - 2);
     (i0, x - i0 as f32)
 }
 
