@@ -5,27 +5,12 @@ mod common;
 
 use std::sync::Arc;
 
-use common::{bubble, synthetic_reflectivity};
+use common::{bubble, settings, synthetic_reflectivity};
 use raster::{
     Camera, CubeMap, Environment, FilmTables, Frame, Ground, Light, Lut, Material, Object,
     ReflectionMode, RenderError, RenderScene, RenderSettings, Renderer, Sky, SphereMap, Texture,
     Vec3,
 };
-
-fn settings(
-    width: usize,
-    height: usize,
-    samples: u32,
-    reflection: ReflectionMode,
-) -> RenderSettings {
-    RenderSettings {
-        width,
-        height,
-        samples,
-        reflection,
-        ..RenderSettings::default()
-    }
-}
 
 fn close(a: [f32; 3], b: [f32; 3], tol: f32) -> bool {
     (0..3).all(|k| (a[k] - b[k]).abs() <= tol)

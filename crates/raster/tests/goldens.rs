@@ -8,7 +8,7 @@ mod common;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use common::{bubble, draining, paper_scene, synthetic_reflectivity};
+use common::{bubble, draining, paper_scene, settings, synthetic_reflectivity};
 use raster::{
     Camera, CubeMap, Environment, FilmTables, Ground, Light, Lut, Material, Object, Pattern,
     ReflectionMode, RenderScene, RenderSettings, Renderer, Sky, SphereMap, Texture, ToneMap,
@@ -65,21 +65,6 @@ fn check_golden(name: &str, scene: &RenderScene, tables: &FilmTables, settings: 
             first / frame.width(),
             out.display()
         );
-    }
-}
-
-fn settings(
-    width: usize,
-    height: usize,
-    samples: u32,
-    reflection: ReflectionMode,
-) -> RenderSettings {
-    RenderSettings {
-        width,
-        height,
-        samples,
-        reflection,
-        ..RenderSettings::default()
     }
 }
 

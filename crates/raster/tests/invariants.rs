@@ -5,7 +5,7 @@ mod common;
 
 use std::sync::Arc;
 
-use common::{bubble, draining, lossless_tables, paper_scene, synthetic_reflectivity};
+use common::{bubble, draining, lossless_tables, paper_scene, settings, synthetic_reflectivity};
 use proptest::prelude::*;
 use raster::{
     Camera, Environment, FilmTables, Frame, Ground, Light, Lut, Material, Object, ReflectionMode,
@@ -17,21 +17,6 @@ fn render(scene: &RenderScene, tables: &FilmTables, settings: &RenderSettings) -
         .render(scene, tables, settings)
         .unwrap()
         .clone()
-}
-
-fn settings(
-    width: usize,
-    height: usize,
-    samples: u32,
-    reflection: ReflectionMode,
-) -> RenderSettings {
-    RenderSettings {
-        width,
-        height,
-        samples,
-        reflection,
-        ..RenderSettings::default()
-    }
 }
 
 /// Largest per-channel difference between two frames, and where.

@@ -5,8 +5,25 @@ use std::collections::HashMap;
 
 use raster::Vec3;
 use raster::{
-    BubbleMesh, Camera, Environment, FilmTables, Ground, Light, Lut, Material, RenderScene, Sky,
+    BubbleMesh, Camera, Environment, FilmTables, Ground, Light, Lut, Material, ReflectionMode,
+    RenderScene, RenderSettings, Sky,
 };
+
+/// Default settings at the given size, sample count and reflection mode.
+pub fn settings(
+    width: usize,
+    height: usize,
+    samples: u32,
+    reflection: ReflectionMode,
+) -> RenderSettings {
+    RenderSettings {
+        width,
+        height,
+        samples,
+        reflection,
+        ..RenderSettings::default()
+    }
+}
 
 /// A unit icosphere subdivided `level` times, outward-wound.
 pub fn icosphere(level: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
