@@ -4,14 +4,14 @@ use std::process::{Command, ExitCode};
 
 const USAGE: &str = "usage: cargo xtask <figures|bench|ci>
   figures  regenerate the PNG figures under docs/figures/
-  bench    run the criterion benches of every crate
+  bench    run every crate's criterion benches, then `bubbles bench` (frame breakdown)
   ci       run what .ci/run runs (fmt, clippy, tests)";
 
 fn main() -> ExitCode {
     let task = std::env::args().nth(1);
     let ok = match task.as_deref() {
         Some("figures") => figures(),
-        Some("bench") => cargo(&["bench", "--workspace"]),
+        Some("bench") => bench(),
         Some("ci") => ci(),
         _ => {
             eprintln!("{USAGE}");
@@ -35,6 +35,28 @@ fn cargo(args: &[&str]) -> bool {
         .current_dir(root)
         .status()
         .is_ok_and(|s| s.success())
+}
+
+/// Criterion benches of the library crates, then the whole-frame breakdown of the CLI.
+fn bench() -> bool {
+    let criterion = cargo(&[
+        "bench",
+        "-p",
+        "thinfilm",
+        "-p",
+        "lut",
+        "-p",
+        "bubble-dynamics",
+        "-p",
+        "raster",
+        "--",
+        "--warm-up-time",
+        "1",
+        "--measurement-time",
+        "3",
+    ]);
+    let frame = cargo(&["run", "--release", "-p", "bubbles", "--", "bench"]);
+    criterion && frame
 }
 
 fn ci() -> bool {
