@@ -10,7 +10,8 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use crate::{Environment, RenderError, texture::read_linear_rgb};
+use crate::texture::{check_texels, read_linear_rgb};
+use crate::{Environment, RenderError};
 
 /// Largest accepted face size, in texels.
 pub const MAX_FACE_SIZE: usize = 8192;
@@ -51,15 +52,7 @@ impl CubeMap {
                     format!("{} texels, expected {face_size}²", face.len()),
                 ));
             }
-            if let Some(k) = face
-                .iter()
-                .position(|t| t.iter().any(|c| !(c.is_finite() && *c >= 0.0)))
-            {
-                return Err(RenderError::scene(
-                    format!("cube face {f} texel ({}, {})", k % face_size, k / face_size),
-                    format!("{:?} is not finite and non-negative", face[k]),
-                ));
-            }
+            check_texels(&format!("cube face {f}"), face, face_size)?;
         }
         let mut cube = Self::black(face_size);
         let m = face_size + 2;

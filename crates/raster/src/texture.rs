@@ -38,15 +38,7 @@ impl Texture {
                 format!("{} texels for a {width}x{height} image", texels.len()),
             ));
         }
-        if let Some(k) = texels
-            .iter()
-            .position(|t| t.iter().any(|c| !(c.is_finite() && *c >= 0.0)))
-        {
-            return Err(RenderError::scene(
-                format!("texture texel ({}, {})", k % width, k / width),
-                format!("{:?} is not finite and non-negative", texels[k]),
-            ));
-        }
+        check_texels("texture", &texels, width)?;
         Ok(Self {
             width,
             height,
@@ -198,6 +190,25 @@ pub(crate) fn read_linear_rgb(path: &Path) -> Result<(usize, usize, Vec<[f32; 3]
         })
         .collect();
     Ok((w, h, texels))
+}
+
+/// Checks that every texel of a row-major image `width` wide is finite and non-negative,
+/// naming `what` and the first bad texel's position otherwise.
+pub(crate) fn check_texels(
+    what: &str,
+    texels: &[[f32; 3]],
+    width: usize,
+) -> Result<(), RenderError> {
+    match texels
+        .iter()
+        .position(|t| t.iter().any(|c| !(c.is_finite() && *c >= 0.0)))
+    {
+        Some(k) => Err(RenderError::scene(
+            format!("{what} texel ({}, {})", k % width, k / width),
+            format!("{:?} is not finite and non-negative", texels[k]),
+        )),
+        None => Ok(()),
+    }
 }
 
 #[cfg(test)]
