@@ -10,7 +10,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use crate::texture::{check_texels, read_linear_rgb};
+use crate::texture::{bilerp, check_texels, read_linear_rgb};
 use crate::{Environment, RenderError};
 
 /// Largest accepted face size, in texels.
@@ -150,13 +150,7 @@ impl CubeMap {
         let b = self.texels[base + 1];
         let c = self.texels[base + m];
         let d = self.texels[base + m + 1];
-        let mut out = [0.0; 3];
-        for k in 0..3 {
-            let top = a[k] + (b[k] - a[k]) * tx;
-            let bottom = c[k] + (d[k] - c[k]) * tx;
-            out[k] = top + (bottom - top) * ty;
-        }
-        out
+        bilerp(a, b, c, d, tx, ty)
     }
 
     /// An all-black cube map, the starting point of a render target.

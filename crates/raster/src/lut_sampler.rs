@@ -3,6 +3,8 @@
 
 use lut::Lut;
 
+use crate::texture::bilerp;
+
 /// A borrowed view of a table, prepared for fast sampling.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct LutSampler<'a> {
@@ -32,13 +34,7 @@ impl<'a> LutSampler<'a> {
         let row1 = row0 + self.width;
         let (a, b) = (self.texels[row0], self.texels[row0 + 1]);
         let (c, d) = (self.texels[row1], self.texels[row1 + 1]);
-        let mut out = [0.0; 3];
-        for k in 0..3 {
-            let top = a[k] + (b[k] - a[k]) * tx;
-            let bottom = c[k] + (d[k] - c[k]) * tx;
-            out[k] = top + (bottom - top) * ty;
-        }
-        out
+        bilerp(a, b, c, d, tx, ty)
     }
 }
 

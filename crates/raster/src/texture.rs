@@ -117,13 +117,7 @@ impl Texture {
         let b = self.texels[y0 * w + x1];
         let c = self.texels[y1 * w + x0];
         let d = self.texels[y1 * w + x1];
-        let mut out = [0.0; 3];
-        for k in 0..3 {
-            let top = a[k] + (b[k] - a[k]) * tx;
-            let bottom = c[k] + (d[k] - c[k]) * tx;
-            out[k] = top + (bottom - top) * ty;
-        }
-        out
+        bilerp(a, b, c, d, tx, ty)
     }
 }
 
@@ -209,6 +203,26 @@ pub(crate) fn check_texels(
         )),
         None => Ok(()),
     }
+}
+
+/// Bilinear blend of the texels `a b` (top row) and `c d` (bottom row), in the one
+/// operation order every sampler uses, so their results stay bit-identical.
+#[inline(always)]
+pub(crate) fn bilerp(
+    a: [f32; 3],
+    b: [f32; 3],
+    c: [f32; 3],
+    d: [f32; 3],
+    tx: f32,
+    ty: f32,
+) -> [f32; 3] {
+    let mut out = [0.0; 3];
+    for k in 0..3 {
+        let top = a[k] + (b[k] - a[k]) * tx;
+        let bottom = c[k] + (d[k] - c[k]) * tx;
+        out[k] = top + (bottom - top) * ty;
+    }
+    out
 }
 
 #[cfg(test)]
