@@ -136,3 +136,65 @@ fn sodium_highlight_has_the_exact_spectral_colour_of_bubbles_color() {
         "highlight colour {got:?} vs bubbles color {want:?}: off by {off}"
     );
 }
+
+/// XYZ rows of `bubbles color` (D65) for the films in `rows` (`thickness_nm,angle_deg`).
+fn film_xyz(rows: &str, dir: &Path) -> Vec<[f64; 3]> {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bubbles"))
+        .arg("color")
+        .current_dir(dir)
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .expect("bubbles runs");
+    let input = format!("thickness_nm,angle_deg\n{rows}");
+    let mut stdin = child.stdin.take().unwrap();
+    let writer = std::thread::spawn(move || {
+        use std::io::Write;
+        stdin.write_all(input.as_bytes()).unwrap();
+    });
+    let out = child.wait_with_output().unwrap();
+    writer.join().unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|line| {
+            let f: Vec<&str> = line.split(',').collect();
+            [f[2], f[3], f[4]].map(|v| v.parse().unwrap())
+        })
+        .collect()
+}
+
+#[test]
+fn film_colours_stop_changing_beyond_the_table_thickness_range() {
+    // The renderer clamps thickness at the tables' last column: past it a film must look
+    // like the thick-film (incoherent) limit, here the mean over 10–12 µm, even exposed
+    // so that the reflection is white (CIELAB relative to that limit).
+    let dir = tempfile::tempdir().unwrap();
+    let d_max = f64::from(lut::config::DEFAULT_THICKNESS_MAX_NM);
+    for angle in [0, 45, 75] {
+        let films: String = (0..)
+            .map(|k| d_max + 5.0 * f64::from(k))
+            .take_while(|d| *d <= 12_000.0)
+            .map(|d| format!("{d},{angle}\n"))
+            .collect();
+        let xyz = film_xyz(&films, dir.path());
+        let tail = &xyz[xyz.len() - 401..];
+        let limit = tail
+            .iter()
+            .fold([0.0; 3], |a, c| [a[0] + c[0], a[1] + c[1], a[2] + c[2]]);
+        let limit = limit.map(|c| c / tail.len() as f64);
+        let lab = |c: [f64; 3]| thinfilm::lab::lab_from_xyz(c, limit);
+        let (worst, at) = xyz
+            .iter()
+            .enumerate()
+            .map(|(k, c)| (thinfilm::lab::ciede2000(lab(*c), lab(limit)), k))
+            .fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a });
+        assert!(
+            worst < 1.0,
+            "{angle}°: ΔE00 {worst:.2} from the thick-film limit at {} nm",
+            d_max + 5.0 * at as f64
+        );
+    }
+}
