@@ -10,7 +10,7 @@ use crate::ground::{SPAN, ground_span, span_supported};
 use crate::lut_sampler::LutSampler;
 use crate::raster::{SamplePattern, SetupTri, for_each_covered_in_row};
 use crate::shading::{ground_albedo, lit, object_albedo};
-use crate::{CubeMap, Environment, Ground, Light, Material, SphereMap};
+use crate::{CubeMap, Environment, Ground, Irradiance, Light, Material, SphereMap};
 
 /// Rows per strip (the unit of parallel work).
 pub(crate) const STRIP_ROWS: usize = 8;
@@ -117,7 +117,8 @@ pub(crate) struct OpaqueCtx<'a> {
     /// Precomputed environment radiance per pixel (single-sample views only).
     pub sky_texels: Option<&'a [[f32; 3]]>,
     pub ground: Option<GroundView<'a>>,
-    pub ambient: [f32; 3],
+    /// Environment and ambient light on opaque surfaces.
+    pub ambient: &'a Irradiance,
     pub lights: &'a [Light],
     pub materials: &'a [&'a Material],
     pub tris: &'a [SetupTri],
@@ -610,7 +611,8 @@ mod tests {
             env: &env,
             sky_texels: None,
             ground: Some(g),
-            ambient: [0.2, 0.3, 0.4],
+            ambient: &Irradiance::from_environment(&Environment::Sky(crate::Sky::default()))
+                .plus_uniform([0.2, 0.3, 0.4]),
             lights: &lights,
             materials: &[],
             tris: &[],
