@@ -109,13 +109,25 @@ impl Scene {
                 self.check_material(material)?;
                 BOX_TRIANGLES
             }
-            ObjectSpec::Mesh { path, material, .. } => {
+            ObjectSpec::Mesh {
+                path,
+                material,
+                offset_m,
+                scale,
+            } => {
                 self.check_material(material)?;
                 let full = self.path(path);
                 let key = format!("objects.path {path:?}");
                 input::check_text_file(&full, "OBJ mesh")
                     .map_err(|e| self.error(format!("{key}: {e}")))?;
-                obj_triangles(&input::read_text(&full, "OBJ mesh")?)
+                let text = input::read_text(&full, "OBJ mesh")?;
+                if let Some((line, c)) = obj_far_vertex(&text, offset_m.get(), scale.get()) {
+                    return Err(self.error(format!(
+                        "{key} line {line}: a vertex lands {} m from the origin after scale and offset_m, beyond the scene's 10000 m",
+                        plain(c)
+                    )));
+                }
+                obj_triangles(&text)
             }
         })
     }
@@ -175,6 +187,20 @@ pub fn check_spectrum_file(path: &std::path::Path) -> Result<(), CliError> {
     Ok(())
 }
 
+/// The first vertex line (1-based) whose scaled, offset coordinate passes 1e4 m, and
+/// that coordinate.
+fn obj_far_vertex(text: &str, offset_m: [f64; 3], scale: f64) -> Option<(usize, f64)> {
+    text.lines().enumerate().find_map(|(i, l)| {
+        let rest = l.trim_start().strip_prefix("v ")?;
+        rest.split_whitespace()
+            .take(3)
+            .zip(offset_m)
+            .filter_map(|(v, o)| Some(v.parse::<f64>().ok()? * scale + o))
+            .find(|c| !(c.abs() <= 1e4))
+            .map(|c| (i + 1, c))
+    })
+}
+
 /// Triangles of an OBJ text: each face line `f a b c …` of n corners is n − 2.
 fn obj_triangles(text: &str) -> u64 {
     text.lines()
@@ -224,6 +250,17 @@ mod tests {
     #[test]
     fn obj_faces_count_as_fans() {
         assert_eq!(obj_triangles("v 0 0 0\nf 1 2 3\nf 1 2 3 4\n# f 1 2 3\n"), 3);
+    }
+
+    #[test]
+    fn far_obj_vertices_are_found() {
+        let text = "v 0 0 0\nv 1e30 0 0\n";
+        assert_eq!(obj_far_vertex(text, [0.0; 3], 1.0), Some((2, 1e30)));
+        assert_eq!(obj_far_vertex("v 1 2 3\n", [0.0; 3], 1.0), None);
+        assert_eq!(
+            obj_far_vertex("v 1 2 3\n", [9999.5, 0.0, 0.0], 1.0).map(|v| v.0),
+            Some(1)
+        );
     }
 
     #[test]
