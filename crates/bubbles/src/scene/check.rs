@@ -196,7 +196,7 @@ fn obj_far_vertex(text: &str, offset_m: [f64; 3], scale: f64) -> Option<(usize, 
             .take(3)
             .zip(offset_m)
             .filter_map(|(v, o)| Some(v.parse::<f64>().ok()? * scale + o))
-            .find(|c| !(c.abs() <= 1e4))
+            .find(|c| c.is_nan() || c.abs() > 1e4)
             .map(|c| (i + 1, c))
     })
 }
