@@ -133,21 +133,29 @@ fn key_at(text: &str, offset: usize) -> Option<String> {
 /// Inside a table the parser reports as a whole (a tagged `kind = …` table), the key
 /// whose literal holds the number that `message` starts with.
 fn key_of_value(text: &str, span: std::ops::Range<usize>, message: &str) -> Option<String> {
-    let number: f64 = message.split_whitespace().next()?.parse().ok()?;
+    let wanted = numbers_at_start(message)?;
     let region = text.get(span.clone())?;
     let mut offset = 0;
     while let Some(eq) = region[offset..].find('=') {
         let value_start = offset + eq + 1;
-        let literal = region[value_start..]
-            .split([',', '}', '\n', '#'])
-            .next()?
-            .trim();
-        if literal.replace('_', "").parse::<f64>().ok() == Some(number) {
+        if numbers_at_start(region[value_start..].trim_start()) == Some(wanted.clone()) {
             return key_at(text, span.start + value_start);
         }
         offset = value_start;
     }
     None
+}
+
+/// The number (`1e300 …`) or array of numbers (`[1e300, 0.5, 1] …`) `text` starts with.
+fn numbers_at_start(text: &str) -> Option<Vec<f64>> {
+    let parse = |s: &str| s.trim().replace('_', "").parse::<f64>().ok();
+    if let Some(rest) = text.strip_prefix('[') {
+        let inner = &rest[..rest.find(']')?];
+        inner.split(',').map(parse).collect()
+    } else {
+        let end = text.find([' ', ',', '}', '\n', '#']).unwrap_or(text.len());
+        Some(vec![parse(&text[..end])?])
+    }
 }
 
 /// 1-based line and column of byte `offset` in `text`.
@@ -202,6 +210,16 @@ mod tests {
             msg,
             "t.toml:6:12: bubbles.radius_m: 1e300 is outside 0.001..=1 m"
         );
+    }
+
+    #[test]
+    fn vector_key_inside_a_tagged_table_is_found() {
+        let text = "[camera]\neye_m = [0.0, 0.0, 1.0]\ntarget_m = [0.0, 0.0, 0.0]\n\
+                    [environment]\nkind = \"uniform\"\nrgb = [1e300, 0.5, 1]\n";
+        let msg = Scene::from_toml_str(text, "t.toml", Path::new("."))
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("environment.rgb: [1e300, 0.5, 1]"), "{msg}");
     }
 
     #[test]

@@ -19,7 +19,7 @@ impl Scene {
             vec3(c.up.get()),
             c.vfov_deg.get() as f32,
         )
-        .map_err(|e| CliError::input(format!("{}: camera: {e}", self.origin)))?;
+        .map_err(|e| CliError::input(format!("{}: {e}", self.origin)))?;
         let mut scene = RenderScene::new(camera, self.environment()?);
         scene.ground = match &self.file.ground {
             Some(g) => Some(Ground {

@@ -255,8 +255,8 @@ bounds! {
     Damping: 0.0, 1e3, "1/s";
     /// Gibbs film elasticity.
     Elasticity: 0.0, 10.0, "N/m";
-    /// Drainage viscosity.
-    Viscosity: 1e-4, 10.0, "Pa·s";
+    /// Effective drainage viscosity (a model parameter: the default is 5e-8).
+    Viscosity: 1e-12, 10.0, "Pa·s";
     /// Relative thickness variation.
     Variation: 0.0, 0.99, "";
     /// Film flow speed.
