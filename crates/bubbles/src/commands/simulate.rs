@@ -9,6 +9,7 @@ use bubble_dynamics::{Bubble, DVec3, Event, World};
 use serde::Serialize;
 
 use crate::error::{CliError, CliResult};
+use crate::frame::progress::{Progress, advance_world, steps_to};
 use crate::scene::Scene;
 use crate::scene::values::Positive;
 
@@ -119,20 +120,35 @@ fn radius_error(r: f64) -> CliError {
 }
 
 /// Advances the world to `--seconds`, through every output frame when exporting;
-/// returns the events and the number of frames written.
+/// returns the events and the number of frames written. A progress bar shows on stderr
+/// when the solver takes more than about a second.
 fn simulate(world: &mut World, args: &Args) -> Result<(Vec<Event>, usize), CliError> {
+    let mut bar = Progress::steps(steps_to(world, args.seconds));
+    let result = simulate_with(world, args, &mut bar);
+    bar.finish();
+    result
+}
+
+fn simulate_with(
+    world: &mut World,
+    args: &Args,
+    bar: &mut Progress,
+) -> Result<(Vec<Event>, usize), CliError> {
     let diverged = |e: bubble_dynamics::SimError| CliError::runtime(e.to_string());
     let Some(dir) = &args.export_obj else {
-        return Ok((world.advance_to(args.seconds).map_err(diverged)?, 0));
+        return Ok((
+            advance_world(world, args.seconds, bar).map_err(diverged)?,
+            0,
+        ));
     };
     // The last frame lands exactly on --seconds; rounding protects k/fps = seconds.
     let last = (args.seconds * args.fps + 1e-9).floor() as usize;
     let mut events = Vec::new();
     for k in 0..=last {
-        events.extend(world.advance_to(k as f64 / args.fps).map_err(diverged)?);
+        events.extend(advance_world(world, k as f64 / args.fps, bar).map_err(diverged)?);
         write_atomic(&dir.join(format!("frame_{k:05}.obj")), &obj_text(world, k))?;
     }
-    events.extend(world.advance_to(args.seconds).map_err(diverged)?);
+    events.extend(advance_world(world, args.seconds, bar).map_err(diverged)?);
     Ok((events, last + 1))
 }
 
