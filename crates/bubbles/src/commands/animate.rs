@@ -31,8 +31,8 @@ pub const MANIFEST: &str = "animation.txt";
     and fps <= 240.\n\n\
     --out DIR writes DIR/frame_00000.png, … each through a temporary file renamed into \
     place, so an interrupted run leaves only whole frames, and DIR/animation.txt records \
-    the scene and settings. --resume renders only the frames missing from DIR (refusing a \
-    DIR made with other settings); --frames A..B renders frames A to B − 1 only. Both give \
+    the scene and settings (a DIR made with other settings is refused). --resume renders \
+    only the frames missing from DIR; --frames A..B renders frames A to B − 1 only. Both give \
     frames byte-identical to those of one uninterrupted run, so one animation can be split \
     across machines (e.g. a Slurm array job, one --frames range per task).\n\n\
     --out PATH.apng or PATH.png writes one animated PNG: the exact 8-bit frames. \
@@ -187,7 +187,7 @@ fn open(
     let unwritable = |e: String| CliError::input(format!("--out {}: {e}", args.out.display()));
     match output {
         Output::Dir(dir) => {
-            open_dir(dir, manifest, args.resume).map_err(unwritable)?;
+            open_dir(dir, manifest).map_err(unwritable)?;
             Ok(Sink::Dir(dir.clone()))
         }
         Output::Apng(path) => {
@@ -202,18 +202,19 @@ fn open(
     }
 }
 
-/// Creates the frame directory and records the manifest; on resume, refuses a directory
-/// whose frames were made with other settings.
-fn open_dir(dir: &Path, manifest: &str, resume: bool) -> Result<(), String> {
+/// Creates the frame directory and records the manifest; refuses a directory whose
+/// frames were made from another scene or with other settings, so that frames of two
+/// animations never mix (several `--frames` runs of one animation share it).
+fn open_dir(dir: &Path, manifest: &str) -> Result<(), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create the directory: {e}"))?;
     let path = dir.join(MANIFEST);
-    if resume && let Ok(existing) = std::fs::read_to_string(&path) {
+    if let Ok(existing) = std::fs::read_to_string(&path) {
         if existing == manifest {
             return Ok(());
         }
         return Err(format!(
-            "{} records another scene or other settings: resume with the same scene, \
-             --fps and render options, or use another directory",
+            "{} records another scene or other settings: use the same scene, --fps and \
+             render options, or another (or emptied) directory",
             path.display()
         ));
     }
