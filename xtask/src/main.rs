@@ -149,8 +149,14 @@ fn figures() -> bool {
         "docs/figures/white-furnace.png",
         ["200", "200"],
     );
+    // A sodium lamp (docs/rendering.md): light outside the sRGB gamut.
+    let sodium = render(
+        "docs/scenes/sodium.toml",
+        "docs/figures/sodium.png",
+        ["400", "400"],
+    );
     let gallery = gallery();
-    fig2 && chart && paper && furnace && gallery
+    fig2 && chart && paper && furnace && sodium && gallery
 }
 
 /// The gallery scenes of docs/gallery.md (seed 000 Figs. 5–7 and the demo): a still

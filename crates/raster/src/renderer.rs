@@ -143,6 +143,7 @@ impl Renderer {
         let cube_maps_s = t.elapsed().as_secs_f64();
 
         let t = Instant::now();
+        let ambient = scene.irradiance.plus_uniform(scene.ambient_rgb);
         let ground = scene
             .ground
             .as_ref()
@@ -153,7 +154,7 @@ impl Renderer {
             env: &scene.environment,
             sky_texels: None,
             ground,
-            ambient: scene.ambient_rgb,
+            ambient: &ambient,
             lights: &scene.lights,
             materials: &materials,
             tris: &self.opaque_tris,
@@ -306,6 +307,7 @@ impl Renderer {
         let env_cube = self.env_cube.as_ref().map(|(_, c)| c);
         let m = face_size + 2;
         let centers: Vec<Vec3> = scene.bubbles.iter().map(BubbleMesh::center).collect();
+        let ambient = scene.irradiance.plus_uniform(scene.ambient_rgb);
         let objects = &self.objects;
         let jobs: Vec<_> = self
             .cube_maps
@@ -338,7 +340,7 @@ impl Renderer {
                     .ground
                     .as_ref()
                     .and_then(|g| GroundView::new(g, &view)),
-                ambient: scene.ambient_rgb,
+                ambient: &ambient,
                 lights: &scene.lights,
                 materials,
                 tris: &scratch.tris,
@@ -493,7 +495,8 @@ mod tests {
     fn entry(dir: Vec3, center: Vec3, radius_m: f32) -> Option<f32> {
         let b = dir.dot(center);
         let h2 = center.length_squared() - b * b;
-        (h2 < radius_m * radius_m).then(|| b - (radius_m * radius_m - h2).sqrt())
+        let t = b - (radius_m * radius_m - h2).sqrt();
+        (h2 < radius_m * radius_m && t > 0.0).then_some(t)
     }
 
     #[test]

@@ -5,8 +5,8 @@ use super::schema::{EnvironmentSpec, MaterialSpec, ObjectSpec};
 use crate::error::CliError;
 use bubble_dynamics::World;
 use raster::{
-    BubbleMesh, Camera, Environment, Ground, Material, Object, Pattern, RenderScene, Sky, Texture,
-    TriMesh, Vec3,
+    BubbleMesh, Camera, Environment, Ground, Irradiance, Material, Object, Pattern, RenderScene,
+    Sky, Texture, TriMesh, Vec3,
 };
 
 impl Scene {
@@ -21,6 +21,8 @@ impl Scene {
         )
         .map_err(|e| CliError::input(format!("{}: camera: {e}", self.origin)))?;
         let mut scene = RenderScene::new(camera, self.environment()?);
+        // The sky lights the ground and the objects, not only the point lights.
+        scene.irradiance = Irradiance::from_environment(&scene.environment);
         scene.ground = match &self.file.ground {
             Some(g) => Some(Ground {
                 height_m: g.height_m.get() as f32,
