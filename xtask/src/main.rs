@@ -155,5 +155,67 @@ fn figures() -> bool {
         "docs/figures/sodium.png",
         ["400", "400"],
     );
-    fig2 && chart && paper && furnace && sodium
+    let gallery = gallery();
+    fig2 && chart && paper && furnace && sodium && gallery
+}
+
+/// The gallery scenes of docs/gallery.md (seed 000 Figs. 5–7 and the demo): a still
+/// and a short animated PNG of each, plus a GIF preview of the wind scene.
+fn gallery() -> bool {
+    const GALLERY: [(&str, &str, &str, &str); 4] = [
+        // scene, still time (s), animation length (s), fps
+        ("wind", "0.2", "1.2", "15"),
+        ("plane-collision", "0.15", "1.2", "15"),
+        ("bubble-collision", "0.12", "1", "20"),
+        ("demo", "0.5", "2", "10"),
+    ];
+    let dir = "docs/figures/gallery";
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    if std::fs::create_dir_all(root.join(dir)).is_err() {
+        return false;
+    }
+    let bubbles = |args: &[&str]| {
+        let mut all = vec!["run", "--release", "-p", "bubbles", "--"];
+        all.extend_from_slice(args);
+        cargo(&all)
+    };
+    let mut ok = true;
+    for (scene, still_s, seconds, fps) in GALLERY {
+        let still = format!("{dir}/{scene}.png");
+        let movie = format!("{dir}/{scene}.apng");
+        ok &= bubbles(&[
+            "render", scene, "--out", &still, "--time-s", still_s, "--width", "400", "--height",
+            "300",
+        ]);
+        ok &= bubbles(&[
+            "animate",
+            scene,
+            "--seconds",
+            seconds,
+            "--fps",
+            fps,
+            "--out",
+            &movie,
+            "--width",
+            "200",
+            "--height",
+            "150",
+        ]);
+    }
+    let gif = format!("{dir}/wind.gif");
+    ok &= bubbles(&[
+        "animate",
+        "wind",
+        "--seconds",
+        "1.2",
+        "--fps",
+        "15",
+        "--out",
+        &gif,
+        "--width",
+        "200",
+        "--height",
+        "150",
+    ]);
+    ok
 }

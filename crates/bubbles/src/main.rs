@@ -34,6 +34,8 @@ enum Command {
     Render(commands::render::Args),
     /// Time the frame and print a breakdown.
     Bench(commands::bench::Args),
+    /// Simulate and render an animation: PNG frames, an animated PNG or a GIF preview.
+    Animate(commands::animate::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -46,6 +48,7 @@ fn main() -> std::process::ExitCode {
         Command::Simulate(args) => commands::simulate::run(args),
         Command::Render(args) => commands::render::run(args),
         Command::Bench(args) => commands::bench::run(args),
+        Command::Animate(args) => commands::animate::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -1,5 +1,6 @@
 //! One module per subcommand, each with `Args` and `run`.
 
+pub mod animate;
 pub mod bake;
 pub mod bench;
 pub mod chart;

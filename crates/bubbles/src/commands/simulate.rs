@@ -9,6 +9,7 @@ use bubble_dynamics::{Bubble, DVec3, Event, SimError, World};
 use serde::Serialize;
 
 use crate::error::{CliError, CliResult};
+use crate::frame::progress::{Progress, advance_world, steps_to};
 use crate::limits;
 use crate::scene::Scene;
 use crate::scene::values::{BubbleRadius, Num, plain};
@@ -143,20 +144,32 @@ fn check_work(scene: &Scene, world: &World, args: &Args) -> CliResult {
 }
 
 /// Advances the world to `--seconds`, through every output frame when exporting;
-/// returns the events and the number of frames written.
+/// returns the events and the number of frames written. A progress bar shows on stderr
+/// when the solver takes more than about a second.
 fn simulate(world: &mut World, args: &Args) -> Result<(Vec<Event>, usize), SimFailure> {
+    let mut bar = Progress::steps(steps_to(world, args.seconds));
+    let result = simulate_with(world, args, &mut bar);
+    bar.finish();
+    result
+}
+
+fn simulate_with(
+    world: &mut World,
+    args: &Args,
+    bar: &mut Progress,
+) -> Result<(Vec<Event>, usize), SimFailure> {
     let Some(dir) = &args.export_obj else {
-        return Ok((world.advance_to(args.seconds)?, 0));
+        return Ok((advance_world(world, args.seconds, bar)?, 0));
     };
     // The last frame lands exactly on --seconds; rounding protects k/fps = seconds.
     let last = (args.seconds * args.fps + 1e-9).floor() as usize;
     let mut events = Vec::new();
     for k in 0..=last {
-        events.extend(world.advance_to(k as f64 / args.fps)?);
+        events.extend(advance_world(world, k as f64 / args.fps, bar)?);
         write_atomic(&dir.join(format!("frame_{k:05}.obj")), &obj_text(world, k))
             .map_err(SimFailure::Write)?;
     }
-    events.extend(world.advance_to(args.seconds)?);
+    events.extend(advance_world(world, args.seconds, bar)?);
     Ok((events, last + 1))
 }
 

@@ -1,5 +1,7 @@
 //! One frame's work shared by `render` and `bench`: scene → solver → tables → renderer.
 
+pub mod progress;
+
 use crate::error::CliError;
 use crate::limits;
 use crate::scene::schema::RenderSpec;
@@ -136,8 +138,9 @@ impl FrameJob {
         &self.settings
     }
 
-    /// Advances the simulation to `time_s`, with a progress bar on stderr when asked.
-    pub fn advance_to(&mut self, time_s: f64, progress: bool) -> Result<(), CliError> {
+    /// Advances the simulation to `time_s` (the step nearest it), with a progress bar on
+    /// stderr when asked and the solver takes more than about a second.
+    pub fn advance_to(&mut self, time_s: f64, show_progress: bool) -> Result<(), CliError> {
         if !(time_s.is_finite() && time_s >= 0.0) {
             return Err(CliError::input(format!(
                 "--time-s {}: must be a finite number of seconds >= 0",
@@ -147,17 +150,15 @@ impl FrameJob {
         let what = format!("advancing to t = {} s", plain(time_s));
         let (now_s, dt_s) = (self.world.time_s(), self.world.dt_s());
         self.scene.check_steps(&what, now_s, time_s, dt_s)?;
-        let steps = ((time_s - now_s) / dt_s).ceil().max(0.0) as u64;
-        let bar = (progress && steps > 0).then(|| indicatif::ProgressBar::new(steps));
-        while self.world.time_s() < time_s - 0.5 * self.world.dt_s() {
-            self.step()?;
-            if let Some(bar) = &bar {
-                bar.inc(1);
-            }
-        }
-        if let Some(bar) = bar {
-            bar.finish_and_clear();
-        }
+        let steps = progress::steps_to(&self.world, time_s).saturating_sub(self.world.steps());
+        let mut bar = if show_progress {
+            progress::Progress::steps(steps)
+        } else {
+            progress::Progress::off()
+        };
+        progress::advance_world(&mut self.world, time_s, &mut bar)
+            .map_err(|e| CliError::runtime(format!("simulation failed: {e}")))?;
+        bar.finish();
         Ok(())
     }
 

@@ -16,12 +16,23 @@ pub use to_dynamics::sim_error;
 pub use to_raster::bubble_meshes;
 
 /// Built-in scenes, by name, with their TOML source.
-pub const BUILTINS: [(&str, &str); 2] = [
+pub const BUILTINS: [(&str, &str); 7] = [
     ("paper", include_str!("../../scenes/paper.toml")),
     (
         "white-furnace",
         include_str!("../../scenes/white-furnace.toml"),
     ),
+    ("wind", include_str!("../../scenes/wind.toml")),
+    (
+        "plane-collision",
+        include_str!("../../scenes/plane-collision.toml"),
+    ),
+    (
+        "bubble-collision",
+        include_str!("../../scenes/bubble-collision.toml"),
+    ),
+    ("demo", include_str!("../../scenes/demo.toml")),
+    ("demo-white", include_str!("../../scenes/demo-white.toml")),
 ];
 
 /// Name of the scene used when none is given.
