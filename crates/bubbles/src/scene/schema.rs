@@ -331,6 +331,10 @@ pub struct BubbleSpec {
     /// Molar mass of the gas inside, kg/mol (air 0.02896, helium 0.004).
     #[serde(default)]
     pub gas_molar_mass_kg_per_mol: Option<Positive>,
+    /// Initial per-axis stretch of the rest bubble (its gas is the rest bubble's, so
+    /// anything but 1 starts it out of equilibrium).
+    #[serde(default)]
+    pub initial_scale: Option<Vec3>,
 }
 
 fn mean_thickness() -> Positive {
