@@ -2,10 +2,13 @@
 
 use std::process::{Command, ExitCode};
 
-const USAGE: &str = "usage: cargo xtask <figures|bench|ci>
-  figures  regenerate the PNG figures under docs/figures/
-  bench    run every crate's criterion benches, then `bubbles bench` (frame breakdown)
-  ci       run what .ci/run runs (fmt, clippy, tests)";
+mod docs_check;
+
+const USAGE: &str = "usage: cargo xtask <figures|bench|ci|docs-check>
+  figures     regenerate the PNG figures under docs/figures/
+  bench       run every crate's criterion benches, then `bubbles bench` (frame breakdown)
+  ci          run what .ci/run runs (fmt, clippy, tests, docs-check)
+  docs-check  check that every figure block in docs/ names the command that reproduces it";
 
 fn main() -> ExitCode {
     let task = std::env::args().nth(1);
@@ -13,6 +16,7 @@ fn main() -> ExitCode {
         Some("figures") => figures(),
         Some("bench") => bench(),
         Some("ci") => ci(),
+        Some("docs-check") => docs_check::run(),
         _ => {
             eprintln!("{USAGE}");
             return ExitCode::from(2);
@@ -70,6 +74,7 @@ fn ci() -> bool {
             "warnings",
         ])
         && cargo(&["test", "--workspace"])
+        && docs_check::run()
 }
 
 fn figures() -> bool {

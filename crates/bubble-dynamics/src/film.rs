@@ -133,11 +133,14 @@ impl Bubble {
     /// to `vertices[1]`.
     ///
     /// Drainage: q = ρ g_t h³/(3μ) per unit width (a film draining under gravity with
-    /// lubrication theory), upwind thickness, times the width of the dual cell boundary
-    /// across the edge, (h_left + h_right)/3 = 2(A_left + A_right)/(3|e|) from the two
-    /// faces' heights. With g_t = g·e/|e| the flux needs no square root. Swirl: film
-    /// volume ψ_left − ψ_right per unit time across the dual edge (`swirl` holds ψ per
-    /// face), upwind thickness.
+    /// lubrication theory), upwind thickness, through the dual-cell boundary across the
+    /// edge. Per face, g_t is the projection of g on the face plane (the gradient of the
+    /// linear function g·x), and its flux through the barycentric dual boundary is
+    /// g·(x_j − x_i)·cot(opposite angle)/2: the cotangent weights, exact for any
+    /// triangle shape. (A width of 2(A_left + A_right)/(3|e|) along the edge is exact
+    /// only for equilateral triangles and drained 7 % too fast on the level-3 icosphere.)
+    /// Swirl: film volume ψ_left − ψ_right per unit time across the dual edge (`swirl`
+    /// holds ψ per face), upwind thickness.
     fn edge_fluxes_kg_per_s(
         &self,
         g_eff: DVec3,
@@ -147,20 +150,27 @@ impl Bubble {
         out: &mut Vec<f64>,
     ) {
         let x = &self.positions_m;
+        let triangles = self.topology.triangles();
         let rho = self.film.density_kg_per_m3;
-        // ρ/(3μ)·ρ h³ g_t·width, with width/|e| = 2(A_l + A_r)/(3|e|²).
-        let mobility = 2.0 * rho * rho / (9.0 * self.film.drainage_viscosity_pa_s);
+        // ρ·ρ h³/(3μ) times g·e·(cot α + cot β)/2, and cot = u·v/(2A) at the corner
+        // opposite the edge.
+        let mobility = rho * rho / (12.0 * self.film.drainage_viscosity_pa_s);
+        let cot_times_2a = |f: usize, i: usize, j: usize| {
+            let t = triangles[f];
+            let k = t[0] as usize + t[1] as usize + t[2] as usize - i - j;
+            (x[i] - x[k]).dot(x[j] - x[k])
+        };
         out.clear();
         out.extend(self.topology.edges().iter().map(|e| {
             let [i, j] = e.vertices.map(|v| v as usize);
             // The sign of a flux is as good as random: select the index, not the branch.
             let upwind = |q: f64| h[if q > 0.0 { i } else { j }];
             let [fa, fb] = e.faces.map(|f| f as usize);
-            let edge = x[j] - x[i];
-            let g_dot_e = g_eff.dot(edge);
+            let g_dot_e = g_eff.dot(x[j] - x[i]);
             let hu = upwind(g_dot_e);
-            let mut q = mobility * g_dot_e * (face_areas[fa] + face_areas[fb]) * (hu * hu * hu)
-                / edge.length_squared();
+            let cot_sum =
+                cot_times_2a(fa, i, j) / face_areas[fa] + cot_times_2a(fb, i, j) / face_areas[fb];
+            let mut q = mobility * g_dot_e * cot_sum * (hu * hu * hu);
             if let Some(psi) = swirl {
                 let volume_rate = psi[fa] - psi[fb];
                 q += rho * volume_rate * upwind(volume_rate);

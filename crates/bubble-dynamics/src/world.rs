@@ -20,6 +20,12 @@ use crate::wind::{Wind, WindField};
 /// Measured: a violent two-bubble collision in gusts stays stable up to 1.5 with the
 /// Gershgorin bound below and blows up at 2; 0.75 leaves a factor 2 of margin.
 const STABILITY_FRACTION: f64 = 0.75;
+/// A substep count, once chosen, is kept while the stability bound asks for no more and
+/// for at least 1/SUBSTEP_HYSTERESIS of it. A count that follows the bound exactly flips
+/// between n and n + 1 in step with a wobble that sits at the boundary, and that
+/// state-dependent step pumped a free bubble's energy up 66-fold in 2 s
+/// (`tests/stability_at_substep_bound.rs`).
+const SUBSTEP_HYSTERESIS: f64 = 1.25;
 /// A bubble whose volume leaves [1/VOLUME_BLOWUP, VOLUME_BLOWUP]× its rest volume diverged.
 const VOLUME_BLOWUP: f64 = 100.0;
 
@@ -260,9 +266,8 @@ impl World {
                 worst = (omega, b.id);
             }
         }
-        let needed = (self.params.dt_s * worst.0 / (2.0 * STABILITY_FRACTION))
-            .ceil()
-            .max(1.0);
+        let raw = self.params.dt_s * worst.0 / (2.0 * STABILITY_FRACTION);
+        let needed = keep_within_band(f64::from(self.last_substeps), raw);
         if needed.is_nan() || needed > f64::from(self.params.max_substeps) {
             return Err(SimError::TooManySubsteps {
                 step,
@@ -349,6 +354,21 @@ impl Bubble {
             }
         }
         (!volume_ok).then_some(Divergence::Volume { ratio })
+    }
+}
+
+/// The substep count for a bound of `raw` substeps after a step that took `last`: at
+/// least ⌈raw⌉ (stability), `last` itself while it lies within the hysteresis band, else
+/// ⌈SUBSTEP_HYSTERESIS·raw⌉ (at least 1; NaN stays NaN for the caller to report).
+fn keep_within_band(last: f64, raw: f64) -> f64 {
+    let lower = raw.ceil().max(1.0);
+    let upper = (SUBSTEP_HYSTERESIS * raw).ceil().max(1.0);
+    if raw.is_nan() {
+        raw
+    } else if last < lower || last > upper {
+        if last < lower { lower } else { upper }
+    } else {
+        last
     }
 }
 

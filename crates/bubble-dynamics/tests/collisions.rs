@@ -67,6 +67,7 @@ fn bubbles_thrown_at_each_other_do_not_interpenetrate_and_bounce() {
         touched |= a.center_m().distance(b.center_m()) < 1.9 * r;
     }
     assert!(touched, "the bubbles never met");
+    println!("thrown pair: deepest vertex {worst:.2e} R inside the other bubble");
     assert!(
         worst <= 0.01,
         "a vertex went {:.3} % of R into the other bubble",
@@ -221,6 +222,7 @@ fn a_crowd_of_bubbles_in_a_box_settles_without_interpenetrating() {
         }
     }
     assert_eq!(w.bubbles().len(), 18, "bubbles lost");
+    println!("18 bubbles in a box: deepest overlap {worst:.2e} R");
     assert!(worst <= 0.01, "deepest overlap {:.3} % of R", 100.0 * worst);
     for b in w.bubbles() {
         assert!(

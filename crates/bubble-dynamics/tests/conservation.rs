@@ -18,12 +18,19 @@ fn volume_is_conserved_under_internal_forces_after_a_perturbation() {
     };
     let mut w = world(isolated(), vec![bubble]);
     let v0 = w.bubbles()[0].volume_m3();
+    // The isothermal gas turns a pressure change δp into δV/V = −δp/p. The film can
+    // change the pressure by no more than a few times its Laplace pressure 4σ/R (2 Pa
+    // here): allow 10× that, 2e-4, where the old 1e-3 allowed 100 Pa. Measured 7.4e-5.
+    // (Even a factor 2 in the tension moves the volume by only 2e-5: the tension itself is
+    // checked by tests/shape_oscillation.rs and by the relaxation tests.)
+    let p_in = w.bubbles()[0].pressure_in_pa();
+    let tolerance = 10.0 * 4.0 * 0.025 / 0.05 / p_in;
     let mut max_ke: f64 = 0.0;
     for _ in 0..120 {
         w.step().expect("stable");
         let b = &w.bubbles()[0];
         max_ke = max_ke.max(b.kinetic_energy_j());
-        assert_rel("volume", b.volume_m3(), v0, 1e-3);
+        assert_rel("volume", b.volume_m3(), v0, tolerance);
     }
     assert!(max_ke > 1e-9, "the bubble never moved: KE {max_ke:.3e} J");
 }

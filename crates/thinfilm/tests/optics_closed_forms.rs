@@ -9,24 +9,34 @@ use proptest::prelude::*;
 use thinfilm::fresnel::{Interface, OpticsError, amplitudes, cos_transmitted};
 use thinfilm::tmm::{Layer, Stack};
 
+/// (r, t) of one polarisation, picked from a set of Fresnel amplitudes.
+type Pick = fn(&thinfilm::fresnel::Amplitudes) -> (Complex64, Complex64);
+
 /// `r` and `t` of a film by adding reflected orders one by one until they stop mattering:
 /// `r = r01 + t01 t10 r12 e^{2iβ} Σ_m (r10 r12 e^{2iβ})^m`, with every coefficient from the
-/// single-interface Fresnel formulas in both directions (no Stokes relations used).
-fn series(n0: f64, n1: f64, n2: Complex64, d: f64, l: f64, cos0: f64) -> (Complex64, Complex64) {
+/// single-interface Fresnel formulas in both directions (no Stokes relations used), for
+/// the polarisation `pick` selects.
+fn series(
+    (n0, n1, n2): (f64, f64, Complex64),
+    d: f64,
+    l: f64,
+    cos0: f64,
+    pick: Pick,
+) -> (Complex64, Complex64) {
     let cos1 = cos_transmitted(n0, re(n1), cos0);
     let cos2 = cos_transmitted(n0, n2, cos0);
     let c0 = re(cos0);
-    let a01 = amplitudes(re(n0), c0, re(n1), cos1);
-    let a10 = amplitudes(re(n1), cos1, re(n0), c0);
-    let a12 = amplitudes(re(n1), cos1, n2, cos2);
+    let (r01, t01) = pick(&amplitudes(re(n0), c0, re(n1), cos1));
+    let (r10, t10) = pick(&amplitudes(re(n1), cos1, re(n0), c0));
+    let (r12, t12) = pick(&amplitudes(re(n1), cos1, n2, cos2));
     let beta = std::f64::consts::TAU * n1 * d * cos1 / l;
     let one_way = (Complex64::i() * beta).exp();
-    let round = a10.r_s * a12.r_s * one_way * one_way;
-    let (mut r, mut t) = (a01.r_s, Complex64::new(0.0, 0.0));
+    let round = r10 * r12 * one_way * one_way;
+    let (mut r, mut t) = (r01, Complex64::new(0.0, 0.0));
     let mut bounce = Complex64::new(1.0, 0.0);
     for _ in 0..100_000 {
-        r += a01.t_s * a10.t_s * a12.r_s * one_way * one_way * bounce;
-        t += a01.t_s * a12.t_s * one_way * bounce;
+        r += t01 * t10 * r12 * one_way * one_way * bounce;
+        t += t01 * t12 * one_way * bounce;
         bounce *= round;
         if bounce.norm() < 1e-17 {
             break;
@@ -44,10 +54,13 @@ proptest! {
         d in 0.0..2000.0f64, l in 360.0..830.0f64, cos0 in 0.2..=1.0f64,
     ) {
         let n2 = Complex64::new(n2r, n2i);
-        let (r_sum, t_sum) = series(n0, n1, n2, d, l, cos0);
         let amp = film(n0, n1, n2, d).try_amplitudes(l, cos0).unwrap();
+        let (r_sum, t_sum) = series((n0, n1, n2), d, l, cos0, |a| (a.r_s, a.t_s));
         assert_close_c("r_s", amp.r_s, r_sum, 1e-10);
         assert_close_c("t_s", amp.t_s, t_sum, 1e-10);
+        let (r_sum, t_sum) = series((n0, n1, n2), d, l, cos0, |a| (a.r_p, a.t_p));
+        assert_close_c("r_p", amp.r_p, r_sum, 1e-10);
+        assert_close_c("t_p", amp.t_p, t_sum, 1e-10);
     }
 
     #[test]

@@ -5,10 +5,10 @@
 
 use super::values::{
     Acceleration, Bounds, BubbleRadius, Coordinate, Count, CubeMapSize, Damping, Direction,
-    Elasticity, Evaporation, Exposure, FieldOfView, FilmIndex, FilmThickness, GustSpeed, Intensity,
-    LightRadius, Luminance, MeshScale, MolarMass, Num, Num3, ObjectRadius, PatternScale, Radiance,
-    Reflectance, RuptureThickness, Samples, Seconds, Shininess, SloshSpeed, Speed, Subdivisions,
-    SurfaceTension, TimeStep, Variation, Viscosity,
+    Elasticity, Evaporation, Exposure, FieldOfView, FilmIndex, FilmThickness, GustSpeed,
+    InitialScale, Intensity, LightRadius, Luminance, MeshScale, MolarMass, Num, Num3, ObjectRadius,
+    PatternScale, Radiance, Reflectance, RuptureThickness, Samples, Seconds, Shininess, SloshSpeed,
+    Speed, Subdivisions, SurfaceTension, TimeStep, Variation, Viscosity,
 };
 use serde::Deserialize;
 
@@ -342,6 +342,10 @@ pub struct BubbleSpec {
     /// Molar mass of the gas inside, kg/mol (air 0.02896, helium 0.004).
     #[serde(default)]
     pub gas_molar_mass_kg_per_mol: Option<Num<MolarMass>>,
+    /// Initial per-axis stretch of the rest bubble (its gas is the rest bubble's, so
+    /// anything but 1 starts it out of equilibrium).
+    #[serde(default)]
+    pub initial_scale: Option<Num3<InitialScale>>,
 }
 
 fn mean_thickness() -> Num<FilmThickness> {

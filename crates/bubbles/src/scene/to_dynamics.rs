@@ -130,6 +130,9 @@ fn bubble_params(spec: &BubbleSpec) -> BubbleParams {
             spec.gas_molar_mass_kg_per_mol.map(|v| v.get()),
             defaults.gas_molar_mass_kg_per_mol,
         ),
+        initial_scale: spec
+            .initial_scale
+            .map_or(defaults.initial_scale, |v| dvec(v.get())),
         ..defaults
     }
 }

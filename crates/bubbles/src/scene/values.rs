@@ -233,6 +233,8 @@ bounds! {
     ObjectRadius: 1e-4, 1e4, "m";
     /// Uniform scale of an OBJ mesh.
     MeshScale: 1e-6, 1e6, "";
+    /// A bubble's initial per-axis stretch: a squash or stretch, never a collapse.
+    InitialScale: 0.5, 2.0, "";
     /// Radius of a light sphere.
     LightRadius: 1e-4, 100.0, "m";
     /// Luminance of a light's surface, relative to white 1.
