@@ -245,18 +245,24 @@ impl Interface {
     }
 }
 
-/// Checks a real refractive index: finite and `> 0`.
+/// The largest index modulus accepted: far above any material's (metals in the far infrared
+/// reach a few hundred), and small enough that `n²` and its products stay finite.
+pub const MAX_INDEX: f64 = 1e6;
+
+/// Checks a real refractive index: finite, `> 0` and `≤ MAX_INDEX`.
 pub(crate) fn check_real_index(what: &'static str, n: f64) -> Result<(), OpticsError> {
-    if n.is_finite() && n > 0.0 {
+    if n.is_finite() && n > 0.0 && n <= MAX_INDEX {
         Ok(())
     } else {
         Err(OpticsError::Index { what, value: n })
     }
 }
 
-/// Checks a complex index: finite, `Re > 0`, `Im ≥ 0` (absorbing, never amplifying).
+/// Checks a complex index: finite, `Re > 0`, `Im ≥ 0` (absorbing, never amplifying),
+/// modulus `≤ MAX_INDEX`.
 pub(crate) fn check_complex_index(what: &'static str, n: Complex64) -> Result<(), OpticsError> {
-    if n.re.is_finite() && n.im.is_finite() && n.re > 0.0 && n.im >= 0.0 {
+    let bounded = n.re <= MAX_INDEX && n.im <= MAX_INDEX;
+    if n.re.is_finite() && n.im.is_finite() && n.re > 0.0 && n.im >= 0.0 && bounded {
         Ok(())
     } else {
         Err(OpticsError::ComplexIndex { what, value: n })

@@ -44,6 +44,7 @@ pub use dispersion::RefractiveIndex;
 pub use fresnel::{Interface, OpticsError};
 pub use incidence::Incidence;
 pub use index::{IndexModel, NkTable};
+pub use num_complex::Complex64;
 pub use tmm::{Layer, Stack};
 
 pub use cmf::Observer;

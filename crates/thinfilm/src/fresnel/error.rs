@@ -94,12 +94,17 @@ impl fmt::Display for OpticsError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             OpticsError::Index { what, value } => {
-                write!(f, "{what} = {value} is not a finite refractive index > 0")
+                write!(
+                    f,
+                    "{what} = {value:?} is not a refractive index in (0, {:?}]",
+                    super::MAX_INDEX
+                )
             }
             OpticsError::ComplexIndex { what, value } => write!(
                 f,
-                "{what} = {value} is not a finite complex index with real part > 0 and \
-                 imaginary part >= 0"
+                "{what} = {value} is not a complex index with real part in (0, {max:?}] and \
+                 imaginary part in [0, {max:?}]",
+                max = super::MAX_INDEX
             ),
             OpticsError::Cosine { what, value } => {
                 write!(f, "{what} = {value} is not a cosine in [0, 1]")
@@ -124,7 +129,8 @@ impl fmt::Display for OpticsError {
                 value,
             } => write!(
                 f,
-                "dispersion model gives n = {value} at {wavelength_nm} nm (not finite and > 0)"
+                "dispersion model gives n = {value:?} at {wavelength_nm} nm (not in (0, {:?}])",
+                super::MAX_INDEX
             ),
             OpticsError::OutOfRange {
                 model,
