@@ -247,11 +247,21 @@ fn bad_options_are_rejected_naming_the_value() {
     assert!(err.contains("1976"), "{err}");
     let err = rejected(&["--n-film", "0"], input);
     assert!(err.contains("--n-film 0"), "{err}");
+    // Finite but so large that n² overflows: once a NaN colour and exit 1.
+    let err = rejected(&["--n-film", "1e155"], input);
+    assert!(err.contains("--n-film 1e155"), "{err}");
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("bad.csv");
     std::fs::write(&path, "wavelength_nm,value\n400,1\n410,-2\n").unwrap();
     let err = rejected(&["--illuminant", path.to_str().unwrap()], input);
     assert!(err.contains("line 3") && err.contains("-2"), "{err}");
+    let huge = dir.path().join("huge.csv");
+    std::fs::write(&huge, "wavelength_nm,value\n400,1\n500,1e308\n600,1\n").unwrap();
+    let err = rejected(&["--illuminant", huge.to_str().unwrap()], input);
+    assert!(
+        err.contains("huge.csv") && err.contains("line 3") && err.contains("1e308"),
+        "{err}"
+    );
     let missing = dir.path().join("missing.csv");
     let err = rejected(&["--illuminant", missing.to_str().unwrap()], input);
     assert!(err.contains("missing.csv"), "{err}");

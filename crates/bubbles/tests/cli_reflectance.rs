@@ -45,7 +45,9 @@ fn rows(text: &str) -> Vec<Vec<f64>> {
 
 fn expected(n_outside: f64, d: f64, angle: f64, l: f64, n: f64) -> [f64; 4] {
     let film = ThinFilm::symmetric(n_outside, RefractiveIndex::Constant(n), d);
-    let resp = film.response(l, angle.to_radians().cos());
+    // The CLI takes the angle itself, not its cosine, so grazing rows stay exact.
+    let incidence = thinfilm::Incidence::try_from_angle_deg(angle).unwrap();
+    let resp = film.try_response_at(l, incidence).unwrap();
     [resp.r_s, resp.r_p, resp.r(), resp.t()]
 }
 
@@ -235,13 +237,27 @@ fn angle_outside_0_to_90_is_rejected() {
 }
 
 #[test]
-fn wavelength_outside_colour_range_is_rejected() {
+fn wavelength_outside_the_constant_index_range_is_rejected() {
     rejects(
         &[],
-        &format!("{GOOD}100,10,359.9\n"),
-        &["line 3", "wavelength_nm", "'359.9'"],
+        &format!("{GOOD}100,10,99.9\n"),
+        &["line 3", "wavelength_nm", "'99.9'", "[100, 100000]"],
     );
-    rejects(&[], &format!("{GOOD}100,10,831\n"), &["line 3", "'831'"]);
+    rejects(
+        &[],
+        &format!("{GOOD}100,10,100001\n"),
+        &["line 3", "'100001'"],
+    );
+}
+
+#[test]
+fn infrared_and_ultraviolet_wavelengths_match_the_library() {
+    let input = "thickness_nm,angle_deg,wavelength_nm\n300,20,1550\n300,20,350\n";
+    let out = rows(&stdout(&run(&[], input)));
+    for (row, l) in out.iter().zip([1550.0, 350.0]) {
+        let want = expected(1.0, 300.0, 20.0, l, 1.33);
+        assert_eq!(&row[4..], &want[..], "{l} nm");
+    }
 }
 
 #[test]
@@ -261,6 +277,12 @@ fn bad_refractive_index_is_rejected() {
         &[],
         &format!("{header}100,10,500,inf\n"),
         &["line 2", "'inf'"],
+    );
+    // Finite, but n² overflows: once printed NaN and exited 0.
+    rejects(
+        &[],
+        &format!("{header}0,0,500,1e155\n"),
+        &["line 2", "'1e155'"],
     );
     rejects(&["--n-outside", "0"], GOOD, &["--n-outside 0"]);
     rejects(&["--n-film", "-2"], GOOD, &["--n-film -2"]);

@@ -70,6 +70,7 @@ fn refuses_bad_film_indices() {
         a: 1.0,
         b_nm2: -1e6,
         c_nm4: 0.0,
+        range_nm: thinfilm::dispersion::VALIDATED_RANGE_NM,
     };
     assert!(matches!(
         refused(BakeConfig::builder().film_index(cauchy)),

@@ -42,7 +42,7 @@ fn bench_reference(c: &mut Criterion) {
         b.iter(|| {
             let mut sum = 0.0;
             for &d in d.iter().step_by(8) {
-                let stack = ThinFilm::soap(d as f64).try_stack(550.0).unwrap();
+                let stack = ThinFilm::soap(d as f64).try_stack().unwrap();
                 for &l in &l {
                     sum += stack.response(l as f64, black_box(0.8)).r();
                 }

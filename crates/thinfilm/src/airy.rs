@@ -16,6 +16,7 @@
 use crate::dispersion::RefractiveIndex;
 pub use crate::fresnel::Response;
 use crate::fresnel::{self, Amplitudes, OpticsError};
+use crate::incidence::Incidence;
 use crate::tmm::{Layer, Stack};
 use num_complex::Complex64;
 
@@ -81,12 +82,11 @@ impl ThinFilm {
         fresnel::check_thickness(self.thickness_nm)
     }
 
-    /// The equivalent one-layer [`Stack`] at `wavelength_nm`.
-    pub fn try_stack(&self, wavelength_nm: f64) -> Result<Stack, OpticsError> {
-        let n_film = self.n_film.try_n_at(wavelength_nm)?;
+    /// The equivalent one-layer [`Stack`] (the film keeps its dispersion model).
+    pub fn try_stack(&self) -> Result<Stack, OpticsError> {
         Stack::new(
             self.n_outside,
-            vec![Layer::lossless(n_film, self.thickness_nm)],
+            vec![Layer::new(self.n_film, self.thickness_nm)],
             self.n_substrate,
         )
     }
@@ -97,12 +97,22 @@ impl ThinFilm {
         wavelength_nm: f64,
         cos_theta_outside: f64,
     ) -> Result<Amplitudes, OpticsError> {
-        let geometry = self.geometry(wavelength_nm, cos_theta_outside)?;
+        fresnel::check_cos("cos_theta_outside", cos_theta_outside)?;
+        self.try_amplitudes_at(wavelength_nm, Incidence::try_from_cos(cos_theta_outside)?)
+    }
+
+    /// Amplitude coefficients at `wavelength_nm` in the direction `incidence`.
+    pub fn try_amplitudes_at(
+        &self,
+        wavelength_nm: f64,
+        incidence: Incidence,
+    ) -> Result<Amplitudes, OpticsError> {
+        let geometry = self.geometry(wavelength_nm, incidence)?;
         match geometry.airy() {
-            Some(amplitudes) if cos_theta_outside > 0.0 => Ok(amplitudes),
+            Some(amplitudes) if incidence.cos() > 0.0 => Ok(amplitudes),
             _ => self
-                .try_stack(wavelength_nm)?
-                .try_amplitudes(wavelength_nm, cos_theta_outside),
+                .try_stack()?
+                .try_amplitudes_at(wavelength_nm, incidence),
         }
     }
 
@@ -116,8 +126,19 @@ impl ThinFilm {
         wavelength_nm: f64,
         cos_theta_outside: f64,
     ) -> Result<Response, OpticsError> {
-        let geometry = self.geometry(wavelength_nm, cos_theta_outside)?;
-        if cos_theta_outside == 0.0 {
+        fresnel::check_cos("cos_theta_outside", cos_theta_outside)?;
+        self.try_response_at(wavelength_nm, Incidence::try_from_cos(cos_theta_outside)?)
+    }
+
+    /// Intensity reflectance and transmittance at `wavelength_nm` in the direction
+    /// `incidence`; pass the angle or `sin θ` there to keep grazing incidence exact.
+    pub fn try_response_at(
+        &self,
+        wavelength_nm: f64,
+        incidence: Incidence,
+    ) -> Result<Response, OpticsError> {
+        let geometry = self.geometry(wavelength_nm, incidence)?;
+        if incidence.cos() == 0.0 {
             let n0 = Complex64::new(self.n_outside, 0.0);
             return Ok(Response::grazing(
                 geometry.n1 == n0 && self.n_substrate == n0,
@@ -125,9 +146,7 @@ impl ThinFilm {
         }
         match geometry.airy() {
             Some(amp) => Ok(geometry.intensities(&amp)),
-            None => self
-                .try_stack(wavelength_nm)?
-                .try_response(wavelength_nm, cos_theta_outside),
+            None => self.try_stack()?.try_response_at(wavelength_nm, incidence),
         }
     }
 
@@ -141,21 +160,15 @@ impl ThinFilm {
             .unwrap_or_else(|err| panic!("{err}"))
     }
 
-    fn geometry(
-        &self,
-        wavelength_nm: f64,
-        cos_theta_outside: f64,
-    ) -> Result<Geometry, OpticsError> {
+    fn geometry(&self, wavelength_nm: f64, incidence: Incidence) -> Result<Geometry, OpticsError> {
         self.validate()?;
         fresnel::check_wavelength(wavelength_nm)?;
-        fresnel::check_cos("cos_theta_outside", cos_theta_outside)?;
         let n1 = Complex64::new(self.n_film.try_n_at(wavelength_nm)?, 0.0);
-        let n_sin = fresnel::n_sin(self.n_outside, cos_theta_outside);
-        let q1 = fresnel::normal_index(n1, n_sin);
-        let q2 = fresnel::normal_index(self.n_substrate, n_sin);
+        let q1 = incidence.normal_index(self.n_outside, n1);
+        let q2 = incidence.normal_index(self.n_outside, self.n_substrate);
         Ok(Geometry {
             n0: self.n_outside,
-            cos0: cos_theta_outside,
+            cos0: incidence.cos(),
             n1,
             cos1: q1 / n1,
             n2: self.n_substrate,

@@ -4,9 +4,13 @@
 
 use crate::fresnel::OpticsError;
 
-/// Wavelengths (nm) over which the validated constructors guarantee a finite index `> 0`:
-/// the range of the CIE colour-matching data.
+/// The range (nm) that [`RefractiveIndex::cauchy`] and [`RefractiveIndex::sellmeier`] give
+/// a model when no range is named: the range of the CIE colour-matching data.
 pub const VALIDATED_RANGE_NM: [f64; 2] = [360.0, 830.0];
+
+/// Wavelengths (nm) a constant index covers: from the far ultraviolet to the far infrared,
+/// where a wavelength-independent index is a fair model of a transparent medium.
+pub const CONSTANT_RANGE_NM: [f64; 2] = [100.0, 100_000.0];
 
 /// Wavelengths (nm) over which the IAPWS water formulation is valid (its release's range).
 pub const WATER_RANGE_NM: [f64; 2] = [200.0, 1100.0];
@@ -22,7 +26,7 @@ pub const WATER_DENSITY_KG_PER_M3: f64 = 998.207;
 pub enum RefractiveIndex {
     /// The same index at every wavelength.
     Constant(f64),
-    /// Cauchy's formula `n = a + b/λ² + c/λ⁴`, with λ in nm.
+    /// Cauchy's formula `n = a + b/λ² + c/λ⁴`, with λ in nm, over `range_nm`.
     Cauchy {
         /// Constant term.
         a: f64,
@@ -30,13 +34,17 @@ pub enum RefractiveIndex {
         b_nm2: f64,
         /// Coefficient of `1/λ⁴`, in nm⁴.
         c_nm4: f64,
+        /// The wavelengths (nm) where the fit holds: `[lo, hi]`.
+        range_nm: [f64; 2],
     },
-    /// Three-term Sellmeier formula `n² = 1 + Σ B_i λ²/(λ² − C_i)`, with λ in nm.
+    /// Three-term Sellmeier formula `n² = 1 + Σ B_i λ²/(λ² − C_i)`, with λ in nm, over `range_nm`.
     Sellmeier {
         /// Oscillator strengths `B_i` (dimensionless).
         b: [f64; 3],
         /// Squared resonance wavelengths `C_i`, in nm².
         c_nm2: [f64; 3],
+        /// The wavelengths (nm) where the fit holds: `[lo, hi]`.
+        range_nm: [f64; 2],
     },
     /// Pure liquid water at 20 °C and atmospheric pressure: the IAPWS R9-97 formulation
     /// (Harvey, Gallagher & Levelt Sengers, J. Phys. Chem. Ref. Data 27, 761 (1998)), valid
@@ -57,21 +65,63 @@ impl RefractiveIndex {
         RefractiveIndex::Constant(n).validated()
     }
 
-    /// A Cauchy model `a + b_nm2/λ² + c_nm4/λ⁴`.
+    /// A Cauchy model `a + b_nm2/λ² + c_nm4/λ⁴` over [`VALIDATED_RANGE_NM`].
     ///
     /// # Guarantees
-    /// All coefficients are finite and the index is finite and `> 0` over [`VALIDATED_RANGE_NM`].
+    /// As [`RefractiveIndex::cauchy_over`] with that range.
     pub fn cauchy(a: f64, b_nm2: f64, c_nm4: f64) -> Result<RefractiveIndex, OpticsError> {
-        RefractiveIndex::Cauchy { a, b_nm2, c_nm4 }.validated()
+        RefractiveIndex::cauchy_over(a, b_nm2, c_nm4, VALIDATED_RANGE_NM)
     }
 
-    /// A three-term Sellmeier model `n² = 1 + Σ b[i] λ²/(λ² − c_nm2[i])`.
+    /// A Cauchy model `a + b_nm2/λ² + c_nm4/λ⁴` valid over `range_nm` = `[lo, hi]`.
     ///
     /// # Guarantees
-    /// All `b[i] ≥ 0` and `c_nm2[i] ≥ 0` are finite, no resonance `sqrt(c_nm2[i])` lies in
-    /// [`VALIDATED_RANGE_NM`], and the index is finite and `> 0` over that range.
+    /// `0 < lo ≤ hi` are finite, all coefficients are finite and the index is finite and
+    /// `> 0` over the whole range.
+    pub fn cauchy_over(
+        a: f64,
+        b_nm2: f64,
+        c_nm4: f64,
+        range_nm: [f64; 2],
+    ) -> Result<RefractiveIndex, OpticsError> {
+        RefractiveIndex::Cauchy {
+            a,
+            b_nm2,
+            c_nm4,
+            range_nm,
+        }
+        .validated()
+    }
+
+    /// A three-term Sellmeier model `n² = 1 + Σ b[i] λ²/(λ² − c_nm2[i])` over [`VALIDATED_RANGE_NM`].
+    ///
+    /// # Guarantees
+    /// As [`RefractiveIndex::sellmeier_over`] with that range.
     pub fn sellmeier(b: [f64; 3], c_nm2: [f64; 3]) -> Result<RefractiveIndex, OpticsError> {
-        RefractiveIndex::Sellmeier { b, c_nm2 }.validated()
+        RefractiveIndex::sellmeier_over(b, c_nm2, VALIDATED_RANGE_NM)
+    }
+
+    /// A three-term Sellmeier model valid over `range_nm` = `[lo, hi]`.
+    ///
+    /// # Guarantees
+    /// `0 < lo ≤ hi` are finite, all `b[i] ≥ 0` and `c_nm2[i] ≥ 0` are finite, no resonance
+    /// `sqrt(c_nm2[i])` lies in the range, and the index is finite and `> 0` over it.
+    pub fn sellmeier_over(
+        b: [f64; 3],
+        c_nm2: [f64; 3],
+        range_nm: [f64; 2],
+    ) -> Result<RefractiveIndex, OpticsError> {
+        RefractiveIndex::Sellmeier { b, c_nm2, range_nm }.validated()
+    }
+
+    /// The wavelengths (nm) this model covers, `[lo, hi]`.
+    pub fn range_nm(&self) -> [f64; 2] {
+        match *self {
+            RefractiveIndex::Constant(_) => CONSTANT_RANGE_NM,
+            RefractiveIndex::Cauchy { range_nm, .. }
+            | RefractiveIndex::Sellmeier { range_nm, .. } => range_nm,
+            RefractiveIndex::Water => WATER_RANGE_NM,
+        }
     }
 
     /// Checks a model built directly from its variant, with the guarantees of its constructor.
@@ -80,8 +130,15 @@ impl RefractiveIndex {
             RefractiveIndex::Constant(n) => {
                 crate::fresnel::check_real_index("constant refractive index", n)
             }
-            RefractiveIndex::Cauchy { a, b_nm2, c_nm4 } => validate_cauchy(a, b_nm2, c_nm4),
-            RefractiveIndex::Sellmeier { b, c_nm2 } => validate_sellmeier(b, c_nm2),
+            RefractiveIndex::Cauchy {
+                a,
+                b_nm2,
+                c_nm4,
+                range_nm,
+            } => check_range(range_nm).and_then(|()| validate_cauchy(a, b_nm2, c_nm4, range_nm)),
+            RefractiveIndex::Sellmeier { b, c_nm2, range_nm } => {
+                check_range(range_nm).and_then(|()| validate_sellmeier(b, c_nm2, range_nm))
+            }
             RefractiveIndex::Water => Ok(()),
         }
     }
@@ -91,26 +148,27 @@ impl RefractiveIndex {
     }
 
     /// The index at `wavelength_nm`, or an error if the wavelength is not finite and
-    /// positive, lies outside [`WATER_RANGE_NM`] for water, or the model gives no finite
-    /// positive index there.
+    /// positive, lies outside the model's [`RefractiveIndex::range_nm`], or the model gives
+    /// no finite positive index there.
     pub fn try_n_at(&self, wavelength_nm: f64) -> Result<f64, OpticsError> {
         crate::fresnel::check_wavelength(wavelength_nm)?;
+        check_in_range(self.name(), self.range_nm(), wavelength_nm)?;
         let n = match *self {
             RefractiveIndex::Constant(n) => n,
-            RefractiveIndex::Cauchy { a, b_nm2, c_nm4 } => {
+            RefractiveIndex::Cauchy {
+                a, b_nm2, c_nm4, ..
+            } => {
                 let inv_l2 = 1.0 / (wavelength_nm * wavelength_nm);
                 a + inv_l2 * (b_nm2 + inv_l2 * c_nm4)
             }
-            RefractiveIndex::Sellmeier { b, c_nm2 } => sellmeier_n2(b, c_nm2, wavelength_nm).sqrt(),
+            RefractiveIndex::Sellmeier { b, c_nm2, .. } => {
+                sellmeier_n2(b, c_nm2, wavelength_nm).sqrt()
+            }
             RefractiveIndex::Water => {
-                let [lo, hi] = WATER_RANGE_NM;
-                if !(lo..=hi).contains(&wavelength_nm) {
-                    return Err(OpticsError::Wavelength { wavelength_nm });
-                }
                 water_iapws(wavelength_nm, WATER_TEMPERATURE_K, WATER_DENSITY_KG_PER_M3)?
             }
         };
-        if n.is_finite() && n > 0.0 {
+        if n.is_finite() && n > 0.0 && n <= crate::fresnel::MAX_INDEX {
             Ok(n)
         } else {
             Err(OpticsError::IndexAtWavelength {
@@ -123,11 +181,51 @@ impl RefractiveIndex {
     /// The index at `wavelength_nm`.
     ///
     /// # Panics
-    /// Where [`RefractiveIndex::try_n_at`] fails; never for a validated model inside
-    /// [`VALIDATED_RANGE_NM`].
+    /// Where [`RefractiveIndex::try_n_at`] fails; never for a validated model inside its
+    /// [`RefractiveIndex::range_nm`].
     pub fn n_at(&self, wavelength_nm: f64) -> f64 {
         self.try_n_at(wavelength_nm)
             .unwrap_or_else(|err| panic!("{err}"))
+    }
+
+    /// The model's name in messages.
+    pub fn name(&self) -> &'static str {
+        match self {
+            RefractiveIndex::Constant(_) => "constant index",
+            RefractiveIndex::Cauchy { .. } => "Cauchy model",
+            RefractiveIndex::Sellmeier { .. } => "Sellmeier model",
+            RefractiveIndex::Water => "water (IAPWS R9-97)",
+        }
+    }
+}
+
+/// Checks a model's wavelength range: finite, `0 < lo ≤ hi`.
+pub(crate) fn check_range(range_nm: [f64; 2]) -> Result<(), OpticsError> {
+    let [lo, hi] = range_nm;
+    if lo.is_finite() && hi.is_finite() && lo > 0.0 && lo <= hi {
+        Ok(())
+    } else {
+        Err(dispersion_error(format!(
+            "wavelength range [{lo}, {hi}] nm is not finite with 0 < lo <= hi"
+        )))
+    }
+}
+
+/// Checks that `wavelength_nm` lies in a model's `range_nm`.
+pub(crate) fn check_in_range(
+    model: &'static str,
+    range_nm: [f64; 2],
+    wavelength_nm: f64,
+) -> Result<(), OpticsError> {
+    let [lo, hi] = range_nm;
+    if (lo..=hi).contains(&wavelength_nm) {
+        Ok(())
+    } else {
+        Err(OpticsError::OutOfRange {
+            model,
+            wavelength_nm,
+            range_nm,
+        })
     }
 }
 
@@ -150,7 +248,7 @@ fn dispersion_error(reason: String) -> OpticsError {
     OpticsError::Dispersion { reason }
 }
 
-fn validate_cauchy(a: f64, b_nm2: f64, c_nm4: f64) -> Result<(), OpticsError> {
+fn validate_cauchy(a: f64, b_nm2: f64, c_nm4: f64, range_nm: [f64; 2]) -> Result<(), OpticsError> {
     for (name, value) in [("a", a), ("b_nm2", b_nm2), ("c_nm4", c_nm4)] {
         if !value.is_finite() {
             return Err(dispersion_error(format!(
@@ -159,7 +257,7 @@ fn validate_cauchy(a: f64, b_nm2: f64, c_nm4: f64) -> Result<(), OpticsError> {
         }
     }
     // n is a quadratic in x = 1/λ²: its minimum over the range is at an end or the vertex.
-    let [lo, hi] = VALIDATED_RANGE_NM;
+    let [lo, hi] = range_nm;
     let (x_lo, x_hi) = (1.0 / (hi * hi), 1.0 / (lo * lo));
     let n_of = |x: f64| a + x * (b_nm2 + x * c_nm4);
     let mut candidates = vec![x_lo, x_hi];
@@ -174,15 +272,15 @@ fn validate_cauchy(a: f64, b_nm2: f64, c_nm4: f64) -> Result<(), OpticsError> {
         if n.is_nan() || n <= 0.0 {
             let wavelength_nm = 1.0 / x.sqrt();
             return Err(dispersion_error(format!(
-                "Cauchy model gives n = {n} at {wavelength_nm} nm, inside the validated range"
+                "Cauchy model gives n = {n} at {wavelength_nm} nm, inside its range [{lo}, {hi}] nm"
             )));
         }
     }
     Ok(())
 }
 
-fn validate_sellmeier(b: [f64; 3], c_nm2: [f64; 3]) -> Result<(), OpticsError> {
-    let [lo, hi] = VALIDATED_RANGE_NM;
+fn validate_sellmeier(b: [f64; 3], c_nm2: [f64; 3], range_nm: [f64; 2]) -> Result<(), OpticsError> {
+    let [lo, hi] = range_nm;
     for i in 0..3 {
         if !(b[i].is_finite() && b[i] >= 0.0) {
             return Err(dispersion_error(format!(

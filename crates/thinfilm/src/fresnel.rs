@@ -11,6 +11,7 @@
 //!   `r_p = (n_i cos θ_t − n_t cos θ_i) / (n_i cos θ_t + n_t cos θ_i)`;
 //! * `t_s`, `t_p` are ratios of the full electric-field amplitudes.
 
+use crate::incidence::Incidence;
 use num_complex::Complex64;
 use std::fmt;
 
@@ -91,15 +92,9 @@ impl fmt::Display for Response {
 ///
 /// Computed as `sqrt(n² − n_sin²)` so that it stays exact at the critical angle and in
 /// absorbing media; `cos θ` itself is this divided by `n`.
+/// Near grazing incidence prefer [`crate::Incidence::normal_index`], which needs no `n_sin`.
 pub fn normal_index(n: Complex64, n_sin: f64) -> Complex64 {
-    let root = (n * n - n_sin * n_sin).sqrt();
-    // The principal root already has Re ≥ 0; a negative zero imaginary part (real
-    // `n² < n_sin²` computed as `x − 0i`) would give −i·a, a growing wave.
-    if root.im < 0.0 || (root.im == 0.0 && root.re < 0.0) {
-        -root
-    } else {
-        root
-    }
+    crate::incidence::decaying_root(n * n - n_sin * n_sin)
 }
 
 /// Complex `cos θ_t` in a medium of index `n_t` for light arriving at `cos_theta_i` from a
@@ -171,19 +166,25 @@ impl Interface {
     /// Amplitude coefficients at `cos_theta_incident` ∈ [0, 1], or an error naming the bad value.
     pub fn try_amplitudes(&self, cos_theta_incident: f64) -> Result<Amplitudes, OpticsError> {
         check_cos("cos_theta_incident", cos_theta_incident)?;
+        Ok(self.amplitudes_at(Incidence::try_from_cos(cos_theta_incident)?))
+    }
+
+    /// Amplitude coefficients in the direction `incidence`.
+    pub fn amplitudes_at(&self, incidence: Incidence) -> Amplitudes {
         let n_i = Complex64::new(self.n_incident, 0.0);
-        let cos_t = cos_transmitted(self.n_incident, self.n_transmitted, cos_theta_incident);
-        let cos_i = Complex64::new(cos_theta_incident, 0.0);
-        if cos_theta_incident == 0.0 && n_i != self.n_transmitted {
+        if incidence.cos() == 0.0 && n_i != self.n_transmitted {
             // Grazing: the formula's limit, written out to avoid 0/0 when cos_t is also 0.
-            return Ok(Amplitudes {
+            return Amplitudes {
                 r_s: Complex64::new(-1.0, 0.0),
                 r_p: Complex64::new(1.0, 0.0),
                 t_s: Complex64::new(0.0, 0.0),
                 t_p: Complex64::new(0.0, 0.0),
-            });
+            };
         }
-        Ok(amplitudes(n_i, cos_i, self.n_transmitted, cos_t))
+        let cos_t =
+            incidence.normal_index(self.n_incident, self.n_transmitted) / self.n_transmitted;
+        let cos_i = Complex64::new(incidence.cos(), 0.0);
+        amplitudes(n_i, cos_i, self.n_transmitted, cos_t)
     }
 
     /// Intensity reflectance and transmittance at `cos_theta_incident` ∈ [0, 1].
@@ -192,19 +193,27 @@ impl Interface {
     /// (power flux normal to the surface); exactly grazing incidence gives its limit
     /// `R = 1, T = 0` (or `R = 0, T = 1` between identical media), never 0/0.
     pub fn try_response(&self, cos_theta_incident: f64) -> Result<Response, OpticsError> {
-        let amp = self.try_amplitudes(cos_theta_incident)?;
+        check_cos("cos_theta_incident", cos_theta_incident)?;
+        Ok(self.response_at(Incidence::try_from_cos(cos_theta_incident)?))
+    }
+
+    /// Intensity reflectance and transmittance in the direction `incidence`
+    /// (see [`Interface::try_response`]).
+    pub fn response_at(&self, incidence: Incidence) -> Response {
+        let amp = self.amplitudes_at(incidence);
         let n_i = self.n_incident;
         let n_t = self.n_transmitted;
-        if cos_theta_incident == 0.0 {
-            return Ok(Response::grazing(Complex64::new(n_i, 0.0) == n_t));
+        if incidence.cos() == 0.0 {
+            return Response::grazing(Complex64::new(n_i, 0.0) == n_t);
         }
-        let cos_t = cos_transmitted(n_i, n_t, cos_theta_incident);
-        Ok(Response {
+        let cos_t = incidence.normal_index(n_i, n_t) / n_t;
+        let flux_in = n_i * incidence.cos();
+        Response {
             r_s: amp.r_s.norm_sqr(),
             r_p: amp.r_p.norm_sqr(),
-            t_s: (n_t * cos_t).re / (n_i * cos_theta_incident) * amp.t_s.norm_sqr(),
-            t_p: (n_t * cos_t.conj()).re / (n_i * cos_theta_incident) * amp.t_p.norm_sqr(),
-        })
+            t_s: (n_t * cos_t).re / flux_in * amp.t_s.norm_sqr(),
+            t_p: (n_t * cos_t.conj()).re / flux_in * amp.t_p.norm_sqr(),
+        }
     }
 
     /// [`Interface::try_response`] for a known-good angle.
@@ -236,18 +245,24 @@ impl Interface {
     }
 }
 
-/// Checks a real refractive index: finite and `> 0`.
+/// The largest index modulus accepted: far above any material's (metals in the far infrared
+/// reach a few hundred), and small enough that `n²` and its products stay finite.
+pub const MAX_INDEX: f64 = 1e6;
+
+/// Checks a real refractive index: finite, `> 0` and `≤ MAX_INDEX`.
 pub(crate) fn check_real_index(what: &'static str, n: f64) -> Result<(), OpticsError> {
-    if n.is_finite() && n > 0.0 {
+    if n.is_finite() && n > 0.0 && n <= MAX_INDEX {
         Ok(())
     } else {
         Err(OpticsError::Index { what, value: n })
     }
 }
 
-/// Checks a complex index: finite, `Re > 0`, `Im ≥ 0` (absorbing, never amplifying).
+/// Checks a complex index: finite, `Re > 0`, `Im ≥ 0` (absorbing, never amplifying),
+/// modulus `≤ MAX_INDEX`.
 pub(crate) fn check_complex_index(what: &'static str, n: Complex64) -> Result<(), OpticsError> {
-    if n.re.is_finite() && n.im.is_finite() && n.re > 0.0 && n.im >= 0.0 {
+    let bounded = n.re <= MAX_INDEX && n.im <= MAX_INDEX;
+    if n.re.is_finite() && n.im.is_finite() && n.re > 0.0 && n.im >= 0.0 && bounded {
         Ok(())
     } else {
         Err(OpticsError::ComplexIndex { what, value: n })

@@ -18,14 +18,18 @@
 //! assert!(xyz[1] > 0.0 && xyz[1] < 0.2);
 //! ```
 //!
-//! Optics: [`fresnel`], [`airy`] (exact single film), [`tmm`] (N-layer stacks),
-//! [`dispersion`], and the f32 fast path [`batch`]. Colour, split pbrt-style:
+//! Optics: [`fresnel`], [`airy`] (exact single film), [`tmm`] (N-layer stacks, exact for
+//! any thickness), [`dispersion`] (real models, each with its wavelength range), [`index`]
+//! (complex and tabulated n,k models), [`incidence`] (angle or sin θ, exact at grazing),
+//! and the f32 fast path [`batch`]. Colour, split pbrt-style:
 //! [`spectrum`], [`cmf`], [`illuminant`], [`integrate`], [`colorspace`], [`lab`].
 
 pub mod airy;
 pub mod batch;
 pub mod dispersion;
 pub mod fresnel;
+pub mod incidence;
+pub mod index;
 pub mod tmm;
 
 pub mod cmf;
@@ -37,7 +41,11 @@ pub mod spectrum;
 
 pub use airy::{Response, ThinFilm};
 pub use dispersion::RefractiveIndex;
-pub use fresnel::OpticsError;
+pub use fresnel::{Interface, OpticsError};
+pub use incidence::Incidence;
+pub use index::{IndexModel, NkTable};
+pub use num_complex::Complex64;
+pub use tmm::{Layer, Stack};
 
 pub use cmf::Observer;
 pub use illuminant::{Illuminant, UnknownIlluminant};

@@ -303,6 +303,10 @@ impl Spectrum {
 }
 
 /// Checks one `(wavelength, value)` pair, describing the first problem found.
+/// The largest spectral value accepted: far above any physical spectrum in any unit, low
+/// enough that integrating hundreds of samples against the CIE tables stays finite.
+pub const MAX_SPECTRAL_VALUE: f64 = 1e100;
+
 fn check_sample(wavelength_nm: f64, value: f64) -> Result<(), String> {
     if !(wavelength_nm.is_finite() && wavelength_nm > 0.0) {
         return Err(format!(
@@ -314,6 +318,11 @@ fn check_sample(wavelength_nm: f64, value: f64) -> Result<(), String> {
     }
     if value < 0.0 {
         return Err(format!("value {value} is negative"));
+    }
+    if value > MAX_SPECTRAL_VALUE {
+        return Err(format!(
+            "value {value:?} is above {MAX_SPECTRAL_VALUE:?} (scale the spectrum down)"
+        ));
     }
     Ok(())
 }

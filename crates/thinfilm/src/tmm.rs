@@ -10,25 +10,33 @@
 //! written as `(2π d / λ)(q / y) sinc δ`, finite even at a layer's critical angle where
 //! `q = 0`.
 
+use crate::dispersion::{CONSTANT_RANGE_NM, check_in_range};
 use crate::fresnel::{self, Amplitudes, OpticsError, Response};
+use crate::incidence::Incidence;
+use crate::index::IndexModel;
 use num_complex::Complex64;
 
 /// One homogeneous layer of a stack.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Layer {
-    /// Complex index `n + iκ` (`κ ≥ 0` absorbs).
-    pub n: Complex64,
+    /// The layer's index model: real or complex `n + iκ` (`κ ≥ 0` absorbs), possibly dispersive.
+    pub index: IndexModel,
     /// Physical thickness in nm.
     pub thickness_nm: f64,
 }
 
 impl Layer {
-    /// A lossless layer of real index `n`.
-    pub fn lossless(n: f64, thickness_nm: f64) -> Layer {
+    /// A layer of any index model (a real or complex constant, a dispersion model, a table).
+    pub fn new(index: impl Into<IndexModel>, thickness_nm: f64) -> Layer {
         Layer {
-            n: Complex64::new(n, 0.0),
+            index: index.into(),
             thickness_nm,
         }
+    }
+
+    /// A lossless layer of constant real index `n`.
+    pub fn lossless(n: f64, thickness_nm: f64) -> Layer {
+        Layer::new(n, thickness_nm)
     }
 }
 
@@ -39,8 +47,8 @@ pub struct Stack {
     pub n_incident: f64,
     /// The layers, front to back.
     pub layers: Vec<Layer>,
-    /// Complex index of the semi-infinite substrate.
-    pub n_substrate: Complex64,
+    /// Index model of the semi-infinite substrate.
+    pub n_substrate: IndexModel,
 }
 
 #[derive(Clone, Copy, PartialEq)]
@@ -49,21 +57,29 @@ enum Polarisation {
     P,
 }
 
+/// The indices of every medium at one wavelength.
+struct Media {
+    n0: f64,
+    layers: Vec<(Complex64, f64)>,
+    n_sub: Complex64,
+}
+
 impl Stack {
     /// A validated stack.
     ///
     /// # Guarantees
-    /// `n_incident` is finite and `> 0`; every layer index and `n_substrate` is finite with
-    /// `Re > 0`, `Im ≥ 0`; every thickness is finite and `≥ 0`.
+    /// `n_incident` is finite and `> 0`; every layer's and the substrate's model passes
+    /// [`IndexModel::validate`] (complex indices finite with `Re > 0`, `Im ≥ 0`); every
+    /// thickness is finite and `≥ 0`.
     pub fn new(
         n_incident: f64,
         layers: Vec<Layer>,
-        n_substrate: Complex64,
+        n_substrate: impl Into<IndexModel>,
     ) -> Result<Stack, OpticsError> {
         let stack = Stack {
             n_incident,
             layers,
-            n_substrate,
+            n_substrate: n_substrate.into(),
         };
         stack.validate().map(|()| stack)
     }
@@ -71,12 +87,22 @@ impl Stack {
     /// Checks a stack built from its fields, with the guarantees of [`Stack::new`].
     pub fn validate(&self) -> Result<(), OpticsError> {
         fresnel::check_real_index("n_incident", self.n_incident)?;
-        fresnel::check_complex_index("n_substrate", self.n_substrate)?;
+        self.n_substrate.validate()?;
         for layer in &self.layers {
-            fresnel::check_complex_index("layer index", layer.n)?;
+            layer.index.validate()?;
             fresnel::check_thickness(layer.thickness_nm)?;
         }
         Ok(())
+    }
+
+    /// The wavelengths (nm) every medium's model covers: the intersection of their ranges
+    /// (the incident medium, a constant, covers [`CONSTANT_RANGE_NM`]). `lo > hi` if empty.
+    pub fn range_nm(&self) -> [f64; 2] {
+        self.layers
+            .iter()
+            .map(|layer| layer.index.range_nm())
+            .chain([self.n_substrate.range_nm()])
+            .fold(CONSTANT_RANGE_NM, |[lo, hi], [a, b]| [lo.max(a), hi.min(b)])
     }
 
     /// Amplitude coefficients at `wavelength_nm` and `cos_theta_incident` ∈ [0, 1].
@@ -85,10 +111,22 @@ impl Stack {
         wavelength_nm: f64,
         cos_theta_incident: f64,
     ) -> Result<Amplitudes, OpticsError> {
-        self.check_query(wavelength_nm, cos_theta_incident)?;
-        if cos_theta_incident == 0.0 {
-            let same = self.all_media_equal();
-            let (r_s, r_p, t) = if same {
+        fresnel::check_cos("cos_theta_incident", cos_theta_incident)?;
+        self.try_amplitudes_at(wavelength_nm, Incidence::try_from_cos(cos_theta_incident)?)
+    }
+
+    /// Amplitude coefficients at `wavelength_nm` in the direction `incidence`.
+    ///
+    /// Exact for any thickness: a layer's growing and decaying exponentials are factored
+    /// out, so a thick absorbing or evanescent layer gives `t → 0`, never an overflow.
+    pub fn try_amplitudes_at(
+        &self,
+        wavelength_nm: f64,
+        incidence: Incidence,
+    ) -> Result<Amplitudes, OpticsError> {
+        let media = self.media(wavelength_nm)?;
+        if incidence.cos() == 0.0 {
+            let (r_s, r_p, t) = if media.all_equal() {
                 (0.0, 0.0, 1.0)
             } else {
                 (-1.0, 1.0, 0.0)
@@ -100,19 +138,15 @@ impl Stack {
                 t_p: t.into(),
             });
         }
-        let (r_s, t_s) = self
-            .solve(Polarisation::S, wavelength_nm, cos_theta_incident)
-            .0;
-        let (r_h, t_h) = self
-            .solve(Polarisation::P, wavelength_nm, cos_theta_incident)
-            .0;
+        let s = media.solve(Polarisation::S, wavelength_nm, incidence);
+        let h = media.solve(Polarisation::P, wavelength_nm, incidence);
         // The p solve works with H_y: its r has the opposite sign and its t is scaled by
         // n_sub/n_0 relative to the electric-field convention of `fresnel`.
         Ok(Amplitudes {
-            r_s,
-            r_p: -r_h,
-            t_s,
-            t_p: t_h * self.n_incident / self.n_substrate,
+            r_s: s.r,
+            r_p: -h.r,
+            t_s: s.t,
+            t_p: h.t * media.n0 / media.n_sub,
         })
     }
 
@@ -122,17 +156,28 @@ impl Stack {
         wavelength_nm: f64,
         cos_theta_incident: f64,
     ) -> Result<Response, OpticsError> {
-        self.check_query(wavelength_nm, cos_theta_incident)?;
-        if cos_theta_incident == 0.0 {
-            return Ok(Response::grazing(self.all_media_equal()));
+        fresnel::check_cos("cos_theta_incident", cos_theta_incident)?;
+        self.try_response_at(wavelength_nm, Incidence::try_from_cos(cos_theta_incident)?)
+    }
+
+    /// Intensity reflectance and transmittance at `wavelength_nm` in the direction
+    /// `incidence`, exact for any thickness (see [`Stack::try_amplitudes_at`]).
+    pub fn try_response_at(
+        &self,
+        wavelength_nm: f64,
+        incidence: Incidence,
+    ) -> Result<Response, OpticsError> {
+        let media = self.media(wavelength_nm)?;
+        if incidence.cos() == 0.0 {
+            return Ok(Response::grazing(media.all_equal()));
         }
-        let ((r_s, _), t_s) = self.solve(Polarisation::S, wavelength_nm, cos_theta_incident);
-        let ((r_p, _), t_p) = self.solve(Polarisation::P, wavelength_nm, cos_theta_incident);
+        let s = media.solve(Polarisation::S, wavelength_nm, incidence);
+        let p = media.solve(Polarisation::P, wavelength_nm, incidence);
         Ok(Response {
-            r_s: r_s.norm_sqr(),
-            r_p: r_p.norm_sqr(),
-            t_s,
-            t_p,
+            r_s: s.r.norm_sqr(),
+            r_p: p.r.norm_sqr(),
+            t_s: s.transmittance,
+            t_p: p.transmittance,
         })
     }
 
@@ -140,65 +185,125 @@ impl Stack {
     ///
     /// # Panics
     /// If the stack is invalid (see [`Stack::new`]), `wavelength_nm` is not finite and
-    /// positive, or `cos_theta_incident` is not in [0, 1].
+    /// positive or outside a medium's range, or `cos_theta_incident` is not in [0, 1].
     pub fn response(&self, wavelength_nm: f64, cos_theta_incident: f64) -> Response {
         self.try_response(wavelength_nm, cos_theta_incident)
             .unwrap_or_else(|err| panic!("{err}"))
     }
 
-    fn check_query(&self, wavelength_nm: f64, cos_theta_incident: f64) -> Result<(), OpticsError> {
+    fn media(&self, wavelength_nm: f64) -> Result<Media, OpticsError> {
         self.validate()?;
         fresnel::check_wavelength(wavelength_nm)?;
-        fresnel::check_cos("cos_theta_incident", cos_theta_incident)
+        check_in_range(
+            "incident medium's constant index",
+            CONSTANT_RANGE_NM,
+            wavelength_nm,
+        )?;
+        let checked = |model: &IndexModel, what: &'static str| {
+            let n = model.try_n_at(wavelength_nm)?;
+            fresnel::check_complex_index(what, n).map(|()| n)
+        };
+        let layers = self
+            .layers
+            .iter()
+            .map(|layer| Ok((checked(&layer.index, "layer index")?, layer.thickness_nm)))
+            .collect::<Result<_, OpticsError>>()?;
+        Ok(Media {
+            n0: self.n_incident,
+            layers,
+            n_sub: checked(&self.n_substrate, "n_substrate")?,
+        })
+    }
+}
+
+/// One polarisation's solution, in the field of its solve (`E_y` for s, `H_y` for p).
+struct Solution {
+    r: Complex64,
+    t: Complex64,
+    transmittance: f64,
+}
+
+impl Media {
+    fn all_equal(&self) -> bool {
+        let n0 = Complex64::new(self.n0, 0.0);
+        self.n_sub == n0 && self.layers.iter().all(|&(n, _)| n == n0)
     }
 
-    fn all_media_equal(&self) -> bool {
-        let n0 = Complex64::new(self.n_incident, 0.0);
-        self.n_substrate == n0 && self.layers.iter().all(|layer| layer.n == n0)
-    }
-
-    /// `((r, t), T)` for one polarisation, in the field of that polarisation's solve
-    /// (`E_y` for s, `H_y` for p). Requires `cos_theta_incident > 0`.
-    fn solve(
-        &self,
-        pol: Polarisation,
-        wavelength_nm: f64,
-        cos_theta_incident: f64,
-    ) -> ((Complex64, Complex64), f64) {
-        let n_sin = fresnel::n_sin(self.n_incident, cos_theta_incident);
+    /// Requires `incidence.cos() > 0`.
+    ///
+    /// `[B, C] = M_1 ⋯ M_N [1, y_sub]` is carried as `e^{L} [B', C']` with `[B', C']` of
+    /// modulus ≤ 1: each layer's matrix is applied divided by `e^{Im δ}` (its largest
+    /// possible growth) and the product renormalised, the scales summed into `L`. Then
+    /// `r` is scale-free, `t = 2 y0 e^{−L} / (y0 B' + C')` and `T` carries `e^{−2L}`.
+    fn solve(&self, pol: Polarisation, wavelength_nm: f64, incidence: Incidence) -> Solution {
         let k_per_nm = std::f64::consts::TAU / wavelength_nm;
         let admittance = |n: Complex64, q: Complex64| match pol {
             Polarisation::S => q,
             Polarisation::P => q / (n * n),
         };
-        let n0 = Complex64::new(self.n_incident, 0.0);
-        let y0 = admittance(n0, n0 * cos_theta_incident);
-        let q_sub = fresnel::normal_index(self.n_substrate, n_sin);
-        let y_sub = admittance(self.n_substrate, q_sub);
-        // [B, C] = M_1 ⋯ M_N [1, y_sub], applied from the back layer forwards.
+        let n0 = Complex64::new(self.n0, 0.0);
+        let y0 = admittance(n0, n0 * incidence.cos());
+        let y_sub = admittance(self.n_sub, incidence.normal_index(self.n0, self.n_sub));
         let mut field = (Complex64::new(1.0, 0.0), y_sub);
-        for layer in self.layers.iter().rev() {
-            let q = fresnel::normal_index(layer.n, n_sin);
-            let y = admittance(layer.n, q);
-            let delta = k_per_nm * layer.thickness_nm * q;
+        let mut log_scale = 0.0;
+        for &(n, thickness_nm) in self.layers.iter().rev() {
+            let q = incidence.normal_index(self.n0, n);
+            let y = admittance(n, q);
+            let delta = k_per_nm * thickness_nm * q;
+            let (cos_d, sin_d, sinc_d) = scaled_trig(delta);
             let q_over_y = match pol {
                 Polarisation::S => Complex64::new(1.0, 0.0),
-                Polarisation::P => layer.n * layer.n,
+                Polarisation::P => n * n,
             };
-            let sin_over_y = k_per_nm * layer.thickness_nm * q_over_y * sinc(delta);
-            let (cos_d, sin_d) = (delta.cos(), delta.sin());
+            let sin_over_y = k_per_nm * thickness_nm * q_over_y * sinc_d;
             let minus_i = Complex64::new(0.0, -1.0);
             field = (
                 cos_d * field.0 + minus_i * sin_over_y * field.1,
                 minus_i * y * sin_d * field.0 + cos_d * field.1,
             );
+            let size = field.0.norm().max(field.1.norm());
+            if size > 0.0 && size.is_finite() {
+                field = (field.0 / size, field.1 / size);
+                log_scale += delta.im + size.ln();
+            } else {
+                log_scale += delta.im;
+            }
         }
         let (b, c) = field;
         let den = y0 * b + c;
-        let r = (y0 * b - c) / den;
-        let t = 2.0 * y0 / den;
-        let transmittance = 4.0 * y0.re * y_sub.re / den.norm_sqr();
-        ((r, t), transmittance)
+        let shrink = (-log_scale).exp();
+        Solution {
+            r: divide(y0 * b - c, den),
+            t: divide(2.0 * y0, den) * shrink,
+            // Divided factor by factor: |den|² alone underflows a hair from grazing.
+            transmittance: 4.0 * (y0.re / den.norm()) * (y_sub.re / den.norm()) * shrink * shrink,
+        }
+    }
+}
+
+/// `(cos δ, sin δ, sin δ / δ)`, each times `e^{−Im δ}` so that none overflows however large
+/// `Im δ ≥ 0` is: `e^{−Im δ} cos δ = (e^{i Re δ − 2 Im δ} + e^{−i Re δ}) / 2`.
+fn scaled_trig(delta: Complex64) -> (Complex64, Complex64, Complex64) {
+    let damp = (-delta.im).exp();
+    let forward = Complex64::from_polar((-2.0 * delta.im).exp(), delta.re);
+    let backward = Complex64::from_polar(1.0, -delta.re);
+    let cos_d = 0.5 * (forward + backward);
+    let sin_d = Complex64::new(0.0, -0.5) * (forward - backward);
+    let sinc_d = if delta.norm_sqr() < 1e-8 {
+        sinc(delta) * damp
+    } else {
+        sin_d / delta
+    };
+    (cos_d, sin_d, sinc_d)
+}
+
+/// `a / b`, scaled first so that `|b|²` cannot underflow (num-complex divides by `|b|²`).
+fn divide(a: Complex64, b: Complex64) -> Complex64 {
+    let scale = b.re.abs().max(b.im.abs());
+    if scale > 0.0 && scale.is_finite() {
+        (a / scale) / (b / scale)
+    } else {
+        a / b
     }
 }
 

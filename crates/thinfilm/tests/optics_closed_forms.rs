@@ -88,10 +88,10 @@ proptest! {
         l in 360.0..830.0f64, cos0 in 0.0..=1.0f64,
     ) {
         let index = Complex64::new(n, k);
-        let whole = Stack::new(1.0, vec![Layer { n: index, thickness_nm: d }], re(1.5)).unwrap();
+        let whole = Stack::new(1.0, vec![Layer::new(index, d)], re(1.5)).unwrap();
         let halves = Stack::new(1.0, vec![
-            Layer { n: index, thickness_nm: d * split },
-            Layer { n: index, thickness_nm: d * (1.0 - split) },
+            Layer::new(index, d * split),
+            Layer::new(index, d * (1.0 - split)),
         ], re(1.5)).unwrap();
         let (a, b) = (whole.response(l, cos0), halves.response(l, cos0));
         assert_close("R", a.r(), b.r(), 1e-12);
@@ -137,15 +137,7 @@ fn absorbing_layer_follows_beer_lambert() {
     // An index-matched weakly absorbing slab: T ≈ exp(−4π κ d / λ); the interfaces reflect ~(κ/2n)².
     let (n, kappa, l) = (1.5, 1e-3, 500.0);
     for d in [1_000.0, 10_000.0, 50_000.0] {
-        let stack = Stack::new(
-            n,
-            vec![Layer {
-                n: Complex64::new(n, kappa),
-                thickness_nm: d,
-            }],
-            re(n),
-        )
-        .unwrap();
+        let stack = Stack::new(n, vec![Layer::new(Complex64::new(n, kappa), d)], re(n)).unwrap();
         let expected = (-4.0 * std::f64::consts::PI * kappa * d / l).exp();
         assert_close(
             &format!("T at {d} nm"),

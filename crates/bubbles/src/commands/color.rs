@@ -66,7 +66,7 @@ impl FilmColour {
     /// Validates the options and builds the integrator.
     pub fn from_args(args: &LightArgs) -> Result<FilmColour, CliError> {
         let n_film = RefractiveIndex::constant(args.n_film)
-            .map_err(|e| CliError::input(format!("--n-film {}: {e}", args.n_film)))?;
+            .map_err(|e| CliError::input(format!("--n-film {:?}: {e}", args.n_film)))?;
         let observer = Observer::from_name(&args.observer).ok_or_else(|| {
             CliError::input(format!(
                 "--observer `{}` is not a CIE observer; valid: 1931, 1964",

@@ -1,25 +1,32 @@
 //! `bubbles reflectance`: spectral reflectance and transmittance of a film
-//! `outside | film | outside`, exact (Airy sum of all orders, f64), from CSV on stdin or
-//! from flags for one query.
+//! `outside | film | outside`, exact (Airy sum of all orders, f64), or of any multilayer
+//! stack with absorbing media (`--stack`, see [`stack`]), from CSV on stdin or from flags
+//! for one query.
 //!
-//! Input columns: `thickness_nm,angle_deg,wavelength_nm[,n_film]`, in any order.
+//! Film input columns: `thickness_nm,angle_deg,wavelength_nm[,n_film]`, in any order.
 //! Output: `thickness_nm,angle_deg,wavelength_nm,n_film,r_s,r_p,r,t` with full f64
 //! precision (shortest round-trip decimal); `r` is the unpolarised mean and `t` the
 //! unpolarised transmittance, computed from the transmitted amplitudes (not `1 − r`).
+//! Stack input columns: `angle_deg,wavelength_nm[,thickness_nm]`; output adds the
+//! absorbed fraction `a = 1 − r − t`.
+
+mod stack;
 
 use std::fmt::Write as _;
 use std::io::{Read as _, Write as _};
 
+use thinfilm::Incidence;
 use thinfilm::airy::ThinFilm;
-use thinfilm::dispersion::RefractiveIndex;
+use thinfilm::dispersion::{CONSTANT_RANGE_NM, RefractiveIndex};
+use thinfilm::fresnel::MAX_INDEX;
 
 use crate::csv_table::{CsvRow, CsvTable};
 use crate::error::{CliError, CliResult};
 
 /// The film index used when neither a column nor `--n-film` gives one.
 const DEFAULT_N_FILM: f64 = 1.33;
-/// Wavelengths accepted, in nm: the range of the colour data.
-const WAVELENGTH_RANGE_NM: [f64; 2] = [360.0, 830.0];
+/// Wavelengths accepted for a film, in nm: the range of a constant index.
+const WAVELENGTH_RANGE_NM: [f64; 2] = CONSTANT_RANGE_NM;
 const HEADER: &str = "thickness_nm,angle_deg,wavelength_nm,n_film,r_s,r_p,r,t";
 
 /// Arguments of `bubbles reflectance`.
@@ -30,22 +37,39 @@ pub struct Args {
         long,
         value_name = "N",
         default_value_t = 1.0,
-        allow_negative_numbers = true
+        allow_negative_numbers = true,
+        conflicts_with = "stack"
     )]
     n_outside: f64,
-    /// Film thickness in nm (single query; with --angle-deg and --wavelength-nm).
+    /// Film thickness in nm (single query; with --angle-deg and --wavelength-nm); with
+    /// --stack, overrides the thickness of the --vary-layer layer.
     #[arg(long, value_name = "NM", allow_negative_numbers = true)]
     thickness_nm: Option<f64>,
     /// Angle of incidence in degrees, in [0, 90) (single query).
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
     angle_deg: Option<f64>,
-    /// Vacuum wavelength in nm, in [360, 830] (single query).
+    /// Vacuum wavelength in nm, in [100, 100000] for a constant index, else the range of
+    /// the index models (single query).
     #[arg(long, value_name = "NM", allow_negative_numbers = true)]
     wavelength_nm: Option<f64>,
     /// Film refractive index [default: 1.33]; on stdin, used for rows when the CSV has no
     /// n_film column.
-    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "N",
+        allow_negative_numbers = true,
+        conflicts_with = "stack"
+    )]
     n_film: Option<f64>,
+    /// A multilayer stack, e.g. "1.0 | 1.38 @ 100 | 2.1 @ 60 | 0.18+3.4i": media from the
+    /// incidence side, inner layers as `index @ thickness_nm`; an index is a number, a+bi,
+    /// `water` or a `wavelength_nm,n,k` CSV file. CSV on stdin then gives
+    /// `angle_deg,wavelength_nm[,thickness_nm]`.
+    #[arg(long, value_name = "STACK")]
+    stack: Option<String>,
+    /// The inner layer (1-based) whose thickness a `thickness_nm` column or flag overrides.
+    #[arg(long, value_name = "K", default_value_t = 1, requires = "stack")]
+    vary_layer: usize,
 }
 
 /// One validated query, with the input line it came from (0 for flags).
@@ -60,11 +84,57 @@ struct Query {
 
 /// Runs `bubbles reflectance`.
 pub fn run(args: Args) -> CliResult {
+    let table = match &args.stack {
+        Some(text) => run_stack(text, &args)?,
+        None => run_film(&args)?,
+    };
+    let mut stdout = std::io::stdout().lock();
+    stdout
+        .write_all(table.as_bytes())
+        .and_then(|()| stdout.flush())
+        .map_err(|e| CliError::runtime(format!("cannot write to stdout: {e}")))
+}
+
+fn run_stack(text: &str, args: &Args) -> Result<String, CliError> {
+    let parsed = stack::parse_stack(text)?;
+    let queries = match (args.angle_deg, args.wavelength_nm) {
+        (None, None) if args.thickness_nm.is_none() => stack::queries_from_csv(&read_stdin()?)?,
+        (Some(angle_deg), Some(wavelength_nm)) => {
+            if let Some(d) = args.thickness_nm {
+                check_thickness(d)
+                    .map_err(|what| CliError::input(format!("--thickness-nm {d} {what}")))?;
+            }
+            vec![stack::StackQuery {
+                line: 0,
+                angle_deg,
+                wavelength_nm,
+                thickness_nm: args.thickness_nm,
+            }]
+        }
+        _ => {
+            return Err(CliError::input(
+                "a single --stack query needs both --angle-deg and --wavelength-nm \
+                 (or give neither and pipe CSV on stdin)",
+            ));
+        }
+    };
+    stack::render(&parsed, args.vary_layer, &queries)
+}
+
+fn read_stdin() -> Result<String, CliError> {
+    let mut text = String::new();
+    std::io::stdin()
+        .read_to_string(&mut text)
+        .map_err(|e| CliError::input(format!("cannot read CSV from stdin: {e}")))?;
+    Ok(text)
+}
+
+fn run_film(args: &Args) -> Result<String, CliError> {
     check_index(args.n_outside)
-        .map_err(|what| CliError::input(format!("--n-outside {} {what}", args.n_outside)))?;
+        .map_err(|what| CliError::input(format!("--n-outside {:?} {what}", args.n_outside)))?;
     let n_film_default = args.n_film.unwrap_or(DEFAULT_N_FILM);
     check_index(n_film_default)
-        .map_err(|what| CliError::input(format!("--n-film {n_film_default} {what}")))?;
+        .map_err(|what| CliError::input(format!("--n-film {n_film_default:?} {what}")))?;
     let queries = match (args.thickness_nm, args.angle_deg, args.wavelength_nm) {
         (None, None, None) => queries_from_stdin(n_film_default)?,
         (Some(thickness_nm), Some(angle_deg), Some(wavelength_nm)) => {
@@ -82,19 +152,11 @@ pub fn run(args: Args) -> CliResult {
             ));
         }
     };
-    let table = render(args.n_outside, &queries)?;
-    let mut stdout = std::io::stdout().lock();
-    stdout
-        .write_all(table.as_bytes())
-        .and_then(|()| stdout.flush())
-        .map_err(|e| CliError::runtime(format!("cannot write to stdout: {e}")))
+    render(args.n_outside, &queries)
 }
 
 fn queries_from_stdin(n_film_default: f64) -> Result<Vec<Query>, CliError> {
-    let mut text = String::new();
-    std::io::stdin()
-        .read_to_string(&mut text)
-        .map_err(|e| CliError::input(format!("cannot read CSV from stdin: {e}")))?;
+    let text = read_stdin()?;
     let table = CsvTable::parse(
         &text,
         &["thickness_nm", "angle_deg", "wavelength_nm"],
@@ -136,7 +198,7 @@ fn query_from_flags(
     n_film: f64,
 ) -> Result<Query, CliError> {
     let flag = |name: &str, value: f64, check: fn(f64) -> Result<(), &'static str>| {
-        check(value).map_err(|what| CliError::input(format!("{name} {value} {what}")))
+        check(value).map_err(|what| CliError::input(format!("{name} {value:?} {what}")))
     };
     flag("--thickness-nm", thickness_nm, check_thickness)?;
     flag("--angle-deg", angle_deg, check_angle)?;
@@ -172,15 +234,15 @@ fn check_wavelength(wavelength_nm: f64) -> Result<(), &'static str> {
     if (lo..=hi).contains(&wavelength_nm) {
         Ok(())
     } else {
-        Err("is not a wavelength in [360, 830] nm")
+        Err("is not a wavelength in [100, 100000] nm (the range of a constant index)")
     }
 }
 
 fn check_index(n: f64) -> Result<(), &'static str> {
-    if n.is_finite() && n > 0.0 {
+    if n.is_finite() && n > 0.0 && n <= MAX_INDEX {
         Ok(())
     } else {
-        Err("is not a refractive index > 0")
+        Err("is not a refractive index in (0, 1e6]")
     }
 }
 
@@ -195,8 +257,10 @@ fn render(n_outside: f64, queries: &[Query]) -> Result<String, CliError> {
             RefractiveIndex::Constant(q.n_film),
             q.thickness_nm,
         );
+        let incidence = Incidence::try_from_angle_deg(q.angle_deg)
+            .map_err(|e| CliError::input(format!("line {}: {e}", q.line)))?;
         let resp = film
-            .try_response(q.wavelength_nm, q.angle_deg.to_radians().cos())
+            .try_response_at(q.wavelength_nm, incidence)
             .map_err(|e| CliError::input(format!("line {}: {e}", q.line)))?;
         // Writing to a String cannot fail.
         let _ = writeln!(

@@ -27,6 +27,13 @@ pub enum OpticsError {
         /// The rejected value.
         value: f64,
     },
+    /// An incidence angle (or its sine) outside its range.
+    Angle {
+        /// Which value: `angle_deg` (in [0, 90]) or `sin_theta` (in [0, 1]).
+        what: &'static str,
+        /// The rejected value.
+        value: f64,
+    },
     /// A wavelength that is not finite and positive.
     Wavelength {
         /// The rejected wavelength in nm.
@@ -48,6 +55,20 @@ pub enum OpticsError {
         wavelength_nm: f64,
         /// What the model gave there.
         value: f64,
+    },
+    /// A wavelength outside the range an index model covers.
+    OutOfRange {
+        /// The model, e.g. "Sellmeier model".
+        model: &'static str,
+        /// The rejected wavelength in nm.
+        wavelength_nm: f64,
+        /// The model's range `[lo, hi]` in nm.
+        range_nm: [f64; 2],
+    },
+    /// A tabulated index file or text that cannot be used (named in `reason`).
+    Table {
+        /// What is wrong, with the line number where there is one.
+        reason: String,
     },
     /// Slices that must have equal lengths do not.
     Length {
@@ -73,15 +94,28 @@ impl fmt::Display for OpticsError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             OpticsError::Index { what, value } => {
-                write!(f, "{what} = {value} is not a finite refractive index > 0")
+                write!(
+                    f,
+                    "{what} = {value:?} is not a refractive index in (0, {:?}]",
+                    super::MAX_INDEX
+                )
             }
             OpticsError::ComplexIndex { what, value } => write!(
                 f,
-                "{what} = {value} is not a finite complex index with real part > 0 and \
-                 imaginary part >= 0"
+                "{what} = {value} is not a complex index with real part in (0, {max:?}] and \
+                 imaginary part in [0, {max:?}]",
+                max = super::MAX_INDEX
             ),
             OpticsError::Cosine { what, value } => {
                 write!(f, "{what} = {value} is not a cosine in [0, 1]")
+            }
+            OpticsError::Angle { what, value } => {
+                let range = if *what == "angle_deg" {
+                    "[0, 90] degrees"
+                } else {
+                    "[0, 1]"
+                };
+                write!(f, "{what} = {value} is not in {range}")
             }
             OpticsError::Wavelength { wavelength_nm } => {
                 write!(f, "wavelength {wavelength_nm} nm is not finite and > 0")
@@ -95,8 +129,18 @@ impl fmt::Display for OpticsError {
                 value,
             } => write!(
                 f,
-                "dispersion model gives n = {value} at {wavelength_nm} nm (not finite and > 0)"
+                "dispersion model gives n = {value:?} at {wavelength_nm} nm (not in (0, {:?}])",
+                super::MAX_INDEX
             ),
+            OpticsError::OutOfRange {
+                model,
+                wavelength_nm,
+                range_nm: [lo, hi],
+            } => write!(
+                f,
+                "wavelength {wavelength_nm} nm is outside the {model}'s range [{lo}, {hi}] nm"
+            ),
+            OpticsError::Table { reason } => write!(f, "invalid n,k table: {reason}"),
             OpticsError::Length {
                 what,
                 len,

@@ -44,7 +44,7 @@ pub fn as_stack(film: &ThinFilm, wavelength_nm: f64) -> Stack {
             film.n_film.n_at(wavelength_nm),
             film.thickness_nm,
         )],
-        n_substrate: film.n_substrate,
+        n_substrate: film.n_substrate.into(),
     }
 }
 

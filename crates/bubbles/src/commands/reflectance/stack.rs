@@ -1,0 +1,226 @@
+//! `bubbles reflectance --stack`: the stack syntax and its queries.
+//!
+//! Syntax: media separated by `|`, from the incidence medium to the substrate; the first
+//! and last are semi-infinite and give only an index, every one between is
+//! `index @ thickness_nm`. An index is a real number (`1.38`), a complex one with `κ ≥ 0`
+//! (`0.18+3.4i`), `water` (IAPWS, 200–1100 nm), or the path of a `wavelength_nm,n,k` CSV
+//! table. The incidence medium must be a real number (its power flux must be defined).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use thinfilm::dispersion::RefractiveIndex;
+use thinfilm::{Complex64, Incidence, IndexModel, Layer, NkTable, Stack};
+
+use crate::csv_table::{CsvRow, CsvTable};
+use crate::error::CliError;
+
+/// Header of the stack output without the optional leading `thickness_nm`.
+const HEADER: &str = "angle_deg,wavelength_nm,r_s,r_p,r,t,a";
+
+/// Parses `--stack` text into a validated stack.
+///
+/// # Errors
+/// An input error quoting the medium (1-based) and the bad token or value.
+pub fn parse_stack(text: &str) -> Result<Stack, CliError> {
+    let media: Vec<&str> = text.split('|').map(str::trim).collect();
+    let bad = |k: usize, what: String| {
+        CliError::input(format!("--stack \"{text}\": medium {}: {what}", k + 1))
+    };
+    if media.len() < 2 {
+        return Err(bad(
+            0,
+            "needs at least an incidence medium and a substrate separated by `|`".into(),
+        ));
+    }
+    let last = media.len() - 1;
+    let n_incident = parse_real(media[0]).ok_or_else(|| {
+        bad(
+            0,
+            format!(
+                "`{}` is not a real index (the incidence medium must be one)",
+                media[0]
+            ),
+        )
+    })?;
+    let mut layers = Vec::new();
+    for (k, medium) in media.iter().enumerate().take(last).skip(1) {
+        let Some((index, thickness)) = medium.split_once('@') else {
+            return Err(bad(k, format!("`{medium}` is not `index @ thickness_nm`")));
+        };
+        let index = parse_index(index.trim()).map_err(|e| bad(k, e))?;
+        let thickness = thickness.trim();
+        let thickness_nm = parse_real(thickness).filter(|d| *d >= 0.0).ok_or_else(|| {
+            bad(
+                k,
+                format!("thickness `{thickness}` is not a number >= 0 nm"),
+            )
+        })?;
+        layers.push(Layer::new(index, thickness_nm));
+    }
+    let substrate = parse_index(media[last]).map_err(|e| bad(last, e))?;
+    Stack::new(n_incident, layers, substrate)
+        .map_err(|e| CliError::input(format!("--stack \"{text}\": {e}")))
+}
+
+fn parse_real(token: &str) -> Option<f64> {
+    token.parse::<f64>().ok().filter(|x| x.is_finite())
+}
+
+/// One index token: a real, `a+bi`, `water`, or a CSV table path.
+fn parse_index(token: &str) -> Result<IndexModel, String> {
+    if token.eq_ignore_ascii_case("water") {
+        return Ok(RefractiveIndex::Water.into());
+    }
+    if token.to_ascii_lowercase().ends_with(".csv") {
+        return NkTable::from_csv_path(Path::new(token))
+            .map(IndexModel::from)
+            .map_err(|e| e.to_string());
+    }
+    let model = if let Some(n) = parse_real(token) {
+        IndexModel::from(n)
+    } else {
+        IndexModel::from(parse_complex(token).ok_or_else(|| {
+            format!("`{token}` is not an index (a number, a+bi, water, or a .csv n,k table)")
+        })?)
+    };
+    model.validate().map(|()| model).map_err(|e| e.to_string())
+}
+
+/// `a+bi` or `a-bi` (the sign splits at its last `+`/`-` that is not an exponent's).
+fn parse_complex(token: &str) -> Option<Complex64> {
+    let body = token.strip_suffix(['i', 'j'])?;
+    let bytes = body.as_bytes();
+    let split = (1..bytes.len())
+        .rev()
+        .find(|&k| matches!(bytes[k], b'+' | b'-') && !matches!(bytes[k - 1], b'e' | b'E'))?;
+    let re = parse_real(&body[..split])?;
+    let im_text = &body[split..];
+    let im = parse_real(im_text.strip_prefix('+').unwrap_or(im_text))?;
+    Some(Complex64::new(re, im))
+}
+
+/// One stack query: the angle, wavelength and the varied layer's thickness, if any.
+#[derive(Debug, Clone, Copy)]
+pub struct StackQuery {
+    /// Input line (0 for flags).
+    pub line: usize,
+    /// Incidence angle in degrees.
+    pub angle_deg: f64,
+    /// Vacuum wavelength in nm.
+    pub wavelength_nm: f64,
+    /// Thickness override for the varied layer, in nm.
+    pub thickness_nm: Option<f64>,
+}
+
+/// Queries from CSV `angle_deg,wavelength_nm[,thickness_nm]` text.
+pub fn queries_from_csv(text: &str) -> Result<Vec<StackQuery>, CliError> {
+    let table = CsvTable::parse(text, &["angle_deg", "wavelength_nm"], &["thickness_nm"])?;
+    let has_thickness = table.has_column("thickness_nm");
+    table
+        .rows()
+        .map(|row| {
+            Ok(StackQuery {
+                line: row.line(),
+                angle_deg: row.number("angle_deg")?,
+                wavelength_nm: row.number("wavelength_nm")?,
+                thickness_nm: has_thickness.then(|| thickness(&row)).transpose()?,
+            })
+        })
+        .collect()
+}
+
+fn thickness(row: &CsvRow<'_>) -> Result<f64, CliError> {
+    let d = row.number("thickness_nm")?;
+    if d >= 0.0 {
+        Ok(d)
+    } else {
+        Err(row.bad(
+            "thickness_nm",
+            row.get("thickness_nm").unwrap_or_default(),
+            "is not a thickness >= 0 nm",
+        ))
+    }
+}
+
+/// The output CSV for `queries` on `stack`, varying layer `vary_layer` (1-based) where a
+/// query overrides a thickness. Built whole before anything is printed.
+pub fn render(
+    stack: &Stack,
+    vary_layer: usize,
+    queries: &[StackQuery],
+) -> Result<String, CliError> {
+    let with_thickness = queries.iter().any(|q| q.thickness_nm.is_some());
+    if with_thickness && !(1..=stack.layers.len()).contains(&vary_layer) {
+        return Err(CliError::input(format!(
+            "--vary-layer {vary_layer} names no layer: the stack has {} inner layer(s)",
+            stack.layers.len()
+        )));
+    }
+    let mut out = String::new();
+    if with_thickness {
+        out.push_str("thickness_nm,");
+    }
+    out.push_str(HEADER);
+    out.push('\n');
+    let mut varied = stack.clone();
+    for q in queries {
+        let at = |what: String| {
+            let place = if q.line == 0 {
+                "flags".to_string()
+            } else {
+                format!("line {}", q.line)
+            };
+            CliError::input(format!("{place}: {what}"))
+        };
+        let incidence = Incidence::try_from_angle_deg(q.angle_deg)
+            .ok()
+            .filter(|_| q.angle_deg < 90.0)
+            .ok_or_else(|| at(format!("angle_deg {} is not in [0, 90)", q.angle_deg)))?;
+        if let Some(d) = q.thickness_nm {
+            varied.layers[vary_layer - 1].thickness_nm = d;
+            let _ = write!(out, "{d},");
+        }
+        let resp = varied
+            .try_response_at(q.wavelength_nm, incidence)
+            .map_err(|e| at(e.to_string()))?;
+        let _ = writeln!(
+            out,
+            "{},{},{},{},{},{},{}",
+            q.angle_deg,
+            q.wavelength_nm,
+            resp.r_s,
+            resp.r_p,
+            resp.r(),
+            resp.t(),
+            resp.absorptance()
+        );
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn complex_tokens_parse_with_exponents_and_signs() {
+        assert_eq!(parse_complex("0.18+3.4i"), Some(Complex64::new(0.18, 3.4)));
+        assert_eq!(parse_complex("1e-1+2E+1i"), Some(Complex64::new(0.1, 20.0)));
+        assert_eq!(parse_complex("1.5-0.1i"), Some(Complex64::new(1.5, -0.1)));
+        assert_eq!(parse_complex("1.5"), None);
+        assert_eq!(parse_complex("+3i"), None);
+    }
+
+    #[test]
+    fn stack_syntax_gives_the_layers_in_order() {
+        let stack = parse_stack("1.0 | 1.38 @ 100 | 2.1 @ 60 | 0.18+3.4i").unwrap();
+        assert_eq!(stack.n_incident, 1.0);
+        let d: Vec<f64> = stack.layers.iter().map(|l| l.thickness_nm).collect();
+        assert_eq!(d, [100.0, 60.0]);
+        assert_eq!(
+            stack.n_substrate.as_constant(),
+            Some(Complex64::new(0.18, 3.4))
+        );
+    }
+}

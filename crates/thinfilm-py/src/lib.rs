@@ -1,0 +1,213 @@
+//! The native half of the `thinfilm` Python package: flat, equally long f64 arrays in,
+//! arrays out. Broadcasting and shapes are done in `python/thinfilm/__init__.py`.
+//!
+//! Every call copies its inputs, releases the GIL and computes in parallel (rayon), so
+//! other Python threads run meanwhile; every bad value raises `ValueError` naming it.
+
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use rayon::prelude::*;
+use thinfilm::airy::ThinFilm;
+use thinfilm::colorspace::{SRGB_FROM_XYZ, apply, srgb_encode};
+use thinfilm::dispersion::RefractiveIndex;
+use thinfilm::{Complex64, Incidence, Layer, Observer, OpticsError, SpectralIntegrator, Stack};
+
+/// Points per rayon task: small enough to balance, large enough to amortise.
+const CHUNK: usize = 1024;
+
+type Pair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
+
+fn value_error(err: OpticsError) -> PyErr {
+    PyValueError::new_err(err.to_string())
+}
+
+fn copy(array: &PyReadonlyArray1<'_, f64>) -> Vec<f64> {
+    array.as_array().iter().copied().collect()
+}
+
+#[derive(Clone, Copy)]
+enum Pol {
+    S,
+    P,
+    Mean,
+}
+
+fn pol_from(name: &str) -> PyResult<Pol> {
+    match name {
+        "s" => Ok(Pol::S),
+        "p" => Ok(Pol::P),
+        "u" => Ok(Pol::Mean),
+        other => Err(PyValueError::new_err(format!(
+            "pol = '{other}' is not one of 's', 'p', 'u'"
+        ))),
+    }
+}
+
+fn pick(pol: Pol, resp: thinfilm::fresnel::Response) -> (f64, f64) {
+    match pol {
+        Pol::S => (resp.r_s, resp.t_s),
+        Pol::P => (resp.r_p, resp.t_p),
+        Pol::Mean => (resp.r(), resp.t()),
+    }
+}
+
+/// `(R, T)` of each point by `f`, in parallel, or the first point's error.
+fn par_rt(
+    len: usize,
+    f: impl Fn(usize) -> Result<(f64, f64), OpticsError> + Sync,
+) -> Result<(Vec<f64>, Vec<f64>), OpticsError> {
+    let pairs: Vec<(f64, f64)> = (0..len)
+        .into_par_iter()
+        .with_min_len(CHUNK)
+        .map(&f)
+        .collect::<Result<_, _>>()?;
+    Ok(pairs.into_iter().unzip())
+}
+
+/// `(R, T)` of a stack (`n` from the incidence medium to the substrate, `d_nm` the inner
+/// layers) at each `(wavelength_nm[i], angle_deg[i])`.
+#[pyfunction]
+fn rt<'py>(
+    py: Python<'py>,
+    n: Vec<Complex64>,
+    d_nm: Vec<f64>,
+    wavelength_nm: PyReadonlyArray1<'py, f64>,
+    angle_deg: PyReadonlyArray1<'py, f64>,
+    pol: &str,
+) -> PyResult<Pair<'py>> {
+    let pol = pol_from(pol)?;
+    if n.len() != d_nm.len() + 2 {
+        return Err(PyValueError::new_err(format!(
+            "n has {} media and d_nm {} thicknesses: n needs len(d_nm) + 2 (both semi-infinite ends)",
+            n.len(),
+            d_nm.len()
+        )));
+    }
+    let n0 = n[0];
+    if n0.im != 0.0 {
+        return Err(PyValueError::new_err(format!(
+            "n[0] = {n0} must be real: the incidence medium cannot absorb"
+        )));
+    }
+    let layers = n[1..n.len() - 1]
+        .iter()
+        .zip(&d_nm)
+        .map(|(&index, &d)| Layer::new(index, d))
+        .collect();
+    let stack = Stack::new(n0.re, layers, n[n.len() - 1]).map_err(value_error)?;
+    let (wl, angle) = (copy(&wavelength_nm), copy(&angle_deg));
+    let (r, t) = py
+        .allow_threads(|| {
+            par_rt(wl.len(), |i| {
+                let incidence = Incidence::try_from_angle_deg(angle[i])?;
+                Ok(pick(pol, stack.try_response_at(wl[i], incidence)?))
+            })
+        })
+        .map_err(value_error)?;
+    Ok((r.into_pyarray(py), t.into_pyarray(py)))
+}
+
+/// `(R, T)` of symmetric films `n_outside | n_film | n_outside`, all arrays equally long.
+#[pyfunction]
+fn film_rt<'py>(
+    py: Python<'py>,
+    thickness_nm: PyReadonlyArray1<'py, f64>,
+    angle_deg: PyReadonlyArray1<'py, f64>,
+    wavelength_nm: PyReadonlyArray1<'py, f64>,
+    n_film: f64,
+    n_outside: f64,
+) -> PyResult<Pair<'py>> {
+    let film_index = RefractiveIndex::constant(n_film).map_err(value_error)?;
+    ThinFilm::new(n_outside, film_index, n_outside.into(), 0.0).map_err(value_error)?;
+    let (d, angle, wl) = (copy(&thickness_nm), copy(&angle_deg), copy(&wavelength_nm));
+    let (r, t) = py
+        .allow_threads(|| {
+            par_rt(d.len(), |i| {
+                let film = ThinFilm::symmetric(n_outside, film_index, d[i]);
+                let incidence = Incidence::try_from_angle_deg(angle[i])?;
+                Ok(pick(Pol::Mean, film.try_response_at(wl[i], incidence)?))
+            })
+        })
+        .map_err(value_error)?;
+    Ok((r.into_pyarray(py), t.into_pyarray(py)))
+}
+
+/// XYZ (perfect reflector at Y = 1) of soap films in air, flattened `[x0, y0, z0, x1, ...]`.
+#[pyfunction]
+fn film_xyz<'py>(
+    py: Python<'py>,
+    thickness_nm: PyReadonlyArray1<'py, f64>,
+    angle_deg: PyReadonlyArray1<'py, f64>,
+    n_film: f64,
+    illuminant: &str,
+    observer: &str,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let film_index = RefractiveIndex::constant(n_film).map_err(value_error)?;
+    let observer = Observer::from_name(observer).ok_or_else(|| {
+        PyValueError::new_err(format!("observer = {observer:?} is not '1931' or '1964'"))
+    })?;
+    let light = thinfilm::Illuminant::from_name(illuminant)
+        .map_err(|e| PyValueError::new_err(format!("illuminant = {illuminant:?}: {e}")))?;
+    // 2 nm as the CLI: within 1e-4 ΔE2000 of the 1 nm CIE sum for daylight.
+    let integrator = SpectralIntegrator::new(observer, &light.spectrum(), 2.0)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let (d, angle) = (copy(&thickness_nm), copy(&angle_deg));
+    let xyz: Vec<[f64; 3]> = py
+        .allow_threads(|| {
+            (0..d.len())
+                .into_par_iter()
+                .with_min_len(64)
+                .map(|i| {
+                    let film = ThinFilm::symmetric(1.0, film_index, d[i]);
+                    let incidence = Incidence::try_from_angle_deg(angle[i])?;
+                    let mut failure = None;
+                    let xyz = integrator.xyz(|w| match film.try_response_at(w, incidence) {
+                        Ok(resp) => resp.r(),
+                        Err(e) => {
+                            failure = Some(e);
+                            0.0
+                        }
+                    });
+                    failure.map_or(Ok(xyz), Err)
+                })
+                .collect::<Result<_, OpticsError>>()
+        })
+        .map_err(value_error)?;
+    Ok(xyz
+        .into_iter()
+        .flatten()
+        .collect::<Vec<f64>>()
+        .into_pyarray(py))
+}
+
+/// sRGB-encoded colours in [0, 1] (clamped) of flattened XYZ triples (D65 white at Y = 1).
+#[pyfunction]
+fn xyz_to_srgb<'py>(
+    py: Python<'py>,
+    xyz: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let flat = copy(&xyz);
+    if let Some(bad) = flat.iter().find(|v| !v.is_finite()) {
+        return Err(PyValueError::new_err(format!(
+            "xyz holds {bad}, not a finite number"
+        )));
+    }
+    let out: Vec<f64> = flat
+        .chunks_exact(3)
+        .flat_map(|c| {
+            apply(&SRGB_FROM_XYZ, [c[0], c[1], c[2]]).map(|v| srgb_encode(v.clamp(0.0, 1.0)))
+        })
+        .collect();
+    Ok(out.into_pyarray(py))
+}
+
+/// The native module `thinfilm._native`.
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(rt, m)?)?;
+    m.add_function(wrap_pyfunction!(film_rt, m)?)?;
+    m.add_function(wrap_pyfunction!(film_xyz, m)?)?;
+    m.add_function(wrap_pyfunction!(xyz_to_srgb, m)?)?;
+    Ok(())
+}
