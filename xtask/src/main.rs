@@ -2,14 +2,22 @@
 
 use std::process::{Command, ExitCode};
 
+mod reference_figures;
+
 const USAGE: &str = "usage: cargo xtask <figures|bench|ci>
   figures  regenerate the PNG figures under docs/figures/
+           (--reference: instead, the slow measured table of docs/reference.md)
   bench    run every crate's criterion benches, then `bubbles bench` (frame breakdown)
   ci       run what .ci/run runs (fmt, clippy, tests)";
 
 fn main() -> ExitCode {
     let task = std::env::args().nth(1);
     let ok = match task.as_deref() {
+        Some("figures") if std::env::args().any(|a| a == "--reference") => {
+            let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+            cargo(&["build", "--release", "-p", "bubbles"])
+                && reference_figures::run(&root, &reference_figures::bubbles_binary(&root))
+        }
         Some("figures") => figures(),
         Some("bench") => bench(),
         Some("ci") => ci(),

@@ -32,6 +32,8 @@ enum Command {
     Render(commands::render::Args),
     /// Time the frame and print a breakdown.
     Bench(commands::bench::Args),
+    /// CIEDE2000 between two images: mean, 95th percentile, maximum, optional heat map.
+    Compare(commands::compare::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -44,6 +46,7 @@ fn main() -> std::process::ExitCode {
         Command::Simulate(args) => commands::simulate::run(args),
         Command::Render(args) => commands::render::run(args),
         Command::Bench(args) => commands::bench::run(args),
+        Command::Compare(args) => commands::compare::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,
