@@ -167,3 +167,19 @@ fn bad_settings_are_named() {
     let err = render_reference(&scene, &soap_spec(2), &small(3, 3), &|| {}).unwrap_err();
     assert!(err.to_string().contains("light spectra"), "{err}");
 }
+
+#[test]
+fn unpolarised_chord_product_overestimates_the_polarised_one_at_60_degrees() {
+    // Issue 13's figure: a 300 nm film at 60°, 450 nm. Along a chord the s and p axes are
+    // shared, so the light reflected off the back film and sent through the front one is
+    // (R_s T_s + R_p T_p)/2, not the product of the unpolarised means the CPU composites.
+    let r = ThinFilm::soap(300.0).response(450.0, 60f64.to_radians().cos());
+    let polarised = 0.5 * (r.r_s * r.t_s + r.r_p * r.t_p);
+    let unpolarised = r.r() * r.t();
+    let excess = unpolarised / polarised - 1.0;
+    assert!(
+        (0.1..0.4).contains(&excess),
+        "unpolarised product {unpolarised} vs polarised {polarised}: {:.1} % brighter",
+        100.0 * excess
+    );
+}

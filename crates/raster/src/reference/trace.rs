@@ -219,12 +219,10 @@ impl Tracer<'_> {
             }
             return;
         }
-        let n = self.grid.len();
         let mut s = [0.0; MAX_WAVELENGTHS];
         self.uplift.spectrum(rgb, &mut s);
-        for k in 0..n {
+        for (k, w) in self.grid.reference_rgb.iter().enumerate() {
             let f = s[k] * 0.5 * (beam.s[k] + beam.p[k]);
-            let w = self.grid.reference_rgb[k];
             for c in 0..3 {
                 out[c] += w[c] * f;
             }
