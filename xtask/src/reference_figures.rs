@@ -17,7 +17,10 @@ struct Variant {
     what: &'static str,
 }
 
-const VARIANTS: [Variant; 9] = [
+/// Pairs compared besides "every variant against the reference": (image, against).
+const PAIRS: [(&str, &str); 1] = [("ref-centre", "ref-no-films")];
+
+const VARIANTS: [Variant; 12] = [
     Variant {
         name: "reference",
         flags: &["--backend", "reference"],
@@ -63,6 +66,21 @@ const VARIANTS: [Variant; 9] = [
         flags: &["--reflection", "static"],
         what: "CPU backend, environment only in reflections (no cube map)",
     },
+    Variant {
+        name: "ref-seed1",
+        flags: &["--backend", "reference", "--ref-seed", "1"],
+        what: "reference with another jitter seed: its noise",
+    },
+    Variant {
+        name: "ref-no-films",
+        flags: &["--backend", "reference", "--ref-reflections", "no-films"],
+        what: "reference, reflected rays pass through all films",
+    },
+    Variant {
+        name: "ref-centre",
+        flags: &["--backend", "reference", "--ref-reflections", "centre"],
+        what: "reference, reflected rays from the bubble's centre through all films (a perfect cube map)",
+    },
 ];
 
 /// Runs every variant, compares each with the reference, writes the table.
@@ -96,6 +114,17 @@ pub fn run(root: &Path, bubbles: &Path) -> bool {
             v.name,
             v.what,
             secs,
+            summary(&json)
+        ));
+    }
+    for (image, against) in PAIRS {
+        let (a, b) = (format!("{DIR}/{against}.png"), format!("{DIR}/{image}.png"));
+        let (ok, json) = run_bubbles(root, bubbles, &["compare", "--json", &a, &b]);
+        if !ok {
+            return false;
+        }
+        rows.push(format!(
+            "| {image} | against {against} | | {} |",
             summary(&json)
         ));
     }

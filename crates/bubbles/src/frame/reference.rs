@@ -2,7 +2,7 @@
 //! its own options and a progress bar with an ETA.
 
 use crate::error::CliError;
-use raster::reference::{FilmSpec, ReferenceSettings, render_reference};
+use raster::reference::{FilmSpec, ReferenceSettings, Reflections, render_reference};
 use raster::{Frame, RenderScene, RenderSettings};
 
 /// Options of the reference backend (ignored by the CPU backend).
@@ -29,6 +29,21 @@ pub struct ReferenceOptions {
     /// Reference: seed of the pixel-sample jitter.
     #[arg(long, default_value_t = 0)]
     pub ref_seed: u64,
+    /// Reference: reflected rays traced (the truth), traced through no films, or cast from
+    /// the bubble's centre through no films (the cube map's viewpoint).
+    #[arg(long, value_enum, default_value_t = RefReflections::Traced)]
+    pub ref_reflections: RefReflections,
+}
+
+/// Where the reference's reflected rays start and what they see.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum RefReflections {
+    /// From the hit point, seeing every film.
+    Traced,
+    /// From the hit point, through all films.
+    NoFilms,
+    /// From the bubble's centre, through all films (a perfect dynamic cube map).
+    Centre,
 }
 
 impl Default for ReferenceOptions {
@@ -42,6 +57,7 @@ impl Default for ReferenceOptions {
             ref_unpolarised: false,
             ref_rgb: false,
             ref_seed: d.seed,
+            ref_reflections: RefReflections::Traced,
         }
     }
 }
@@ -58,6 +74,11 @@ impl ReferenceOptions {
             step_nm: self.ref_step_nm,
             polarised: !self.ref_unpolarised,
             spectral: !self.ref_rgb,
+            reflections: match self.ref_reflections {
+                RefReflections::Traced => Reflections::Traced,
+                RefReflections::NoFilms => Reflections::NoFilms,
+                RefReflections::Centre => Reflections::FromCentre,
+            },
             seed: self.ref_seed,
         }
     }

@@ -32,6 +32,8 @@ pub(crate) struct Geometry<'a> {
     pub bubble_tris: Vec<[Vec3; 3]>,
     /// Per bubble triangle: its bubble and vertex indices.
     pub bubble_owner: Vec<(u32, [u32; 3])>,
+    /// Per bubble: its centre (where the CPU backend renders its cube map from).
+    pub centres: Vec<Vec3>,
     bubble_bvh: Bvh,
     pub opaque_tris: Vec<[Vec3; 3]>,
     /// Per opaque triangle: its object and vertex indices into [`Geometry::meshes`].
@@ -62,6 +64,7 @@ impl<'a> Geometry<'a> {
         }
         Geometry {
             scene,
+            centres: scene.bubbles.iter().map(|b| b.center()).collect(),
             bubble_bvh: Bvh::build(&bubble_tris),
             bubble_tris,
             bubble_owner,

@@ -48,8 +48,23 @@ pub struct ReferenceSettings {
     pub polarised: bool,
     /// Carry spectra (true), or RGB with films projected as the LUT bakes them (false).
     pub spectral: bool,
+    /// Where rays reflected off a film come from (to isolate the cube map's approximations).
+    pub reflections: Reflections,
     /// Seed of the sample jitter.
     pub seed: u64,
+}
+
+/// Where a film's reflected rays start and what they see.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Reflections {
+    /// Traced from the hit point, seeing every film (the truth).
+    #[default]
+    Traced,
+    /// Traced from the hit point, passing through all films (as a cube map without bubbles).
+    NoFilms,
+    /// From the bubble's centre, passing through all films: the dynamic cube map's single
+    /// viewpoint (seed 000 §4.2.2), at the cube map's infinite resolution.
+    FromCentre,
 }
 
 impl Default for ReferenceSettings {
@@ -64,6 +79,7 @@ impl Default for ReferenceSettings {
             step_nm: 10.0,
             polarised: true,
             spectral: true,
+            reflections: Reflections::Traced,
             seed: 0,
         }
     }

@@ -13,7 +13,7 @@ use thinfilm::{Response, ThinFilm};
 use super::geometry::{Geometry, Hit, blend};
 use super::spectral::{Grid, MAX_WAVELENGTHS};
 use super::upsample::Uplift;
-use super::{FilmSpec, ReferenceSettings};
+use super::{FilmSpec, ReferenceSettings, Reflections};
 use crate::shading::{ground_albedo, lit, object_albedo};
 
 /// Per-channel s and p factors of a beam and its s axis (`None`: unpolarised so far).
@@ -150,7 +150,12 @@ impl Tracer<'_> {
         let min = self.settings.min_weight;
         if reflected.weight(ch) >= min {
             let r_dir = (dir - n * (2.0 * dir.dot(n))).normalize_or(-dir);
-            self.trace(p, r_dir, &reflected, films_left - 1, Some(tri), out);
+            let (origin, films) = match self.settings.reflections {
+                Reflections::Traced => (p, films_left - 1),
+                Reflections::NoFilms => (p, 0),
+                Reflections::FromCentre => (self.geo.centres[b as usize], 0),
+            };
+            self.trace(origin, r_dir, &reflected, films, Some(tri), out);
         }
         if transmitted.weight(ch) >= min {
             self.trace(p, dir, &transmitted, films_left - 1, Some(tri), out);
