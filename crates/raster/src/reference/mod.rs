@@ -139,6 +139,7 @@ pub fn render_reference(
         light_rgb,
         spec,
         settings,
+        ambient: scene.irradiance.plus_uniform(scene.ambient_rgb),
     };
     let view = scene.camera.view(settings.width, settings.height);
     let rows: Vec<Vec<[f32; 3]>> = (0..settings.height)

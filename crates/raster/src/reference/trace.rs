@@ -72,6 +72,8 @@ pub(crate) struct Tracer<'a> {
     pub light_rgb: Vec<Vec<[f64; 3]>>,
     pub spec: &'a FilmSpec,
     pub settings: &'a ReferenceSettings,
+    /// Sky irradiance plus the scene's ambient term, as the CPU backend lights surfaces.
+    pub ambient: crate::Irradiance,
 }
 
 impl Tracer<'_> {
@@ -262,7 +264,7 @@ impl Tracer<'_> {
             p,
             Vec3::Y,
             dir,
-            scene.ambient_rgb,
+            &self.ambient,
             &scene.lights,
         )
     }
@@ -280,15 +282,7 @@ impl Tracer<'_> {
         };
         let material = scene.objects[o as usize].material();
         let albedo = object_albedo(material, p, uv);
-        lit(
-            material,
-            albedo,
-            p,
-            n,
-            dir,
-            scene.ambient_rgb,
-            &scene.lights,
-        )
+        lit(material, albedo, p, n, dir, &self.ambient, &scene.lights)
     }
 }
 
