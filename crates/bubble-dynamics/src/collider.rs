@@ -152,8 +152,8 @@ impl Collider {
                 } else {
                     Err(ParamError::new(
                         "max_m",
-                        max_m,
-                        format!("must exceed min_m = {min_m:?} on every axis"),
+                        max_m.to_array(),
+                        format!("must exceed min_m = {:?} on every axis", min_m.to_array()),
                     ))
                 }
             }

@@ -252,7 +252,7 @@ impl BubbleParams {
         if self.initial_scale.min_element() <= 0.0 {
             return Err(ParamError::new(
                 "initial_scale",
-                self.initial_scale,
+                self.initial_scale.to_array(),
                 "must have positive components",
             ));
         }

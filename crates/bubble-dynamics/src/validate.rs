@@ -32,7 +32,7 @@ pub(crate) fn finite_vec(name: &str, v: DVec3) -> Result<(), ParamError> {
     if v.is_finite() {
         Ok(())
     } else {
-        Err(ParamError::new(name, v, "must be finite"))
+        Err(ParamError::new(name, v.to_array(), "must be finite"))
     }
 }
 
@@ -40,6 +40,10 @@ pub(crate) fn nonzero_vec(name: &str, v: DVec3) -> Result<(), ParamError> {
     if v.is_finite() && v.length_squared() > 0.0 {
         Ok(())
     } else {
-        Err(ParamError::new(name, v, "must be finite and non-zero"))
+        Err(ParamError::new(
+            name,
+            v.to_array(),
+            "must be finite and non-zero",
+        ))
     }
 }

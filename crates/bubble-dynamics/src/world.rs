@@ -448,7 +448,7 @@ fn check_initial_overlaps(
             if gap < reach(bi) + reach(bj) {
                 return Err(ParamError::new(
                     format!("bubbles[{j}].center_m"),
-                    bj.center_m,
+                    bj.center_m.to_array(),
                     format!(
                         "overlaps bubbles[{i}] (centres {gap:.4} m apart, reach {:.4} m)",
                         reach(bi) + reach(bj)
@@ -461,7 +461,7 @@ fn check_initial_overlaps(
             if d < reach(bj) {
                 return Err(ParamError::new(
                     format!("bubbles[{j}].center_m"),
-                    bj.center_m,
+                    bj.center_m.to_array(),
                     format!(
                         "is {d:.4} m from colliders[{k}], closer than the bubble's reach {:.4} m",
                         reach(bj)

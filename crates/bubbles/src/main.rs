@@ -4,13 +4,15 @@ mod commands;
 mod csv_table;
 mod error;
 mod frame;
+mod input;
+mod limits;
 mod scene;
 
 use clap::{Parser, Subcommand};
 
 /// Soap bubbles with real thin-film optics.
 #[derive(Debug, Parser)]
-#[command(name = "bubbles", version, about, long_about = None)]
+#[command(name = "bubbles", version, about, long_about = None, after_help = limits::HELP)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

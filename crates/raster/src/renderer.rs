@@ -539,5 +539,34 @@ mod tests {
                 prop_assert_eq!(order[1], nearer, "entries {} and {}", e0, e1);
             }
         }
+
+        #[test]
+        fn a_small_bubble_behind_the_rim_of_a_large_one_is_drawn_first(
+            radius_m in 0.5f32..2.0,
+            distance in 1.05f32..3.0,
+            small in 0.02f32..0.3,
+            angle_offset in -0.15f32..0.15,
+            depth in 0.85f32..1.05,
+            aim in prop::array::uniform2(-1.0f32..1.0),
+        ) {
+            // Where centre distance fails: a small bubble about as far as the large one's
+            // centre, seen just inside the large one's silhouette.
+            let c0 = Vec3::new(0.0, 0.0, -radius_m * distance);
+            let r1 = small * radius_m;
+            let theta = (1.0 / distance).asin() + angle_offset;
+            let c1 = Vec3::new(theta.sin(), 0.0, -theta.cos()) * (c0.length() * depth);
+            if c0.distance(c1) <= (radius_m + r1) * 1.001 || c1.length() <= r1 * 1.001 {
+                return Ok(());
+            }
+            let dir = (c1 + Vec3::new(aim[0], aim[1], 0.0) * r1).normalize();
+            if let (Some(e0), Some(e1)) = (entry(dir, c0, radius_m), entry(dir, c1, r1)) {
+                let order = far_to_near(
+                    &[icosahedron(c0, radius_m), icosahedron(c1, r1)],
+                    Vec3::ZERO,
+                );
+                let nearer = if e0 < e1 { 0 } else { 1 };
+                prop_assert_eq!(order[1], nearer, "entries {} and {}", e0, e1);
+            }
+        }
     }
 }

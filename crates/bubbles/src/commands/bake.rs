@@ -154,6 +154,7 @@ fn light_from(arg: &str) -> Result<Light, CliError> {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
     if looks_like_path {
+        crate::scene::check_spectrum_file(path)?;
         return Light::try_from_csv_path(path).map_err(|e| CliError::input(e.to_string()));
     }
     Illuminant::from_name(arg)

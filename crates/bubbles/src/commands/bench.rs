@@ -1,18 +1,21 @@
 //! `bubbles bench`: time whole frames (simulation + render) and print a breakdown.
 
-use crate::error::CliResult;
+use crate::error::{CliError, CliResult};
 use crate::frame::{FrameJob, Options};
+use crate::limits;
 use std::time::Instant;
 
 /// Arguments of `bubbles bench`.
 #[derive(Debug, clap::Args)]
+#[command(after_help = limits::HELP)]
 pub struct Args {
     /// A scene file (.toml) or a built-in scene (default `paper`).
     pub scene: Option<String>,
-    /// Frames timed at each size (after two warm-up frames).
+    /// Frames timed at each size (after two warm-up frames), 1..=100000.
     #[arg(long, default_value_t = 50)]
     pub frames: u32,
-    /// Image sizes to time, as WxH (repeatable; default 400x400 and 1920x1080).
+    /// Image sizes to time, as WxH (repeatable; default: --width x --height when either
+    /// is given, else 400x400 and 1920x1080).
     #[arg(long = "size", value_parser = parse_size)]
     pub sizes: Vec<(usize, usize)>,
     #[command(flatten)]
@@ -32,12 +35,23 @@ struct Breakdown {
 
 /// Runs `bubbles bench`.
 pub fn run(args: Args) -> CliResult {
-    let sizes = if args.sizes.is_empty() {
-        vec![(400, 400), (1920, 1080)]
-    } else {
-        args.sizes.clone()
+    let sizes = match (
+        args.sizes.is_empty(),
+        args.options.width,
+        args.options.height,
+    ) {
+        (false, ..) => args.sizes.clone(),
+        (true, None, None) => vec![(400, 400), (1920, 1080)],
+        (true, ..) => vec![args.options.size()],
     };
-    let frames = args.frames.max(1);
+    if !(1..=limits::MAX_BENCH_FRAMES).contains(&args.frames) {
+        return Err(CliError::input(format!(
+            "--frames {} is outside 1..={} (see --help)",
+            args.frames,
+            limits::MAX_BENCH_FRAMES
+        )));
+    }
+    let frames = args.frames;
     let mut job = FrameJob::prepare(args.scene.as_deref(), &args.options)?;
     let mut report = String::new();
     report.push_str(&format!(
@@ -51,7 +65,7 @@ pub fn run(args: Args) -> CliResult {
         "size        sim_ms  cube_ms  opaque_ms  bubbles_ms  other_ms  frame_ms     fps\n",
     );
     for (w, h) in sizes {
-        job.set_size(w, h);
+        job.set_size(w, h)?;
         let b = time_frames(&mut job, frames)?;
         report.push_str(&format!(
             "{:<10} {:>7.3} {:>8.3} {:>10.3} {:>11.3} {:>9.3} {:>9.3} {:>7.1}\n",
@@ -69,7 +83,7 @@ pub fn run(args: Args) -> CliResult {
     Ok(())
 }
 
-fn time_frames(job: &mut FrameJob, frames: u32) -> Result<Breakdown, crate::error::CliError> {
+fn time_frames(job: &mut FrameJob, frames: u32) -> Result<Breakdown, CliError> {
     for _ in 0..2 {
         job.step()?;
         job.render()?;
@@ -107,12 +121,13 @@ fn parse_size(s: &str) -> Result<(usize, usize), String> {
         v.trim()
             .parse::<usize>()
             .ok()
-            .filter(|n| (1..=16384).contains(n))
+            .filter(|n| (1..=limits::MAX_IMAGE_SIDE).contains(n))
     };
     match (parse(w), parse(h)) {
         (Some(w), Some(h)) => Ok((w, h)),
         _ => Err(format!(
-            "{s:?}: width and height must be whole numbers in 1..=16384"
+            "{s:?}: width and height must be whole numbers in 1..={}",
+            limits::MAX_IMAGE_SIDE
         )),
     }
 }

@@ -2,18 +2,21 @@
 
 use crate::error::{CliError, CliResult};
 use crate::frame::{FrameJob, Options};
+use crate::limits;
+use crate::scene::values::{Num, Seconds, plain};
 use std::path::{Path, PathBuf};
 
 /// Arguments of `bubbles render`.
 #[derive(Debug, clap::Args)]
+#[command(after_help = limits::HELP)]
 pub struct Args {
     /// A scene file (.toml) or a built-in scene: `paper` (default) or `white-furnace`.
     pub scene: Option<String>,
     /// Output image: `.png` (8-bit sRGB, tone-mapped) or `.exr` (linear HDR).
     #[arg(long)]
     pub out: PathBuf,
-    /// Simulated time to advance before rendering, in seconds (default: the scene's `time_s`).
-    #[arg(long)]
+    /// Simulated time to advance before rendering, 0..=3600 s (default: the scene's `time_s`).
+    #[arg(long, allow_negative_numbers = true)]
     pub time_s: Option<f64>,
     #[command(flatten)]
     pub options: Options,
@@ -30,7 +33,13 @@ pub fn run(args: Args) -> CliResult {
     let kind = output_kind(&args.out)?;
     check_parent_dir(&args.out)?;
     let mut job = FrameJob::prepare(args.scene.as_deref(), &args.options)?;
-    job.advance_to(args.time_s.unwrap_or(job.scene_time_s()), true)?;
+    let time_s = match args.time_s {
+        Some(t) => Num::<Seconds>::try_new(t)
+            .map_err(|m| CliError::input(format!("--time-s {}: {m}", plain(t))))?
+            .get(),
+        None => job.scene_time_s(),
+    };
+    job.advance_to(time_s, true)?;
     let (exposure_ev, tonemap) = (job.settings().exposure_ev, job.settings().tonemap);
     let bubbles = job.bubble_count();
     let time_s = job.time_s();

@@ -5,20 +5,19 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use bubble_dynamics::{Bubble, DVec3, Event, World};
+use bubble_dynamics::{Bubble, DVec3, Event, SimError, World};
 use serde::Serialize;
 
 use crate::error::{CliError, CliResult};
+use crate::limits;
 use crate::scene::Scene;
-use crate::scene::values::Positive;
+use crate::scene::values::{BubbleRadius, Num, plain};
 
 /// Thickness written as vertex colour 1.0 in exported OBJ files: the tables' range.
 pub const OBJ_FULL_SCALE_NM: f64 = lut::config::DEFAULT_THICKNESS_MAX_NM as f64;
 
-/// Arguments of `bubbles simulate`.
-#[derive(Debug, clap::Args)]
-#[command(
-    after_help = "Simulates the scene's bubbles (seed 000 §3: film tension, isothermal \
+/// What `simulate` prints and writes, for its `--help`.
+const ABOUT_OUTPUT: &str = "Simulates the scene's bubbles (seed 000 §3: film tension, isothermal \
     gas, gravity, buoyancy, drag, contacts, drainage) for --seconds and prints each bubble's \
     centre, volume-equivalent radius, volume, pressure excess, film thickness (min, mean, max) \
     and kinetic energy, the step count, the wall time and any burst events.\n\n\
@@ -27,8 +26,11 @@ pub const OBJ_FULL_SCALE_NM: f64 = lut::config::DEFAULT_THICKNESS_MAX_NM as f64;
     each vertex line is `v x y z r g b` with r = g = b = thickness / 4000 nm (clamped to 1), the \
     vertex-colour extension that Blender, MeshLab and most OBJ readers import as a colour \
     attribute, and the exact thicknesses follow as `#thickness_nm` comment lines, in vertex \
-    order. Files are written to a temporary name in DIR, then renamed."
-)]
+    order. Files are written to a temporary name in DIR, then renamed.";
+
+/// Arguments of `bubbles simulate`.
+#[derive(Debug, clap::Args)]
+#[command(after_help = format!("{}\n\n{}", ABOUT_OUTPUT, limits::HELP))]
 pub struct Args {
     /// A built-in scene name (`paper`, the default: two bubbles above a plane) or a TOML path.
     pub scene: Option<String>,
@@ -54,17 +56,19 @@ pub fn run(args: Args) -> CliResult {
     check_args(&args)?;
     let mut scene = Scene::resolve(args.scene.as_deref())?;
     if let Some(r) = args.radius_m {
-        let radius = Positive::new(r).ok_or_else(|| radius_error(r))?;
+        let radius = Num::<BubbleRadius>::try_new(r).map_err(|m| radius_error(r, &m))?;
         scene
             .file
             .bubbles
             .iter_mut()
             .for_each(|b| b.radius_m = radius);
     }
+    scene.check_limits()?;
     let mut world = scene.dynamics_world().map_err(|e| match args.radius_m {
-        Some(r) => CliError::input(format!("with --radius-m {r}: {e}")),
+        Some(r) => CliError::input(format!("with --radius-m {}: {e}", plain(r))),
         None => e,
     })?;
+    check_work(&scene, &world, &args)?;
     if let Some(dir) = &args.export_obj {
         std::fs::create_dir_all(dir).map_err(|e| {
             CliError::input(format!(
@@ -74,7 +78,10 @@ pub fn run(args: Args) -> CliResult {
         })?;
     }
     let started = Instant::now();
-    let (events, frames) = simulate(&mut world, &args)?;
+    let (events, frames) = simulate(&mut world, &args).map_err(|failure| match failure {
+        SimFailure::Solver(e) => crate::scene::sim_error(&scene, e),
+        SimFailure::Write(e) => e,
+    })?;
     let report = Report::new(
         &scene.origin,
         &args,
@@ -100,9 +107,9 @@ fn check_args(args: &Args) -> CliResult {
         )));
     }
     if let Some(r) = args.radius_m
-        && Positive::new(r).is_none()
+        && let Err(m) = Num::<BubbleRadius>::try_new(r)
     {
-        return Err(radius_error(r));
+        return Err(radius_error(r, &m));
     }
     if !(args.fps.is_finite() && args.fps > 0.0) {
         return Err(CliError::input(format!(
@@ -113,26 +120,56 @@ fn check_args(args: &Args) -> CliResult {
     Ok(())
 }
 
-fn radius_error(r: f64) -> CliError {
-    CliError::input(format!("--radius-m {r} must be a finite number > 0"))
+fn radius_error(r: f64, message: &str) -> CliError {
+    CliError::input(format!("--radius-m {}: {message}", plain(r)))
+}
+
+/// Refuses `--seconds` and `--fps` that would take too many steps or write too many files.
+fn check_work(scene: &Scene, world: &World, args: &Args) -> CliResult {
+    let what = format!("--seconds {}", plain(args.seconds));
+    scene.check_steps(&what, world.time_s(), args.seconds, world.dt_s())?;
+    if args.export_obj.is_some() {
+        let frames = (args.seconds * args.fps + 1e-9).floor() + 1.0;
+        if frames > limits::MAX_OBJ_FRAMES as f64 {
+            return Err(CliError::input(format!(
+                "--seconds {} at --fps {} would write {frames:.3e} OBJ files, above the limit of {} (see --help)",
+                plain(args.seconds),
+                plain(args.fps),
+                limits::MAX_OBJ_FRAMES
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Advances the world to `--seconds`, through every output frame when exporting;
 /// returns the events and the number of frames written.
-fn simulate(world: &mut World, args: &Args) -> Result<(Vec<Event>, usize), CliError> {
-    let diverged = |e: bubble_dynamics::SimError| CliError::runtime(e.to_string());
+fn simulate(world: &mut World, args: &Args) -> Result<(Vec<Event>, usize), SimFailure> {
     let Some(dir) = &args.export_obj else {
-        return Ok((world.advance_to(args.seconds).map_err(diverged)?, 0));
+        return Ok((world.advance_to(args.seconds)?, 0));
     };
     // The last frame lands exactly on --seconds; rounding protects k/fps = seconds.
     let last = (args.seconds * args.fps + 1e-9).floor() as usize;
     let mut events = Vec::new();
     for k in 0..=last {
-        events.extend(world.advance_to(k as f64 / args.fps).map_err(diverged)?);
-        write_atomic(&dir.join(format!("frame_{k:05}.obj")), &obj_text(world, k))?;
+        events.extend(world.advance_to(k as f64 / args.fps)?);
+        write_atomic(&dir.join(format!("frame_{k:05}.obj")), &obj_text(world, k))
+            .map_err(SimFailure::Write)?;
     }
-    events.extend(world.advance_to(args.seconds).map_err(diverged)?);
+    events.extend(world.advance_to(args.seconds)?);
     Ok((events, last + 1))
+}
+
+/// Why [`simulate`] stopped: the solver, or writing a frame.
+enum SimFailure {
+    Solver(SimError),
+    Write(CliError),
+}
+
+impl From<SimError> for SimFailure {
+    fn from(e: SimError) -> Self {
+        Self::Solver(e)
+    }
 }
 
 /// The world's bubbles as one OBJ document (see the command's help for the layout).

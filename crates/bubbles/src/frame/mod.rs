@@ -3,23 +3,27 @@
 pub mod reference;
 
 use crate::error::CliError;
+use crate::limits;
+use crate::scene::schema::RenderSpec;
+use crate::scene::values::{Exposure, Num, plain};
 use crate::scene::{Scene, bubble_meshes};
 use bubble_dynamics::World;
 use lut::LutSet;
 use raster::{
-    FilmTables, Frame, ReflectionMode, RenderScene, RenderSettings, Renderer, SphereMap, ToneMap,
+    FilmTables, Frame, ReflectionMode, RenderScene, RenderSettings, Renderer, SAMPLE_COUNTS,
+    SphereMap, ToneMap,
 };
 use std::sync::Arc;
 
 /// Renderer options shared by `render` and `bench` (flags override the scene's `[render]`).
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct Options {
-    /// Image width in pixels.
-    #[arg(long, default_value_t = 800)]
-    pub width: usize,
-    /// Image height in pixels.
-    #[arg(long, default_value_t = 600)]
-    pub height: usize,
+    /// Image width in pixels, 1..=16384 (default 800).
+    #[arg(long)]
+    pub width: Option<usize>,
+    /// Image height in pixels, 1..=16384 (default 600).
+    #[arg(long)]
+    pub height: Option<usize>,
     /// Anti-aliasing samples per pixel: 1, 4, 8, 9 or 16 (default: the scene's, else 4).
     #[arg(long)]
     pub samples: Option<u32>,
@@ -31,7 +35,7 @@ pub struct Options {
     /// Bubble reflections: dynamic cube maps, the static environment, or a sphere map (seed 002).
     #[arg(long, value_enum)]
     pub reflection: Option<Reflection>,
-    /// Face size of the dynamic cube maps, in texels (default: the scene's, else 128).
+    /// Face size of the dynamic cube maps, 1..=1024 texels (default: the scene's, else 128).
     #[arg(long)]
     pub cube_map_size: Option<usize>,
     /// Exposure multiplier applied before tone mapping (default: the scene's, else 1).
@@ -40,6 +44,13 @@ pub struct Options {
     /// Tone curve for PNG output (default: the scene's, else aces).
     #[arg(long, value_enum)]
     pub tonemap: Option<Tone>,
+}
+
+impl Options {
+    /// `--width` and `--height`, or 800 × 600.
+    pub fn size(&self) -> (usize, usize) {
+        (self.width.unwrap_or(800), self.height.unwrap_or(600))
+    }
 }
 
 /// Rendering backends.
@@ -94,7 +105,12 @@ pub struct FrameJob {
 impl FrameJob {
     /// Loads the scene, builds the world, bakes the tables and checks the settings.
     pub fn prepare(scene_arg: Option<&str>, options: &Options) -> Result<Self, CliError> {
-        let scene = Scene::resolve(scene_arg)?;
+        Self::from_scene(Scene::resolve(scene_arg)?, options)
+    }
+
+    /// [`FrameJob::prepare`] for a scene already parsed.
+    pub fn from_scene(scene: Scene, options: &Options) -> Result<Self, CliError> {
+        scene.check_limits()?;
         let world = scene.dynamics_world()?;
         let luts = scene.bake_tables()?;
         let mut render_scene = scene.render_scene()?;
@@ -141,12 +157,14 @@ impl FrameJob {
     pub fn advance_to(&mut self, time_s: f64, progress: bool) -> Result<(), CliError> {
         if !(time_s.is_finite() && time_s >= 0.0) {
             return Err(CliError::input(format!(
-                "--time-s {time_s}: must be a finite number of seconds >= 0"
+                "--time-s {}: must be a finite number of seconds >= 0",
+                plain(time_s)
             )));
         }
-        let steps = ((time_s - self.world.time_s()) / self.world.dt_s())
-            .ceil()
-            .max(0.0) as u64;
+        let what = format!("advancing to t = {} s", plain(time_s));
+        let (now_s, dt_s) = (self.world.time_s(), self.world.dt_s());
+        self.scene.check_steps(&what, now_s, time_s, dt_s)?;
+        let steps = ((time_s - now_s) / dt_s).ceil().max(0.0) as u64;
         let bar = (progress && steps > 0).then(|| indicatif::ProgressBar::new(steps));
         while self.world.time_s() < time_s - 0.5 * self.world.dt_s() {
             self.step()?;
@@ -165,7 +183,7 @@ impl FrameJob {
         self.world
             .step()
             .map(drop)
-            .map_err(|e| CliError::runtime(format!("simulation failed: {e}")))
+            .map_err(|e| crate::scene::sim_error(&self.scene, e))
     }
 
     /// The solver's time step, in seconds.
@@ -187,9 +205,14 @@ impl FrameJob {
     }
 
     /// Replaces the image size (for benchmarks at several sizes).
-    pub fn set_size(&mut self, width: usize, height: usize) {
+    ///
+    /// # Errors
+    /// When the new size's buffers pass the memory limit.
+    pub fn set_size(&mut self, width: usize, height: usize) -> Result<(), CliError> {
+        check_memory(self.bubble_count(), &self.settings, width, height)?;
         self.settings.width = width;
         self.settings.height = height;
+        Ok(())
     }
 }
 
@@ -213,10 +236,7 @@ fn settings(
     let reflection = match (o.reflection, r.reflection.as_deref()) {
         (Some(Reflection::Dynamic), _) | (None, None | Some("dynamic")) => {
             ReflectionMode::DynamicCubeMap {
-                face_size: o
-                    .cube_map_size
-                    .or(r.cube_map_size.map(|s| s as usize))
-                    .unwrap_or(128),
+                face_size: cube_map_size(o, r)?,
             }
         }
         (Some(Reflection::Static), _) | (None, Some("static")) => ReflectionMode::StaticEnvironment,
@@ -247,16 +267,20 @@ fn settings(
             )));
         }
     };
-    let exposure = o.exposure.or(r.exposure.map(|e| e.get())).unwrap_or(1.0);
-    if !(exposure.is_finite() && exposure > 0.0) {
-        return Err(CliError::input(format!(
-            "--exposure {exposure}: must be a finite number > 0"
-        )));
+    let exposure = match o.exposure {
+        Some(e) => Num::<Exposure>::try_new(e)
+            .map_err(|m| CliError::input(format!("--exposure {}: {m}", plain(e))))?
+            .get(),
+        None => r.exposure.map_or(1.0, Num::get),
+    };
+    let (width, height) = o.size();
+    for (flag, side) in [("--width", width), ("--height", height)] {
+        check_side(flag, side)?;
     }
     let settings = RenderSettings {
-        width: o.width,
-        height: o.height,
-        samples: o.samples.or(r.samples).unwrap_or(4),
+        width,
+        height,
+        samples: samples(scene, o, r)?,
         reflection,
         exposure_ev: exposure.log2() as f32,
         tonemap,
@@ -265,5 +289,59 @@ fn settings(
     settings
         .validate()
         .map_err(|e| CliError::input(e.to_string()))?;
+    check_memory(scene.file.bubbles.len(), &settings, width, height)?;
     Ok(settings)
+}
+
+/// The cube-map face size from `--cube-map-size`, else `[render] cube_map_size`, else 128.
+fn cube_map_size(o: &Options, r: &RenderSpec) -> Result<usize, CliError> {
+    match o.cube_map_size {
+        Some(s) if (1..=limits::MAX_CUBE_MAP_SIZE).contains(&s) => Ok(s),
+        Some(s) => Err(CliError::input(format!(
+            "--cube-map-size {s} is outside 1..={} texels (see --help)",
+            limits::MAX_CUBE_MAP_SIZE
+        ))),
+        None => Ok(r.cube_map_size.map_or(128, |s| s.get() as usize)),
+    }
+}
+
+/// Samples per pixel from `--samples`, else `[render] samples`, else 4.
+fn samples(scene: &Scene, o: &Options, r: &RenderSpec) -> Result<u32, CliError> {
+    let (value, key) = match (o.samples, r.samples) {
+        (Some(s), _) => (s, "--samples".to_string()),
+        (None, Some(s)) => (s.get(), format!("{}: render.samples =", scene.origin)),
+        (None, None) => return Ok(4),
+    };
+    if SAMPLE_COUNTS.contains(&value) {
+        Ok(value)
+    } else {
+        Err(CliError::input(format!(
+            "{key} {value} must be one of {SAMPLE_COUNTS:?}"
+        )))
+    }
+}
+
+/// Refuses an image side outside `1..=MAX_IMAGE_SIDE`, naming the flag.
+pub fn check_side(flag: &str, side: usize) -> Result<(), CliError> {
+    if (1..=limits::MAX_IMAGE_SIDE).contains(&side) {
+        Ok(())
+    } else {
+        Err(CliError::input(format!(
+            "{flag} {side} is outside 1..={} pixels (see --help)",
+            limits::MAX_IMAGE_SIDE
+        )))
+    }
+}
+
+fn check_memory(
+    bubbles: usize,
+    settings: &RenderSettings,
+    width: usize,
+    height: usize,
+) -> Result<(), CliError> {
+    let cube = match settings.reflection {
+        ReflectionMode::DynamicCubeMap { face_size } => Some(face_size),
+        _ => None,
+    };
+    crate::scene::check_memory(bubbles, cube, width, height, settings.samples)
 }

@@ -3,7 +3,13 @@
 //! Every table uses `deny_unknown_fields`, so a misspelt key is an error with its
 //! line and column rather than a silently ignored setting.
 
-use super::values::{Direction, Finite, NonNegative, Positive, Rgb, Vec3};
+use super::values::{
+    Acceleration, Bounds, BubbleRadius, Coordinate, Count, CubeMapSize, Damping, Direction,
+    Elasticity, Evaporation, Exposure, FieldOfView, FilmIndex, FilmThickness, GustSpeed, Intensity,
+    LightRadius, Luminance, MeshScale, MolarMass, Num, Num3, ObjectRadius, PatternScale, Radiance,
+    Reflectance, RuptureThickness, Samples, Seconds, Shininess, SloshSpeed, Speed, Subdivisions,
+    SurfaceTension, TimeStep, Variation, Viscosity,
+};
 use serde::Deserialize;
 
 /// A whole scene file.
@@ -12,7 +18,7 @@ use serde::Deserialize;
 pub struct SceneFile {
     /// Simulated time to advance before rendering, in seconds.
     #[serde(default = "zero")]
-    pub time_s: NonNegative,
+    pub time_s: Num<Seconds>,
     /// The viewpoint.
     pub camera: CameraSpec,
     /// What surrounds the scene.
@@ -44,8 +50,13 @@ pub struct SceneFile {
     pub render: RenderSpec,
 }
 
-fn zero() -> NonNegative {
-    NonNegative::new(0.0).expect("0 is non-negative")
+/// A literal default, checked against its range by the tests of the built-in scenes.
+fn num<B: Bounds>(v: f64) -> Num<B> {
+    Num::new(v).expect("literal default is in range")
+}
+
+fn zero() -> Num<Seconds> {
+    num(0.0)
 }
 
 /// A look-at camera.
@@ -53,23 +64,23 @@ fn zero() -> NonNegative {
 #[serde(deny_unknown_fields)]
 pub struct CameraSpec {
     /// Eye position, m.
-    pub eye_m: Vec3,
+    pub eye_m: Num3<Coordinate>,
     /// Point looked at, m.
-    pub target_m: Vec3,
+    pub target_m: Num3<Coordinate>,
     /// Up direction.
     #[serde(default = "y_up")]
     pub up: Direction,
     /// Vertical field of view, degrees.
     #[serde(default = "default_vfov")]
-    pub vfov_deg: Positive,
+    pub vfov_deg: Num<FieldOfView>,
 }
 
 fn y_up() -> Direction {
     Direction::new([0.0, 1.0, 0.0]).expect("y is a direction")
 }
 
-fn default_vfov() -> Positive {
-    Positive::new(40.0).expect("40 > 0")
+fn default_vfov() -> Num<FieldOfView> {
+    num(40.0)
 }
 
 /// The environment: what a ray that hits nothing sees.
@@ -80,24 +91,24 @@ pub enum EnvironmentSpec {
     Sky {
         /// Sky radiance straight up.
         #[serde(default = "zenith")]
-        zenith_rgb: Rgb,
+        zenith_rgb: Num3<Radiance>,
         /// Sky radiance at the horizon.
         #[serde(default = "horizon")]
-        horizon_rgb: Rgb,
+        horizon_rgb: Num3<Radiance>,
         /// Radiance below the horizon.
         #[serde(default = "below")]
-        ground_rgb: Rgb,
+        ground_rgb: Num3<Radiance>,
         /// Direction towards the sun.
         #[serde(default = "sun_dir")]
         sun_direction: Direction,
         /// Sun disc radiance (0 for none).
         #[serde(default = "sun_rgb")]
-        sun_rgb: Rgb,
+        sun_rgb: Num3<Radiance>,
     },
     /// The same radiance in every direction.
     Uniform {
         /// The radiance.
-        rgb: Rgb,
+        rgb: Num3<Radiance>,
     },
     /// An equirectangular (latitude-longitude) image.
     Equirect {
@@ -105,7 +116,7 @@ pub enum EnvironmentSpec {
         path: String,
         /// Radiance scale applied to the decoded linear values.
         #[serde(default = "one")]
-        intensity: NonNegative,
+        intensity: Num<Intensity>,
     },
     /// Six cube-map face images, in the order +x, −x, +y, −y, +z, −z.
     Cube {
@@ -113,7 +124,7 @@ pub enum EnvironmentSpec {
         faces: [String; 6],
         /// Radiance scale applied to the decoded linear values.
         #[serde(default = "one")]
-        intensity: NonNegative,
+        intensity: Num<Intensity>,
     },
 }
 
@@ -129,26 +140,26 @@ impl Default for EnvironmentSpec {
     }
 }
 
-fn rgb(v: [f64; 3]) -> Rgb {
-    Rgb::new(v).expect("literal colour is valid")
+fn rgb<B: Bounds>(v: [f64; 3]) -> Num3<B> {
+    Num3::new(v).expect("literal colour is in range")
 }
-fn zenith() -> Rgb {
+fn zenith() -> Num3<Radiance> {
     rgb([0.25, 0.45, 0.9])
 }
-fn horizon() -> Rgb {
+fn horizon() -> Num3<Radiance> {
     rgb([0.85, 0.9, 1.0])
 }
-fn below() -> Rgb {
+fn below() -> Num3<Radiance> {
     rgb([0.3, 0.28, 0.25])
 }
 fn sun_dir() -> Direction {
     Direction::new([0.4, 0.8, 0.3]).expect("literal direction is valid")
 }
-fn sun_rgb() -> Rgb {
+fn sun_rgb() -> Num3<Radiance> {
     rgb([0.0, 0.0, 0.0])
 }
-fn one() -> NonNegative {
-    NonNegative::new(1.0).expect("1 >= 0")
+fn one() -> Num<Intensity> {
+    num(1.0)
 }
 
 /// An infinite horizontal ground plane (drawn and collided with).
@@ -157,14 +168,14 @@ fn one() -> NonNegative {
 pub struct GroundSpec {
     /// Height of the plane, m.
     #[serde(default = "finite_zero")]
-    pub height_m: Finite,
+    pub height_m: Num<Coordinate>,
     /// Surface appearance.
     #[serde(default)]
     pub material: MaterialSpec,
 }
 
-fn finite_zero() -> Finite {
-    Finite::new(0.0).expect("0 is finite")
+fn finite_zero() -> Num<Coordinate> {
+    num(0.0)
 }
 
 /// How an opaque surface looks.
@@ -174,29 +185,29 @@ pub enum MaterialSpec {
     /// Two alternating colours.
     Checker {
         /// First albedo.
-        a: Rgb,
+        a: Num3<Reflectance>,
         /// Second albedo.
-        b: Rgb,
+        b: Num3<Reflectance>,
         /// Side of one square, m.
-        scale_m: Positive,
+        scale_m: Num<PatternScale>,
     },
     /// An image repeated every `scale_m`.
     Image {
         /// Image path, relative to the scene file.
         path: String,
         /// Side of one repeat, m.
-        scale_m: Positive,
+        scale_m: Num<PatternScale>,
     },
     /// One colour with a Blinn-Phong highlight.
     Solid {
         /// Diffuse albedo.
-        albedo: Rgb,
+        albedo: Num3<Reflectance>,
         /// Specular colour.
         #[serde(default = "no_specular")]
-        specular: Rgb,
+        specular: Num3<Reflectance>,
         /// Blinn-Phong exponent.
         #[serde(default = "shininess")]
-        shininess: Positive,
+        shininess: Num<Shininess>,
     },
 }
 
@@ -205,16 +216,16 @@ impl Default for MaterialSpec {
         Self::Checker {
             a: rgb([0.8, 0.8, 0.8]),
             b: rgb([0.15, 0.15, 0.18]),
-            scale_m: Positive::new(0.05).expect("0.05 > 0"),
+            scale_m: num(0.05),
         }
     }
 }
 
-fn no_specular() -> Rgb {
+fn no_specular() -> Num3<Reflectance> {
     rgb([0.0, 0.0, 0.0])
 }
-fn shininess() -> Positive {
-    Positive::new(32.0).expect("32 > 0")
+fn shininess() -> Num<Shininess> {
+    num(32.0)
 }
 
 /// An opaque object.
@@ -224,18 +235,18 @@ pub enum ObjectSpec {
     /// A sphere.
     Sphere {
         /// Centre, m.
-        center_m: Vec3,
+        center_m: Num3<Coordinate>,
         /// Radius, m.
-        radius_m: Positive,
+        radius_m: Num<ObjectRadius>,
         /// Appearance.
         material: MaterialSpec,
     },
     /// An axis-aligned box.
     Box {
         /// Lowest corner, m.
-        min_m: Vec3,
+        min_m: Num3<Coordinate>,
         /// Highest corner, m.
-        max_m: Vec3,
+        max_m: Num3<Coordinate>,
         /// Appearance.
         material: MaterialSpec,
     },
@@ -245,20 +256,20 @@ pub enum ObjectSpec {
         path: String,
         /// Translation applied to the mesh, m.
         #[serde(default = "origin")]
-        offset_m: Vec3,
+        offset_m: Num3<Coordinate>,
         /// Uniform scale applied to the mesh.
         #[serde(default = "unit_scale")]
-        scale: Positive,
+        scale: Num<MeshScale>,
         /// Appearance.
         material: MaterialSpec,
     },
 }
 
-fn origin() -> Vec3 {
-    Vec3::new([0.0; 3]).expect("origin is finite")
+fn origin<B: Bounds>() -> Num3<B> {
+    Num3::new([0.0; 3]).expect("0 is in every vector range")
 }
-fn unit_scale() -> Positive {
-    Positive::new(1.0).expect("1 > 0")
+fn unit_scale() -> Num<MeshScale> {
+    num(1.0)
 }
 
 /// A small spherical light.
@@ -266,22 +277,22 @@ fn unit_scale() -> Positive {
 #[serde(deny_unknown_fields)]
 pub struct LightSpec {
     /// Centre, m.
-    pub position_m: Vec3,
+    pub position_m: Num3<Coordinate>,
     /// Radius of the emitting sphere, m.
-    pub radius_m: Positive,
+    pub radius_m: Num<LightRadius>,
     /// Emission spectrum: an illuminant name (`d65`, `sodium`, …) or a CSV path.
     #[serde(default = "d65")]
     pub spectrum: String,
     /// Luminance of the emitting surface, relative to a white of 1.
     #[serde(default = "light_luminance")]
-    pub luminance: NonNegative,
+    pub luminance: Num<Luminance>,
 }
 
 fn d65() -> String {
     "d65".into()
 }
-fn light_luminance() -> NonNegative {
-    NonNegative::new(20.0).expect("20 >= 0")
+fn light_luminance() -> Num<Luminance> {
+    num(20.0)
 }
 
 /// One soap bubble.
@@ -289,55 +300,55 @@ fn light_luminance() -> NonNegative {
 #[serde(deny_unknown_fields)]
 pub struct BubbleSpec {
     /// Centre at time 0, m.
-    pub center_m: Vec3,
+    pub center_m: Num3<Coordinate>,
     /// Radius at rest, m.
-    pub radius_m: Positive,
+    pub radius_m: Num<BubbleRadius>,
     /// Initial velocity, m/s.
     #[serde(default = "origin")]
-    pub velocity_m_per_s: Vec3,
+    pub velocity_m_per_s: Num3<Speed>,
     /// Mean film thickness at rest, nm.
     #[serde(default = "mean_thickness")]
-    pub mean_thickness_nm: Positive,
+    pub mean_thickness_nm: Num<FilmThickness>,
     /// Icosphere subdivision level (3 gives 642 vertices, as in seed 000).
     #[serde(default = "subdivisions")]
-    pub subdivisions: u32,
+    pub subdivisions: Count<Subdivisions>,
     /// Surface tension, N/m.
     #[serde(default)]
-    pub sigma_n_per_m: Option<Positive>,
+    pub sigma_n_per_m: Option<Num<SurfaceTension>>,
     /// Velocity damping rate γ/m, 1/s.
     #[serde(default)]
-    pub damping_per_s: Option<NonNegative>,
+    pub damping_per_s: Option<Num<Damping>>,
     /// Seed of the thickness perturbation (sloshing).
     #[serde(default)]
     pub seed: u64,
     /// Gibbs film elasticity, N/m.
     #[serde(default)]
-    pub gibbs_elasticity_n_per_m: Option<NonNegative>,
+    pub gibbs_elasticity_n_per_m: Option<Num<Elasticity>>,
     /// Effective drainage viscosity, Pa·s.
     #[serde(default)]
-    pub drainage_viscosity_pa_s: Option<Positive>,
+    pub drainage_viscosity_pa_s: Option<Num<Viscosity>>,
     /// Thickness below which the film bursts, nm.
     #[serde(default)]
-    pub rupture_thickness_nm: Option<NonNegative>,
+    pub rupture_thickness_nm: Option<Num<RuptureThickness>>,
     /// Relative amplitude of the initial random thickness variation, in [0, 1).
     #[serde(default)]
-    pub thickness_variation: Option<NonNegative>,
+    pub thickness_variation: Option<Num<Variation>>,
     /// Typical speed of the swirling film flow (sloshing), m/s.
     #[serde(default)]
-    pub slosh_speed_m_per_s: Option<NonNegative>,
+    pub slosh_speed_m_per_s: Option<Num<SloshSpeed>>,
     /// Evaporative thinning rate, nm/s.
     #[serde(default)]
-    pub evaporation_nm_per_s: Option<NonNegative>,
+    pub evaporation_nm_per_s: Option<Num<Evaporation>>,
     /// Molar mass of the gas inside, kg/mol (air 0.02896, helium 0.004).
     #[serde(default)]
-    pub gas_molar_mass_kg_per_mol: Option<Positive>,
+    pub gas_molar_mass_kg_per_mol: Option<Num<MolarMass>>,
 }
 
-fn mean_thickness() -> Positive {
-    Positive::new(500.0).expect("500 > 0")
+fn mean_thickness() -> Num<FilmThickness> {
+    num(500.0)
 }
-fn subdivisions() -> u32 {
-    3
+fn subdivisions() -> Count<Subdivisions> {
+    Count::new(3).expect("3 subdivisions are in range")
 }
 
 /// Wind: a uniform velocity plus seeded gusts.
@@ -346,10 +357,10 @@ fn subdivisions() -> u32 {
 pub struct WindSpec {
     /// Uniform air velocity, m/s.
     #[serde(default)]
-    pub velocity_m_per_s: Option<Vec3>,
+    pub velocity_m_per_s: Option<Num3<Speed>>,
     /// Gust amplitude, m/s.
     #[serde(default)]
-    pub gust_m_per_s: Option<NonNegative>,
+    pub gust_m_per_s: Option<Num<GustSpeed>>,
     /// Gust seed.
     #[serde(default)]
     pub seed: u64,
@@ -361,7 +372,7 @@ pub struct WindSpec {
 pub struct FilmSpec {
     /// Film refractive index (ignored when `dispersion = "water"`).
     #[serde(default = "n_soap")]
-    pub n_film: Positive,
+    pub n_film: Num<FilmIndex>,
     /// `"none"` for a constant index, `"water"` for water's n(λ).
     #[serde(default = "no_dispersion")]
     pub dispersion: String,
@@ -380,8 +391,8 @@ impl Default for FilmSpec {
     }
 }
 
-fn n_soap() -> Positive {
-    Positive::new(1.33).expect("1.33 > 0")
+fn n_soap() -> Num<FilmIndex> {
+    num(1.33)
 }
 fn no_dispersion() -> String {
     "none".into()
@@ -393,10 +404,10 @@ fn no_dispersion() -> String {
 pub struct DynamicsSpec {
     /// Fixed time step, s.
     #[serde(default)]
-    pub dt_s: Option<Positive>,
+    pub dt_s: Option<Num<TimeStep>>,
     /// Gravity, m/s².
     #[serde(default)]
-    pub gravity_m_per_s2: Option<Vec3>,
+    pub gravity_m_per_s2: Option<Num3<Acceleration>>,
     /// `"symplectic-euler"` (default) or `"explicit-euler"` (seed 000).
     #[serde(default)]
     pub integrator: Option<String>,
@@ -411,14 +422,14 @@ pub struct RenderSpec {
     pub reflection: Option<String>,
     /// Cube-map face size, texels.
     #[serde(default)]
-    pub cube_map_size: Option<u32>,
+    pub cube_map_size: Option<Count<CubeMapSize>>,
     /// Exposure multiplier before tone mapping.
     #[serde(default)]
-    pub exposure: Option<Positive>,
+    pub exposure: Option<Num<Exposure>>,
     /// `"aces"`, `"reinhard"` or `"clamp"`.
     #[serde(default)]
     pub tonemap: Option<String>,
     /// Anti-aliasing samples per pixel.
     #[serde(default)]
-    pub samples: Option<u32>,
+    pub samples: Option<Count<Samples>>,
 }

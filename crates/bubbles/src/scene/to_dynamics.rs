@@ -3,14 +3,32 @@
 use super::Scene;
 use super::schema::{BubbleSpec, ObjectSpec};
 use crate::error::CliError;
-use bubble_dynamics::{BubbleParams, Collider, DVec3, Gusts, Integrator, Wind, World, WorldParams};
+use bubble_dynamics::{
+    BubbleParams, Collider, DVec3, Gusts, Integrator, SimError, Wind, World, WorldParams,
+};
 
 impl Scene {
     /// Builds the solver's world: the bubbles, the ground and box/sphere objects as colliders.
     pub fn dynamics_world(&self) -> Result<World, CliError> {
         let bubbles = self.file.bubbles.iter().map(bubble_params).collect();
-        World::try_new(self.world_params()?, bubbles)
-            .map_err(|e| CliError::input(format!("{}: {e}", self.origin)))
+        World::try_new(self.world_params()?, bubbles).map_err(|e| {
+            let message = scene_names(&e.to_string(), &self.collider_names());
+            CliError::input(format!("{}: {message}", self.origin))
+        })
+    }
+
+    /// The scene's name for each solver collider, in [`Scene::colliders`]'s order.
+    fn collider_names(&self) -> Vec<String> {
+        let ground = self.file.ground.iter().map(|_| "the ground".to_string());
+        let objects = self.file.objects.iter().enumerate().filter_map(|(i, o)| {
+            let kind = match o {
+                ObjectSpec::Sphere { .. } => "sphere",
+                ObjectSpec::Box { .. } => "box",
+                ObjectSpec::Mesh { .. } => return None,
+            };
+            Some(format!("[[objects]] #{} ({kind})", i + 1))
+        });
+        ground.chain(objects).collect()
     }
 
     fn world_params(&self) -> Result<WorldParams, CliError> {
@@ -76,7 +94,7 @@ fn bubble_params(spec: &BubbleSpec) -> BubbleParams {
         velocity_m_per_s: dvec(spec.velocity_m_per_s.get()),
         radius_m: spec.radius_m.get(),
         mean_thickness_nm: spec.mean_thickness_nm.get(),
-        subdivisions: spec.subdivisions,
+        subdivisions: spec.subdivisions.get(),
         sigma_n_per_m: spec
             .sigma_n_per_m
             .map_or(defaults.sigma_n_per_m, |v| v.get()),
@@ -122,4 +140,91 @@ fn or(value: Option<f64>, default: f64) -> f64 {
 
 fn dvec(v: [f64; 3]) -> DVec3 {
     DVec3::from_array(v)
+}
+
+/// Replaces the solver's `bubbles[i]` and `colliders[k]` with the scene's own names:
+/// `[[bubbles]] #i+1` and `colliders[k]` (the ground or an object).
+fn scene_names(message: &str, colliders: &[String]) -> String {
+    let mut out = String::new();
+    let mut rest = message;
+    while let Some(start) = rest.find(['b', 'c']) {
+        out.push_str(&rest[..start]);
+        rest = &rest[start..];
+        let named = ["bubbles[", "colliders["].iter().find_map(|prefix| {
+            let tail = rest.strip_prefix(prefix)?;
+            let end = tail.find(']')?;
+            let index: usize = tail[..end].parse().ok()?;
+            let name = if prefix.starts_with('b') {
+                format!("[[bubbles]] #{}", index + 1)
+            } else {
+                colliders.get(index)?.clone()
+            };
+            Some((name, prefix.len() + end + 1))
+        });
+        match named {
+            Some((name, len)) => {
+                out.push_str(&name);
+                rest = &rest[len..];
+            }
+            None => {
+                out.push_str(&rest[..1]);
+                rest = &rest[1..];
+            }
+        }
+    }
+    out.push_str(rest);
+    out
+}
+
+/// A solver failure as the user's error: a time step too coarse for a bubble is bad
+/// input (exit code 2, naming `dynamics.dt_s`); a divergence is a runtime failure.
+pub fn sim_error(scene: &Scene, error: SimError) -> CliError {
+    match error {
+        SimError::TooManySubsteps {
+            bubble_id,
+            needed,
+            limit,
+            ..
+        } => {
+            let needed = if needed == u64::MAX {
+                "an unbounded number of".to_string()
+            } else {
+                needed.to_string()
+            };
+            CliError::input(format!(
+                "{}: dynamics.dt_s = {} s is too coarse for [[bubbles]] #{}: it needs {needed} substeps per step, above the solver's {limit}; lower dt_s, or check that bubble's radius_m, sigma_n_per_m and mean_thickness_nm",
+                scene.origin,
+                scene
+                    .file
+                    .dynamics
+                    .dt_s
+                    .map_or(WorldParams::default().dt_s, |v| v.get()),
+                bubble_id + 1
+            ))
+        }
+        other => CliError::runtime(format!(
+            "{}: simulation failed: {}",
+            scene.origin,
+            scene_names(&other.to_string(), &[])
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solver_names_become_the_scene_names() {
+        let names = vec!["the ground".to_string(), "[[objects]] #2 (box)".to_string()];
+        let message = "bubbles[1].center_m = [0.0, 0.1, 0.0] is 0.0100 m from colliders[1], closer";
+        assert_eq!(
+            scene_names(message, &names),
+            "[[bubbles]] #2.center_m = [0.0, 0.1, 0.0] is 0.0100 m from [[objects]] #2 (box), closer"
+        );
+        assert_eq!(
+            scene_names("colliders[7] bubbles[x]", &names),
+            "colliders[7] bubbles[x]"
+        );
+    }
 }

@@ -19,7 +19,7 @@ impl Scene {
             vec3(c.up.get()),
             c.vfov_deg.get() as f32,
         )
-        .map_err(|e| CliError::input(format!("{}: camera: {e}", self.origin)))?;
+        .map_err(|e| CliError::input(format!("{}: {e}", self.origin)))?;
         let mut scene = RenderScene::new(camera, self.environment()?);
         // The sky lights the ground and the objects, not only the point lights.
         scene.irradiance = Irradiance::from_environment(&scene.environment);

@@ -1,117 +1,283 @@
 //! Validated scalar and vector types for scene files.
 //!
 //! Validation happens inside deserialisation, so a bad value is reported by the TOML
-//! parser with its line and column.
+//! parser with its line and column (and [`super::Scene::from_toml_str`] adds the key).
+//! Every number carries the physical range its key accepts (a [`Bounds`] type): inside
+//! it the whole pipeline, f64 solver and f32 renderer alike, stays finite.
 
 use serde::{Deserialize, Deserializer, de::Error as _};
+use std::fmt;
+use std::marker::PhantomData;
 
-/// A finite `f64` that is strictly positive.
+/// The closed range `MIN..=MAX` one kind of scene number may take, and its unit.
+pub trait Bounds {
+    /// Smallest accepted value.
+    const MIN: f64;
+    /// Largest accepted value.
+    const MAX: f64;
+    /// Unit written after the range in messages (may be empty).
+    const UNIT: &'static str;
+}
+
+/// A finite `f64` inside `B`'s range.
 ///
 /// # Guarantees
-/// The value is finite and `> 0`.
-#[derive(Debug, Clone, Copy, PartialEq, PartialOrd)]
-pub struct Positive(f64);
+/// The value is finite and `B::MIN <= value <= B::MAX`.
+pub struct Num<B>(f64, PhantomData<B>);
 
-/// A finite `f64` that is zero or positive.
+/// Three finite components, each inside `B`'s range.
 ///
 /// # Guarantees
-/// The value is finite and `>= 0`.
-#[derive(Debug, Clone, Copy, PartialEq, PartialOrd)]
-pub struct NonNegative(f64);
+/// Every component is finite and `B::MIN <= c <= B::MAX`.
+pub struct Num3<B>([f64; 3], PhantomData<B>);
 
-/// A finite `f64`.
+/// A direction: three components in `-1e6..=1e6`, of length at least `1e-6`.
 ///
 /// # Guarantees
-/// The value is finite.
-#[derive(Debug, Clone, Copy, PartialEq, PartialOrd)]
-pub struct Finite(f64);
-
-/// Three finite components.
-///
-/// # Guarantees
-/// Every component is finite.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Vec3([f64; 3]);
-
-/// Three finite, non-negative components (a colour or radiance).
-///
-/// # Guarantees
-/// Every component is finite and `>= 0`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Rgb([f64; 3]);
-
-/// A non-zero direction with finite components.
-///
-/// # Guarantees
-/// Every component is finite and the length is `> 1e-12`.
+/// Every component is finite with `|c| <= 1e6`, and the length is `>= 1e-6`, so the
+/// direction normalises without overflow in f32.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Direction([f64; 3]);
 
-macro_rules! checked_scalar {
-    ($name:ident, $ok:expr, $what:literal) => {
-        impl $name {
-            /// Checks `value`, returning `None` when it breaks the guarantee.
-            pub fn new(value: f64) -> Option<Self> {
-                let ok: fn(f64) -> bool = $ok;
-                (value.is_finite() && ok(value)).then_some(Self(value))
-            }
+/// A whole number inside `B`'s range.
+///
+/// # Guarantees
+/// `B::MIN <= value <= B::MAX`.
+pub struct Count<B>(u32, PhantomData<B>);
 
-            /// The checked value.
-            pub fn get(self) -> f64 {
-                self.0
+/// `MIN..=MAX UNIT`, with the short forms Rust prints (`0.0001`, `1e30`).
+pub fn range_text<B: Bounds>() -> String {
+    let unit = if B::UNIT.is_empty() {
+        String::new()
+    } else {
+        format!(" {}", B::UNIT)
+    };
+    format!("{}..={}{unit}", B::MIN, B::MAX)
+}
+
+impl<B: Bounds> Num<B> {
+    /// Checks `value`, returning `None` outside the range or when not finite.
+    pub fn new(value: f64) -> Option<Self> {
+        (value.is_finite() && (B::MIN..=B::MAX).contains(&value))
+            .then_some(Self(value, PhantomData))
+    }
+
+    /// Like [`Num::new`], with the message a user reads when `value` is refused.
+    pub fn try_new(value: f64) -> Result<Self, String> {
+        Self::new(value).ok_or_else(|| format!("{} is outside {}", plain(value), range_text::<B>()))
+    }
+
+    /// The checked value.
+    pub fn get(self) -> f64 {
+        self.0
+    }
+}
+
+impl<B: Bounds> Num3<B> {
+    /// Checks every component, returning `None` when one breaks the guarantee.
+    pub fn new(value: [f64; 3]) -> Option<Self> {
+        let ok = |c: &f64| c.is_finite() && (B::MIN..=B::MAX).contains(c);
+        value.iter().all(ok).then_some(Self(value, PhantomData))
+    }
+
+    /// The checked components.
+    pub fn get(self) -> [f64; 3] {
+        self.0
+    }
+}
+
+impl<B: Bounds> Count<B> {
+    /// Checks `value`, returning `None` outside the range.
+    pub fn new(value: u32) -> Option<Self> {
+        (B::MIN <= f64::from(value) && f64::from(value) <= B::MAX)
+            .then_some(Self(value, PhantomData))
+    }
+
+    /// The checked value.
+    pub fn get(self) -> u32 {
+        self.0
+    }
+}
+
+impl Direction {
+    /// Checks `value`, returning `None` when it breaks the guarantee.
+    pub fn new(value: [f64; 3]) -> Option<Self> {
+        let finite = value.iter().all(|c| c.is_finite() && c.abs() <= 1e6);
+        let length_sq: f64 = value.iter().map(|c| c * c).sum();
+        (finite && length_sq >= 1e-12).then_some(Self(value))
+    }
+
+    /// The checked components.
+    pub fn get(self) -> [f64; 3] {
+        self.0
+    }
+}
+
+// Manual impls: derives would demand `B: Clone` etc. of the marker types.
+macro_rules! plain_value_impls {
+    ($name:ident) => {
+        impl<B> Clone for $name<B> {
+            fn clone(&self) -> Self {
+                *self
             }
         }
-
-        impl<'de> Deserialize<'de> for $name {
-            fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-                let value = f64::deserialize(d)?;
-                Self::new(value)
-                    .ok_or_else(|| D::Error::custom(format!("{value} is not {}", $what)))
+        impl<B> Copy for $name<B> {}
+        impl<B> PartialEq for $name<B> {
+            fn eq(&self, other: &Self) -> bool {
+                self.0 == other.0
+            }
+        }
+        impl<B> fmt::Debug for $name<B> {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                fmt::Debug::fmt(&self.0, f)
             }
         }
     };
 }
 
-checked_scalar!(Positive, |v| v > 0.0, "a finite number > 0");
-checked_scalar!(NonNegative, |v| v >= 0.0, "a finite number >= 0");
-checked_scalar!(Finite, |_| true, "a finite number");
+plain_value_impls!(Num);
+plain_value_impls!(Num3);
+plain_value_impls!(Count);
 
-macro_rules! checked_triple {
-    ($name:ident, $ok:expr, $what:literal) => {
-        impl $name {
-            /// Checks `value`, returning `None` when it breaks the guarantee.
-            pub fn new(value: [f64; 3]) -> Option<Self> {
-                let ok: fn([f64; 3]) -> bool = $ok;
-                (value.iter().all(|c| c.is_finite()) && ok(value)).then_some(Self(value))
-            }
+impl<'de, B: Bounds> Deserialize<'de> for Num<B> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        Self::try_new(f64::deserialize(d)?).map_err(D::Error::custom)
+    }
+}
 
-            /// The checked components.
-            pub fn get(self) -> [f64; 3] {
-                self.0
-            }
-        }
+impl<'de, B: Bounds> Deserialize<'de> for Num3<B> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let value = <[f64; 3]>::deserialize(d)?;
+        Self::new(value).ok_or_else(|| {
+            D::Error::custom(format!(
+                "{} has a component outside {}",
+                numbers(&value),
+                range_text::<B>()
+            ))
+        })
+    }
+}
 
-        impl<'de> Deserialize<'de> for $name {
-            fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-                let value = <[f64; 3]>::deserialize(d)?;
-                Self::new(value)
-                    .ok_or_else(|| D::Error::custom(format!("{value:?} is not {}", $what)))
+impl<'de, B: Bounds> Deserialize<'de> for Count<B> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let value = i64::deserialize(d)?;
+        u32::try_from(value)
+            .ok()
+            .and_then(Self::new)
+            .ok_or_else(|| D::Error::custom(format!("{value} is outside {}", range_text::<B>())))
+    }
+}
+
+impl<'de> Deserialize<'de> for Direction {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let value = <[f64; 3]>::deserialize(d)?;
+        Self::new(value).ok_or_else(|| {
+            D::Error::custom(format!(
+                "{} is not a direction: components in -1e6..=1e6, length at least 1e-6",
+                numbers(&value)
+            ))
+        })
+    }
+}
+
+/// `[a, b, c]` as [`plain`] numbers.
+pub fn numbers(v: &[f64; 3]) -> String {
+    format!("[{}, {}, {}]", plain(v[0]), plain(v[1]), plain(v[2]))
+}
+
+/// A number as a user reads it: the shortest round-trip decimal between 1e-4 and 1e7,
+/// scientific (`1e300`, `1e-300`) outside, never hundreds of digits.
+pub fn plain(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e7).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+macro_rules! bounds {
+    ($($(#[$doc:meta])* $name:ident: $min:expr, $max:expr, $unit:literal;)*) => {
+        $(
+            $(#[$doc])*
+            #[derive(Debug)]
+            pub enum $name {}
+            impl Bounds for $name {
+                const MIN: f64 = $min;
+                const MAX: f64 = $max;
+                const UNIT: &'static str = $unit;
             }
-        }
+        )*
     };
 }
 
-checked_triple!(Vec3, |_| true, "three finite numbers");
-checked_triple!(
-    Rgb,
-    |v| v.iter().all(|c| *c >= 0.0),
-    "three finite numbers >= 0"
-);
-checked_triple!(
-    Direction,
-    |v| v.iter().map(|c| c * c).sum::<f64>() > 1e-24,
-    "a non-zero direction of three finite numbers"
-);
+// Ranges wide enough for any soap-bubble scene, narrow enough that products of them
+// (radiance × luminance × exposure, positions squared in f32) stay far from overflow.
+bounds! {
+    /// A coordinate of a position: within 10 km of the origin.
+    Coordinate: -1e4, 1e4, "m";
+    /// Simulated time.
+    Seconds: 0.0, 3600.0, "s";
+    /// Vertical field of view.
+    FieldOfView: 0.1, 179.0, "degrees";
+    /// Radiance of a sky, environment or sun, per channel.
+    Radiance: 0.0, 1e6, "";
+    /// Albedo or specular colour, per channel.
+    Reflectance: 0.0, 1.0, "";
+    /// A scale factor on image radiance.
+    Intensity: 0.0, 1e6, "";
+    /// Side of a checker square or texture repeat.
+    PatternScale: 1e-4, 1e4, "m";
+    /// Blinn-Phong exponent.
+    Shininess: 1.0, 1e4, "";
+    /// Radius of an opaque sphere.
+    ObjectRadius: 1e-4, 1e4, "m";
+    /// Uniform scale of an OBJ mesh.
+    MeshScale: 1e-6, 1e6, "";
+    /// Radius of a light sphere.
+    LightRadius: 1e-4, 100.0, "m";
+    /// Luminance of a light's surface, relative to white 1.
+    Luminance: 0.0, 1e6, "";
+    /// Rest radius of a soap bubble.
+    BubbleRadius: 1e-3, 1.0, "m";
+    /// A velocity component (bubble or wind).
+    Speed: -100.0, 100.0, "m/s";
+    /// A gust amplitude.
+    GustSpeed: 0.0, 100.0, "m/s";
+    /// Soap-film thickness.
+    FilmThickness: 1.0, 1e4, "nm";
+    /// Thickness at which a film bursts.
+    RuptureThickness: 0.0, 1e4, "nm";
+    /// Icosphere subdivision level.
+    Subdivisions: 0.0, crate::limits::MAX_SUBDIVISIONS as f64, "";
+    /// Surface tension.
+    SurfaceTension: 1e-3, 1.0, "N/m";
+    /// Velocity damping rate.
+    Damping: 0.0, 1e3, "1/s";
+    /// Gibbs film elasticity.
+    Elasticity: 0.0, 10.0, "N/m";
+    /// Effective drainage viscosity (a model parameter: the default is 5e-8).
+    Viscosity: 1e-12, 10.0, "Pa·s";
+    /// Relative thickness variation.
+    Variation: 0.0, 0.99, "";
+    /// Film flow speed.
+    SloshSpeed: 0.0, 10.0, "m/s";
+    /// Evaporative thinning rate.
+    Evaporation: 0.0, 1e4, "nm/s";
+    /// Molar mass of the gas inside.
+    MolarMass: 1e-3, 1.0, "kg/mol";
+    /// Film refractive index.
+    FilmIndex: 1.0, 4.0, "";
+    /// Solver time step.
+    TimeStep: 1e-6, 0.1, "s";
+    /// A gravity component.
+    Acceleration: -1e3, 1e3, "m/s²";
+    /// Exposure multiplier.
+    Exposure: 1e-6, 1e6, "";
+    /// Cube-map face size.
+    CubeMapSize: 1.0, crate::limits::MAX_CUBE_MAP_SIZE as f64, "texels";
+    /// Anti-aliasing samples (1, 4, 8, 9 or 16; the set is checked later).
+    Samples: 1.0, 16.0, "";
+}
 
 #[cfg(test)]
 mod tests {
@@ -119,12 +285,37 @@ mod tests {
 
     #[test]
     fn rejects_what_the_guarantees_exclude() {
-        assert!(Positive::new(0.0).is_none());
-        assert!(Positive::new(f64::NAN).is_none());
-        assert!(NonNegative::new(-1e-300).is_none());
-        assert!(Finite::new(f64::INFINITY).is_none());
-        assert!(Rgb::new([0.1, -0.1, 0.0]).is_none());
+        assert!(Num::<BubbleRadius>::new(0.0).is_none());
+        assert!(Num::<BubbleRadius>::new(1e-300).is_none());
+        assert!(Num::<BubbleRadius>::new(1e300).is_none());
+        assert!(Num::<BubbleRadius>::new(f64::NAN).is_none());
+        assert!(Num::<Seconds>::new(-1e-300).is_none());
+        assert!(Num::<Coordinate>::new(f64::INFINITY).is_none());
+        assert!(Num3::<Radiance>::new([0.1, -0.1, 0.0]).is_none());
         assert!(Direction::new([0.0; 3]).is_none());
-        assert_eq!(Positive::new(2.5).map(Positive::get), Some(2.5));
+        assert!(Direction::new([1e30, 0.0, 0.0]).is_none());
+        assert!(Count::<Subdivisions>::new(7).is_none());
+        assert_eq!(Num::<BubbleRadius>::new(0.05).map(Num::get), Some(0.05));
+    }
+
+    #[test]
+    fn plain_numbers_stay_short() {
+        assert_eq!(plain(1e-300), "1e-300");
+        assert_eq!(plain(1e300), "1e300");
+        assert_eq!(plain(-0.5), "-0.5");
+        assert_eq!(plain(4294967295.0), "4.294967295e9");
+    }
+
+    #[test]
+    fn range_edges_are_accepted() {
+        assert!(Num::<FilmIndex>::new(1.0).is_some());
+        assert!(Num::<FilmIndex>::new(4.0).is_some());
+        assert!(Count::<Subdivisions>::new(0).is_some());
+    }
+
+    #[test]
+    fn refusal_names_value_and_range() {
+        let msg = Num::<BubbleRadius>::try_new(1e300).err().unwrap();
+        assert_eq!(msg, "1e300 is outside 0.001..=1 m");
     }
 }

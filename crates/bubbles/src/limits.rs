@@ -1,0 +1,119 @@
+//! Every bound on the work and memory a user can ask for, in one place.
+//!
+//! Each limit keeps one run within [`MEMORY_BUDGET_BYTES`] and a bounded number of
+//! steps, frames and files; `--help` prints them through [`HELP`]. A request beyond a
+//! limit is refused before any work starts, with exit code 2 and a message naming the
+//! limit.
+
+/// Memory one run may plan to allocate for its large buffers (cube maps, frame buffers,
+/// decoded textures, opaque triangles, bubble meshes), in bytes.
+pub const MEMORY_BUDGET_BYTES: u64 = 3 << 30;
+
+/// Solver steps one `render` or `simulate` may take (`time_s / dt_s`).
+pub const MAX_SOLVER_STEPS: u64 = 1_000_000;
+
+/// OBJ files one `simulate --export-obj` may write.
+pub const MAX_OBJ_FRAMES: u64 = 10_000;
+
+/// Frames `bench --frames` may time at each size.
+pub const MAX_BENCH_FRAMES: u32 = 100_000;
+
+/// Largest dynamic cube-map face, in texels (`--cube-map-size`, `[render] cube_map_size`).
+pub const MAX_CUBE_MAP_SIZE: usize = 1024;
+
+/// Largest icosphere subdivision level of a bubble (6 gives 40 962 vertices).
+pub const MAX_SUBDIVISIONS: u32 = 6;
+
+/// Largest image side, in pixels (`--width`, `--height`, `bench --size`).
+pub const MAX_IMAGE_SIDE: usize = raster::MAX_IMAGE_SIDE;
+
+/// Bubbles in one scene.
+pub const MAX_BUBBLES: usize = 1000;
+
+/// Bubble vertices in one scene, summed over its bubbles.
+pub const MAX_BUBBLE_VERTICES: usize = 1_000_000;
+
+/// Opaque objects (spheres, boxes, meshes) in one scene.
+pub const MAX_OBJECTS: usize = 1000;
+
+/// Lights in one scene.
+pub const MAX_LIGHTS: usize = 64;
+
+/// Opaque triangles in one scene, after tessellation (a sphere is 2304).
+pub const MAX_OPAQUE_TRIANGLES: u64 = 4_000_000;
+
+/// Pixels of one decoded image (environment, texture, cube face), checked before decoding.
+pub const MAX_IMAGE_PIXELS: u64 = 64 << 20;
+
+/// Bytes of one text input: a scene, an OBJ mesh, a spectrum CSV.
+pub const MAX_INPUT_BYTES: u64 = 64 << 20;
+
+/// The limits as printed at the end of `--help`.
+pub const HELP: &str = "Limits (a larger request is refused with exit code 2):
+  solver steps per run (time_s / dt_s)        1000000
+  OBJ frames per simulate --export-obj        10000
+  bench --frames                              100000
+  cube_map_size / --cube-map-size             1..=1024 texels
+  bubble subdivisions                         0..=6
+  --width, --height, bench --size             1..=16384 pixels
+  bubbles per scene                           1000 (1000000 vertices in all)
+  objects per scene                           1000 (4000000 triangles in all)
+  lights per scene                            64
+  pixels of one image file                    67108864
+  bytes of one scene, OBJ or CSV file         67108864
+  planned memory of one run                   3 GiB";
+
+/// Bytes of one dynamic cube map of `face_size` (six bordered faces of RGB f32, plus
+/// the depth and triangle scratch the renderer keeps per face).
+pub fn cube_map_bytes(face_size: usize) -> u64 {
+    let side = face_size as u64 + 2;
+    6 * side * side * (12 + 8)
+}
+
+/// Bytes of the frame buffers for `width × height` at `samples` per pixel (HDR colour
+/// and depth per sample, plus the resolved image).
+pub fn frame_bytes(width: usize, height: usize, samples: u32) -> u64 {
+    let pixels = width as u64 * height as u64;
+    pixels * (u64::from(samples) * 16 + 16)
+}
+
+/// Vertices of an icosphere with `subdivisions` levels: 10·4ˢ + 2.
+pub fn icosphere_vertices(subdivisions: u32) -> usize {
+    10 * 4_usize.pow(subdivisions.min(MAX_SUBDIVISIONS)) + 2
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn help_states_the_constants() {
+        for value in [
+            MAX_SOLVER_STEPS,
+            MAX_OBJ_FRAMES,
+            u64::from(MAX_BENCH_FRAMES),
+            MAX_CUBE_MAP_SIZE as u64,
+            MAX_IMAGE_SIDE as u64,
+            MAX_BUBBLES as u64,
+            MAX_BUBBLE_VERTICES as u64,
+            MAX_OBJECTS as u64,
+            MAX_LIGHTS as u64,
+            MAX_OPAQUE_TRIANGLES,
+            MAX_IMAGE_PIXELS,
+            MAX_INPUT_BYTES,
+        ] {
+            assert!(
+                HELP.contains(&value.to_string()),
+                "{value} missing from HELP"
+            );
+        }
+        assert!(HELP.contains(&format!("0..={MAX_SUBDIVISIONS}")));
+        assert!(HELP.contains(&format!("{} GiB", MEMORY_BUDGET_BYTES >> 30)));
+    }
+
+    #[test]
+    fn icosphere_vertex_count_matches_the_solver() {
+        assert_eq!(icosphere_vertices(3), 642, "seed 000's 642 vertices");
+        assert_eq!(icosphere_vertices(0), 12);
+    }
+}
