@@ -3,9 +3,11 @@
 use std::process::{Command, ExitCode};
 
 mod docs_check;
+mod reference_figures;
 
 const USAGE: &str = "usage: cargo xtask <figures|bench|ci|docs-check>
   figures     regenerate the PNG figures under docs/figures/
+              (--reference: instead, the slow measured table of docs/reference.md)
   bench       run every crate's criterion benches, then `bubbles bench` (frame breakdown)
   ci          run what .ci/run runs (fmt, clippy, tests, docs-check)
   docs-check  check that every figure block in docs/ names the command that reproduces it";
@@ -13,6 +15,11 @@ const USAGE: &str = "usage: cargo xtask <figures|bench|ci|docs-check>
 fn main() -> ExitCode {
     let task = std::env::args().nth(1);
     let ok = match task.as_deref() {
+        Some("figures") if std::env::args().any(|a| a == "--reference") => {
+            let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+            cargo(&["build", "--release", "-p", "bubbles"])
+                && reference_figures::run(&root, &reference_figures::bubbles_binary(&root))
+        }
         Some("figures") => figures(),
         Some("bench") => bench(),
         Some("ci") => ci(),

@@ -36,6 +36,8 @@ enum Command {
     Bench(commands::bench::Args),
     /// Simulate and render an animation: PNG frames, an animated PNG or a GIF preview.
     Animate(commands::animate::Args),
+    /// CIEDE2000 between two images: mean, 95th percentile, maximum, optional heat map.
+    Compare(commands::compare::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -49,6 +51,7 @@ fn main() -> std::process::ExitCode {
         Command::Render(args) => commands::render::run(args),
         Command::Bench(args) => commands::bench::run(args),
         Command::Animate(args) => commands::animate::run(args),
+        Command::Compare(args) => commands::compare::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

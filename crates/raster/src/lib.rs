@@ -31,6 +31,7 @@ mod mesh;
 mod obj;
 mod passes;
 mod raster;
+pub mod reference;
 mod renderer;
 mod scene;
 mod settings;

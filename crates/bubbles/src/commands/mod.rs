@@ -5,6 +5,7 @@ pub mod bake;
 pub mod bench;
 pub mod chart;
 pub mod color;
+pub mod compare;
 pub mod reflectance;
 pub mod render;
 pub mod simulate;

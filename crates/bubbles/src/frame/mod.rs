@@ -1,6 +1,7 @@
 //! One frame's work shared by `render` and `bench`: scene → solver → tables → renderer.
 
 pub mod progress;
+pub mod reference;
 
 use crate::error::CliError;
 use crate::limits;
@@ -27,9 +28,11 @@ pub struct Options {
     /// Anti-aliasing samples per pixel: 1, 4, 8, 9 or 16 (default: the scene's, else 4).
     #[arg(long)]
     pub samples: Option<u32>,
-    /// Rendering backend (only the CPU backend exists).
+    /// Rendering backend: the real-time CPU rasteriser, or the spectral reference tracer.
     #[arg(long, value_enum, default_value_t = Backend::Cpu)]
     pub backend: Backend,
+    #[command(flatten)]
+    pub reference: reference::ReferenceOptions,
     /// Bubble reflections: dynamic cube maps, the static environment, or a sphere map (seed 002).
     #[arg(long, value_enum)]
     pub reflection: Option<Reflection>,
@@ -57,6 +60,8 @@ pub enum Backend {
     /// The pure-CPU sorted-triangle renderer.
     #[default]
     Cpu,
+    /// The spectral reference ray tracer (slow; the truth the CPU backend is measured against).
+    Reference,
 }
 
 /// Where bubble reflections come from.
@@ -92,6 +97,10 @@ pub struct FrameJob {
     tables: FilmTables,
     settings: RenderSettings,
     renderer: Renderer,
+    /// The film for the reference backend; `None` for the CPU backend.
+    film_spec: Option<raster::reference::FilmSpec>,
+    reference: reference::ReferenceOptions,
+    reference_frame: Frame,
 }
 
 impl FrameJob {
@@ -108,7 +117,14 @@ impl FrameJob {
         let mut render_scene = scene.render_scene()?;
         render_scene.lights = scene.raster_lights(&luts)?;
         let settings = settings(&scene, &render_scene, options)?;
+        let film_spec = match options.backend {
+            Backend::Cpu => None,
+            Backend::Reference => Some(scene.film_spec(&render_scene.lights)?),
+        };
         Ok(Self {
+            film_spec,
+            reference: options.reference.clone(),
+            reference_frame: Frame::default(),
             tables: film_tables(luts),
             scene,
             world,
@@ -178,6 +194,11 @@ impl FrameJob {
     /// Renders the current state.
     pub fn render(&mut self) -> Result<&Frame, CliError> {
         self.render_scene.bubbles = bubble_meshes(&self.world);
+        if let Some(spec) = &self.film_spec {
+            let settings = self.reference.settings(&self.settings);
+            self.reference_frame = reference::render(&self.render_scene, spec, &settings, true)?;
+            return Ok(&self.reference_frame);
+        }
         self.renderer
             .render(&self.render_scene, &self.tables, &self.settings)
             .map_err(|e| CliError::input(format!("{}: {e}", self.scene.origin)))

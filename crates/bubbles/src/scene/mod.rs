@@ -6,6 +6,7 @@ mod film;
 pub mod schema;
 mod to_dynamics;
 mod to_raster;
+mod to_reference;
 pub mod values;
 
 use crate::error::CliError;

@@ -1,0 +1,118 @@
+//! `--backend reference`: the spectral reference tracer behind the same frame job, with
+//! its own options and a progress bar with an ETA.
+
+use crate::error::CliError;
+use raster::reference::{FilmSpec, ReferenceSettings, Reflections, render_reference};
+use raster::{Frame, RenderScene, RenderSettings};
+
+/// Options of the reference backend (ignored by the CPU backend).
+#[derive(Debug, Clone, clap::Args)]
+pub struct ReferenceOptions {
+    /// Reference: camera rays per pixel along each axis (the pixel gets the square).
+    #[arg(long, default_value_t = 4)]
+    pub ref_samples: u32,
+    /// Reference: films a path may meet before further films are passed straight through.
+    #[arg(long, default_value_t = 8)]
+    pub ref_depth: u32,
+    /// Reference: drop a beam whose largest factor is below this.
+    #[arg(long, default_value_t = 1e-4)]
+    pub ref_min_weight: f64,
+    /// Reference: wavelength spacing in nm (10 nm: 48 wavelengths).
+    #[arg(long, default_value_t = 10.0)]
+    pub ref_step_nm: f64,
+    /// Reference: average s and p at every film instead of carrying both.
+    #[arg(long)]
+    pub ref_unpolarised: bool,
+    /// Reference: carry RGB (films projected as the LUT bakes them) instead of spectra.
+    #[arg(long)]
+    pub ref_rgb: bool,
+    /// Reference: seed of the pixel-sample jitter.
+    #[arg(long, default_value_t = 0)]
+    pub ref_seed: u64,
+    /// Reference: reflected rays traced (the truth), traced through no films, or cast from
+    /// the bubble's centre through no films (the cube map's viewpoint).
+    #[arg(long, value_enum, default_value_t = RefReflections::Traced)]
+    pub ref_reflections: RefReflections,
+}
+
+/// Where the reference's reflected rays start and what they see.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum RefReflections {
+    /// From the hit point, seeing every film.
+    Traced,
+    /// From the hit point, through all films.
+    NoFilms,
+    /// From the bubble's centre, through all films (a perfect dynamic cube map).
+    Centre,
+}
+
+impl Default for ReferenceOptions {
+    fn default() -> Self {
+        let d = ReferenceSettings::default();
+        Self {
+            ref_samples: d.samples_per_side,
+            ref_depth: d.max_depth,
+            ref_min_weight: d.min_weight,
+            ref_step_nm: d.step_nm,
+            ref_unpolarised: false,
+            ref_rgb: false,
+            ref_seed: d.seed,
+            ref_reflections: RefReflections::Traced,
+        }
+    }
+}
+
+impl ReferenceOptions {
+    /// The tracer's settings at the frame's size.
+    pub fn settings(&self, frame: &RenderSettings) -> ReferenceSettings {
+        ReferenceSettings {
+            width: frame.width,
+            height: frame.height,
+            samples_per_side: self.ref_samples,
+            max_depth: self.ref_depth,
+            min_weight: self.ref_min_weight,
+            step_nm: self.ref_step_nm,
+            polarised: !self.ref_unpolarised,
+            spectral: !self.ref_rgb,
+            reflections: match self.ref_reflections {
+                RefReflections::Traced => Reflections::Traced,
+                RefReflections::NoFilms => Reflections::NoFilms,
+                RefReflections::Centre => Reflections::FromCentre,
+            },
+            seed: self.ref_seed,
+        }
+    }
+}
+
+/// Traces one frame, with a progress bar on stderr when `progress` is set.
+pub fn render(
+    scene: &RenderScene,
+    spec: &FilmSpec,
+    settings: &ReferenceSettings,
+    progress: bool,
+) -> Result<Frame, CliError> {
+    let bar = if progress {
+        indicatif::ProgressBar::new(settings.height as u64)
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "reference {bar:40} {pos}/{len} rows, {elapsed} elapsed, ETA {eta}",
+    ) {
+        bar.set_style(style);
+    }
+    let start = std::time::Instant::now();
+    let frame = render_reference(scene, spec, settings, &|| bar.inc(1))
+        .map_err(|e| CliError::input(format!("reference: {e}")))?;
+    bar.finish_and_clear();
+    if progress {
+        eprintln!(
+            "reference: traced {}x{} in {:.2} s on {} threads",
+            settings.width,
+            settings.height,
+            start.elapsed().as_secs_f64(),
+            rayon::current_num_threads()
+        );
+    }
+    Ok(frame)
+}
