@@ -41,6 +41,21 @@ pub struct Frame {
 }
 
 impl Frame {
+    /// A frame holding `rgb` (row-major, row 0 at the top), or `None` unless
+    /// `rgb.len() == width * height` with both sides non-zero.
+    ///
+    /// # Guarantees
+    /// The returned frame's pixel count matches its size; its timings are zero.
+    pub fn try_from_rgb(width: usize, height: usize, rgb: Vec<[f32; 3]>) -> Option<Frame> {
+        let matches = width > 0 && height > 0 && width.checked_mul(height) == Some(rgb.len());
+        matches.then(|| Frame {
+            width,
+            height,
+            rgb,
+            timings: FrameTimings::default(),
+        })
+    }
+
     /// Width in pixels.
     pub fn width(&self) -> usize {
         self.width
@@ -157,23 +172,44 @@ pub fn tone_map(rgb: [f32; 3], tonemap: ToneMap) -> [f32; 3] {
     }
 }
 
+/// sRGB → ACES AP1-ish input matrix of Stephen Hill's fit (shared with the wgpu backend).
+pub(crate) const ACES_FROM_SRGB: [[f32; 3]; 3] = [
+    [0.59719, 0.35458, 0.04823],
+    [0.07600, 0.90834, 0.01566],
+    [0.02840, 0.13383, 0.83777],
+];
+/// Its output matrix back to linear sRGB.
+pub(crate) const SRGB_FROM_ACES: [[f32; 3]; 3] = [
+    [1.60475, -0.53108, -0.07367],
+    [-0.10208, 1.10813, -0.00605],
+    [-0.00327, -0.07276, 1.07602],
+];
+/// RRT+ODT rational fit `(x (x + a0) − a1) / (x (b0 x + b1) + b2)`: `[a0, a1]`.
+pub(crate) const ACES_NUMERATOR: [f32; 2] = [0.024_578_6, 0.000_090_537];
+/// Its denominator's `[b0, b1, b2]`.
+pub(crate) const ACES_DENOMINATOR: [f32; 3] = [0.983_729, 0.432_951, 0.238_081];
+/// Inputs are clamped here first, so the rational fit never sees infinity.
+pub(crate) const ACES_INPUT_MAX: f32 = 1e6;
+/// sRGB encoding (IEC 61966-2-1): below this linear value the curve is linear...
+pub(crate) const SRGB_LINEAR_MAX: f32 = 0.003_130_8;
+/// ...with this slope; above it `scale · c^(1/gamma) − offset`.
+pub(crate) const SRGB_LINEAR_SLOPE: f32 = 12.92;
+/// The encoding's power-law scale.
+pub(crate) const SRGB_SCALE: f32 = 1.055;
+/// The encoding's power-law offset.
+pub(crate) const SRGB_OFFSET: f32 = 0.055;
+/// The encoding's gamma.
+pub(crate) const SRGB_GAMMA: f32 = 2.4;
+
 /// Stephen Hill's ACES fit: sRGB → ACES AP1-ish input matrix, RRT+ODT rational fit, back.
 fn aces_fitted(rgb: [f32; 3]) -> [f32; 3] {
-    const ACES_FROM_SRGB: [[f32; 3]; 3] = [
-        [0.59719, 0.35458, 0.04823],
-        [0.07600, 0.90834, 0.01566],
-        [0.02840, 0.13383, 0.83777],
-    ];
-    const SRGB_FROM_ACES: [[f32; 3]; 3] = [
-        [1.60475, -0.53108, -0.07367],
-        [-0.10208, 1.10813, -0.00605],
-        [-0.00327, -0.07276, 1.07602],
-    ];
-    let rgb = rgb.map(|c| c.min(1e6));
+    let [a0, a1] = ACES_NUMERATOR;
+    let [b0, b1, b2] = ACES_DENOMINATOR;
+    let rgb = rgb.map(|c| c.min(ACES_INPUT_MAX));
     let v = mat3_mul(&ACES_FROM_SRGB, rgb);
     let v = v.map(|x| {
-        let a = x * (x + 0.024_578_6) - 0.000_090_537;
-        let b = x * (0.983_729 * x + 0.432_951) + 0.238_081;
+        let a = x * (x + a0) - a1;
+        let b = x * (b0 * x + b1) + b2;
         a / b
     });
     mat3_mul(&SRGB_FROM_ACES, v).map(|c| c.clamp(0.0, 1.0))
@@ -186,10 +222,10 @@ fn mat3_mul(m: &[[f32; 3]; 3], v: [f32; 3]) -> [f32; 3] {
 /// The sRGB encoding curve (IEC 61966-2-1) for one channel in `[0, 1]`.
 pub fn linear_to_srgb(c: f32) -> f32 {
     let c = c.clamp(0.0, 1.0);
-    if c <= 0.003_130_8 {
-        c * 12.92
+    if c <= SRGB_LINEAR_MAX {
+        c * SRGB_LINEAR_SLOPE
     } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
+        SRGB_SCALE * c.powf(1.0 / SRGB_GAMMA) - SRGB_OFFSET
     }
 }
 
@@ -240,6 +276,18 @@ mod tests {
         }
         // Reinhard of 1 is exactly one half.
         assert_eq!(tone_map([1.0; 3], ToneMap::Reinhard), [0.5; 3]);
+    }
+
+    #[test]
+    fn frame_from_rgb_checks_its_size() {
+        assert!(Frame::try_from_rgb(2, 2, vec![[0.0; 3]; 3]).is_none());
+        assert!(Frame::try_from_rgb(0, 0, Vec::new()).is_none());
+        assert_eq!(
+            Frame::try_from_rgb(2, 1, vec![[0.0; 3]; 2])
+                .unwrap()
+                .width(),
+            2
+        );
     }
 
     #[test]

@@ -24,6 +24,8 @@ mod cubemap;
 mod environment;
 mod error;
 mod frame;
+#[cfg(feature = "wgpu")]
+pub mod gpu;
 mod ground;
 mod irradiance;
 mod lut_sampler;

@@ -1,0 +1,46 @@
+//! [`GpuError`]: why the wgpu backend could not start or finish a frame.
+
+use std::fmt;
+
+/// Why the wgpu backend failed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum GpuError {
+    /// No adapter (GPU or software Vulkan driver) was found.
+    NoAdapter {
+        /// wgpu's own explanation.
+        reason: String,
+    },
+    /// The adapter refused to open a device with the limits the backend needs.
+    Device(String),
+    /// A frame or image is larger than the device's texture limit.
+    TooLarge {
+        /// Requested width and height in pixels.
+        size: (u32, u32),
+        /// The device's maximum texture side.
+        max_side: u32,
+    },
+    /// Mapping the read-back buffer failed.
+    Readback(String),
+}
+
+impl fmt::Display for GpuError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            GpuError::NoAdapter { reason } => write!(
+                f,
+                "no wgpu adapter found ({reason}); install a Vulkan driver (on Debian, the \
+                 packages mesa-vulkan-drivers and libvulkan1 give the CPU driver lavapipe), \
+                 point VK_DRIVER_FILES at its ICD json if it is not found, or use --backend cpu"
+            ),
+            GpuError::Device(reason) => write!(f, "the wgpu device could not be opened: {reason}"),
+            GpuError::TooLarge { size, max_side } => write!(
+                f,
+                "image {}x{} is larger than this GPU's texture limit of {max_side} pixels a side",
+                size.0, size.1
+            ),
+            GpuError::Readback(reason) => write!(f, "reading the frame back failed: {reason}"),
+        }
+    }
+}
+
+impl std::error::Error for GpuError {}
