@@ -5,6 +5,8 @@ mod csv_table;
 mod error;
 mod frame;
 mod scene;
+#[cfg(feature = "view")]
+mod view;
 
 use clap::{Parser, Subcommand};
 
@@ -32,6 +34,10 @@ enum Command {
     Render(commands::render::Args),
     /// Time the frame and print a breakdown.
     Bench(commands::bench::Args),
+    /// Open a live window on the scene (simulated in real time, CPU-rendered).
+    #[cfg(feature = "view")]
+    #[command(after_help = view::CONTROLS)]
+    View(view::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -44,6 +50,8 @@ fn main() -> std::process::ExitCode {
         Command::Simulate(args) => commands::simulate::run(args),
         Command::Render(args) => commands::render::run(args),
         Command::Bench(args) => commands::bench::run(args),
+        #[cfg(feature = "view")]
+        Command::View(args) => view::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

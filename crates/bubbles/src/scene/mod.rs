@@ -10,6 +10,7 @@ pub mod values;
 use crate::error::CliError;
 use schema::SceneFile;
 use std::path::{Path, PathBuf};
+pub(crate) use to_dynamics::bubble_params;
 pub use to_raster::bubble_meshes;
 
 /// Built-in scenes, by name, with their TOML source.
