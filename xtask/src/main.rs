@@ -149,5 +149,11 @@ fn figures() -> bool {
         "docs/figures/white-furnace.png",
         ["200", "200"],
     );
-    fig2 && chart && paper && furnace
+    // A sodium lamp (docs/rendering.md): light outside the sRGB gamut.
+    let sodium = render(
+        "docs/scenes/sodium.toml",
+        "docs/figures/sodium.png",
+        ["400", "400"],
+    );
+    fig2 && chart && paper && furnace && sodium
 }

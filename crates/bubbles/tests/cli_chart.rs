@@ -49,7 +49,7 @@ fn rows_show_newtons_series_from_black_to_the_first_order_white() {
     assert_eq!(img.dimensions(), (w, h));
     let plot_w = w - LEFT_PX - RIGHT_PX;
     let y = TOP_PX + 5;
-    let column = |d_nm: f64| LEFT_PX + ((d_nm / 2000.0) * f64::from(plot_w)) as u32;
+    let column = |d_nm: f64| LEFT_PX + ((d_nm / 4000.0) * f64::from(plot_w)) as u32;
     // A film much thinner than λ/4 reflects almost nothing (destructive
     // interference of the two surface reflections, one with a phase flip).
     let thin = img.get_pixel(column(2.0), y);

@@ -200,7 +200,7 @@ fn export_obj_writes_one_frame_per_output_time_with_thickness() {
     );
     for (c, d) in colours.iter().zip(&thickness) {
         assert!(
-            (c - (d / 2000.0).min(1.0)).abs() < 2e-6,
+            (c - (d / 4000.0).min(1.0)).abs() < 2e-6,
             "colour {c} for {d} nm"
         );
     }

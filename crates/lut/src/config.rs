@@ -14,12 +14,18 @@ use crate::set::is_valid_light_name;
 use crate::weights::{linear_srgb_white, sample_wavelengths};
 
 /// Default number of thickness columns: the thickness axis sets the lookup error, and
-/// 2048 keeps the reflectivity within the published ΔE00 bound (docs/lut.md).
-pub const DEFAULT_WIDTH: usize = 2048;
+/// 4096 over 4000 nm (0.98 nm per column, as 2048 over 2000 nm) keeps the reflectivity
+/// within the published ΔE00 bound (docs/lut.md).
+pub const DEFAULT_WIDTH: usize = 4096;
 /// Default number of cos θ rows: more rows barely change the error above grazing.
 pub const DEFAULT_HEIGHT: usize = 128;
-/// Default thickness of the last column, in nm (seed 000, Fig. 2).
-pub const DEFAULT_THICKNESS_MAX_NM: f32 = 2000.0;
+/// Default thickness of the last column, in nm: the one definition of the thickness range
+/// used by the tables, `bubbles chart` and the OBJ export. Seed 000's Fig. 2 stops at
+/// 2000 nm, but films drain thicker (2731 nm in `paper` at t = 0.5 s); beyond 4000 nm the
+/// reflected colour stays within ΔE76 1 of the thick-film (incoherent) limit at every
+/// angle up to 75°, even exposed so the reflection is white (docs/rendering.md), so the
+/// renderer's clamp at the last column no longer shows.
+pub const DEFAULT_THICKNESS_MAX_NM: f32 = 4000.0;
 /// Default spacing of the integration wavelengths, in nm.
 pub const DEFAULT_STEP_NM: f64 = 5.0;
 /// Refractive index on both sides of the film: air.
@@ -211,7 +217,7 @@ pub struct BakeConfig {
 }
 
 impl Default for BakeConfig {
-    /// 2048 × 128 texels over 0–2000 nm, soap film index, CIE 1931 observer, 5 nm step,
+    /// 4096 × 128 texels over 0–4000 nm, soap film index, CIE 1931 observer, 5 nm step,
     /// D65 reference white, one light-source table for the sodium lamp.
     fn default() -> Self {
         Self::builder()

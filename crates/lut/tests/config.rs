@@ -11,8 +11,8 @@ fn refused(builder: lut::BakeConfigBuilder) -> ConfigError {
 #[test]
 fn defaults_are_the_documented_ones() {
     let config = BakeConfig::default();
-    assert_eq!((config.width(), config.height()), (2048, 128));
-    assert_eq!(config.thickness_max_nm(), 2000.0);
+    assert_eq!((config.width(), config.height()), (4096, 128));
+    assert_eq!(config.thickness_max_nm(), 4000.0);
     assert_eq!(config.step_nm(), 5.0);
     assert_eq!(*config.film_index(), RefractiveIndex::SOAP);
     assert_eq!(config.reference().name(), "d65");

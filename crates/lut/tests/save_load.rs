@@ -123,7 +123,10 @@ fn lut_json_states_axes_mapping_and_provenance() {
     assert_eq!(doc["format_version"], lut::FORMAT_VERSION);
     assert_eq!(doc["width"], 40);
     assert_eq!(doc["height"], 9);
-    assert_eq!(doc["axes"]["u"]["max"], 2000.0);
+    assert_eq!(
+        doc["axes"]["u"]["max"],
+        f64::from(lut::config::DEFAULT_THICKNESS_MAX_NM)
+    );
     let u = doc["axes"]["u"]["texture_coordinate"]
         .as_str()
         .expect("string");
@@ -334,7 +337,7 @@ fn png16_refuses_a_range_too_wide_for_f32_and_writes_nothing() {
     set.reflectivity = {
         let mut texels = set.reflectivity.texels().to_vec();
         texels[0] = [f32::MAX, -f32::MAX, 0.0];
-        Lut::try_new(40, 9, 2000.0, texels).expect("finite")
+        Lut::try_new(40, 9, lut::config::DEFAULT_THICKNESS_MAX_NM, texels).expect("finite")
     };
     let err = set
         .save(dir.path(), &[Format::Exr, Format::Png16])

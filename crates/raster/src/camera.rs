@@ -35,8 +35,12 @@ impl Camera {
         }
     }
 
-    /// Checked [`Camera::look_at`]: rejects non-finite input, `eye == target`, `up` parallel to
-    /// the view direction, and a field of view outside `(0, 180)` degrees.
+    /// Checked [`Camera::look_at`]: rejects non-finite input, `eye == target`, a zero `up`
+    /// and a field of view outside `(0, 180)` degrees.
+    ///
+    /// When `up` is parallel to the view direction (a camera looking straight up or down),
+    /// the screen's up is the limit of tilting towards that pose from the +Z side (for
+    /// `up = Y`: −Z looking down, +Z looking up; X when the view runs along Z).
     pub fn try_look_at(
         eye: Vec3,
         target: Vec3,
@@ -63,13 +67,15 @@ impl Camera {
                 format!("eye and target are both {eye}"),
             ));
         }
-        let right = forward.cross(up).normalize_or_zero();
-        if right == Vec3::ZERO || forward.cross(up).length() < 1e-6 * up.length() {
-            return Err(RenderError::scene(
-                "camera",
-                format!("up {up} is parallel to the view direction {forward}"),
-            ));
+        if up.length_squared() == 0.0 {
+            return Err(RenderError::scene("camera", format!("up {up} is zero")));
         }
+        let up = if forward.cross(up).length() < 1e-6 * up.length() {
+            fallback_up(forward, up)
+        } else {
+            up
+        };
+        let right = forward.cross(up).normalize();
         Ok(Camera {
             eye,
             forward,
@@ -132,6 +138,17 @@ impl Camera {
             self.near_m,
         )
     }
+}
+
+/// An up hint for a view direction parallel to `up`: the world axis Z (X when the view
+/// runs along Z), signed as the limit of a camera tilting into that pose from +Z.
+fn fallback_up(forward: Vec3, up: Vec3) -> Vec3 {
+    let axis = if forward.z.abs() < 0.9 {
+        Vec3::Z
+    } else {
+        Vec3::X
+    };
+    axis * forward.dot(up).signum()
 }
 
 /// A camera fitted to a pixel grid: the projection every pass shares.
@@ -257,9 +274,33 @@ mod tests {
     }
 
     #[test]
+    fn camera_looking_straight_up_or_down_gets_the_limit_of_a_tilted_camera() {
+        for (eye, target) in [
+            (Vec3::new(0.0, 2.0, 0.0), Vec3::ZERO),
+            (Vec3::new(0.0, -2.0, 0.0), Vec3::ZERO),
+            (Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO),
+            (Vec3::new(0.0, 0.0, -2.0), Vec3::ZERO),
+        ] {
+            let up = if eye.y == 0.0 { Vec3::Z } else { Vec3::Y };
+            let straight = Camera::try_look_at(eye, target, up, 45.0).unwrap();
+            // Tilt the eye a little towards +Z (or +X when the view runs along Z).
+            let nudge = if eye.y == 0.0 { Vec3::X } else { Vec3::Z } * 1e-3;
+            let tilted = Camera::try_look_at(eye + nudge, target, up, 45.0).unwrap();
+            for (a, b) in [
+                (straight.up(), tilted.up()),
+                (straight.right(), tilted.right()),
+            ] {
+                assert!((a - b).length() < 1e-2, "{eye}: {a} vs tilted {b}");
+            }
+            let (f, r, u) = (straight.forward(), straight.right(), straight.up());
+            assert!(f.dot(r).abs() < 1e-6 && f.dot(u).abs() < 1e-6 && r.dot(u).abs() < 1e-6);
+        }
+    }
+
+    #[test]
     fn rejects_degenerate_cameras() {
         assert!(Camera::try_look_at(Vec3::ONE, Vec3::ONE, Vec3::Y, 45.0).is_err());
-        assert!(Camera::try_look_at(Vec3::ZERO, Vec3::Y, Vec3::Y, 45.0).is_err());
+        assert!(Camera::try_look_at(Vec3::ZERO, Vec3::Y, Vec3::ZERO, 45.0).is_err());
         assert!(Camera::try_look_at(Vec3::ZERO, Vec3::X, Vec3::Y, 180.0).is_err());
         assert!(Camera::try_look_at(Vec3::ZERO, Vec3::X, Vec3::Y, f32::NAN).is_err());
         assert!(Camera::try_look_at(Vec3::NAN, Vec3::X, Vec3::Y, 45.0).is_err());

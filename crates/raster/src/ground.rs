@@ -86,8 +86,9 @@ pub(crate) fn ground_span(
         );
     }
     let mut irradiance = [[0.0f32; SPAN]; 3];
+    let ambient = ctx.ambient.diffuse(g.normal);
     for (k, irr) in irradiance.iter_mut().enumerate() {
-        irr[..n].fill(ctx.ambient[k]);
+        irr[..n].fill(ambient[k]);
     }
     let height = g.ground.height_m;
     for light in ctx.lights {
@@ -103,7 +104,8 @@ pub(crate) fn ground_span(
     for (i, o) in out.iter_mut().enumerate() {
         let w = weight[i];
         for k in 0..3 {
-            o[k] = (a[k] * (1.0 - w) + b[k] * w) * irradiance[k][i];
+            // a + (b − a)·w is exact when a = b: a solid ground in a white furnace stays white.
+            o[k] = (a[k] + (b[k] - a[k]) * w) * irradiance[k][i];
         }
     }
 }

@@ -5,7 +5,7 @@
 //!
 //! A frame ([`Renderer::render`]):
 //! 1. the opaque scene — [`Environment`], optional [`Ground`] plane, [`Object`]s lit by
-//!    [`Light`]s — rasterised with a depth buffer into an HDR sample buffer;
+//!    [`Light`]s and by the environment's [`Irradiance`] — rasterised with a depth buffer into an HDR sample buffer;
 //! 2. per bubble, a dynamic [`CubeMap`] of that scene from the bubble's centre
 //!    ([`ReflectionMode::DynamicCubeMap`]), or the environment / a [`SphereMap`] instead;
 //! 3. bubbles sorted far to near, each drawn back faces then front faces with
@@ -25,6 +25,7 @@ mod environment;
 mod error;
 mod frame;
 mod ground;
+mod irradiance;
 mod lut_sampler;
 mod mesh;
 mod obj;
@@ -43,6 +44,7 @@ pub use environment::{Environment, Sky};
 pub use error::RenderError;
 pub use frame::{Frame, FrameTimings, linear_to_srgb, tone_map};
 pub use glam::{Mat3, Vec3};
+pub use irradiance::Irradiance;
 pub use lut::Lut;
 pub use mesh::TriMesh;
 pub use renderer::Renderer;

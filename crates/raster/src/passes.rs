@@ -10,7 +10,7 @@ use crate::ground::{SPAN, ground_span, span_supported};
 use crate::lut_sampler::LutSampler;
 use crate::raster::{SamplePattern, SetupTri, for_each_covered_in_row};
 use crate::shading::{ground_albedo, lit, object_albedo};
-use crate::{CubeMap, Environment, Ground, Light, Material, SphereMap};
+use crate::{CubeMap, Environment, Ground, Irradiance, Light, Material, SphereMap};
 
 /// Rows per strip (the unit of parallel work).
 pub(crate) const STRIP_ROWS: usize = 8;
@@ -117,7 +117,8 @@ pub(crate) struct OpaqueCtx<'a> {
     /// Precomputed environment radiance per pixel (single-sample views only).
     pub sky_texels: Option<&'a [[f32; 3]]>,
     pub ground: Option<GroundView<'a>>,
-    pub ambient: [f32; 3],
+    /// Environment and ambient light on opaque surfaces.
+    pub ambient: &'a Irradiance,
     pub lights: &'a [Light],
     pub materials: &'a [&'a Material],
     pub tris: &'a [SetupTri],
@@ -521,8 +522,17 @@ impl BubbleCtx<'_> {
     }
 }
 
-/// Fraction of a pixel whose reflected rays (unit `reflected`) hit `light`: a linear ramp one pixel wide
-/// (`pixel_angle_rad`) across the edge of the light's disc, so highlights are anti-aliased.
+/// Fraction of a pixel's reflected rays (unit `reflected` at its centre) that hit `light`,
+/// given the angle the reflected direction sweeps per pixel, `pixel_angle_rad`.
+///
+/// A light of angular radius α at angle γ from `reflected` is filtered by a Gaussian of
+/// σ = 0.6 pixel in reflected directions: `vis = α²/(2s²) · exp(−γ²/2s²)` with
+/// `s² = σ² + α²/4` (the disc's own variance), whose integral over directions is the
+/// light's solid angle πα² for every α; and a normalised Gaussian this wide sums to one
+/// over the pixel grid at any sub-pixel offset (within 0.2 %), so a highlight's energy
+/// in the image is the light's power, whatever its radius. Lights wider than 2σ (whose
+/// peak reaches 1) get a one-pixel linear ramp across the disc's rim instead, within
+/// 6 % of the same energy and with a sharp edge.
 #[inline]
 pub(crate) fn light_visibility(
     light: &Light,
@@ -538,16 +548,27 @@ pub(crate) fn light_visibility(
     let cos_gamma = reflected.dot(to_light) / dist;
     let sin_alpha = light.radius_m / dist;
     let w = pixel_angle_rad.max(1e-5);
-    // asin x ≤ πx/2 bounds the disc's angular radius; and 1 − cos γ ≤ γ²/2, so this
-    // rejects only rays with γ beyond the disc plus half a pixel (most of them, cheaply).
-    let reach = std::f32::consts::FRAC_PI_2 * sin_alpha + 0.5 * w;
+    // asin x ≤ πx/2 bounds α; 1 − cos γ ≤ γ²/2, so this rejects only rays beyond both
+    // the Gaussian's 4 s and the ramp's reach (most rays, cheaply).
+    let reach = std::f32::consts::PI * sin_alpha + 2.5 * w;
     if 1.0 - cos_gamma > 0.5 * reach * reach {
         return 0.0;
     }
     let alpha = sin_alpha.asin();
-    let gamma = cos_gamma.clamp(-1.0, 1.0).acos();
-    ((alpha - gamma) / w + 0.5).clamp(0.0, 1.0)
+    // atan2 keeps small angles exact where acos(cos γ) would round them to 3e-4 rad.
+    let gamma = reflected.cross(to_light).length().atan2(cos_gamma * dist);
+    let sigma = HIGHLIGHT_SIGMA_PX * w;
+    if alpha <= 2.0 * sigma {
+        let s2 = sigma * sigma + 0.25 * alpha * alpha;
+        alpha * alpha / (2.0 * s2) * (-gamma * gamma / (2.0 * s2)).exp()
+    } else {
+        ((alpha - gamma) / w + 0.5).clamp(0.0, 1.0)
+    }
 }
+
+/// Width of the highlight filter in pixels: wide enough that the Gaussian's sum over the
+/// pixel grid ripples by 2·exp(−2π²σ²) ≈ 0.16 % with the sub-pixel offset.
+const HIGHLIGHT_SIGMA_PX: f32 = 0.6;
 
 #[cfg(test)]
 mod tests {
@@ -569,6 +590,17 @@ mod tests {
         let rim = Vec3::new(alpha.sin(), 0.0, -alpha.cos());
         let v = light_visibility(&light, Vec3::ZERO, rim, w);
         assert!((v - 0.5).abs() < 0.05, "rim visibility {v}");
+        // A light far smaller than a pixel: its solid angle times the filter's peak.
+        let tiny = Light {
+            radius_m: 1e-4,
+            ..light
+        };
+        let (alpha, w) = (1e-5f32, 0.01f32);
+        let sigma = HIGHLIGHT_SIGMA_PX * w;
+        let v = light_visibility(&tiny, Vec3::ZERO, -Vec3::Z, w);
+        let want =
+            std::f32::consts::PI * alpha * alpha / (2.0 * std::f32::consts::PI * sigma * sigma);
+        assert!((v - want).abs() < 1e-3 * want, "tiny light {v} vs {want}");
         // Inside the light everything is visible.
         assert_eq!(light_visibility(&light, light.position, Vec3::X, w), 1.0);
     }
@@ -610,7 +642,8 @@ mod tests {
             env: &env,
             sky_texels: None,
             ground: Some(g),
-            ambient: [0.2, 0.3, 0.4],
+            ambient: &Irradiance::from_environment(&Environment::Sky(crate::Sky::default()))
+                .plus_uniform([0.2, 0.3, 0.4]),
             lights: &lights,
             materials: &[],
             tris: &[],

@@ -6,7 +6,7 @@ use lut::Lut;
 
 use crate::environment::check_rgb;
 use crate::mesh::{check_triangles, check_vertices};
-use crate::{Camera, Environment, RenderError, Texture, TriMesh};
+use crate::{Camera, Environment, Irradiance, RenderError, Texture, TriMesh};
 
 /// How a surface's albedo varies over it.
 #[derive(Debug, Clone, PartialEq)]
@@ -261,8 +261,11 @@ pub struct RenderScene {
     pub camera: Camera,
     /// Radiance from infinitely far away.
     pub environment: Environment,
-    /// Ambient radiance lighting opaque surfaces (unoccluded); e.g. the environment's average.
+    /// Ambient radiance lighting opaque surfaces (unoccluded), added to `irradiance`.
     pub ambient_rgb: [f32; 3],
+    /// Environment light on opaque surfaces by their normal (unoccluded), e.g.
+    /// [`Irradiance::from_environment`] of `environment`; zero from [`RenderScene::new`].
+    pub irradiance: Irradiance,
     /// Optional ground plane.
     pub ground: Option<Ground>,
     /// Opaque objects.
@@ -280,6 +283,7 @@ impl RenderScene {
             camera,
             environment,
             ambient_rgb: [0.0; 3],
+            irradiance: Irradiance::default(),
             ground: None,
             objects: Vec::new(),
             lights: Vec::new(),
@@ -291,6 +295,12 @@ impl RenderScene {
     pub fn validate(&self, tables: &FilmTables) -> Result<(), RenderError> {
         self.environment.validate()?;
         check_rgb("ambient_rgb", self.ambient_rgb)?;
+        if !self.irradiance.is_finite() {
+            return Err(RenderError::scene(
+                "irradiance",
+                "the environment is too bright: its irradiance overflows f32".to_string(),
+            ));
+        }
         if let Some(g) = &self.ground {
             if !g.height_m.is_finite() {
                 return Err(RenderError::scene(

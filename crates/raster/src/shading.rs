@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use crate::{Light, Material, Pattern};
+use crate::{Irradiance, Light, Material, Pattern};
 
 /// `x.floor()` without a libm call (baseline x86-64 has no rounding instruction);
 /// exact for |x| < 2²³, where every f32 beyond is already an integer.
@@ -71,11 +71,12 @@ pub(crate) fn lit(
     p: Vec3,
     n: Vec3,
     v: Vec3,
-    ambient: [f32; 3],
+    ambient: &Irradiance,
     lights: &[Light],
 ) -> [f32; 3] {
     // Two-sided: light the side facing the viewer.
     let n = if n.dot(v) > 0.0 { -n } else { n };
+    let ambient = ambient.diffuse(n);
     let mut out = [
         albedo[0] * ambient[0],
         albedo[1] * ambient[1],
@@ -160,7 +161,7 @@ mod tests {
             Vec3::ZERO,
             Vec3::Y,
             -Vec3::Y,
-            [0.0; 3],
+            &Irradiance::default(),
             &[light],
         );
         // albedo · L · (ρ/D)² = 0.5 · 10 · (0.5/4)².
@@ -173,7 +174,7 @@ mod tests {
             Vec3::ZERO,
             -Vec3::Y,
             Vec3::Y,
-            [0.0; 3],
+            &Irradiance::default(),
             &[light],
         );
         assert_eq!(back, [0.0; 3]);
@@ -183,7 +184,15 @@ mod tests {
     fn white_lambertian_in_uniform_ambient_is_the_ambient() {
         let m = Material::matte([1.0; 3]);
         assert_eq!(
-            lit(&m, [1.0; 3], Vec3::ZERO, Vec3::Y, -Vec3::Y, [0.7; 3], &[]),
+            lit(
+                &m,
+                [1.0; 3],
+                Vec3::ZERO,
+                Vec3::Y,
+                -Vec3::Y,
+                &Irradiance::uniform([0.7; 3]),
+                &[]
+            ),
             [0.7; 3]
         );
     }

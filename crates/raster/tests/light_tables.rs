@@ -28,7 +28,9 @@ fn light_table_highlight_is_not_coloured_twice() {
     });
     scene.lights.push(Light {
         position: Vec3::new(0.0, 0.0, 2.0),
-        radius_m: 0.2,
+        // Wider (0.25 rad) than the highlight filter's 2σ at this resolution, so the
+        // centre pixel sees the whole light, not its energy spread over a sub-pixel spot.
+        radius_m: 0.5,
         radiance: hue.map(|c| c * 5.0),
         light_lut: Some(0),
     });
@@ -38,8 +40,8 @@ fn light_table_highlight_is_not_coloured_twice() {
         lights: vec![flat(table)],
     };
     let settings = RenderSettings {
-        width: 33,
-        height: 33,
+        width: 65,
+        height: 65,
         samples: 1,
         reflection: ReflectionMode::StaticEnvironment,
         exposure_ev: 0.0,

@@ -11,8 +11,8 @@ use crate::error::{CliError, CliResult};
 
 /// Angles of incidence of the chart's rows, top to bottom.
 pub const ANGLES_DEG: [f64; 5] = [0.0, 30.0, 45.0, 60.0, 75.0];
-/// Thickness at the right edge of the chart.
-pub const MAX_THICKNESS_NM: f64 = 2000.0;
+/// Thickness at the right edge of the chart: the tables' range.
+pub const MAX_THICKNESS_NM: f64 = lut::config::DEFAULT_THICKNESS_MAX_NM as f64;
 
 const LEFT_PX: u32 = 28;
 const RIGHT_PX: u32 = 12;
@@ -26,7 +26,7 @@ const MAX_SIZE_PX: u32 = 16384;
 #[derive(Debug, clap::Args)]
 #[command(
     after_help = "Draw the interference colour chart of a soap film in air: reflected colour \
-    against thickness 0–2000 nm (x axis; ticks every 100 nm, long ticks every 500 nm), one row \
+    against thickness 0–4000 nm (x axis; ticks every 100 nm, long ticks every 500 nm), one row \
     per angle of incidence 0°, 30°, 45°, 60°, 75° (top to bottom; the glyph left of each row \
     shows its ray). Colours are exact Airy reflectance integrated against the CIE tables, \
     shown in sRGB without chromatic adaptation.\n\n\

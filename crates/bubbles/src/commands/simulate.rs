@@ -12,9 +12,8 @@ use crate::error::{CliError, CliResult};
 use crate::scene::Scene;
 use crate::scene::values::Positive;
 
-/// Thickness written as vertex colour 1.0 in exported OBJ files (the range of the
-/// reflectance tables, seed 000 Fig. 2).
-pub const OBJ_FULL_SCALE_NM: f64 = 2000.0;
+/// Thickness written as vertex colour 1.0 in exported OBJ files: the tables' range.
+pub const OBJ_FULL_SCALE_NM: f64 = lut::config::DEFAULT_THICKNESS_MAX_NM as f64;
 
 /// Arguments of `bubbles simulate`.
 #[derive(Debug, clap::Args)]
@@ -25,7 +24,7 @@ pub const OBJ_FULL_SCALE_NM: f64 = 2000.0;
     and kinetic energy, the step count, the wall time and any burst events.\n\n\
     --export-obj DIR writes DIR/frame_00000.obj, … at --fps frames per second (the first at \
     t = 0, the last at the end). Each bubble is an object `bubble_<id>` with vertex normals; \
-    each vertex line is `v x y z r g b` with r = g = b = thickness / 2000 nm (clamped to 1), the \
+    each vertex line is `v x y z r g b` with r = g = b = thickness / 4000 nm (clamped to 1), the \
     vertex-colour extension that Blender, MeshLab and most OBJ readers import as a colour \
     attribute, and the exact thicknesses follow as `#thickness_nm` comment lines, in vertex \
     order. Files are written to a temporary name in DIR, then renamed."

@@ -84,7 +84,8 @@ impl Scene {
         Ok(raster::Light {
             position: raster::Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32),
             radius_m: spec.radius_m.get() as f32,
-            radiance: rgb.map(|c| (c * luminance) as f32),
+            // Opaque surfaces see the in-gamut colour; bubbles the light's own table.
+            radiance: super::to_raster::in_gamut_rgb(rgb).map(|c| (c * luminance) as f32),
             light_lut: index,
         })
     }

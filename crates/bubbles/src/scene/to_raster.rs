@@ -5,8 +5,8 @@ use super::schema::{EnvironmentSpec, MaterialSpec, ObjectSpec};
 use crate::error::CliError;
 use bubble_dynamics::World;
 use raster::{
-    BubbleMesh, Camera, Environment, Ground, Material, Object, Pattern, RenderScene, Sky, Texture,
-    TriMesh, Vec3,
+    BubbleMesh, Camera, Environment, Ground, Irradiance, Material, Object, Pattern, RenderScene,
+    Sky, Texture, TriMesh, Vec3,
 };
 
 impl Scene {
@@ -21,6 +21,8 @@ impl Scene {
         )
         .map_err(|e| CliError::input(format!("{}: camera: {e}", self.origin)))?;
         let mut scene = RenderScene::new(camera, self.environment()?);
+        // The sky lights the ground and the objects, not only the point lights.
+        scene.irradiance = Irradiance::from_environment(&scene.environment);
         scene.ground = match &self.file.ground {
             Some(g) => Some(Ground {
                 height_m: g.height_m.get() as f32,
@@ -173,10 +175,66 @@ fn scale_cube(cube: &raster::CubeMap, k: f32) -> Result<raster::CubeMap, raster:
     raster::CubeMap::try_from_faces(n, faces)
 }
 
+/// The colour a light shades opaque surfaces with: `rgb` (linear sRGB, possibly negative
+/// in a channel for a spectrum outside the sRGB gamut, e.g. sodium) moved towards the
+/// white of equal luminance until no channel is negative.
+///
+/// # Guarantees
+/// For finite `rgb` with luminance `Y >= 0`: every channel is finite and `>= 0`, the
+/// luminance stays `Y`, and the chromaticity stays on the line from the white point
+/// through the light's own (the same dominant wavelength); in-gamut colours are unchanged.
+pub(super) fn in_gamut_rgb(rgb: [f64; 3]) -> [f64; 3] {
+    let y = 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+    let min = rgb.iter().copied().fold(f64::INFINITY, f64::min);
+    if min >= 0.0 {
+        return rgb;
+    }
+    if y <= 0.0 {
+        return [0.0; 3];
+    }
+    // rgb' = Y + s (rgb − Y) with s chosen so the smallest channel lands on 0.
+    let s = y / (y - min);
+    rgb.map(|c| (y + s * (c - y)).max(0.0))
+}
+
 fn vec3(v: [f64; 3]) -> Vec3 {
     Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)
 }
 
 fn rgb(v: [f64; 3]) -> [f32; 3] {
     v.map(|c| c as f32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::in_gamut_rgb;
+
+    fn luminance(c: [f64; 3]) -> f64 {
+        0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+    }
+
+    #[test]
+    fn in_gamut_rgb_keeps_luminance_and_hue_line_and_clears_negatives() {
+        // The sodium lamp at luminance 400 (the message of issue 8).
+        let sodium = [1108.8159, 234.81322, -51.370678];
+        let c = in_gamut_rgb(sodium);
+        assert!(c.iter().all(|v| v.is_finite() && *v >= 0.0), "{c:?}");
+        assert!(c[2].abs() < 1e-9, "smallest channel lands on 0: {c:?}");
+        let dy = luminance(c) - luminance(sodium);
+        assert!(dy.abs() < 1e-9, "luminance off by {dy}");
+        // On the line through white: (c − Y) ∥ (sodium − Y).
+        let (y, ys) = (luminance(c), luminance(sodium));
+        let a = [c[0] - y, c[1] - y, c[2] - y];
+        let b = [sodium[0] - ys, sodium[1] - ys, sodium[2] - ys];
+        let cross = [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ];
+        let norm = |v: [f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let off = norm(cross) / (norm(a) * norm(b));
+        assert!(off < 1e-9, "off the white line by sin {off}");
+        assert_eq!(in_gamut_rgb([0.3, 0.5, 0.0]), [0.3, 0.5, 0.0]);
+        assert_eq!(in_gamut_rgb([-1.0, 0.1, 0.0]), [0.0; 3]);
+    }
 }
