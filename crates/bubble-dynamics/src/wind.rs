@@ -142,6 +142,16 @@ impl WindField {
         }
     }
 
+    /// The steady part, m/s.
+    pub(crate) fn uniform_m_per_s(&self) -> DVec3 {
+        self.uniform
+    }
+
+    /// Replaces the steady part (the gusts and the user field stay).
+    pub(crate) fn set_uniform_m_per_s(&mut self, velocity_m_per_s: DVec3) {
+        self.uniform = velocity_m_per_s;
+    }
+
     /// True when the air is still everywhere, always.
     pub(crate) fn is_still(&self) -> bool {
         self.uniform == DVec3::ZERO && self.modes.is_empty() && self.field.is_none()

@@ -16,6 +16,8 @@ use crate::params::{BubbleParams, WorldParams};
 use crate::topology::Topology;
 use crate::wind::{Wind, WindField};
 
+mod interact;
+
 /// Fraction of the symplectic-Euler stability limit ω·dt < 2 that a substep may use.
 /// Measured: a violent two-bubble collision in gusts stays stable up to 1.5 with the
 /// Gershgorin bound below and blows up at 2; 0.75 leaves a factor 2 of margin.
@@ -62,6 +64,8 @@ pub struct World {
     steps: u64,
     last_substeps: u32,
     failed: Option<SimError>,
+    /// The id the next added bubble gets (ids are never reused).
+    next_id: u64,
 }
 
 impl Clone for World {
@@ -78,6 +82,7 @@ impl Clone for World {
             steps: self.steps,
             last_substeps: self.last_substeps,
             failed: self.failed.clone(),
+            next_id: self.next_id,
         }
     }
 }
@@ -105,7 +110,7 @@ impl World {
         check_initial_overlaps(&bubbles, &params.colliders, |b| {
             meshes[&b.subdivisions].circumradius_per_radius
         })?;
-        let built = bubbles
+        let built: Vec<Bubble> = bubbles
             .iter()
             .enumerate()
             .map(|(i, b)| {
@@ -120,6 +125,7 @@ impl World {
             })
             .collect();
         let wind = WindField::new(std::mem::take(&mut params.wind));
+        let next_id = built.len() as u64;
         Ok(World {
             params,
             wind,
@@ -127,6 +133,7 @@ impl World {
             steps: 0,
             last_substeps: 0,
             failed: None,
+            next_id,
         })
     }
 

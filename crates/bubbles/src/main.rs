@@ -7,6 +7,8 @@ mod frame;
 mod input;
 mod limits;
 mod scene;
+#[cfg(feature = "view")]
+mod view;
 
 use clap::{Parser, Subcommand};
 
@@ -38,6 +40,10 @@ enum Command {
     Animate(commands::animate::Args),
     /// CIEDE2000 between two images: mean, 95th percentile, maximum, optional heat map.
     Compare(commands::compare::Args),
+    /// Open a live window on the scene (simulated in real time, CPU-rendered).
+    #[cfg(feature = "view")]
+    #[command(after_help = view::CONTROLS)]
+    View(view::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -52,6 +58,8 @@ fn main() -> std::process::ExitCode {
         Command::Bench(args) => commands::bench::run(args),
         Command::Animate(args) => commands::animate::run(args),
         Command::Compare(args) => commands::compare::run(args),
+        #[cfg(feature = "view")]
+        Command::View(args) => view::run(args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

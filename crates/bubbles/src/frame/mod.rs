@@ -8,11 +8,11 @@ use crate::limits;
 use crate::scene::schema::RenderSpec;
 use crate::scene::values::{Exposure, Num, plain};
 use crate::scene::{Scene, bubble_meshes};
-use bubble_dynamics::World;
+use bubble_dynamics::{BubbleParams, Event, World};
 use lut::LutSet;
 use raster::{
-    FilmTables, Frame, ReflectionMode, RenderScene, RenderSettings, Renderer, SAMPLE_COUNTS,
-    SphereMap, ToneMap,
+    Camera, FilmTables, Frame, ReflectionMode, RenderScene, RenderSettings, Renderer,
+    SAMPLE_COUNTS, SphereMap, ToneMap,
 };
 use std::sync::Arc;
 
@@ -202,6 +202,59 @@ impl FrameJob {
         self.renderer
             .render(&self.render_scene, &self.tables, &self.settings)
             .map_err(|e| CliError::input(format!("{}: {e}", self.scene.origin)))
+    }
+
+    /// One solver step, returning what happened (bursts).
+    pub fn step_events(&mut self) -> Result<Vec<Event>, CliError> {
+        self.world
+            .step()
+            .map_err(|e| CliError::runtime(format!("simulation failed: {e}")))
+    }
+
+    /// The solver's world, for changes between steps (wind, new bubbles, pokes).
+    pub fn world_mut(&mut self) -> &mut World {
+        &mut self.world
+    }
+
+    /// The solver's world.
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// Rebuilds the world from the scene, back to t = 0.
+    pub fn reset(&mut self) -> Result<(), CliError> {
+        self.world = self.scene.dynamics_world()?;
+        Ok(())
+    }
+
+    /// The scene's first bubble (a template for blowing new ones), if it has any.
+    pub fn bubble_template(&self) -> Option<BubbleParams> {
+        self.scene
+            .file
+            .bubbles
+            .first()
+            .map(crate::scene::bubble_params)
+    }
+
+    /// The camera in force.
+    pub fn camera(&self) -> Camera {
+        self.render_scene.camera
+    }
+
+    /// Replaces the camera.
+    pub fn set_camera(&mut self, camera: Camera) {
+        self.render_scene.camera = camera;
+    }
+
+    /// The scene's camera target, m.
+    pub fn scene_target_m(&self) -> [f64; 3] {
+        self.scene.file.camera.target_m.get()
+    }
+
+    /// Rebuilds the settings from new options (keeps the scene's values where a flag is unset).
+    pub fn set_options(&mut self, options: &Options) -> Result<(), CliError> {
+        self.settings = settings(&self.scene, &self.render_scene, options)?;
+        Ok(())
     }
 
     /// Replaces the image size (for benchmarks at several sizes).

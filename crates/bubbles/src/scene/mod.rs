@@ -13,6 +13,7 @@ use crate::error::CliError;
 pub use check::{check_memory, check_spectrum_file};
 use schema::SceneFile;
 use std::path::{Path, PathBuf};
+pub(crate) use to_dynamics::bubble_params;
 pub use to_dynamics::sim_error;
 pub use to_raster::bubble_meshes;
 

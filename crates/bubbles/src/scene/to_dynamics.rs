@@ -87,7 +87,8 @@ impl Scene {
     }
 }
 
-fn bubble_params(spec: &BubbleSpec) -> BubbleParams {
+/// The solver's parameters for one bubble of the scene file.
+pub(crate) fn bubble_params(spec: &BubbleSpec) -> BubbleParams {
     let defaults = BubbleParams::default();
     BubbleParams {
         center_m: dvec(spec.center_m.get()),

@@ -1,0 +1,611 @@
+//! The window: winit events in, [`ViewState`] updated, the solver stepped at its fixed
+//! step against the wall clock, the CPU renderer drawn through softbuffer.
+
+use super::controls::{self, Command, Input, Key, Orbit, ReflectionKey, ViewState};
+use super::font;
+use super::scale::ResolutionScale;
+use super::{Args, CONTROLS};
+use crate::error::{CliError, CliResult};
+use crate::frame::{FrameJob, Options, Reflection};
+use bubble_dynamics::Event;
+use glam::Vec3;
+use std::collections::VecDeque;
+use std::num::NonZeroU32;
+use std::path::PathBuf;
+use std::rc::Rc;
+use std::time::{Duration, Instant};
+use winit::application::ApplicationHandler;
+use winit::dpi::{PhysicalPosition, PhysicalSize};
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::{Key as WKey, NamedKey};
+use winit::window::{Window, WindowId};
+
+/// Solver steps allowed per displayed frame; beyond it the simulation runs in slow
+/// motion rather than spiralling (each late frame asking for ever more steps).
+const MAX_STEPS_PER_FRAME: u32 = 8;
+/// Wall-clock time folded in per frame at most (a stall must not replay seconds).
+const MAX_FRAME_S: f64 = 0.25;
+/// A press that moves less than this many pixels is a click, not a drag.
+const CLICK_SLOP_PX: f64 = 3.0;
+/// Speed a poke gives the bubble as a whole, m/s (impulse = this × its mass).
+const POKE_SPEED_M_PER_S: f64 = 0.4;
+/// Speed a blown bubble leaves with, m/s, and its distance from the eye as a fraction of
+/// the eye–target distance.
+const BLOW_SPEED_M_PER_S: f64 = 0.15;
+const BLOW_DISTANCE: f64 = 0.45;
+/// How long an event stays in the overlay.
+const EVENT_LIFETIME: Duration = Duration::from_secs(6);
+
+/// Opens the window and runs until Escape or close.
+pub fn run(args: Args) -> CliResult {
+    let job = FrameJob::prepare(args.scene.as_deref(), &args.options)?;
+    let event_loop =
+        EventLoop::new().map_err(|e| CliError::input(format!("cannot open the display: {e}")))?;
+    event_loop.set_control_flow(ControlFlow::Poll);
+    let mut app = App::new(job, args)?;
+    event_loop
+        .run_app(&mut app)
+        .map_err(|e| CliError::runtime(format!("window event loop failed: {e}")))?;
+    app.error.map_or(Ok(()), Err)
+}
+
+struct Gfx {
+    window: Rc<Window>,
+    surface: softbuffer::Surface<Rc<Window>, Rc<Window>>,
+    size: (u32, u32),
+}
+
+#[derive(Default)]
+struct Pointer {
+    at: PhysicalPosition<f64>,
+    left: bool,
+    right: bool,
+    shift: bool,
+    pressed_at: PhysicalPosition<f64>,
+    dragged: bool,
+}
+
+#[derive(Default, Clone, Copy)]
+struct Stats {
+    sim_s: f64,
+    cube_s: f64,
+    opaque_s: f64,
+    bubbles_s: f64,
+    frame_s: f64,
+    slow_motion: bool,
+}
+
+struct App {
+    job: FrameJob,
+    options: Options,
+    state: ViewState,
+    scale: ResolutionScale,
+    gfx: Option<Gfx>,
+    pointer: Pointer,
+    last_frame: Option<Instant>,
+    behind_s: f64,
+    stats: Stats,
+    internal: Vec<u32>,
+    events: VecDeque<(String, Instant)>,
+    error: Option<CliError>,
+}
+
+impl App {
+    fn new(job: FrameJob, args: Args) -> Result<App, CliError> {
+        let cam = job.camera();
+        let target = Vec3::from_array(job.scene_target_m().map(|v| v as f32));
+        let orbit = Orbit::from_eye(cam.eye(), target, cam.vfov_deg())
+            .ok_or_else(|| CliError::input("camera: eye and target coincide"))?;
+        let reflection = match job.settings().reflection {
+            raster::ReflectionMode::StaticEnvironment => ReflectionKey::Static,
+            raster::ReflectionMode::SphereMap(_) => ReflectionKey::SphereMap,
+            _ => ReflectionKey::Dynamic,
+        };
+        let state = ViewState::new(orbit, reflection, job.settings().samples);
+        Ok(App {
+            job,
+            options: args.options,
+            state,
+            scale: ResolutionScale::new(args.target_fps, args.fixed_scale),
+            gfx: None,
+            pointer: Pointer::default(),
+            last_frame: None,
+            behind_s: 0.0,
+            stats: Stats::default(),
+            internal: Vec::new(),
+            events: VecDeque::new(),
+            error: None,
+        })
+    }
+
+    fn fail(&mut self, event_loop: &ActiveEventLoop, err: CliError) {
+        self.error = Some(err);
+        event_loop.exit();
+    }
+
+    fn note(&mut self, text: String) {
+        eprintln!("view: {text}");
+        self.events.push_back((text, Instant::now()));
+        while self.events.len() > 4 {
+            self.events.pop_front();
+        }
+    }
+
+    fn window_size(&self) -> (f32, f32) {
+        self.gfx
+            .as_ref()
+            .map_or((1.0, 1.0), |g| (g.size.0 as f32, g.size.1 as f32))
+    }
+
+    fn input(&mut self, event_loop: &ActiveEventLoop, input: Input) {
+        let (w, h) = self.window_size();
+        let result = match self.state.apply(input, h) {
+            Command::None => Ok(()),
+            Command::Quit => {
+                event_loop.exit();
+                Ok(())
+            }
+            Command::Blow => {
+                self.blow();
+                Ok(())
+            }
+            Command::Poke { x_px, y_px } => {
+                self.poke(x_px, y_px, w, h);
+                Ok(())
+            }
+            Command::Step => self.step_once(),
+            Command::Reset => self.reset(),
+            Command::Screenshot => self.screenshot(),
+            Command::Settings => self.apply_settings(),
+            Command::Wind => self.apply_wind(),
+        };
+        if let Err(err) = result {
+            self.fail(event_loop, err);
+        }
+    }
+
+    fn blow(&mut self) {
+        let Some(template) = self.job.bubble_template() else {
+            self.note("this scene has no bubble to copy".into());
+            return;
+        };
+        let cam = self.job.camera();
+        let forward = cam.forward().as_dvec3();
+        let distance = f64::from(self.state.orbit.distance_m) * BLOW_DISTANCE;
+        let params = bubble_dynamics::BubbleParams {
+            center_m: cam.eye().as_dvec3() + forward * distance,
+            velocity_m_per_s: forward * BLOW_SPEED_M_PER_S,
+            ..template
+        };
+        match self.job.world_mut().try_add_bubble(params) {
+            Ok(id) => self.note(format!("blew bubble {id}")),
+            Err(e) => self.note(format!("no room to blow: {e}")),
+        }
+    }
+
+    fn poke(&mut self, x: f32, y: f32, w: f32, h: f32) {
+        let cam = self.job.camera();
+        let ray = controls::pixel_ray(&cam, x, y, w, h);
+        let world = self.job.world();
+        let spheres: Vec<(Vec3, f32)> = world
+            .bubbles()
+            .iter()
+            .map(|b| (b.center_m().as_vec3(), b.radius_m() as f32))
+            .collect();
+        let Some((index, t)) = controls::pick_sphere(cam.eye(), ray, &spheres) else {
+            return;
+        };
+        let b = &world.bubbles()[index];
+        let (id, mass) = (b.id(), b.inertial_mass_kg());
+        let point = (cam.eye() + ray * t).as_dvec3();
+        let impulse = ray.as_dvec3() * (POKE_SPEED_M_PER_S * mass);
+        if self.job.world_mut().poke(id, point, impulse) {
+            self.note(format!("poked bubble {id}"));
+        }
+    }
+
+    fn step_once(&mut self) -> CliResult {
+        let events = self.job.step_events()?;
+        self.report(&events);
+        Ok(())
+    }
+
+    fn reset(&mut self) -> CliResult {
+        self.job.reset()?;
+        self.apply_wind()?;
+        self.behind_s = 0.0;
+        self.note("reset".into());
+        Ok(())
+    }
+
+    fn apply_wind(&mut self) -> CliResult {
+        let wind = self.state.wind_m_per_s().as_dvec3();
+        self.job
+            .world_mut()
+            .set_uniform_wind_m_per_s(wind)
+            .map_err(|e| CliError::runtime(format!("wind: {e}")))?;
+        let text = if self.state.wind_on {
+            format!(
+                "wind {:.2} m/s towards ({:.2}, {:.2}, {:.2})",
+                wind.length(),
+                wind.x,
+                wind.y,
+                wind.z
+            )
+        } else {
+            "wind off".to_string()
+        };
+        self.note(text);
+        Ok(())
+    }
+
+    fn apply_settings(&mut self) -> CliResult {
+        self.options.reflection = Some(match self.state.reflection {
+            ReflectionKey::Dynamic => Reflection::Dynamic,
+            ReflectionKey::Static => Reflection::Static,
+            ReflectionKey::SphereMap => Reflection::SphereMap,
+        });
+        self.options.samples = Some(self.state.samples());
+        self.job.set_options(&self.options)?;
+        self.note(format!(
+            "reflections {:?}, {} sample(s)",
+            self.state.reflection,
+            self.state.samples()
+        ));
+        Ok(())
+    }
+
+    fn screenshot(&mut self) -> CliResult {
+        let path = next_screenshot_path();
+        let (ev, tone) = (self.job.settings().exposure_ev, self.job.settings().tonemap);
+        let frame = self.job.render()?;
+        frame
+            .write_png(&path, ev, tone)
+            .map_err(|e| CliError::runtime(format!("cannot write {}: {e}", path.display())))?;
+        let (w, h) = (frame.width(), frame.height());
+        self.note(format!("saved {} ({w}x{h})", path.display()));
+        Ok(())
+    }
+
+    /// Steps the solver to catch up with the wall clock, at its fixed step.
+    fn simulate(&mut self, now: Instant) -> CliResult {
+        let elapsed = self
+            .last_frame
+            .map_or(0.0, |t| (now - t).as_secs_f64().min(MAX_FRAME_S));
+        self.last_frame = Some(now);
+        if self.state.paused {
+            self.behind_s = 0.0;
+            return Ok(());
+        }
+        self.behind_s += elapsed;
+        let dt = self.job.dt_s();
+        let mut steps = 0;
+        while self.behind_s >= dt && steps < MAX_STEPS_PER_FRAME {
+            let events = self.job.step_events()?;
+            self.report(&events);
+            self.behind_s -= dt;
+            steps += 1;
+        }
+        self.stats.slow_motion = self.behind_s >= dt;
+        if self.stats.slow_motion {
+            self.behind_s = 0.0;
+        }
+        Ok(())
+    }
+
+    fn report(&mut self, events: &[Event]) {
+        for e in events {
+            let Event::Burst {
+                bubble_id,
+                time_s,
+                min_thickness_nm,
+                ..
+            } = e;
+            self.note(format!(
+                "bubble {bubble_id} burst at t = {time_s:.2} s (film {min_thickness_nm:.0} nm); space blows a new one"
+            ));
+        }
+    }
+
+    fn redraw(&mut self) -> CliResult {
+        let Some((win_w, win_h)) = self.gfx.as_ref().map(|g| g.size) else {
+            return Ok(());
+        };
+        let start = Instant::now();
+        self.simulate(start)?;
+        let sim_s = start.elapsed().as_secs_f64();
+        if let Some(camera) = self.state.orbit.camera() {
+            self.job.set_camera(camera);
+        }
+        let (iw, ih) = self.scale.internal_size(win_w as usize, win_h as usize);
+        self.job.set_size(iw, ih)?;
+        let (ev, tone) = (self.job.settings().exposure_ev, self.job.settings().tonemap);
+        let frame = self.job.render()?;
+        let t = frame.timings;
+        tone_map_into(&mut self.internal, frame.rgb(), ev, tone);
+        let render_s = t.total_s();
+        self.scale.update(render_s as f32);
+        self.present(iw, ih)?;
+        let frame_s = start.elapsed().as_secs_f64();
+        let k = 0.1;
+        let s = &mut self.stats;
+        let mix = |old: f64, new: f64| {
+            if old == 0.0 {
+                new
+            } else {
+                old + k * (new - old)
+            }
+        };
+        s.sim_s = mix(s.sim_s, sim_s);
+        s.cube_s = mix(s.cube_s, t.cube_maps_s);
+        s.opaque_s = mix(s.opaque_s, t.opaque_s);
+        s.bubbles_s = mix(s.bubbles_s, t.bubbles_s);
+        s.frame_s = mix(s.frame_s, frame_s);
+        Ok(())
+    }
+
+    fn present(&mut self, iw: usize, ih: usize) -> CliResult {
+        let overlay = self.overlay_text(iw, ih);
+        let Some(gfx) = self.gfx.as_mut() else {
+            return Ok(());
+        };
+        let (w, h) = (gfx.size.0 as usize, gfx.size.1 as usize);
+        let mut buffer = gfx
+            .surface
+            .buffer_mut()
+            .map_err(|e| CliError::runtime(format!("window buffer: {e}")))?;
+        upscale(&self.internal, iw, ih, &mut buffer, w, h);
+        if let Some(text) = overlay {
+            font::draw_text(&mut buffer, w, 8, 8, 2, &text);
+        }
+        buffer
+            .present()
+            .map_err(|e| CliError::runtime(format!("window present: {e}")))
+    }
+
+    fn overlay_text(&mut self, iw: usize, ih: usize) -> Option<String> {
+        let now = Instant::now();
+        self.events.retain(|(_, at)| now - *at < EVENT_LIFETIME);
+        let mut text = String::new();
+        if self.state.overlay {
+            let s = self.stats;
+            let world = self.job.world();
+            text += &format!(
+                "fps {:.1}  frame {:.1} ms\n",
+                1.0 / s.frame_s.max(1e-9),
+                s.frame_s * 1e3
+            );
+            text += &format!(
+                "sim {:.1}  cube {:.1}  opaque {:.1}  bubbles {:.1} ms\n",
+                s.sim_s * 1e3,
+                s.cube_s * 1e3,
+                s.opaque_s * 1e3,
+                s.bubbles_s * 1e3
+            );
+            text += &format!(
+                "scale {:.0}% ({}) {iw}x{ih}{}\n",
+                self.scale.scale() * 100.0,
+                if self.scale.is_fixed() {
+                    "fixed"
+                } else {
+                    "adaptive"
+                },
+                if self.scale.scale() < 1.0 {
+                    " upscaled"
+                } else {
+                    ""
+                }
+            );
+            text += &format!(
+                "bubbles {}  t {:.2} s{}{}\n",
+                world.bubbles().len(),
+                world.time_s(),
+                if self.state.paused { "  paused" } else { "" },
+                if s.slow_motion { "  slow motion" } else { "" }
+            );
+            text += &format!(
+                "reflect {:?}  samples {}\n",
+                self.state.reflection,
+                self.state.samples()
+            );
+            for (e, _) in &self.events {
+                text += e;
+                text.push('\n');
+            }
+        }
+        if self.state.help {
+            text += CONTROLS;
+        }
+        (!text.is_empty()).then_some(text)
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.gfx.is_some() {
+            return;
+        }
+        let s = self.job.settings();
+        let attrs = Window::default_attributes()
+            .with_title("bubbles view (H: help)")
+            .with_inner_size(PhysicalSize::new(s.width as u32, s.height as u32));
+        let gfx = event_loop
+            .create_window(attrs)
+            .map_err(|e| e.to_string())
+            .and_then(|window| {
+                let window = Rc::new(window);
+                let context =
+                    softbuffer::Context::new(window.clone()).map_err(|e| e.to_string())?;
+                let surface = softbuffer::Surface::new(&context, window.clone())
+                    .map_err(|e| e.to_string())?;
+                Ok(Gfx {
+                    window,
+                    surface,
+                    size: (0, 0),
+                })
+            });
+        match gfx {
+            Ok(gfx) => {
+                self.gfx = Some(gfx);
+                self.resize();
+            }
+            Err(e) => self.fail(
+                event_loop,
+                CliError::runtime(format!("cannot open a window: {e}")),
+            ),
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        match event {
+            WindowEvent::CloseRequested => self.input(event_loop, Input::Close),
+            WindowEvent::Resized(_) => self.resize(),
+            WindowEvent::RedrawRequested => {
+                if let Err(err) = self.redraw() {
+                    self.fail(event_loop, err);
+                }
+            }
+            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+                if let Some(key) = map_key(&event.logical_key) {
+                    self.input(event_loop, Input::Key(key));
+                }
+            }
+            WindowEvent::ModifiersChanged(m) => self.pointer.shift = m.state().shift_key(),
+            WindowEvent::MouseInput { state, button, .. } => {
+                self.mouse_button(event_loop, state, button)
+            }
+            WindowEvent::CursorMoved { position, .. } => self.cursor_moved(event_loop, position),
+            WindowEvent::MouseWheel { delta, .. } => {
+                let lines = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y,
+                    MouseScrollDelta::PixelDelta(p) => (p.y / 40.0) as f32,
+                };
+                self.input(event_loop, Input::Wheel { lines });
+            }
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, _: &ActiveEventLoop) {
+        if let Some(gfx) = &self.gfx {
+            gfx.window.request_redraw();
+        }
+    }
+}
+
+impl App {
+    fn resize(&mut self) {
+        let Some(gfx) = self.gfx.as_mut() else { return };
+        let size = gfx.window.inner_size();
+        let (Some(w), Some(h)) = (NonZeroU32::new(size.width), NonZeroU32::new(size.height)) else {
+            return;
+        };
+        if gfx.size != (size.width, size.height) && gfx.surface.resize(w, h).is_ok() {
+            gfx.size = (size.width, size.height);
+        }
+    }
+
+    fn mouse_button(
+        &mut self,
+        event_loop: &ActiveEventLoop,
+        state: ElementState,
+        button: MouseButton,
+    ) {
+        let pressed = state == ElementState::Pressed;
+        let p = &mut self.pointer;
+        match button {
+            MouseButton::Left => p.left = pressed,
+            MouseButton::Right => p.right = pressed,
+            _ => return,
+        }
+        if pressed {
+            p.pressed_at = p.at;
+            p.dragged = false;
+        } else if button == MouseButton::Left && !p.dragged {
+            let (x, y) = (p.at.x as f32, p.at.y as f32);
+            self.input(event_loop, Input::Click { x_px: x, y_px: y });
+        }
+    }
+
+    fn cursor_moved(&mut self, event_loop: &ActiveEventLoop, at: PhysicalPosition<f64>) {
+        let p = &mut self.pointer;
+        let (dx, dy) = (at.x - p.at.x, at.y - p.at.y);
+        p.at = at;
+        if !(p.left || p.right) {
+            return;
+        }
+        let travel = (at.x - p.pressed_at.x).hypot(at.y - p.pressed_at.y);
+        p.dragged |= travel >= CLICK_SLOP_PX;
+        if p.dragged {
+            let pan = p.right || p.shift;
+            self.input(
+                event_loop,
+                Input::Drag {
+                    dx_px: dx as f32,
+                    dy_px: dy as f32,
+                    pan,
+                },
+            );
+        }
+    }
+}
+
+fn map_key(key: &WKey) -> Option<Key> {
+    Some(match key {
+        WKey::Named(NamedKey::Escape) => Key::Escape,
+        WKey::Named(NamedKey::ArrowLeft) => Key::Left,
+        WKey::Named(NamedKey::ArrowRight) => Key::Right,
+        WKey::Named(NamedKey::ArrowUp) => Key::Up,
+        WKey::Named(NamedKey::ArrowDown) => Key::Down,
+        WKey::Named(NamedKey::Space) => Key::Space,
+        WKey::Character(c) => match c.as_str() {
+            "w" | "W" => Key::W,
+            "+" | "=" => Key::Plus,
+            "-" | "_" => Key::Minus,
+            " " => Key::Space,
+            "1" => Key::Digit(1),
+            "2" => Key::Digit(2),
+            "3" => Key::Digit(3),
+            "m" | "M" => Key::M,
+            "p" | "P" => Key::P,
+            "." => Key::Period,
+            "r" | "R" => Key::R,
+            "f" | "F" => Key::F,
+            "s" | "S" => Key::S,
+            "h" | "H" => Key::H,
+            _ => return None,
+        },
+        _ => return None,
+    })
+}
+
+/// Tone-maps linear radiance into 0RGB words, reusing `out`'s allocation.
+fn tone_map_into(out: &mut Vec<u32>, rgb: &[[f32; 3]], exposure_ev: f32, tonemap: raster::ToneMap) {
+    let scale = exposure_ev.exp2();
+    out.clear();
+    out.extend(rgb.iter().map(|px| {
+        let [r, g, b] = raster::tone_map(px.map(|c| c * scale), tonemap)
+            .map(|c| (raster::linear_to_srgb(c) * 255.0 + 0.5) as u32);
+        (r << 16) | (g << 8) | b
+    }));
+}
+
+/// Nearest-neighbour upscale of an `iw`×`ih` image into a `w`×`h` one.
+fn upscale(src: &[u32], iw: usize, ih: usize, dst: &mut [u32], w: usize, h: usize) {
+    for (y, row) in dst.chunks_exact_mut(w).take(h).enumerate() {
+        let sy = (y * ih / h).min(ih - 1);
+        let src_row = &src[sy * iw..(sy + 1) * iw];
+        for (x, px) in row.iter_mut().enumerate() {
+            *px = src_row[(x * iw / w).min(iw - 1)];
+        }
+    }
+}
+
+/// The first `bubbles-view-NNNN.png` in the working directory that does not exist yet.
+fn next_screenshot_path() -> PathBuf {
+    (1..)
+        .map(|n| PathBuf::from(format!("bubbles-view-{n:04}.png")))
+        .find(|p| !p.exists())
+        .expect("fewer than usize::MAX screenshots")
+}
