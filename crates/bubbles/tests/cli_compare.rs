@@ -1,15 +1,9 @@
 //! `bubbles compare` end to end, and `render --backend reference` on the furnace.
 
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn bubbles(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bubbles"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("bubbles runs")
-}
+mod common;
+use common::bubbles;
 
 fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()

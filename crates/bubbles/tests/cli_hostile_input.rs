@@ -3,15 +3,10 @@
 //! or flag and the value, or finishes within the limits of `bubbles --help`.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn bubbles(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bubbles"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("bubbles runs")
-}
+mod common;
+use common::bubbles;
 
 /// Asserts exit code 2 and that stderr holds every one of `needles`; returns stderr.
 fn refused(out: &Output, needles: &[&str]) -> String {

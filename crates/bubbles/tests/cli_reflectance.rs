@@ -1,27 +1,17 @@
 //! `bubbles reflectance` run as a process: values against the library, and every class of
 //! bad input rejected with exit code 2 and nothing on stdout.
 
-use std::io::Write;
-use std::process::{Command, Output, Stdio};
+use std::process::Output;
 
 use thinfilm::airy::ThinFilm;
 use thinfilm::dispersion::RefractiveIndex;
 
+mod common;
+
 const HEADER: &str = "thickness_nm,angle_deg,wavelength_nm,n_film,r_s,r_p,r,t";
 
 fn run(args: &[&str], stdin: &str) -> Output {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_bubbles"))
-        .arg("reflectance")
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn bubbles");
-    // The command may reject its options and exit before reading stdin; the broken
-    // pipe that then ends this write is expected, and the exit status tells the story.
-    let _ = child.stdin.take().unwrap().write_all(stdin.as_bytes());
-    child.wait_with_output().unwrap()
+    common::bubbles_piped(&[&["reflectance"], args].concat(), stdin)
 }
 
 fn stdout(output: &Output) -> String {

@@ -1,25 +1,16 @@
 //! `bubbles reflectance --stack` run as a process: multilayer and absorbing stacks against
 //! the library's single film, closed forms and R + T + A = 1, and bad stacks rejected.
 
-use std::io::Write;
-use std::process::{Command, Output, Stdio};
+use std::process::Output;
 
 use thinfilm::airy::ThinFilm;
 use thinfilm::dispersion::RefractiveIndex;
 use thinfilm::{Complex64, Incidence, Interface};
 
+mod common;
+
 fn run(args: &[&str], stdin: &str) -> Output {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_bubbles"))
-        .arg("reflectance")
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn bubbles");
-    // The command may exit before reading stdin; the exit status tells the story.
-    let _ = child.stdin.take().unwrap().write_all(stdin.as_bytes());
-    child.wait_with_output().unwrap()
+    common::bubbles_piped(&[&["reflectance"], args].concat(), stdin)
 }
 
 /// The header and the numeric rows of a successful run.

@@ -2,19 +2,10 @@
 //! (scene → solver → baked tables → renderer → file) and bad-input handling.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn bubbles(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bubbles"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("bubbles runs")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
+mod common;
+use common::{bubbles, stderr};
 
 fn rgb8(path: &Path) -> image::RgbImage {
     image::open(path).expect("output decodes").to_rgb8()

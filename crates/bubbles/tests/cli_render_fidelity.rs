@@ -3,19 +3,10 @@
 //! spectral colour of `bubbles color`.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn bubbles(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bubbles"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("bubbles runs")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
+mod common;
+use common::{bubbles, stderr};
 
 /// Renders `scene` (TOML text) at `size`² with one sample to EXR; returns the linear image.
 fn render_exr(scene: &str, size: u32, dir: &Path) -> image::Rgb32FImage {
