@@ -181,3 +181,47 @@ fn gpu_refuses_what_it_does_not_draw_naming_it() {
     let err = gpu.render(&scene, &tables, &s).unwrap_err();
     assert!(err.to_string().contains("samples"), "{err}");
 }
+
+/// A 5 × 3 table whose neighbouring texels differ strongly: a lookup that misses the texel
+/// centres (d = d_max·i/(W−1), cos θ = j/(H−1)) by half a texel changes the film's colour.
+fn coarse_tables() -> FilmTables {
+    let r = raster::Lut::try_from_fn(5, 3, 1000.0, |d, c| {
+        let i = (d / 250.0).round() as u32;
+        let j = (c * 2.0).round() as u32;
+        [
+            if (i + j) % 2 == 0 { 0.8 } else { 0.05 },
+            0.1 + 0.2 * i as f32,
+            0.4 * j as f32,
+        ]
+    })
+    .unwrap();
+    let t = raster::Lut::try_from_fn(5, 3, 1000.0, |_, _| [0.5; 3]).unwrap();
+    FilmTables {
+        reflectivity: r,
+        transmittance: Some(t),
+        lights: Vec::new(),
+    }
+}
+
+#[test]
+fn gpu_bubble_reads_the_lut_at_the_cpu_texel_centres() {
+    let Some(mut gpu) = gpu() else { return };
+    let camera = raster::Camera::look_at(Vec3::new(0.0, 0.0, 2.5), Vec3::ZERO, Vec3::Y, 40.0);
+    let mut scene = RenderScene::new(camera, Environment::Uniform([0.6, 0.7, 0.8]));
+    scene
+        .bubbles
+        .push(common::bubble(Vec3::ZERO, 0.6, 4, |n| 500.0 + 450.0 * n.y));
+    let tables = coarse_tables();
+    let s = settings(120, 120, 1, ReflectionMode::StaticEnvironment);
+    let cpu = Renderer::new()
+        .render(&scene, &tables, &s)
+        .unwrap()
+        .to_srgb8(s.exposure_ev, s.tonemap);
+    let gpu_bytes = gpu.render_srgb8(&scene, &tables, &s).unwrap();
+    let (mean, p99) = delta_e(&cpu, &gpu_bytes);
+    eprintln!("coarse LUT: mean ΔE2000 {mean:.3}, p99 {p99:.3}");
+    assert!(
+        mean <= 0.5 && p99 <= 2.0,
+        "coarse LUT: mean {mean}, p99 {p99}"
+    );
+}
