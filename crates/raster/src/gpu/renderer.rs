@@ -14,6 +14,12 @@ use crate::{
     BubbleMesh, FilmTables, Frame, FrameTimings, ReflectionMode, RenderScene, RenderSettings,
 };
 
+/// Size `(width, height, layers)` and sample count of a cached texture.
+type TextureKey = ((u32, u32, u32), u32);
+
+/// Makes a texture: device, label, size and layers, samples.
+type MakeTexture = fn(&wgpu::Device, &str, (u32, u32, u32), u32) -> wgpu::Texture;
+
 /// Bytes between two views in the view uniform buffer (the dynamic-offset alignment).
 const VIEW_STRIDE: u64 = 256;
 
@@ -28,8 +34,8 @@ pub struct GpuRenderer {
     layouts: Layouts,
     pipelines: Vec<Pipelines>,
     frame: Frame,
-    /// The last frame's resolved HDR texture, for the tone-map pass.
-    resolved: Option<wgpu::Texture>,
+    /// Render targets kept from frame to frame, by role, with their size and samples.
+    textures: Vec<(&'static str, TextureKey, wgpu::Texture)>,
 }
 
 /// The targets one view renders into.
@@ -49,7 +55,7 @@ impl GpuRenderer {
             layouts,
             pipelines: Vec::new(),
             frame: Frame::default(),
-            resolved: None,
+            textures: Vec::new(),
         })
     }
 
@@ -83,7 +89,6 @@ impl GpuRenderer {
             resolve_s: t.elapsed().as_secs_f64(),
             ..FrameTimings::default()
         };
-        self.resolved = Some(resolved);
         Ok(&self.frame)
     }
 
@@ -133,6 +138,19 @@ impl GpuRenderer {
                 )));
             }
         }
+        let m = face_size.map_or(1, |n| n as u32 + 2);
+        let layers = if face_size.is_some() {
+            6 * scene.bubbles.len().max(1) as u32
+        } else {
+            1
+        };
+        let samples = settings.samples;
+        let cubes = self.texture("cube faces", ((m, m, layers), 1), hdr_texture);
+        let face_depth = self.texture("face depth", ((m, m, 1), 1), depth_texture);
+        let resolved = self.texture("frame", ((w, h, 1), 1), hdr_texture);
+        let msaa =
+            (samples > 1).then(|| self.texture("frame samples", ((w, h, 1), samples), hdr_texture));
+        let depth = self.texture("depth", ((w, h, 1), samples), depth_texture);
         let mut views = vec![view];
         views.extend(&face_views);
         let view_buffer = self.view_buffer(scene, &views);
@@ -173,13 +191,6 @@ impl GpuRenderer {
             ],
         });
         let lut_texture = self.lut_texture(&data.luts);
-        let m = face_size.map_or(1, |n| n as u32 + 2);
-        let layers = if face_size.is_some() {
-            6 * scene.bubbles.len().max(1) as u32
-        } else {
-            1
-        };
-        let cubes = hdr_texture(device, "cube faces", (m, m, layers), 1);
         let bubble_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("bubble tables"),
             layout: &self.layouts.bubble,
@@ -204,8 +215,7 @@ impl GpuRenderer {
         });
         let mut encoder = device.create_command_encoder(&Default::default());
         let single = self.pipelines_for(1);
-        let face_depth =
-            depth_texture(&self.gpu.device, (m, m), 1).create_view(&Default::default());
+        let face_depth = face_depth.create_view(&Default::default());
         for (k, _) in face_views.iter().enumerate() {
             let layer = cubes.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2),
@@ -229,14 +239,10 @@ impl GpuRenderer {
                 data.object_vertices,
             );
         }
-        let samples = settings.samples;
         let main = self.pipelines_for(samples);
-        let device = &self.gpu.device;
-        let resolved = hdr_texture(device, "frame", (w, h, 1), 1);
         let resolved_view = resolved.create_view(&Default::default());
-        let msaa = (samples > 1).then(|| hdr_texture(device, "frame samples", (w, h, 1), samples));
         let msaa_view = msaa.as_ref().map(|t| t.create_view(&Default::default()));
-        let depth = depth_texture(device, (w, h), samples).create_view(&Default::default());
+        let depth = depth.create_view(&Default::default());
         let target = match &msaa_view {
             Some(v) => Target {
                 color: v,
@@ -274,6 +280,19 @@ impl GpuRenderer {
             depth_or_array_layers: 1,
         };
         Ok((encoder, resolved, size))
+    }
+
+    /// The texture of `role` with `key`, made on first use and when its key changes.
+    fn texture(&mut self, role: &'static str, key: TextureKey, make: MakeTexture) -> wgpu::Texture {
+        if let Some((_, k, t)) = self.textures.iter().find(|(r, ..)| *r == role) {
+            if *k == key {
+                return t.clone();
+            }
+        }
+        let texture = make(&self.gpu.device, role, key.0, key.1);
+        self.textures.retain(|(r, ..)| *r != role);
+        self.textures.push((role, key, texture.clone()));
+        texture
     }
 
     /// Index of the pipelines for `samples`, compiled on first use.
@@ -423,11 +442,12 @@ fn hdr_texture(
 
 fn depth_texture(
     device: &wgpu::Device,
-    (width, height): (u32, u32),
+    label: &str,
+    (width, height, _): (u32, u32, u32),
     samples: u32,
 ) -> wgpu::Texture {
     device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("depth"),
+        label: Some(label),
         size: wgpu::Extent3d {
             width,
             height,
