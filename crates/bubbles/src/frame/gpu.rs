@@ -22,6 +22,11 @@ impl GpuBackend {
             .map_err(|e| CliError::input(format!("--backend wgpu: {e}")))
     }
 
+    /// The adapter's name and driver.
+    pub fn adapter_name(&self) -> String {
+        self.0.gpu().adapter_name()
+    }
+
     /// Renders one frame on the GPU and reads it back.
     pub fn render(
         &mut self,
@@ -41,6 +46,11 @@ impl GpuBackend {
             "--backend wgpu: this bubbles was built without the wgpu backend; rebuild it with \
              `cargo build --release -p bubbles --features wgpu`, or use --backend cpu",
         ))
+    }
+
+    /// Unreachable: no value of this type exists.
+    pub fn adapter_name(&self) -> String {
+        match *self {}
     }
 
     /// Unreachable: no value of this type exists.

@@ -160,6 +160,15 @@ impl FrameJob {
         self.world.bubbles().len()
     }
 
+    /// The backend in use, for reports (`"wgpu on <adapter>"` for the GPU backend).
+    pub fn backend_name(&self) -> String {
+        match (&self.gpu, &self.film_spec) {
+            (Some(gpu), _) => format!("wgpu on {}", gpu.adapter_name()),
+            (None, Some(_)) => "reference".to_string(),
+            (None, None) => "cpu".to_string(),
+        }
+    }
+
     /// The render settings in force.
     pub fn settings(&self) -> &RenderSettings {
         &self.settings
