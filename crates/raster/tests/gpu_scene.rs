@@ -109,7 +109,7 @@ fn gpu_frame_matches_the_cpu_backend_in_ciede2000() {
             let gpu_bytes = gpu.render_srgb8(&scene, &tables, &s).unwrap();
             let (mean, p99) = delta_e(&cpu, &gpu_bytes);
             eprintln!("{reflection:?}, {samples} samples: mean ΔE2000 {mean:.3}, p99 {p99:.3}");
-            if mean > 5.0 || p99 > 20.0 {
+            if mean > 0.5 || p99 > 2.0 {
                 let dir = std::env::temp_dir();
                 let name = format!("gpu_scene_{}_{samples}", (mean * 1e6) as u64);
                 let diff: Vec<u8> = cpu

@@ -183,25 +183,48 @@ fn lit(m: Material, albedo: vec3<f32>, p: vec3<f32>, n_in: vec3<f32>, v: vec3<f3
     return out;
 }
 
-// shading.rs `filtered_checker`.
-fn filtered_checker(p: vec2<f32>, footprint: vec2<f32>) -> f32 {
-    let w = footprint + vec2<f32>(1e-3);
-    let lo = (p - 0.5 * w) * 0.5;
-    let hi = (p + 0.5 * w) * 0.5;
-    let tri_lo = abs(lo - floor(lo) - 0.5);
-    let tri_hi = abs(hi - floor(hi) - 0.5);
-    let i = 2.0 * (tri_lo - tri_hi) / w;
-    return 0.5 - 0.5 * i.x * i.y;
+// shading.rs `filtered_square`: the ±1 square wave of unit cells box-filtered over `w`.
+fn filtered_square(x: f32, footprint: f32) -> f32 {
+    let w = footprint + 1e-3;
+    let lo = (x - 0.5 * w) * 0.5;
+    let hi = (x + 0.5 * w) * 0.5;
+    return 2.0 * (abs(lo - floor(lo) - 0.5) - abs(hi - floor(hi) - 0.5)) / w;
 }
 
-// shading.rs `object_albedo` (solid and 3-D checker).
-fn object_albedo(m: Material, p: vec3<f32>) -> vec3<f32> {
-    if (m.specular.w == PATTERN_CHECKER) {
-        let cell = vec3<i32>(floor(p / m.a.w));
-        let parity = ((cell.x + cell.y + cell.z) % 2 + 2) % 2;
-        return select(m.b.xyz, m.a.xyz, parity == 0);
+// shading.rs `filtered_checker`.
+fn filtered_checker(p: vec2<f32>, footprint: vec2<f32>) -> f32 {
+    return 0.5 - 0.5 * filtered_square(p.x, footprint.x) * filtered_square(p.y, footprint.y);
+}
+
+// passes.rs `surface_footprint`: metres per axis one pixel covers on a surface with normal
+// `n` hit at depth `t` along view ray `d` (forward component 1).
+fn surface_footprint(d: vec3<f32>, t: f32, n: vec3<f32>) -> vec3<f32> {
+    let dn = dot(d, n);
+    let ddx = view.right.xyz * view.tan_half_per_px.z;
+    let ddy = -view.up.xyz * view.tan_half_per_px.w;
+    let dx = (ddx - d * (dot(ddx, n) / dn)) * t;
+    let dy = (ddy - d * (dot(ddy, n) / dn)) * t;
+    let f = abs(dx) + abs(dy);
+    return select(vec3<f32>(1e6), f, f < vec3<f32>(1e6));
+}
+
+// shading.rs `object_albedo` (solid, and the 3-D checker box-filtered over `footprint`).
+fn object_albedo(m: Material, p: vec3<f32>, footprint: vec3<f32>) -> vec3<f32> {
+    if (m.specular.w != PATTERN_CHECKER) {
+        return m.a.xyz;
     }
-    return m.a.xyz;
+    let q = p / m.a.w;
+    let f = min(footprint / m.a.w, vec3<f32>(1e6));
+    var i = 1.0;
+    for (var k = 0; k < 3; k++) {
+        let x = clamp(q[k], -1e6, 1e6);
+        if (f[k] < FLAT_FOOTPRINT_CELLS) {
+            i *= 1.0 - 2.0 * (floor(x) - 2.0 * floor(x * 0.5));
+        } else {
+            i *= filtered_square(x, f[k]);
+        }
+    }
+    return lerp3(m.a.xyz, m.b.xyz, 0.5 - 0.5 * i);
 }
 
 // ---- sky ---------------------------------------------------------------------------------
@@ -302,7 +325,11 @@ fn fs_object(in: ObjectOut) -> @location(0) vec4<f32> {
     let v = normalize_or(in.world - view.eye.xyz, view.forward.xyz);
     let n = normalize_or(in.normal, -v);
     let m = materials[in.tag];
-    return vec4<f32>(lit(m, object_albedo(m, in.world), in.world, n, v), 1.0);
+    // The view ray with forward component 1 and the depth along it, as the CPU's `d`, `t`.
+    let rel = in.world - view.eye.xyz;
+    let t = dot(rel, view.forward.xyz);
+    let footprint = surface_footprint(rel / t, t, n);
+    return vec4<f32>(lit(m, object_albedo(m, in.world, footprint), in.world, n, v), 1.0);
 }
 
 // ---- bubbles -----------------------------------------------------------------------------

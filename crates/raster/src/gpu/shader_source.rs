@@ -62,6 +62,7 @@ fn scene_constants() -> String {
         ("PI", std::f32::consts::PI),
         ("PATTERN_SOLID", PATTERN_SOLID),
         ("PATTERN_CHECKER", PATTERN_CHECKER),
+        ("FLAT_FOOTPRINT_CELLS", crate::shading::FLAT_FOOTPRINT_CELLS),
     ] {
         out += &format!("const {name}: f32 = {};\n", float(value));
     }
