@@ -164,6 +164,12 @@ impl Pipelines {
             step_mode: wgpu::VertexStepMode::Vertex,
             attributes: &object_attrs,
         })];
+        let ground_attrs = wgpu::vertex_attr_array![0 => Float32x3];
+        let ground = [Some(wgpu::VertexBufferLayout {
+            array_stride: 12,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &ground_attrs,
+        })];
         let bubble_attrs = wgpu::vertex_attr_array![
             0 => Float32x3, 1 => Float32x3, 2 => Float32, 3 => Float32, 4 => Uint32
         ];
@@ -236,7 +242,7 @@ impl Pipelines {
         Pipelines {
             samples,
             sky: opaque("sky", "vs_sky", "fs_sky", &[], Always),
-            ground: opaque("ground", "vs_ground", "fs_ground", &[], Greater),
+            ground: opaque("ground", "vs_ground", "fs_ground", &ground, Greater),
             objects: opaque("objects", "vs_object", "fs_object", &objects, Greater),
             transmit: film("bubble transmit", "fs_bubble_transmit", transmit_blend()),
             add: film("bubble add", "fs_bubble_add", add_blend()),

@@ -5,7 +5,7 @@ use std::time::Instant;
 use wgpu::util::DeviceExt;
 
 use super::pipelines::{DEPTH_FORMAT, HDR_FORMAT, Layouts, Pipelines};
-use super::scene_data::{SceneData, VIEW_BYTES, check_supported, view_bytes};
+use super::scene_data::{SceneData, VIEW_BYTES, check_supported, ground_triangles, view_bytes};
 use super::{Gpu, GpuError, GpuOptions};
 use crate::camera::View;
 use crate::cubemap::FACE_BASES;
@@ -153,7 +153,7 @@ impl GpuRenderer {
         let depth = self.texture("depth", ((w, h, 1), samples), depth_texture);
         let mut views = vec![view];
         views.extend(&face_views);
-        let view_buffer = self.view_buffer(scene, &views);
+        let (view_buffer, ground, ground_draws) = self.view_buffers(scene, &views);
         let device = &self.gpu.device;
         let buffer = |label, contents: &[u8], usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -232,9 +232,11 @@ impl GpuRenderer {
             let offset = (VIEW_STRIDE * (k as u64 + 1)) as u32;
             pass.set_bind_group(0, &view_group, &[offset]);
             pass.set_bind_group(1, &scene_group, &[]);
+            let ground = (&ground, ground_draws[k + 1].clone());
             draw_opaque(
                 &mut pass,
                 &self.pipelines[single],
+                ground,
                 objects.as_ref(),
                 data.object_vertices,
             );
@@ -260,7 +262,8 @@ impl GpuRenderer {
             let mut pass = begin(&mut encoder, &target);
             pass.set_bind_group(0, &view_group, &[0]);
             pass.set_bind_group(1, &scene_group, &[]);
-            draw_opaque(&mut pass, p, objects.as_ref(), data.all_vertices);
+            let ground = (&ground, ground_draws[0].clone());
+            draw_opaque(&mut pass, p, ground, objects.as_ref(), data.all_vertices);
             if let Some(bubbles) = &bubbles {
                 pass.set_bind_group(2, &bubble_group, &[]);
                 pass.set_vertex_buffer(0, bubbles.slice(..));
@@ -305,21 +308,42 @@ impl GpuRenderer {
         self.pipelines.len() - 1
     }
 
-    /// Every view's `View` uniform, `VIEW_STRIDE` bytes apart.
-    fn view_buffer(&self, scene: &RenderScene, views: &[View]) -> wgpu::Buffer {
+    /// Every view's `View` uniform, `VIEW_STRIDE` bytes apart; the ground triangles of
+    /// every view in one vertex buffer, and each view's vertex range in it.
+    fn view_buffers(
+        &self,
+        scene: &RenderScene,
+        views: &[View],
+    ) -> (wgpu::Buffer, wgpu::Buffer, Vec<std::ops::Range<u32>>) {
         let mut bytes = Vec::with_capacity(views.len() * VIEW_STRIDE as usize);
+        let mut ground_bytes: Vec<u8> = Vec::new();
+        let mut ranges = Vec::with_capacity(views.len());
         for v in views {
             let ground = scene.ground.as_ref().and_then(|g| GroundView::new(g, v));
             bytes.extend(view_bytes(v, ground.as_ref()));
             bytes.resize(bytes.len().next_multiple_of(VIEW_STRIDE as usize), 0);
+            let start = (ground_bytes.len() / 12) as u32;
+            for vertex in ground.map_or(Vec::new(), |g| ground_triangles(v, &g)) {
+                ground_bytes.extend(vertex.iter().flat_map(|x| x.to_le_bytes()));
+            }
+            ranges.push(start..(ground_bytes.len() / 12) as u32);
         }
-        self.gpu
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("views"),
-                contents: &bytes,
-                usage: wgpu::BufferUsages::UNIFORM,
-            })
+        // A vertex buffer may not be empty.
+        ground_bytes.resize(ground_bytes.len().max(12), 0);
+        let buffer = |label, contents: &[u8], usage| {
+            self.gpu
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage,
+                })
+        };
+        (
+            buffer("views", &bytes, wgpu::BufferUsages::UNIFORM),
+            buffer("ground", &ground_bytes, wgpu::BufferUsages::VERTEX),
+            ranges,
+        )
     }
 
     /// The stacked LUT tables as an Rgba32Float texture.
@@ -392,17 +416,21 @@ fn begin<'e>(encoder: &'e mut wgpu::CommandEncoder, target: &Target<'_>) -> wgpu
     })
 }
 
-/// Sky, ground, then the first `vertices` object vertices.
+/// Sky, the view's ground triangles, then the first `vertices` object vertices.
 fn draw_opaque(
     pass: &mut wgpu::RenderPass<'_>,
     p: &Pipelines,
+    (ground, ground_range): (&wgpu::Buffer, std::ops::Range<u32>),
     objects: Option<&wgpu::Buffer>,
     vertices: u32,
 ) {
     pass.set_pipeline(&p.sky);
     pass.draw(0..3, 0..1);
-    pass.set_pipeline(&p.ground);
-    pass.draw(0..3, 0..1);
+    if !ground_range.is_empty() {
+        pass.set_pipeline(&p.ground);
+        pass.set_vertex_buffer(0, ground.slice(..));
+        pass.draw(ground_range, 0..1);
+    }
     if let (Some(objects), true) = (objects, vertices > 0) {
         pass.set_pipeline(&p.objects);
         pass.set_vertex_buffer(0, objects.slice(..));

@@ -262,15 +262,12 @@ fn ground_inv_depth(pix: vec2<f32>) -> f32 {
     return view.ground.x + view.ground.y * pix.x + view.ground.z * pix.y;
 }
 
-// The plane's inverse depth is affine in pixel space, so one full-screen triangle with
-// w = 1 carries it exactly; the clipper cuts it at z = 0 (the horizon) per sample.
+// The plane's visible polygon, clipped on the CPU (`scene_data::ground_triangles`) to
+// where its inverse depth is positive, with depth near/t at each vertex: depth is affine in
+// pixel space, so the rasteriser interpolates it exactly.
 @vertex
-fn vs_ground(@builtin(vertex_index) k: u32) -> FullScreen {
-    let ndc = full_screen_corner(k);
-    let pix = pixel_of_ndc(ndc);
-    let z = view.size_near.z * ground_inv_depth(pix);
-    let on = view.ground_ddy.w > 0.0;
-    return FullScreen(select(vec4<f32>(0.0), vec4<f32>(ndc, z, 1.0), on), pix);
+fn vs_ground(@location(0) ndc_depth: vec3<f32>) -> FullScreen {
+    return FullScreen(vec4<f32>(ndc_depth, 1.0), pixel_of_ndc(ndc_depth.xy));
 }
 
 @fragment

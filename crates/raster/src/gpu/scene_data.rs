@@ -83,6 +83,46 @@ pub(super) fn view_bytes(view: &View, ground: Option<&GroundView<'_>>) -> Vec<u8
     b.0
 }
 
+/// The ground plane's visible part of `view` as a triangle list of `(ndc x, ndc y, depth)`:
+/// the screen rectangle clipped, in pixel space, to where the plane's inverse depth `1/t`
+/// lies in `(0, 1/near]` (the CPU's per-sample test `1/t > 0`), with depth `near/t`.
+///
+/// Clipping here rather than by the GPU's depth clip gives every internal edge of the
+/// polygon the same two vertices in both triangles, so coverage stays watertight.
+pub(super) fn ground_triangles(view: &View, g: &GroundView<'_>) -> Vec<[f32; 3]> {
+    let (w, h) = (view.width as f32, view.height as f32);
+    let inv_depth = |p: [f32; 2]| g.inv_depth(p[0], p[1]);
+    let mut poly = vec![[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]];
+    poly = clip(&poly, inv_depth);
+    poly = clip(&poly, |p| 1.0 / view.near_m - inv_depth(p));
+    let vertex = |p: [f32; 2]| {
+        let z = (view.near_m * inv_depth(p)).clamp(0.0, 1.0);
+        [2.0 * p[0] / w - 1.0, 1.0 - 2.0 * p[1] / h, z]
+    };
+    let mut out = Vec::new();
+    for k in 1..poly.len().saturating_sub(1) {
+        out.extend([vertex(poly[0]), vertex(poly[k]), vertex(poly[k + 1])]);
+    }
+    out
+}
+
+/// The convex polygon `poly` cut to where the affine `f` is ≥ 0 (Sutherland–Hodgman).
+fn clip(poly: &[[f32; 2]], f: impl Fn([f32; 2]) -> f32) -> Vec<[f32; 2]> {
+    let mut out = Vec::with_capacity(poly.len() + 1);
+    for (k, &a) in poly.iter().enumerate() {
+        let b = poly[(k + 1) % poly.len()];
+        let (fa, fb) = (f(a), f(b));
+        if fa >= 0.0 {
+            out.push(a);
+        }
+        if (fa >= 0.0) != (fb >= 0.0) {
+            let t = fa / (fa - fb);
+            out.push([a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t]);
+        }
+    }
+    out
+}
+
 /// Everything of a frame that the shaders read, packed.
 #[derive(Debug, Default)]
 pub(super) struct SceneData {
