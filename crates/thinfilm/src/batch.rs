@@ -218,7 +218,11 @@ pub fn try_weighted_cell_row(
             });
         }
     }
-    let half_weights: Vec<[f32; 3]> = spectrum.weights.iter().map(|w| w.map(|x| 0.5 * x)).collect();
+    let half_weights: Vec<[f32; 3]> = spectrum
+        .weights
+        .iter()
+        .map(|w| w.map(|x| 0.5 * x))
+        .collect();
     let row = cells::CellRow {
         edge_q: &edge_q,
         cells: &row_cells,
@@ -259,7 +263,12 @@ fn cell_terms(
     };
     let mut edge_q = Vec::with_capacity(k + 1);
     let mut q = Vec::with_capacity(k + 1);
-    for (i, (&wavelength_nm, &n)) in spectrum.edge_nm.iter().zip(spectrum.n_film_edge).enumerate() {
+    for (i, (&wavelength_nm, &n)) in spectrum
+        .edge_nm
+        .iter()
+        .zip(spectrum.n_film_edge)
+        .enumerate()
+    {
         fresnel::check_wavelength(wavelength_nm)?;
         if i > 0 && wavelength_nm <= spectrum.edge_nm[i - 1] {
             return Err(OpticsError::NotFinite {
@@ -273,7 +282,12 @@ fn cell_terms(
         edge_q.push(term::Split::of_f64(rate));
     }
     let mut row_cells = Vec::with_capacity(k);
-    for (c, (&n, w)) in spectrum.n_film_cell.iter().zip(spectrum.weights).enumerate() {
+    for (c, (&n, w)) in spectrum
+        .n_film_cell
+        .iter()
+        .zip(spectrum.weights)
+        .enumerate()
+    {
         if let Some(bad) = w.iter().find(|x| !x.is_finite()) {
             return Err(not_finite("weights", c, *bad));
         }

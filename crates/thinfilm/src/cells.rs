@@ -264,7 +264,11 @@ impl SpectralIntegrator {
 fn cells_xyz(cells: &CellWeights, film: &ThinFilm, cos_theta_outside: f64) -> [f64; 3] {
     let mut xyz = [0.0; 3];
     for (c, w) in cells.weights.iter().enumerate() {
-        let cell = [cells.edges_nm[c], cells.centres_nm[c], cells.edges_nm[c + 1]];
+        let cell = [
+            cells.edges_nm[c],
+            cells.centres_nm[c],
+            cells.edges_nm[c + 1],
+        ];
         let r = cell_mean_reflectance(
             film.n_outside,
             &film.n_film,

@@ -78,7 +78,9 @@ fn truth_xyz(
 #[ignore]
 fn calibrate_steps() {
     let d65 = Illuminant::D65.spectrum();
-    let angles = [0.0, 60.0, 70.0, 75.0, 78.0, 80.0, 83.0, 85.0, 87.0, 88.0, 89.0, 89.5, 89.9f64];
+    let angles = [
+        0.0, 60.0, 70.0, 75.0, 78.0, 80.0, 83.0, 85.0, 87.0, 88.0, 89.0, 89.5, 89.9f64,
+    ];
     let steps = [8.0, 5.0];
     for &angle in &angles {
         let cos = angle.to_radians().cos();

@@ -23,7 +23,7 @@ const COS_PI: [f32; 7] = [
     4.058_712_3,
     -1.335_262_8,
     0.235_330_63,
-    -0.025_806_891,
+    -0.025_806_89,
     0.001_929_574_3,
 ];
 
@@ -222,7 +222,10 @@ mod tests {
             let exact = (y as f64).atan2(x as f64);
             atan = atan.max((atan2(y, x) as f64 - exact).abs());
         }
-        assert!(sin < 3e-7 && cos < 3e-7, "sin off by {sin:e}, cos by {cos:e}");
+        assert!(
+            sin < 3e-7 && cos < 3e-7,
+            "sin off by {sin:e}, cos by {cos:e}"
+        );
         assert!(atan < 5e-7, "atan2 off by {atan:e}");
     }
 }
