@@ -24,6 +24,8 @@ use num_complex::Complex64;
 
 use crate::airy::ThinFilm;
 use crate::dispersion::RefractiveIndex;
+use crate::fresnel::Response;
+use crate::incidence::Incidence;
 use crate::integrate::SpectralIntegrator;
 
 /// Cells are used once the film's sharpest feature, the half-width of its s-polarised
@@ -229,9 +231,20 @@ impl SpectralIntegrator {
     /// # Panics
     /// Where [`ThinFilm::response`] panics.
     pub fn film_xyz(&self, film: &ThinFilm, cos_theta_outside: f64) -> [f64; 3] {
-        match self.cell_use(film, cos_theta_outside) {
-            Some(cells) => cells_xyz(cells, film, cos_theta_outside),
-            None => self.xyz(|w| film.response(w, cos_theta_outside).r()),
+        let incidence =
+            Incidence::try_from_cos(cos_theta_outside).unwrap_or_else(|err| panic!("{err}"));
+        self.film_xyz_at(film, incidence)
+    }
+
+    /// [`SpectralIntegrator::film_xyz`] in the direction `incidence` (given by its angle or
+    /// sin θ, the point samples stay exact however near grazing).
+    ///
+    /// # Panics
+    /// Where [`ThinFilm::try_response_at`] fails.
+    pub fn film_xyz_at(&self, film: &ThinFilm, incidence: Incidence) -> [f64; 3] {
+        match self.cell_use(film, incidence.cos()) {
+            Some(cells) => cells_xyz(cells, film, incidence.cos()),
+            None => self.xyz(|w| response_at(film, w, incidence).r()),
         }
     }
 
@@ -259,6 +272,11 @@ impl SpectralIntegrator {
         let threshold = cell_threshold_nm(cells, film.n_outside, &film.n_film, cos_theta_outside);
         (symmetric && threshold.is_some_and(|t| film.thickness_nm >= t)).then_some(cells)
     }
+}
+
+fn response_at(film: &ThinFilm, wavelength_nm: f64, incidence: Incidence) -> Response {
+    film.try_response_at(wavelength_nm, incidence)
+        .unwrap_or_else(|err| panic!("{err}"))
 }
 
 fn cells_xyz(cells: &CellWeights, film: &ThinFilm, cos_theta_outside: f64) -> [f64; 3] {
