@@ -128,7 +128,7 @@ impl CellWeights {
 
 /// The thickness (nm) from which cell means are used for the symmetric film
 /// `n_outside | n_film | n_outside` seen at `cos_theta_outside`; `None` where they never
-/// are (no cells, normal-ish incidence is handled by any film thinner than the result).
+/// are. Thinner films are point-sampled.
 ///
 /// Cells are used for `d >= threshold`, where the threshold is the larger of
 /// * the thickness at which the s-polarised lines' half-width at the shortest cell
