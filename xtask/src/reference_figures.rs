@@ -20,7 +20,7 @@ struct Variant {
 /// Pairs compared besides "every variant against the reference": (image, against).
 const PAIRS: [(&str, &str); 1] = [("ref-centre", "ref-no-films")];
 
-const VARIANTS: [Variant; 12] = [
+const VARIANTS: [Variant; 14] = [
     Variant {
         name: "reference",
         flags: &["--backend", "reference"],
@@ -60,6 +60,26 @@ const VARIANTS: [Variant; 12] = [
         name: "cpu-16spp",
         flags: &["--samples", "16"],
         what: "CPU backend, 16 samples per pixel",
+    },
+    Variant {
+        name: "cpu-lut256x64",
+        flags: &[
+            "--lut-thickness-samples",
+            "256",
+            "--lut-angle-samples",
+            "64",
+        ],
+        what: "CPU backend, film tables of 256 x 64 instead of 4096 x 128",
+    },
+    Variant {
+        name: "cpu-lut1024x32",
+        flags: &[
+            "--lut-thickness-samples",
+            "1024",
+            "--lut-angle-samples",
+            "32",
+        ],
+        what: "CPU backend, film tables of 1024 x 32",
     },
     Variant {
         name: "cpu-static",

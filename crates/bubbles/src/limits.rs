@@ -21,6 +21,13 @@ pub const MAX_BENCH_FRAMES: u32 = 100_000;
 /// Largest dynamic cube-map face, in texels (`--cube-map-size`, `[render] cube_map_size`).
 pub const MAX_CUBE_MAP_SIZE: usize = 1024;
 
+/// Film-table columns over thickness (`--lut-thickness-samples`,
+/// `[render] lut_thickness_samples`): `lut`'s largest side.
+pub const MAX_LUT_THICKNESS_SAMPLES: usize = lut::MAX_SIDE;
+
+/// Film-table rows over cos θ (`--lut-angle-samples`, `[render] lut_angle_samples`).
+pub const MAX_LUT_ANGLE_SAMPLES: usize = 1024;
+
 /// Largest icosphere subdivision level of a bubble (6 gives 40 962 vertices).
 pub const MAX_SUBDIVISIONS: u32 = 6;
 
@@ -54,6 +61,8 @@ pub const HELP: &str = "Limits (a larger request is refused with exit code 2):
   OBJ frames per simulate --export-obj        10000
   bench --frames                              100000
   cube_map_size / --cube-map-size             1..=1024 texels
+  lut_thickness_samples / --lut-thickness-samples  2..=16384 columns
+  lut_angle_samples / --lut-angle-samples     2..=1024 rows
   bubble subdivisions                         0..=6
   --width, --height, bench --size             1..=16384 pixels
   bubbles per scene                           1000 (1000000 vertices in all)
@@ -68,6 +77,11 @@ pub const HELP: &str = "Limits (a larger request is refused with exit code 2):
 pub fn cube_map_bytes(face_size: usize) -> u64 {
     let side = face_size as u64 + 2;
     raster::CubeMap::stored_texels(face_size) as u64 * 12 + 6 * side * side * 8
+}
+
+/// Bytes of the baked film tables: `tables` RGB f32 tables of `width × height` texels.
+pub fn lut_bytes(width: usize, height: usize, tables: usize) -> u64 {
+    width as u64 * height as u64 * 12 * tables as u64
 }
 
 /// Bytes of the frame buffers for `width × height` at `samples` per pixel (HDR colour
@@ -93,6 +107,8 @@ mod tests {
             MAX_OBJ_FRAMES,
             u64::from(MAX_BENCH_FRAMES),
             MAX_CUBE_MAP_SIZE as u64,
+            MAX_LUT_THICKNESS_SAMPLES as u64,
+            MAX_LUT_ANGLE_SAMPLES as u64,
             MAX_IMAGE_SIDE as u64,
             MAX_BUBBLES as u64,
             MAX_BUBBLE_VERTICES as u64,

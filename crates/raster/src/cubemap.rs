@@ -160,8 +160,9 @@ impl CubeMap {
 
     /// Seamless filtered lookup along `dir` for a pixel over which the direction changes
     /// by `derivatives` (per pixel along x and y): trilinear taps spread along the longer
-    /// derivative ([`crate::lod::anisotropic_taps`]), each at the level
-    /// [`crate::lod::cube_lod`] gives, clamped to the chain.
+    /// derivative ([`crate::lod::anisotropic_taps`]), all at the level
+    /// [`crate::lod::cube_lod`] gives at `dir`, clamped to the chain. A footprint within
+    /// level 0 reads one bilinear tap, as [`CubeMap::sample`].
     #[inline]
     pub fn sample_footprint(&self, dir: Vec3, derivatives: [Vec3; 2]) -> [f32; 3] {
         let [a, b] = derivatives;
@@ -170,15 +171,23 @@ impl CubeMap {
         } else {
             (b, a)
         };
-        let scale = dir.length();
-        let (taps, footprint) = anisotropic_taps(major.length(), minor.length());
-        if taps == 1 {
-            return self.sample_trilinear(dir, footprint);
+        let (face, s, t) = face_coordinates(dir);
+        let major_rad = major.length();
+        let n = self.face_size();
+        if cube_lod(major_rad, n, s, t) <= 0.0 {
+            return self.levels[0].bilinear(face, s, t);
         }
+        let (taps, footprint_rad) = anisotropic_taps(major_rad, minor.length());
+        let lod = cube_lod(footprint_rad, n, s, t).min((self.levels.len() - 1) as f32);
+        if taps == 1 {
+            return self.trilinear(face, s, t, lod);
+        }
+        let step = major * dir.length();
         let mut sum = [0.0f32; 3];
         for i in 0..taps {
             let offset = (i as f32 + 0.5) / taps as f32 - 0.5;
-            let c = self.sample_trilinear(dir + major * (offset * scale), footprint);
+            let (face, s, t) = face_coordinates(dir + step * offset);
+            let c = self.trilinear(face, s, t, lod);
             for k in 0..3 {
                 sum[k] += c[k];
             }
@@ -186,17 +195,15 @@ impl CubeMap {
         sum.map(|c| c / taps as f32)
     }
 
-    /// Seamless trilinear lookup along `dir`, filtered over `footprint_rad`.
+    /// Seamless trilinear tap at face coordinates `(s, t)` and level `lod` in
+    /// `[0, levels − 1]`.
     #[inline]
-    fn sample_trilinear(&self, dir: Vec3, footprint_rad: f32) -> [f32; 3] {
-        let (face, s, t) = face_coordinates(dir);
-        let last = self.levels.len() - 1;
-        let lod = cube_lod(footprint_rad, self.face_size(), s, t).min(last as f32);
+    fn trilinear(&self, face: usize, s: f32, t: f32, lod: f32) -> [f32; 3] {
         // lod is in [0, last]: the conversion is exact.
         let l0 = lod as usize;
         let frac = lod - l0 as f32;
         let a = self.levels[l0].bilinear(face, s, t);
-        if frac <= 0.0 || l0 == last {
+        if frac <= 0.0 || l0 + 1 == self.levels.len() {
             return a;
         }
         let b = self.levels[l0 + 1].bilinear(face, s, t);
@@ -316,8 +323,24 @@ impl Level {
     /// Interior texels as area averages of `above`'s interior (exact 2 × 2 boxes when its
     /// size is even; an odd size spreads each edge texel over two outputs by its overlap).
     fn downsample_from(&mut self, above: &Level) {
-        let weights = box_weights(above.face_size, self.face_size);
         let (m_src, m) = (above.face_size + 2, self.face_size + 2);
+        if above.face_size == 2 * self.face_size {
+            // Exact 2 × 2 boxes: the common case, without the general weights.
+            for f in 0..6 {
+                let (src, dst) = (above.face_offset(f), self.face_offset(f));
+                for y in 0..self.face_size {
+                    let row = src + (2 * y + 1) * m_src + 1;
+                    for x in 0..self.face_size {
+                        let i = row + 2 * x;
+                        let q = [i, i + 1, i + m_src, i + m_src + 1].map(|j| above.texels[j]);
+                        self.texels[dst + (y + 1) * m + x + 1] =
+                            std::array::from_fn(|k| (q[0][k] + q[1][k] + q[2][k] + q[3][k]) * 0.25);
+                    }
+                }
+            }
+            return;
+        }
+        let weights = box_weights(above.face_size, self.face_size);
         for f in 0..6 {
             let (src, dst) = (above.face_offset(f), self.face_offset(f));
             for (y, wy) in weights.iter().enumerate() {

@@ -40,11 +40,11 @@ pub(crate) fn cube_lod(footprint_rad: f32, face_size: usize, s: f32, t: f32) -> 
 }
 
 /// Most taps one lookup spreads along the footprint's long axis (a GPU's anisotropy clamp).
-pub(crate) const MAX_ANISOTROPY: usize = 16;
+pub(crate) const MAX_ANISOTROPY: usize = 8;
 
-/// How one footprint-filtered lookup is made: `taps` trilinear taps spaced evenly along
-/// the longer of the two per-pixel derivatives, each filtered over `footprint_rad`
-/// (the longer derivative over `taps`, but never less than the shorter one).
+/// How one footprint-filtered lookup is made: `taps` (the axis ratio, rounded) trilinear
+/// taps spaced evenly along the longer of the two per-pixel derivatives, each filtered
+/// over `footprint_rad` (the longer derivative over `taps`, never less than the shorter).
 ///
 /// An isotropic filter as wide as the longer derivative would blur a bubble's rim along
 /// the silhouette as much as across it (there they differ tenfold); spreading taps along
@@ -52,8 +52,9 @@ pub(crate) const MAX_ANISOTROPY: usize = 16;
 #[inline]
 pub(crate) fn anisotropic_taps(major_rad: f32, minor_rad: f32) -> (usize, f32) {
     let ratio = major_rad / minor_rad.max(1e-12);
-    // NaN or ≤ 1 → one tap; the float-to-int conversion saturates.
-    let taps = (ratio.ceil() as usize).clamp(1, MAX_ANISOTROPY);
+    // Rounded: below 1.5 one tap (isotropic, as wide as the longer axis). NaN → one tap;
+    // the float-to-int conversion saturates.
+    let taps = ((ratio + 0.5) as usize).clamp(1, MAX_ANISOTROPY);
     (taps, (major_rad / taps as f32).max(minor_rad))
 }
 
@@ -157,6 +158,7 @@ mod tests {
     #[test]
     fn anisotropic_taps_cover_the_long_axis_at_the_short_axis_width() {
         assert_eq!(anisotropic_taps(0.01, 0.01), (1, 0.01));
+        assert_eq!(anisotropic_taps(0.014, 0.01), (1, 0.014));
         assert_eq!(anisotropic_taps(0.0, 0.0), (1, 0.0));
         // 4:1 → four taps, each as wide as the short axis.
         assert_eq!(anisotropic_taps(0.4, 0.1), (4, 0.1));

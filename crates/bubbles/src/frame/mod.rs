@@ -41,6 +41,12 @@ pub struct Options {
     /// Face size of the dynamic cube maps, 1..=1024 texels (default: the scene's, else 128).
     #[arg(long)]
     pub cube_map_size: Option<usize>,
+    /// Film-table columns over thickness, 2..=16384 (default: the scene's, else 4096).
+    #[arg(long)]
+    pub lut_thickness_samples: Option<usize>,
+    /// Film-table rows over cos θ, 2..=1024 (default: the scene's, else 128).
+    #[arg(long)]
+    pub lut_angle_samples: Option<usize>,
     /// Exposure multiplier applied before tone mapping (default: the scene's, else 1).
     #[arg(long)]
     pub exposure: Option<f64>,
@@ -119,7 +125,8 @@ impl FrameJob {
     pub fn from_scene(scene: Scene, options: &Options) -> Result<Self, CliError> {
         scene.check_limits()?;
         let world = scene.dynamics_world()?;
-        let luts = scene.bake_tables()?;
+        let (width, height) = lut_size(&scene, options)?;
+        let luts = scene.bake_tables(width, height)?;
         let mut render_scene = scene.render_scene()?;
         render_scene.lights = scene.raster_lights(&luts)?;
         let settings = settings(&scene, &render_scene, options)?;
@@ -381,6 +388,46 @@ fn cube_map_size(o: &Options, r: &RenderSpec) -> Result<usize, CliError> {
         ))),
         None => Ok(r.cube_map_size.map_or(128, |s| s.get() as usize)),
     }
+}
+
+/// The film tables' size: each side from its flag, else `[render]`, else `lut`'s default;
+/// refused when the tables (one per distinct light spectrum, plus the reflectivity) would
+/// pass the memory limit.
+fn lut_size(scene: &Scene, o: &Options) -> Result<(usize, usize), CliError> {
+    let r = &scene.file.render;
+    let side = |flag: Option<usize>, name: &str, max: usize, key: Option<u32>, default: usize| {
+        match flag {
+            Some(v) if (2..=max).contains(&v) => Ok(v),
+            Some(v) => Err(CliError::input(format!(
+                "--{name} {v} is outside 2..={max} (see --help)"
+            ))),
+            None => Ok(key.map_or(default, |k| k as usize)),
+        }
+    };
+    let width = side(
+        o.lut_thickness_samples,
+        "lut-thickness-samples",
+        limits::MAX_LUT_THICKNESS_SAMPLES,
+        r.lut_thickness_samples.map(|c| c.get()),
+        lut::config::DEFAULT_WIDTH,
+    )?;
+    let height = side(
+        o.lut_angle_samples,
+        "lut-angle-samples",
+        limits::MAX_LUT_ANGLE_SAMPLES,
+        r.lut_angle_samples.map(|c| c.get()),
+        lut::config::DEFAULT_HEIGHT,
+    )?;
+    let tables = 1 + scene.file.lights.len();
+    let bytes = limits::lut_bytes(width, height, tables);
+    if bytes > limits::MEMORY_BUDGET_BYTES {
+        return Err(CliError::input(format!(
+            "{tables} film tables of {width}x{height} (lut_thickness_samples x lut_angle_samples) need {:.2} GiB, above the {} GiB limit (see --help)",
+            bytes as f64 / f64::from(1u32 << 30),
+            limits::MEMORY_BUDGET_BYTES >> 30
+        )));
+    }
+    Ok((width, height))
 }
 
 /// Samples per pixel from `--samples`, else `[render] samples`, else 4.

@@ -36,8 +36,13 @@ impl Scene {
         }
     }
 
-    /// The bake configuration for this scene's film and lights.
+    /// The bake configuration for this scene's film and lights, at the default table size.
     pub fn bake_config(&self) -> Result<BakeConfig, CliError> {
+        self.bake_config_sized(lut::config::DEFAULT_WIDTH, lut::config::DEFAULT_HEIGHT)
+    }
+
+    /// The bake configuration with tables of `width` thickness columns × `height` cos θ rows.
+    pub fn bake_config_sized(&self, width: usize, height: usize) -> Result<BakeConfig, CliError> {
         let film = &self.file.film;
         let index = match film.dispersion.as_str() {
             "none" => RefractiveIndex::Constant(film.n_film.get()),
@@ -51,6 +56,7 @@ impl Scene {
         };
         let reference = self.lut_light(&film.illuminant)?;
         BakeConfig::builder()
+            .resolution(width, height)
             .film_index(index)
             .reference(reference)
             .lights(self.lut_lights()?)
@@ -58,9 +64,9 @@ impl Scene {
             .map_err(|e| CliError::input(format!("{}: {e}", self.origin)))
     }
 
-    /// Bakes the film tables for this scene.
-    pub fn bake_tables(&self) -> Result<LutSet, CliError> {
-        Ok(lut::bake(&self.bake_config()?))
+    /// Bakes the film tables for this scene, `width × height` texels each.
+    pub fn bake_tables(&self, width: usize, height: usize) -> Result<LutSet, CliError> {
+        Ok(lut::bake(&self.bake_config_sized(width, height)?))
     }
 
     /// The renderer's lights: radiance is the spectrum's colour at the given luminance,

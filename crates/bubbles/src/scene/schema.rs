@@ -6,9 +6,10 @@
 use super::values::{
     Acceleration, Bounds, BubbleRadius, Coordinate, Count, CubeMapSize, Damping, Direction,
     Elasticity, Evaporation, Exposure, FieldOfView, FilmIndex, FilmThickness, GustSpeed,
-    InitialScale, Intensity, LightRadius, Luminance, MeshScale, MolarMass, Num, Num3, ObjectRadius,
-    PatternScale, Radiance, Reflectance, RuptureThickness, Samples, Seconds, Shininess, SloshSpeed,
-    Speed, Subdivisions, SurfaceTension, TimeStep, Variation, Viscosity,
+    InitialScale, Intensity, LightRadius, Luminance, LutAngleSamples, LutThicknessSamples,
+    MeshScale, MolarMass, Num, Num3, ObjectRadius, PatternScale, Radiance, Reflectance,
+    RuptureThickness, Samples, Seconds, Shininess, SloshSpeed, Speed, Subdivisions, SurfaceTension,
+    TimeStep, Variation, Viscosity,
 };
 use serde::Deserialize;
 
@@ -436,4 +437,10 @@ pub struct RenderSpec {
     /// Anti-aliasing samples per pixel.
     #[serde(default)]
     pub samples: Option<Count<Samples>>,
+    /// Film-table columns over thickness (default 4096).
+    #[serde(default)]
+    pub lut_thickness_samples: Option<Count<LutThicknessSamples>>,
+    /// Film-table rows over cos θ (default 128).
+    #[serde(default)]
+    pub lut_angle_samples: Option<Count<LutAngleSamples>>,
 }

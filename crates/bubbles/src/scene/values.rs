@@ -277,6 +277,10 @@ bounds! {
     Exposure: 1e-6, 1e6, "";
     /// Cube-map face size.
     CubeMapSize: 1.0, crate::limits::MAX_CUBE_MAP_SIZE as f64, "texels";
+    /// Film-table columns over thickness.
+    LutThicknessSamples: 2.0, crate::limits::MAX_LUT_THICKNESS_SAMPLES as f64, "columns";
+    /// Film-table rows over cos θ.
+    LutAngleSamples: 2.0, crate::limits::MAX_LUT_ANGLE_SAMPLES as f64, "rows";
     /// Anti-aliasing samples (1, 4, 8, 9 or 16; the set is checked later).
     Samples: 1.0, 16.0, "";
 }
