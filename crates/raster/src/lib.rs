@@ -40,6 +40,8 @@ mod settings;
 mod shading;
 mod spheremap;
 mod texture;
+mod water;
+mod water_pass;
 
 pub use camera::{Camera, DEFAULT_NEAR_M};
 pub use cubemap::{CubeMap, MAX_FACE_SIZE};
@@ -55,3 +57,4 @@ pub use scene::{BubbleMesh, FilmTables, Ground, Light, Material, Object, Pattern
 pub use settings::{MAX_IMAGE_SIDE, ReflectionMode, RenderSettings, SAMPLE_COUNTS, ToneMap};
 pub use spheremap::SphereMap;
 pub use texture::Texture;
+pub use water::{WATER_IOR, WaterSurface, refract, sphere_map_direction, sphere_map_uv};
