@@ -8,7 +8,8 @@ use bubble_dynamics::{
 };
 
 impl Scene {
-    /// Builds the solver's world: the bubbles, the ground and box/sphere objects as colliders.
+    /// Builds the solver's world: the bubbles, the ground, box/sphere objects and the
+    /// water's rest plane as colliders.
     pub fn dynamics_world(&self) -> Result<World, CliError> {
         let bubbles = self.file.bubbles.iter().map(bubble_params).collect();
         World::try_new(self.world_params()?, bubbles).map_err(|e| {
@@ -28,7 +29,12 @@ impl Scene {
             };
             Some(format!("[[objects]] #{} ({kind})", i + 1))
         });
-        ground.chain(objects).collect()
+        let water = self
+            .file
+            .water
+            .iter()
+            .map(|_| "the water's rest plane".to_string());
+        ground.chain(objects).chain(water).collect()
     }
 
     fn world_params(&self) -> Result<WorldParams, CliError> {
@@ -83,7 +89,14 @@ impl Scene {
             // Meshes are drawn but do not collide: the solver has no mesh collider.
             ObjectSpec::Mesh { .. } => None,
         });
-        ground.chain(objects).collect()
+        // Bubbles bounce on the water's rest plane, everywhere (the solver's planes are
+        // infinite): a wave's height is not felt.
+        let water = self
+            .file
+            .water
+            .iter()
+            .map(|w| Collider::ground(w.rest_height_m.get()));
+        ground.chain(objects).chain(water).collect()
     }
 }
 
