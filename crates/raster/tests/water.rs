@@ -3,9 +3,9 @@
 
 use proptest::prelude::*;
 use raster::{
-    Camera, Environment, FilmTables, Lut, Material, ReflectionMode, RenderScene, RenderSettings,
-    Renderer, Sky, ToneMap, Vec3, WATER_IOR, WaterSurface, refract, sphere_map_direction,
-    sphere_map_uv,
+    Camera, Environment, FilmTables, Light, Lut, Material, ReflectionMode, RenderScene,
+    RenderSettings, Renderer, Sky, ToneMap, Vec3, WATER_IOR, WaterSurface, refract,
+    sphere_map_direction, sphere_map_uv,
 };
 
 /// Asserts `|got − want| <= tol`, printing the difference.
@@ -117,11 +117,19 @@ fn render(camera: Camera, water: WaterSurface, reflection: ReflectionMode) -> Ve
     let mut scene = RenderScene::new(camera, Environment::Sky(Sky::default()));
     scene.ambient_rgb = [0.3; 3];
     scene.water = Some(water);
+    render_scene(&scene, reflection, (48, 36))
+}
+
+fn render_scene(
+    scene: &RenderScene,
+    reflection: ReflectionMode,
+    (width, height): (usize, usize),
+) -> Vec<[f32; 3]> {
     let lut = Lut::try_from_fn(8, 4, 1000.0, |_, _| [0.04; 3]).unwrap();
     let tables = FilmTables::from_reflectivity(lut);
     let settings = RenderSettings {
-        width: 48,
-        height: 36,
+        width,
+        height,
         samples: 1,
         reflection,
         exposure_ev: 0.0,
@@ -129,7 +137,7 @@ fn render(camera: Camera, water: WaterSurface, reflection: ReflectionMode) -> Ve
         draw_lights: true,
     };
     let mut renderer = Renderer::new();
-    let frame = renderer.render(&scene, &tables, &settings).unwrap();
+    let frame = renderer.render(scene, &tables, &settings).unwrap();
     frame.rgb().to_vec()
 }
 
@@ -173,5 +181,87 @@ fn water_seen_from_above_shows_the_floor_through_it() {
         "white floor {:?} vs black floor {:?}",
         white[centre],
         black[centre]
+    );
+}
+
+#[test]
+fn with_nothing_to_reflect_the_mirrored_cube_map_reflects_the_environment() {
+    // No objects, no bubbles: the water's cube map holds only the sky, so the dynamic
+    // mode must give the static mode's image (up to the cube map's texel filtering).
+    let mut water = flat_water(8, 3.0, Material::matte([0.0; 3]));
+    water.absorption_per_m = [0.0; 3];
+    let camera = Camera::look_at(
+        Vec3::new(0.0, 0.3, 1.5),
+        Vec3::new(0.0, 0.0, -1.0),
+        Vec3::Y,
+        50.0,
+    );
+    let dynamic = render(
+        camera,
+        water.clone(),
+        ReflectionMode::DynamicCubeMap { face_size: 64 },
+    );
+    let fixed = render(camera, water, ReflectionMode::StaticEnvironment);
+    for (k, (d, s)) in dynamic.iter().zip(&fixed).enumerate() {
+        for c in 0..3 {
+            assert!(
+                (d[c] - s[c]).abs() <= 0.03 * s[c].max(0.05),
+                "pixel ({}, {}): dynamic {d:?} vs static {s:?}",
+                k % 48,
+                k / 48
+            );
+        }
+    }
+}
+
+#[test]
+fn a_lamp_shows_in_the_water_where_a_plane_mirror_puts_it() {
+    // Independent truth: the reflection of a lamp at L in flat water at y = 0 lies where
+    // the line from the eye to L mirrored (L.y → −L.y) crosses the water.
+    let lamp = Vec3::new(0.0, 0.5, -1.0);
+    let eye = Vec3::new(0.0, 0.3, 1.5);
+    let camera = Camera::look_at(eye, Vec3::new(0.0, 0.0, 0.0), Vec3::Y, 50.0);
+    let mut scene = RenderScene::new(camera, Environment::Uniform([0.01; 3]));
+    let mut water = flat_water(8, 3.0, Material::matte([0.0; 3]));
+    water.absorption_per_m = [0.0; 3];
+    scene.water = Some(water);
+    scene.lights.push(Light {
+        position: lamp,
+        radius_m: 0.1,
+        radiance: [100.0; 3],
+        light_lut: None,
+    });
+    let (w, h) = (96, 72);
+    let image = render_scene(
+        &scene,
+        ReflectionMode::DynamicCubeMap { face_size: 64 },
+        (w, h),
+    );
+    let mirrored = Vec3::new(lamp.x, -lamp.y, lamp.z);
+    let hit = eye + (mirrored - eye) * (eye.y / (eye.y - mirrored.y));
+    // The pixel row of `hit` (column: the centre, as everything lies in x = 0).
+    let d = hit - eye;
+    let ndc_y =
+        d.dot(camera.up()) / d.dot(camera.forward()) / (camera.vfov_deg().to_radians() * 0.5).tan();
+    let row = ((1.0 - ndc_y) * 0.5 * h as f32) as usize;
+    let brightness = |r: usize| image[r * w + w / 2][1];
+    assert!(
+        brightness(row) > 5.0,
+        "row {row}: {} where the lamp's mirror image should be",
+        brightness(row)
+    );
+    for far in [row - 10, row + 10] {
+        assert!(
+            brightness(far) < 1.0,
+            "row {far}: {} away from it",
+            brightness(far)
+        );
+    }
+    // The static mode has only the environment to reflect: no lamp.
+    let plain = render_scene(&scene, ReflectionMode::StaticEnvironment, (w, h));
+    assert!(
+        plain[row * w + w / 2][1] < 1.0,
+        "static mode: {:?}",
+        plain[row * w + w / 2]
     );
 }
