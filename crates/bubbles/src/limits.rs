@@ -72,11 +72,11 @@ pub const HELP: &str = "Limits (a larger request is refused with exit code 2):
   bytes of one scene, OBJ or CSV file         67108864
   planned memory of one run                   3 GiB";
 
-/// Bytes of one dynamic cube map of `face_size` (six bordered faces of RGB f32, plus
-/// the depth and triangle scratch the renderer keeps per face).
+/// Bytes of one dynamic cube map of `face_size` (six bordered faces of RGB f32 and their
+/// mip chain, plus the depth and triangle scratch the renderer keeps per level-0 face).
 pub fn cube_map_bytes(face_size: usize) -> u64 {
     let side = face_size as u64 + 2;
-    6 * side * side * (12 + 8)
+    raster::CubeMap::stored_texels(face_size) as u64 * 12 + 6 * side * side * 8
 }
 
 /// Bytes of the frame buffers for `width × height` at `samples` per pixel (HDR colour

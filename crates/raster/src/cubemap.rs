@@ -1,4 +1,5 @@
-//! [`CubeMap`]: six square faces with a one-texel border, sampled seamlessly and bilinearly.
+//! [`CubeMap`]: six square faces with a one-texel border and a mip chain, sampled seamlessly
+//! (bilinearly at level 0, or trilinearly by a pixel's footprint).
 //!
 //! Face layout and orientation follow OpenGL (`GL_TEXTURE_CUBE_MAP_POSITIVE_X` ..): face
 //! `f` maps `(s, t) ∈ [−1, 1]²` (s right, t down the image) to `major + s·U + t·V`.
@@ -10,6 +11,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
+use crate::lod::{anisotropic_taps, cube_lod};
 use crate::texture::{bilerp, check_texels, read_linear_rgb};
 use crate::{Environment, RenderError};
 
@@ -26,13 +28,22 @@ pub(crate) const FACE_BASES: [(Vec3, Vec3, Vec3); 6] = [
     (Vec3::NEG_Z, Vec3::NEG_X, Vec3::NEG_Y),
 ];
 
-/// A cube map of linear RGB radiance with bordered faces.
+/// A cube map of linear RGB radiance with bordered faces and a mip chain.
 ///
 /// # Guarantees
 /// - `1 <= face_size <= 8192`;
-/// - each face holds `(face_size + 2)²` finite, non-negative texels.
+/// - each face holds `(face_size + 2)²` finite, non-negative texels;
+/// - levels 1.. halve the face (rounded down) down to 1 texel, each texel the area
+///   average of the level above, each border filled from the neighbouring faces.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CubeMap {
+    /// Level 0 (full resolution) first.
+    levels: Vec<Level>,
+}
+
+/// One mip level: six bordered `(face_size + 2)²` faces.
+#[derive(Debug, Clone, PartialEq)]
+struct Level {
     face_size: usize,
     texels: Vec<[f32; 3]>,
 }
@@ -56,14 +67,16 @@ impl CubeMap {
         }
         let mut cube = Self::black(face_size);
         let m = face_size + 2;
+        let top = &mut cube.levels[0];
         for (f, face) in faces.iter().enumerate() {
             for y in 0..face_size {
-                let row = cube.face_offset(f) + (y + 1) * m + 1;
-                cube.texels[row..row + face_size]
+                let row = top.face_offset(f) + (y + 1) * m + 1;
+                top.texels[row..row + face_size]
                     .copy_from_slice(&face[y * face_size..(y + 1) * face_size]);
             }
         }
-        cube.fill_borders_from_neighbours();
+        top.fill_borders_from_neighbours();
+        cube.build_mips();
         Ok(cube)
     }
 
@@ -100,22 +113,34 @@ impl CubeMap {
     pub fn from_environment(env: &Environment, face_size: usize) -> Result<Self, RenderError> {
         check_face_size(face_size)?;
         let mut cube = Self::black(face_size);
+        let top = &mut cube.levels[0];
         let m = face_size + 2;
         for f in 0..6 {
             for y in 0..m {
                 for x in 0..m {
-                    let dir = cube.texel_direction(f, x, y);
-                    let off = cube.face_offset(f) + y * m + x;
-                    cube.texels[off] = env.radiance(dir);
+                    let dir = top.texel_direction(f, x, y);
+                    let off = top.face_offset(f) + y * m + x;
+                    top.texels[off] = env.radiance(dir);
                 }
             }
         }
+        cube.build_mips();
         Ok(cube)
     }
 
-    /// Edge length of a face in texels, border excluded.
+    /// Edge length of a level-0 face in texels, border excluded.
     pub fn face_size(&self) -> usize {
-        self.face_size
+        self.levels[0].face_size
+    }
+
+    /// Number of mip levels, level 0 included (`⌊log2 face_size⌋ + 1`).
+    pub fn levels(&self) -> usize {
+        self.levels.len()
+    }
+
+    /// Texels stored for a cube map of `face_size`, every level and border included.
+    pub fn stored_texels(face_size: usize) -> usize {
+        mip_sizes(face_size).map(|n| 6 * (n + 2) * (n + 2)).sum()
     }
 
     /// Interior texel `(x, y)` of face `face` (0..6 in +X, −X, +Y, −Y, +Z, −Z order).
@@ -123,6 +148,112 @@ impl CubeMap {
     /// # Panics
     /// Panics if `face >= 6` or `x, y >= face_size`.
     pub fn texel(&self, face: usize, x: usize, y: usize) -> [f32; 3] {
+        self.levels[0].texel(face, x, y)
+    }
+
+    /// Seamless bilinear lookup of level 0 along `dir` (any length; zero reads +X).
+    #[inline(always)]
+    pub fn sample(&self, dir: Vec3) -> [f32; 3] {
+        let (face, s, t) = face_coordinates(dir);
+        self.levels[0].bilinear(face, s, t)
+    }
+
+    /// Seamless filtered lookup along `dir` for a pixel over which the direction changes
+    /// by `derivatives` (per pixel along x and y): trilinear taps spread along the longer
+    /// derivative ([`crate::lod::anisotropic_taps`]), each at the level
+    /// [`crate::lod::cube_lod`] gives, clamped to the chain.
+    #[inline]
+    pub fn sample_footprint(&self, dir: Vec3, derivatives: [Vec3; 2]) -> [f32; 3] {
+        let [a, b] = derivatives;
+        let (major, minor) = if a.length_squared() >= b.length_squared() {
+            (a, b)
+        } else {
+            (b, a)
+        };
+        let scale = dir.length();
+        let (taps, footprint) = anisotropic_taps(major.length(), minor.length());
+        if taps == 1 {
+            return self.sample_trilinear(dir, footprint);
+        }
+        let mut sum = [0.0f32; 3];
+        for i in 0..taps {
+            let offset = (i as f32 + 0.5) / taps as f32 - 0.5;
+            let c = self.sample_trilinear(dir + major * (offset * scale), footprint);
+            for k in 0..3 {
+                sum[k] += c[k];
+            }
+        }
+        sum.map(|c| c / taps as f32)
+    }
+
+    /// Seamless trilinear lookup along `dir`, filtered over `footprint_rad`.
+    #[inline]
+    fn sample_trilinear(&self, dir: Vec3, footprint_rad: f32) -> [f32; 3] {
+        let (face, s, t) = face_coordinates(dir);
+        let last = self.levels.len() - 1;
+        let lod = cube_lod(footprint_rad, self.face_size(), s, t).min(last as f32);
+        // lod is in [0, last]: the conversion is exact.
+        let l0 = lod as usize;
+        let frac = lod - l0 as f32;
+        let a = self.levels[l0].bilinear(face, s, t);
+        if frac <= 0.0 || l0 == last {
+            return a;
+        }
+        let b = self.levels[l0 + 1].bilinear(face, s, t);
+        std::array::from_fn(|k| a[k] + (b[k] - a[k]) * frac)
+    }
+
+    /// An all-black cube map with its whole chain allocated, the starting point of a
+    /// render target.
+    pub(crate) fn black(face_size: usize) -> Self {
+        Self {
+            levels: mip_sizes(face_size).map(Level::black).collect(),
+        }
+    }
+
+    /// Bordered level-0 face `face` as an `(N + 2)²` slice.
+    pub(crate) fn face(&self, face: usize) -> &[[f32; 3]] {
+        let m = self.face_size() + 2;
+        &self.levels[0].texels[face * m * m..(face + 1) * m * m]
+    }
+
+    /// The six bordered level-0 faces as mutable `(N + 2)²` slices, for rendering into
+    /// (then call [`CubeMap::build_mips`]).
+    pub(crate) fn faces_mut(&mut self) -> std::slice::ChunksExactMut<'_, [f32; 3]> {
+        let m = self.face_size() + 2;
+        self.levels[0].texels.chunks_exact_mut(m * m)
+    }
+
+    /// Rebuilds levels 1.. from level 0: O(level-0 texels).
+    pub(crate) fn build_mips(&mut self) {
+        for k in 1..self.levels.len() {
+            let (above, below) = self.levels.split_at_mut(k);
+            below[0].downsample_from(&above[k - 1]);
+            below[0].fill_borders_from_neighbours();
+        }
+    }
+}
+
+/// Face sizes of the chain: `face_size`, halved (rounded down) until 1.
+fn mip_sizes(face_size: usize) -> impl Iterator<Item = usize> {
+    std::iter::successors(Some(face_size), |&n| (n > 1).then_some(n / 2))
+}
+
+impl Level {
+    fn black(face_size: usize) -> Self {
+        let m = face_size + 2;
+        Self {
+            face_size,
+            texels: vec![[0.0; 3]; 6 * m * m],
+        }
+    }
+
+    fn face_offset(&self, face: usize) -> usize {
+        let m = self.face_size + 2;
+        face * m * m
+    }
+
+    fn texel(&self, face: usize, x: usize, y: usize) -> [f32; 3] {
         assert!(
             face < 6 && x < self.face_size && y < self.face_size,
             "texel out of range"
@@ -130,10 +261,9 @@ impl CubeMap {
         self.texels[self.face_offset(face) + (y + 1) * (self.face_size + 2) + x + 1]
     }
 
-    /// Seamless bilinear lookup of the radiance along `dir` (any length; zero reads +X).
+    /// Bilinear tap at face coordinates `(s, t) ∈ [−1, 1]²`, borders included.
     #[inline(always)]
-    pub fn sample(&self, dir: Vec3) -> [f32; 3] {
-        let (face, s, t) = face_coordinates(dir);
+    fn bilinear(&self, face: usize, s: f32, t: f32) -> [f32; 3] {
         let n = self.face_size as f32;
         let m = self.face_size + 2;
         // Interior texel i has its centre at s = (2i + 1)/N − 1 and is stored at i + 1.
@@ -151,32 +281,6 @@ impl CubeMap {
         let c = self.texels[base + m];
         let d = self.texels[base + m + 1];
         bilerp(a, b, c, d, tx, ty)
-    }
-
-    /// An all-black cube map, the starting point of a render target.
-    pub(crate) fn black(face_size: usize) -> Self {
-        let m = face_size + 2;
-        Self {
-            face_size,
-            texels: vec![[0.0; 3]; 6 * m * m],
-        }
-    }
-
-    /// Bordered face `face` as an `(N + 2)²` slice.
-    pub(crate) fn face(&self, face: usize) -> &[[f32; 3]] {
-        let m = self.face_size + 2;
-        &self.texels[face * m * m..(face + 1) * m * m]
-    }
-
-    /// The six bordered faces as mutable `(N + 2)²` slices, for rendering into.
-    pub(crate) fn faces_mut(&mut self) -> std::slice::ChunksExactMut<'_, [f32; 3]> {
-        let m = self.face_size + 2;
-        self.texels.chunks_exact_mut(m * m)
-    }
-
-    fn face_offset(&self, face: usize) -> usize {
-        let m = self.face_size + 2;
-        face * m * m
     }
 
     /// Direction through the centre of bordered texel `(x, y)` of face `face`.
@@ -208,6 +312,48 @@ impl CubeMap {
             }
         }
     }
+
+    /// Interior texels as area averages of `above`'s interior (exact 2 × 2 boxes when its
+    /// size is even; an odd size spreads each edge texel over two outputs by its overlap).
+    fn downsample_from(&mut self, above: &Level) {
+        let weights = box_weights(above.face_size, self.face_size);
+        let (m_src, m) = (above.face_size + 2, self.face_size + 2);
+        for f in 0..6 {
+            let (src, dst) = (above.face_offset(f), self.face_offset(f));
+            for (y, wy) in weights.iter().enumerate() {
+                for (x, wx) in weights.iter().enumerate() {
+                    let mut sum = [0.0f32; 3];
+                    for &(j, vy) in wy {
+                        for &(i, vx) in wx {
+                            let texel = above.texels[src + (j + 1) * m_src + i + 1];
+                            for k in 0..3 {
+                                sum[k] += texel[k] * (vx * vy);
+                            }
+                        }
+                    }
+                    self.texels[dst + (y + 1) * m + x + 1] = sum;
+                }
+            }
+        }
+    }
+}
+
+/// Per output texel of `n_out`, the source texels of `n` it overlaps and their weights
+/// (overlap over the output texel's width in source texels; they sum to one).
+fn box_weights(n: usize, n_out: usize) -> Vec<Vec<(usize, f32)>> {
+    let ratio = n as f64 / n_out as f64;
+    (0..n_out)
+        .map(|i| {
+            let (lo, hi) = (i as f64 * ratio, (i + 1) as f64 * ratio);
+            (lo.floor() as usize..(hi.ceil() as usize).min(n))
+                .map(|j| {
+                    let overlap = hi.min((j + 1) as f64) - lo.max(j as f64);
+                    (j, (overlap / ratio) as f32)
+                })
+                .filter(|&(_, w)| w > 0.0)
+                .collect()
+        })
+        .collect()
 }
 
 /// Face index and `(s, t) ∈ [−1, 1]²` of a direction (major axis wins; ties go to X, then Y).
@@ -330,6 +476,129 @@ mod tests {
                 );
             }
             prev = cur;
+        }
+    }
+
+    /// Faces of a linear function of direction (+1 so it is non-negative).
+    fn linear_faces(n: usize) -> [Vec<[f32; 3]>; 6] {
+        std::array::from_fn(|face| {
+            let (major, u, v) = FACE_BASES[face];
+            (0..n * n)
+                .map(|k| {
+                    let s = (2.0 * (k % n) as f32 + 1.0) / n as f32 - 1.0;
+                    let t = (2.0 * (k / n) as f32 + 1.0) / n as f32 - 1.0;
+                    let d = (major + u * s + v * t).normalize();
+                    [d.x + 1.0, d.y + 1.0, d.z + 1.0]
+                })
+                .collect()
+        })
+    }
+
+    fn face_mean(level: &Level, face: usize) -> [f64; 3] {
+        let n = level.face_size;
+        let mut sum = [0.0f64; 3];
+        for y in 0..n {
+            for x in 0..n {
+                let t = level.texel(face, x, y);
+                for k in 0..3 {
+                    sum[k] += f64::from(t[k]) / (n * n) as f64;
+                }
+            }
+        }
+        sum
+    }
+
+    #[test]
+    fn every_level_keeps_each_face_mean_and_halves_down_to_one_texel() {
+        for n in [32, 24, 5] {
+            let cube = CubeMap::try_from_faces(n, linear_faces(n)).unwrap();
+            let sizes: Vec<usize> = cube.levels.iter().map(|l| l.face_size).collect();
+            assert_eq!(sizes.last(), Some(&1), "{n}: sizes {sizes:?}");
+            assert_eq!(sizes.len(), n.ilog2() as usize + 1, "{n}: sizes {sizes:?}");
+            for level in &cube.levels[1..] {
+                for f in 0..6 {
+                    let (want, got) = (face_mean(&cube.levels[0], f), face_mean(level, f));
+                    for k in 0..3 {
+                        assert!(
+                            (got[k] - want[k]).abs() < 1e-5,
+                            "{n}: level of {} face {f} channel {k}: mean off by {}",
+                            level.face_size,
+                            got[k] - want[k]
+                        );
+                    }
+                }
+            }
+        }
+        // An even size halves by exact 2 × 2 boxes.
+        let cube = CubeMap::try_from_faces(8, linear_faces(8)).unwrap();
+        let (l0, l1) = (&cube.levels[0], &cube.levels[1]);
+        let want: f32 = [(2, 4), (3, 4), (2, 5), (3, 5)]
+            .iter()
+            .map(|&(x, y)| l0.texel(3, x, y)[1] / 4.0)
+            .sum();
+        assert!((l1.texel(3, 1, 2)[1] - want).abs() < 1e-6);
+        assert_eq!(CubeMap::stored_texels(8), 6 * (100 + 36 + 16 + 9));
+    }
+
+    #[test]
+    fn box_weights_sum_to_one_and_cover_the_source() {
+        for (n, m) in [(8, 4), (5, 2), (3, 1), (7, 3)] {
+            let w = box_weights(n, m);
+            let mut per_source = vec![0.0f32; n];
+            for taps in &w {
+                let total: f32 = taps.iter().map(|&(_, v)| v).sum();
+                assert!(
+                    (total - 1.0).abs() < 1e-6,
+                    "{n}→{m}: weights sum to {total}"
+                );
+                for &(j, v) in taps {
+                    per_source[j] += v;
+                }
+            }
+            for (j, &p) in per_source.iter().enumerate() {
+                let want = m as f32 / n as f32;
+                assert!((p - want).abs() < 1e-6, "{n}→{m}: source {j} weighs {p}");
+            }
+        }
+    }
+
+    #[test]
+    fn filtered_lookup_is_seamless_across_edges_at_every_level() {
+        let cube = CubeMap::try_from_faces(32, linear_faces(32)).unwrap();
+        // Through the 4 × 4 level (0.8 rad reads levels 2-3 of 32²); at 2 × 2 and 1 × 1 each
+        // border texel stands for much of a neighbouring face and a seam of 1-2 % remains.
+        for footprint in [0.0f32, 0.1, 0.4, 0.8] {
+            let derivatives = [Vec3::X * footprint, Vec3::Z * footprint];
+            let mut prev = cube.sample_footprint(Vec3::new(1.0, 0.98, 0.2), derivatives);
+            for k in 1..=40 {
+                let y = 0.98 + 0.001 * k as f32;
+                let cur = cube.sample_footprint(Vec3::new(1.0, y, 0.2), derivatives);
+                for c in 0..3 {
+                    assert!(
+                        (cur[c] - prev[c]).abs() < 0.02,
+                        "footprint {footprint}: jump {} at y {y}",
+                        cur[c] - prev[c]
+                    );
+                }
+                prev = cur;
+            }
+        }
+    }
+
+    #[test]
+    fn filtered_lookup_reads_level_zero_for_tiny_footprints_and_the_mean_for_huge_ones() {
+        let cube = CubeMap::try_from_faces(16, linear_faces(16)).unwrap();
+        let d = Vec3::new(0.3, -0.2, 1.0);
+        assert_eq!(cube.sample_footprint(d, [Vec3::ZERO; 2]), cube.sample(d));
+        // A footprint wider than the cube reads the one-texel level: at the face's centre,
+        // the face's mean.
+        let huge = cube.sample_footprint(Vec3::Z, [Vec3::X * 10.0, Vec3::Y * 10.0]);
+        let want = face_mean(&cube.levels[0], 4);
+        for k in 0..3 {
+            assert!(
+                (f64::from(huge[k]) - want[k]).abs() < 1e-5,
+                "channel {k}: {huge:?} vs {want:?}"
+            );
         }
     }
 

@@ -28,6 +28,7 @@ mod frame;
 pub mod gpu;
 mod ground;
 mod irradiance;
+mod lod;
 mod lut_sampler;
 mod mesh;
 mod obj;
@@ -54,7 +55,9 @@ pub use lut::Lut;
 pub use mesh::TriMesh;
 pub use renderer::Renderer;
 pub use scene::{BubbleMesh, FilmTables, Ground, Light, Material, Object, Pattern, RenderScene};
-pub use settings::{MAX_IMAGE_SIDE, ReflectionMode, RenderSettings, SAMPLE_COUNTS, ToneMap};
+pub use settings::{
+    MAX_IMAGE_SIDE, ReflectionFilter, ReflectionMode, RenderSettings, SAMPLE_COUNTS, ToneMap,
+};
 pub use spheremap::SphereMap;
 pub use texture::Texture;
 pub use water::{WATER_IOR, WaterSurface, refract, sphere_map_direction, sphere_map_uv};

@@ -7,11 +7,14 @@ use glam::Vec3;
 
 use crate::camera::View;
 use crate::ground::{SPAN, ground_span, span_supported};
+use crate::lod::reflection_derivatives;
 use crate::lut_sampler::LutSampler;
-use crate::raster::{SamplePattern, SetupTri, for_each_covered_in_row};
+use crate::raster::{ATTRS, Plane, SamplePattern, SetupTri, for_each_covered_in_row};
 use crate::shading::{ground_albedo, lit, object_albedo};
 use crate::water_pass::{WATER, WaterShading, shade_water};
-use crate::{CubeMap, Environment, Ground, Irradiance, Light, Material, SphereMap};
+use crate::{
+    CubeMap, Environment, Ground, Irradiance, Light, Material, Pattern, ReflectionFilter, SphereMap,
+};
 
 /// Rows per strip (the unit of parallel work).
 pub(crate) const STRIP_ROWS: usize = 8;
@@ -378,9 +381,33 @@ impl OpaqueCtx<'_> {
         let v = d.normalize_or(self.view.forward);
         let n = Vec3::new(a[0], a[1], a[2]).normalize_or(-v);
         let material = self.materials[tri.tag as usize];
-        let albedo = object_albedo(material, p, [a[3], a[4]]);
+        let footprint = match material.pattern {
+            Pattern::Checker { .. } => surface_footprint(&self.view, d, 1.0 / inv_w, n),
+            _ => [0.0; 3],
+        };
+        let albedo = object_albedo(material, p, [a[3], a[4]], footprint);
         lit(material, albedo, p, n, v, self.ambient, self.lights)
     }
+}
+
+/// World-space extent (metres per axis) that one pixel covers on a surface with normal `n`
+/// hit at depth `t` along view ray `d` (forward component 1): the plane's
+/// `∂P/∂px = t·(∂d − d·(∂d·n)/(d·n))`, summed over both pixel axes.
+#[inline]
+fn surface_footprint(view: &View, d: Vec3, t: f32, n: Vec3) -> [f32; 3] {
+    let dn = d.dot(n);
+    let step = |dd: Vec3| (dd - d * (dd.dot(n) / dn)) * t;
+    let (dx, dy) = (
+        step(view.right * view.x_per_px),
+        step(-view.up * view.y_per_px),
+    );
+    // Edge-on (d·n → 0) the footprint is unbounded: the filter then returns the mean.
+    [
+        dx.x.abs() + dy.x.abs(),
+        dx.y.abs() + dy.y.abs(),
+        dx.z.abs() + dy.z.abs(),
+    ]
+    .map(|f| if f < 1e6 { f } else { 1e6 })
 }
 
 /// Where one bubble's reflections come from.
@@ -392,13 +419,26 @@ pub(crate) enum Reflection<'a> {
 }
 
 impl Reflection<'_> {
+    /// Radiance along unit `dir`; cube maps are filtered by `derivatives`, the change of
+    /// the direction per pixel along x and y, unless `filter` asks for the single
+    /// bilinear tap.
     #[inline]
-    fn sample(&self, dir: Vec3) -> [f32; 3] {
-        match self {
-            Self::Cube(c) => c.sample(dir),
-            Self::Env(e) => e.radiance(dir),
-            Self::Sphere(s) => s.sample(dir),
+    fn sample(&self, dir: Vec3, derivatives: [Vec3; 2], filter: ReflectionFilter) -> [f32; 3] {
+        let cube: &CubeMap = match *self {
+            Self::Cube(c) | Self::Env(Environment::CubeFaces(c)) => c,
+            Self::Env(e) => return e.radiance(dir),
+            Self::Sphere(s) => return s.sample(dir),
+        };
+        match filter {
+            ReflectionFilter::Footprint => cube.sample_footprint(dir, derivatives),
+            ReflectionFilter::Bilinear => cube.sample(dir),
         }
+    }
+
+    /// Whether the lookup uses a footprint (so the shader should compute one).
+    #[inline]
+    fn is_cube(&self) -> bool {
+        matches!(self, Self::Cube(_) | Self::Env(Environment::CubeFaces(_)))
     }
 }
 
@@ -414,6 +454,8 @@ pub(crate) struct BubbleCtx<'a> {
     pub light_tables: &'a [LutSampler<'a>],
     /// Per bubble (by original index).
     pub reflections: &'a [Reflection<'a>],
+    /// How cube maps are read.
+    pub filter: ReflectionFilter,
     pub tris: &'a [SetupTri],
     pub bins: &'a Bins,
 }
@@ -509,7 +551,13 @@ impl BubbleCtx<'_> {
             None => r_rgb.map(|r| 1.0 - r),
         };
         let reflected = v - n * (2.0 * c);
-        let env = self.reflections[tri.tag as usize].sample(reflected);
+        let reflection = &self.reflections[tri.tag as usize];
+        let derivatives = if reflection.is_cube() && self.filter == ReflectionFilter::Footprint {
+            self.reflection_derivatives(tri, d, inv_w, a)
+        } else {
+            [Vec3::ZERO; 2]
+        };
+        let env = reflection.sample(reflected, derivatives, self.filter);
         let mut add = [r_rgb[0] * env[0], r_rgb[1] * env[1], r_rgb[2] * env[2]];
         if !self.lights.is_empty() {
             let p = self.view.eye + d / inv_w;
@@ -525,6 +573,35 @@ impl BubbleCtx<'_> {
             }
         }
         (t_rgb, add)
+    }
+
+    /// Change of the unit reflected direction per pixel along x and y at the point with
+    /// view ray `d`, inverse depth `inv_w` and interpolated attributes `a`.
+    #[inline]
+    fn reflection_derivatives(
+        &self,
+        tri: &SetupTri,
+        d: Vec3,
+        inv_w: f32,
+        a: [f32; ATTRS],
+    ) -> [Vec3; 2] {
+        let w = 1.0 / inv_w;
+        let n_raw = Vec3::new(a[0], a[1], a[2]);
+        // n = (attr/w) / (1/w), both affine in pixels: ∂n = (∂(attr/w) − n·∂(1/w))·w.
+        let along = |pick: fn(&Plane) -> f32| {
+            let da = Vec3::new(
+                pick(&tri.attrs[0]),
+                pick(&tri.attrs[1]),
+                pick(&tri.attrs[2]),
+            );
+            (da - n_raw * pick(&tri.inv_w)) * w
+        };
+        let dn_raw = [along(|p| p.dx), along(|p| p.dy)];
+        let dd = [
+            self.view.right * self.view.x_per_px,
+            -self.view.up * self.view.y_per_px,
+        ];
+        reflection_derivatives(d, dd, n_raw, dn_raw)
     }
 }
 

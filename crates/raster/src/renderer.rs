@@ -13,8 +13,8 @@ use crate::passes::{Bins, BubbleCtx, EMISSIVE, GroundView, OpaqueCtx, Reflection
 use crate::raster::{ATTRS, ClipVertex, SamplePattern, SetupTri, setup_triangle};
 use crate::water_pass::{WaterPass, setup_water};
 use crate::{
-    BubbleMesh, CubeMap, Environment, FilmTables, Frame, Material, Object, ReflectionMode,
-    RenderError, RenderScene, RenderSettings, TriMesh,
+    BubbleMesh, CubeMap, Environment, FilmTables, Frame, Material, Object, ReflectionFilter,
+    ReflectionMode, RenderError, RenderScene, RenderSettings, TriMesh,
 };
 
 /// Slices and stacks of a tessellated [`Object::Sphere`].
@@ -95,12 +95,19 @@ pub struct Renderer {
     /// (kept only for the cheap-to-compare procedural kinds).
     env_cube: Option<(Environment, CubeMap)>,
     water: WaterPass,
+    filter: ReflectionFilter,
 }
 
 impl Renderer {
     /// A renderer with empty buffers (they grow on the first frame).
     pub fn new() -> Renderer {
         Renderer::default()
+    }
+
+    /// Chooses how bubbles read cube maps from the next frame on (default: filtered by the
+    /// footprint; bilinear is the unfiltered lookup, kept to measure the filter against).
+    pub fn set_reflection_filter(&mut self, filter: ReflectionFilter) {
+        self.filter = filter;
     }
 
     /// The last rendered frame.
@@ -200,6 +207,7 @@ impl Renderer {
             lights: &scene.lights,
             light_tables: &light_tables,
             reflections: &reflections,
+            filter: self.filter,
             tris: &self.bubble_tris,
             bins: &self.bubble_bins,
         };
@@ -372,6 +380,7 @@ impl Renderer {
                 .enumerate()
                 .for_each(|(s, (color, depth))| ctx.render_strip(s, color, depth));
         });
+        self.cube_maps.par_iter_mut().for_each(CubeMap::build_mips);
     }
 
     /// Caches the environment's cube faces when it is procedural (cheap to compare);

@@ -26,6 +26,19 @@ impl Default for ReflectionMode {
     }
 }
 
+/// How bubbles read their cube maps (dynamic or environment cube faces).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ReflectionFilter {
+    /// One bilinear tap of the full-resolution faces: aliases wherever the reflected
+    /// direction turns by more than a texel per pixel (bubble rims). Kept to measure the
+    /// filter against (crates/raster/tests/rim_aliasing.rs).
+    Bilinear,
+    /// Filtered by the reflected direction's footprint per pixel: trilinear taps between
+    /// the mip levels that match it, spread along its long axis (anisotropic; `lod.rs`).
+    #[default]
+    Footprint,
+}
+
 /// The tone curve applied when converting HDR radiance to display values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum ToneMap {

@@ -21,25 +21,52 @@ pub(crate) fn fast_floor(x: f32) -> f32 {
 /// the pattern-space position and its footprint per pixel (Quilez's closed form).
 #[inline]
 pub(crate) fn filtered_checker(p: [f32; 2], footprint: [f32; 2]) -> f32 {
-    let tri = |x: f32| (x - fast_floor(x) - 0.5).abs();
-    let mut i = [0.0; 2];
-    for k in 0..2 {
-        let w = footprint[k] + 1e-3;
-        i[k] = 2.0 * (tri((p[k] - 0.5 * w) * 0.5) - tri((p[k] + 0.5 * w) * 0.5)) / w;
-    }
-    0.5 - 0.5 * i[0] * i[1]
+    0.5 - 0.5 * filtered_square(p[0], footprint[0]) * filtered_square(p[1], footprint[1])
 }
 
-/// Albedo of `material` at world point `p` with mesh UV `uv` (objects, unfiltered).
+/// The square wave that is +1 on even unit cells and −1 on odd ones, box-filtered over
+/// `[x − w/2, x + w/2]`: the difference of its integral, a triangle wave, over `w`.
 #[inline]
-pub(crate) fn object_albedo(material: &Material, p: Vec3, uv: [f32; 2]) -> [f32; 3] {
+fn filtered_square(x: f32, footprint: f32) -> f32 {
+    let tri = |x: f32| (x - fast_floor(x) - 0.5).abs();
+    let w = footprint + 1e-3;
+    2.0 * (tri((x - 0.5 * w) * 0.5) - tri((x + 0.5 * w) * 0.5)) / w
+}
+
+/// Footprints below this many checker cells along an axis count as flat (no extent).
+const FLAT_FOOTPRINT_CELLS: f32 = 1e-3;
+
+/// Albedo of `material` at world point `p` with mesh UV `uv`; a checker is box-filtered
+/// over `footprint`, the world-space extent (metres per axis) one pixel covers there
+/// (zero: point-sampled).
+#[inline]
+pub(crate) fn object_albedo(
+    material: &Material,
+    p: Vec3,
+    uv: [f32; 2],
+    footprint: [f32; 3],
+) -> [f32; 3] {
     match &material.pattern {
         Pattern::Solid(c) => *c,
         Pattern::Checker { a, b, scale_m } => {
+            // A 3-D checker's ±1 form is the product of one square wave per axis, so the
+            // box filter over an axis-aligned footprint is the product of filtered waves.
             let q = p / *scale_m;
-            let cell = |c: f32| fast_floor(c) as i64;
-            let parity = (cell(q.x) + cell(q.y) + cell(q.z)).rem_euclid(2);
-            if parity == 0 { *a } else { *b }
+            let f = footprint.map(|f| (f / *scale_m).min(1e6));
+            let i = (0..3)
+                .map(|k| {
+                    let x = q[k].clamp(-1e6, 1e6);
+                    // Along an axis the surface does not move in (a box face's normal), the
+                    // footprint is flat: point-sample it, as a face lying on a cell boundary
+                    // would otherwise average its two sides into grey.
+                    if f[k] < FLAT_FOOTPRINT_CELLS {
+                        1.0 - 2.0 * (fast_floor(x) - 2.0 * fast_floor(x * 0.5))
+                    } else {
+                        filtered_square(x, f[k])
+                    }
+                })
+                .product::<f32>();
+            crate::environment::lerp3(*a, *b, 0.5 - 0.5 * i)
         }
         Pattern::Textured { texture, .. } => texture.sample_repeat(uv[0], uv[1]),
     }
@@ -144,6 +171,49 @@ mod tests {
         assert!(filtered_checker([1.25, -0.75], [1e-4, 1e-4]) < 1e-3);
         let wide = filtered_checker([0.3, 0.7], [8.0, 8.0]);
         assert!((wide - 0.5).abs() < 0.01, "wide footprint gives {wide}");
+    }
+
+    #[test]
+    fn object_checker_averages_its_cells_over_the_footprint() {
+        let m = Material::checker([1.0, 0.0, 0.0], [0.0, 0.0, 1.0], 0.5);
+        // Point-sampled cells: (0, 0, 0) is `a`, one step along any axis is `b`.
+        let sharp = |p: Vec3| object_albedo(&m, p, [0.0; 2], [0.0; 3]);
+        assert!(sharp(Vec3::splat(0.25))[0] > 0.99);
+        assert!(sharp(Vec3::new(0.75, 0.25, 0.25))[2] > 0.99);
+        assert!(sharp(Vec3::new(0.75, 0.75, 0.25))[0] > 0.99);
+        // A box face lying on a cell boundary (z = 0.5 exactly) keeps its checker.
+        let face = |x: f32| object_albedo(&m, Vec3::new(x, 0.25, 0.5), [0.0; 2], [0.05, 0.05, 0.0]);
+        assert!(
+            face(0.25)[2] > 0.99 && face(0.75)[0] > 0.99,
+            "{:?} {:?}",
+            face(0.25),
+            face(0.75)
+        );
+        // A footprint of two cells along x straddles one of each: half and half.
+        let wide = object_albedo(&m, Vec3::new(0.5, 0.25, 0.25), [0.0; 2], [1.0, 0.0, 0.0]);
+        assert!(
+            (wide[0] - 0.5).abs() < 0.01 && (wide[2] - 0.5).abs() < 0.01,
+            "{wide:?}"
+        );
+        // The filter is the mean of point samples over the box (midpoint rule).
+        let (p, f) = (Vec3::new(0.13, 0.41, -0.37), [0.6f32, 0.35, 0.8]);
+        let n = 80;
+        let mut mean = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                for k in 0..n {
+                    let o = |c: usize, w: f32| ((c as f32 + 0.5) / n as f32 - 0.5) * w;
+                    mean += sharp(p + Vec3::new(o(i, f[0]), o(j, f[1]), o(k, f[2])))[0];
+                }
+            }
+        }
+        mean /= (n * n * n) as f32;
+        let got = object_albedo(&m, p, [0.0; 2], f)[0];
+        assert!(
+            (got - mean).abs() < 5e-3,
+            "filtered {got} vs mean {mean}: {}",
+            got - mean
+        );
     }
 
     #[test]

@@ -303,6 +303,10 @@ impl WaterPass {
                     face_bubbles.render_strip(s, color, depth);
                 });
         });
+        // The water reads level 0 only; the chain keeps the public map consistent.
+        if let Some(c) = &mut self.cube {
+            c.build_mips();
+        }
     }
 }
 

@@ -281,7 +281,7 @@ impl Tracer<'_> {
             [0.0; 2]
         };
         let material = scene.objects[o as usize].material();
-        let albedo = object_albedo(material, p, uv);
+        let albedo = object_albedo(material, p, uv, [0.0; 3]);
         lit(material, albedo, p, n, dir, &self.ambient, &scene.lights)
     }
 }

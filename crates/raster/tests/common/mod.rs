@@ -5,8 +5,8 @@ use std::collections::HashMap;
 
 use raster::Vec3;
 use raster::{
-    BubbleMesh, Camera, Environment, FilmTables, Ground, Light, Lut, Material, ReflectionMode,
-    RenderScene, RenderSettings, Sky,
+    BubbleMesh, Camera, Environment, FilmTables, Frame, Ground, Irradiance, Light, Lut, Material,
+    Object, ReflectionMode, RenderScene, RenderSettings, Sky,
 };
 
 /// Default settings at the given size, sample count and reflection mode.
@@ -175,4 +175,62 @@ pub fn paper_scene() -> RenderScene {
         .bubbles
         .push(bubble(Vec3::new(0.6, 1.1, -0.6), 0.5, 3, draining));
     scene
+}
+
+/// Centre of the rim scene's bubble.
+pub const RIM_BUBBLE_CENTER: Vec3 = Vec3::new(0.0, 0.6, 0.0);
+/// Radius of the rim scene's bubble.
+pub const RIM_BUBBLE_RADIUS_M: f32 = 0.5;
+
+/// A bubble over a 5 cm checker ground beside a 4 cm checker ball, under the sky: at its
+/// rim the reflected direction sweeps the fine checkers fast (crates/raster/tests/rim_aliasing.rs).
+pub fn rim_scene() -> RenderScene {
+    let camera = Camera::look_at(Vec3::new(0.0, 0.9, 1.6), RIM_BUBBLE_CENTER, Vec3::Y, 40.0);
+    let sky = Environment::Sky(Sky::default());
+    let mut scene = RenderScene::new(camera, sky.clone());
+    scene.irradiance = Irradiance::from_environment(&sky);
+    scene.ground = Some(Ground {
+        height_m: 0.0,
+        material: Material::checker([0.9; 3], [0.05; 3], 0.05),
+    });
+    scene.objects.push(Object::Sphere {
+        center: Vec3::new(0.9, 0.4, -0.6),
+        radius_m: 0.4,
+        material: Material::checker([0.9, 0.2, 0.1], [0.1, 0.2, 0.9], 0.04),
+    });
+    scene
+        .bubbles
+        .push(bubble(RIM_BUBBLE_CENTER, RIM_BUBBLE_RADIUS_M, 5, |_| 500.0));
+    scene
+}
+
+/// A perfect mirror film: R = 1, T = 0 at every thickness and angle.
+pub fn mirror_tables() -> FilmTables {
+    let constant = |v: f32| Lut::try_from_fn(4, 4, 1000.0, move |_, _| [v; 3]).unwrap();
+    FilmTables {
+        reflectivity: constant(1.0),
+        transmittance: Some(constant(0.0)),
+        lights: Vec::new(),
+    }
+}
+
+/// Each `factor × factor` block of `hi` averaged into one pixel.
+///
+/// # Panics
+/// Panics if `factor` does not divide both sides.
+pub fn box_downsample(hi: &Frame, factor: usize) -> Frame {
+    assert!(hi.width() % factor == 0 && hi.height() % factor == 0);
+    let (w, h) = (hi.width() / factor, hi.height() / factor);
+    let mut out = vec![[0.0f32; 3]; w * h];
+    let weight = 1.0 / (factor * factor) as f32;
+    for y in 0..hi.height() {
+        for x in 0..hi.width() {
+            let p = hi.pixel(x, y);
+            let o = &mut out[(y / factor) * w + x / factor];
+            for k in 0..3 {
+                o[k] += p[k] * weight;
+            }
+        }
+    }
+    Frame::try_from_rgb(w, h, out).unwrap()
 }

@@ -1,0 +1,181 @@
+//! Which cube-map levels a bubble pixel reads: the reflected direction's derivatives per
+//! pixel, the anisotropic tap plan and the one LOD formula (ported to WGSL by the GPU
+//! backend with these constants).
+//!
+//! At a bubble's rim the reflected direction turns by up to half a radian per pixel; read
+//! with one bilinear tap of the full-resolution cube map, everything it sweeps over aliases.
+//! The mip level whose texels are as wide as the pixel's footprint averages it instead.
+
+use glam::Vec3;
+
+/// Levels added to the computed level of detail: −log2 √3. A bilinear tap of a level
+/// whose texels are `T` wide (box-averaged from level 0) is a box of width `T` convolved
+/// with a tent of half-width `T`, a kernel of standard deviation `T/2`; the pixel's own
+/// footprint `f` is a box of standard deviation `f/√12`. They match at `T = f/√3`. At 0 the
+/// rims blur half again too much (crates/raster/tests/rim_aliasing.rs measured it).
+pub(crate) const LOD_BIAS: f32 = -0.792_481_25;
+
+/// Footprints below this many level-0 texels read level 0 alone (one bilinear tap).
+pub(crate) const MIN_FOOTPRINT_TEXELS: f32 = 1.0;
+
+/// Level of detail (fractional mip level, ≥ 0) of a cube-map read whose direction turns by
+/// `footprint_rad` per pixel, at face coordinates `(s, t)` of a cube with level-0 faces of
+/// `face_size` texels.
+///
+/// A texel at `(s, t)` subtends the solid angle `(2/N)² / (1 + s² + t²)^{3/2}`; its square
+/// root is the texel's angular width, so the footprint spans
+/// `footprint · N/2 · (1 + s² + t²)^{3/4}` level-0 texels, and level `log2` of that has
+/// texels as wide as the footprint. The caller clamps to the levels it has.
+#[inline]
+pub(crate) fn cube_lod(footprint_rad: f32, face_size: usize, s: f32, t: f32) -> f32 {
+    let q = 1.0 + s * s + t * t;
+    let q34 = q.sqrt() * q.sqrt().sqrt();
+    let texels = footprint_rad * face_size as f32 * 0.5 * q34;
+    // NaN compares false: it reads level 0, as a zero footprint would.
+    if texels > MIN_FOOTPRINT_TEXELS {
+        (texels.log2() + LOD_BIAS).max(0.0)
+    } else {
+        0.0
+    }
+}
+
+/// Most taps one lookup spreads along the footprint's long axis (a GPU's anisotropy clamp).
+pub(crate) const MAX_ANISOTROPY: usize = 16;
+
+/// How one footprint-filtered lookup is made: `taps` trilinear taps spaced evenly along
+/// the longer of the two per-pixel derivatives, each filtered over `footprint_rad`
+/// (the longer derivative over `taps`, but never less than the shorter one).
+///
+/// An isotropic filter as wide as the longer derivative would blur a bubble's rim along
+/// the silhouette as much as across it (there they differ tenfold); spreading taps along
+/// the long axis filters each axis by its own width, as a GPU's anisotropic filter does.
+#[inline]
+pub(crate) fn anisotropic_taps(major_rad: f32, minor_rad: f32) -> (usize, f32) {
+    let ratio = major_rad / minor_rad.max(1e-12);
+    // NaN or ≤ 1 → one tap; the float-to-int conversion saturates.
+    let taps = (ratio.ceil() as usize).clamp(1, MAX_ANISOTROPY);
+    (taps, (major_rad / taps as f32).max(minor_rad))
+}
+
+/// Change per pixel of the unit reflected direction along screen x and y.
+///
+/// `d` is the (unnormalised) view ray and `dd` its change per pixel along x and y;
+/// `n_raw` is the interpolated (unnormalised) normal and `dn_raw` its change per pixel.
+/// The normal is turned to face the viewer as the shading does. Exact derivatives of
+/// `r = v − 2(v·n)n` with `v = d/|d|`, `n = ±n_raw/|n_raw|`; zero where not finite.
+#[inline]
+pub(crate) fn reflection_derivatives(
+    d: Vec3,
+    dd: [Vec3; 2],
+    n_raw: Vec3,
+    dn_raw: [Vec3; 2],
+) -> [Vec3; 2] {
+    let (d_len, n_len) = (d.length(), n_raw.length());
+    let v = d / d_len;
+    let n_hat = n_raw / n_len;
+    let sign = if v.dot(n_hat) > 0.0 { -1.0 } else { 1.0 };
+    let n = n_hat * sign;
+    let c = v.dot(n);
+    std::array::from_fn(|k| {
+        let dv = (dd[k] - v * v.dot(dd[k])) / d_len;
+        let dn = (dn_raw[k] - n_hat * n_hat.dot(dn_raw[k])) * (sign / n_len);
+        let dc = dv.dot(n) + v.dot(dn);
+        let dr = dv - (n * dc + dn * c) * 2.0;
+        if dr.is_finite() { dr } else { Vec3::ZERO }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn reflect(d: Vec3, n_raw: Vec3) -> Vec3 {
+        let v = d.normalize();
+        let mut n = n_raw.normalize();
+        if v.dot(n) > 0.0 {
+            n = -n;
+        }
+        v - n * (2.0 * v.dot(n))
+    }
+
+    proptest! {
+        #[test]
+        fn footprint_matches_finite_differences_of_the_reflected_direction(
+            d in prop::array::uniform3(-1.0f32..1.0),
+            dd in prop::array::uniform3(-0.05f32..0.05),
+            ee in prop::array::uniform3(-0.05f32..0.05),
+            n in prop::array::uniform3(-1.0f32..1.0),
+            dn in prop::array::uniform3(-0.05f32..0.05),
+            en in prop::array::uniform3(-0.05f32..0.05),
+        ) {
+            let (d, n) = (Vec3::from(d) + Vec3::Z * 1.5, Vec3::from(n));
+            prop_assume!(n.length() > 0.3);
+            // Away from grazing, where the facing flip would make r jump.
+            prop_assume!(d.normalize().dot(n.normalize()).abs() > 0.2);
+            let dd = [Vec3::from(dd), Vec3::from(ee)];
+            let dn = [Vec3::from(dn), Vec3::from(en)];
+            let h = 1e-2f32;
+            let got = reflection_derivatives(d, dd, n, dn);
+            for k in 0..2 {
+                let plus = reflect(d + dd[k] * h, n + dn[k] * h);
+                let minus = reflect(d - dd[k] * h, n - dn[k] * h);
+                let fd = (plus - minus) / (2.0 * h);
+                prop_assert!(
+                    (got[k] - fd).length() <= 2e-3 + 1e-2 * fd.length(),
+                    "axis {}: analytic {} vs finite differences {} (difference {})",
+                    k, got[k], fd, (got[k] - fd).length()
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn footprint_of_a_mirror_sphere_seen_head_on_is_twice_the_normals_turn() {
+        // Centre of a sphere of radius R px: the normal turns 1/R rad per pixel, the view
+        // ray not at all (orthographic limit), so r turns 2/R.
+        let r_px = 50.0;
+        let got = reflection_derivatives(
+            Vec3::NEG_Z,
+            [Vec3::ZERO; 2],
+            Vec3::Z,
+            [Vec3::X / r_px, Vec3::Y / r_px],
+        );
+        for (k, axis) in [Vec3::X, Vec3::Y].into_iter().enumerate() {
+            let want = axis * (2.0 / r_px);
+            assert!(
+                (got[k] - want).length() < 1e-6,
+                "axis {k}: {} vs {want}",
+                got[k]
+            );
+        }
+        let degenerate =
+            reflection_derivatives(Vec3::NEG_Z, [Vec3::ZERO; 2], Vec3::ZERO, [Vec3::X; 2]);
+        assert_eq!(degenerate, [Vec3::ZERO; 2]);
+    }
+
+    #[test]
+    fn anisotropic_taps_cover_the_long_axis_at_the_short_axis_width() {
+        assert_eq!(anisotropic_taps(0.01, 0.01), (1, 0.01));
+        assert_eq!(anisotropic_taps(0.0, 0.0), (1, 0.0));
+        // 4:1 → four taps, each as wide as the short axis.
+        assert_eq!(anisotropic_taps(0.4, 0.1), (4, 0.1));
+        // Beyond the clamp the taps widen instead.
+        let (taps, width) = anisotropic_taps(1.0, 0.001);
+        assert_eq!(taps, MAX_ANISOTROPY);
+        assert!((width - 1.0 / MAX_ANISOTROPY as f32).abs() < 1e-7);
+        assert_eq!(anisotropic_taps(f32::NAN, 0.1).0, 1);
+    }
+
+    #[test]
+    fn lod_is_zero_for_small_footprints_and_log2_of_the_texel_span_otherwise() {
+        assert_eq!(cube_lod(0.0, 128, 0.0, 0.0), 0.0);
+        assert_eq!(cube_lod(f32::NAN, 128, 0.0, 0.0), 0.0);
+        // At the face centre a texel is 2/N rad wide: 8 texels' worth reads level 3 (+ bias).
+        let lod = cube_lod(8.0 * 2.0 / 128.0, 128, 0.0, 0.0);
+        assert!((lod - 3.0 - LOD_BIAS).abs() < 1e-5, "lod {lod}");
+        assert!((3.0f32.sqrt().log2() + LOD_BIAS).abs() < 1e-6);
+        // Towards a corner texels subtend less: the same footprint spans more of them.
+        assert!(cube_lod(0.1, 128, 0.9, 0.9) > cube_lod(0.1, 128, 0.0, 0.0));
+    }
+}
