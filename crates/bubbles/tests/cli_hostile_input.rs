@@ -353,13 +353,24 @@ fn solver_messages_use_the_scene_names() {
         &out,
         &[
             "[[bubbles]] #1",
-            "[[objects]] #1 (sphere)",
+            "[[objects]] #1 (sphere, center_m = [0, 0.06, 0], radius_m = 0.02)",
             "[0.0, 0.06, 0.0]",
         ],
     );
     assert!(
         !err.contains("colliders[") && !err.contains("DVec3"),
         "{err}"
+    );
+}
+
+/// Found by cli_extreme_numbers: a ground raised above the bubble was refused with a
+/// message that named only the bubble's centre, never the key that was wrong.
+#[test]
+fn a_ground_above_the_bubble_is_refused_naming_ground_height_m() {
+    let dir = scene("[ground]\nheight_m = 100.0\n");
+    refused(
+        &bubbles(&["simulate", "s.toml"], dir.path()),
+        &["ground.height_m = 100", "[[bubbles]] #1"],
     );
 }
 

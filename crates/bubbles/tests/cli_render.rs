@@ -193,3 +193,20 @@ fn bench_prints_a_breakdown_per_size() {
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.contains("fps") && text.contains("64x48"), "{text}");
 }
+
+#[cfg(not(feature = "wgpu"))]
+#[test]
+fn backend_wgpu_without_the_feature_says_how_to_rebuild() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = bubbles(
+        &["render", "--backend", "wgpu", "--out", "x.png"],
+        dir.path(),
+    );
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--features wgpu") && err.contains("--backend cpu"),
+        "{err}"
+    );
+    assert!(!dir.path().join("x.png").exists());
+}

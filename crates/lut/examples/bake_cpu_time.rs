@@ -3,7 +3,7 @@
 //! [WIDTHxHEIGHT] [REPEATS]`. Linux only (reads `/proc/self/stat`); 512x512 and 20 by default.
 //!
 //! Prints CPU ms per bake and CPU ns per spectral sample, for one thread and for rayon's
-//! default pool; on an idle machine the default pool's wall time is about the CPU time
+//! default pool, for the bake with cell means and the point-sampled bake before them; on an idle machine the default pool's wall time is about the CPU time
 //! divided by the core count.
 
 use std::time::Instant;
@@ -19,6 +19,9 @@ fn cpu_seconds() -> Option<f64> {
     // USER_HZ is 100 on every Linux the workspace targets.
     Some(ticks / 100.0)
 }
+
+/// One way of baking a configuration.
+type Bake = fn(&BakeConfig) -> lut::LutSet;
 
 fn main() {
     let mut args = std::env::args().skip(1);
@@ -36,30 +39,36 @@ fn main() {
         .build()
         .expect("valid resolution");
     let samples = lut::spectral_samples(&config) as f64;
+    let bakes: [(&str, Bake); 2] = [
+        ("point-sampled (before cell means)", lut::bake_point_sampled),
+        ("with cell means", lut::bake),
+    ];
     for threads in [1, rayon::current_num_threads()] {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .expect("thread pool");
-        pool.install(|| lut::bake(&config));
-        let (cpu0, wall0) = (cpu_seconds(), Instant::now());
-        for _ in 0..repeats {
-            pool.install(|| std::hint::black_box(lut::bake(&config)));
+        for (name, bake) in bakes {
+            pool.install(|| bake(&config));
+            let (cpu0, wall0) = (cpu_seconds(), Instant::now());
+            for _ in 0..repeats {
+                pool.install(|| std::hint::black_box(bake(&config)));
+            }
+            let wall = wall0.elapsed().as_secs_f64() / repeats as f64;
+            let cpu = cpu_seconds()
+                .zip(cpu0)
+                .map(|(b, a)| (b - a) / repeats as f64);
+            let cpu_text = cpu.map_or("n/a".into(), |c| {
+                format!(
+                    "{:.1} ms CPU, {:.2} ns CPU per point sample",
+                    c * 1e3,
+                    c * 1e9 / samples
+                )
+            });
+            println!(
+                "{width}x{height}, reflectivity + transmittance, {name}, {threads} thread(s): {samples:.0} point samples, {:.1} ms wall, {cpu_text}",
+                wall * 1e3
+            );
         }
-        let wall = wall0.elapsed().as_secs_f64() / repeats as f64;
-        let cpu = cpu_seconds()
-            .zip(cpu0)
-            .map(|(b, a)| (b - a) / repeats as f64);
-        let cpu_text = cpu.map_or("n/a".into(), |c| {
-            format!(
-                "{:.1} ms CPU, {:.2} ns CPU per sample",
-                c * 1e3,
-                c * 1e9 / samples
-            )
-        });
-        println!(
-            "{width}x{height}, reflectivity + transmittance, {threads} thread(s): {samples:.0} samples, {:.1} ms wall, {cpu_text}",
-            wall * 1e3
-        );
     }
 }

@@ -1,6 +1,7 @@
 //! How far a bilinear lookup strays from the exact colour: CIEDE2000 between
 //! [`Lut::sample`](crate::Lut::sample) and direct f64 evaluation of the film
-//! (`thinfilm::airy`) at the same (thickness, cos θ).
+//! (`thinfilm::airy`, integrated by `SpectralIntegrator::film_xyz`, exact at grazing) at the
+//! same (thickness, cos θ).
 //!
 //! The looked-up RGB is turned back into XYZ (undoing the reference-white normalisation
 //! for reflectivity and transmittance) and both colours go to CIELAB relative to the
@@ -123,13 +124,10 @@ fn direct_xyz(
         thickness_nm: f64::from(thickness_nm),
     };
     let cos_theta = f64::from(cos_theta);
-    integrator.xyz(|wavelength_nm| {
-        let response = film.response(wavelength_nm, cos_theta);
-        match table {
-            Table::Transmittance => response.t(),
-            Table::Reflectivity | Table::Light(_) => response.r(),
-        }
-    })
+    match table {
+        Table::Transmittance => integrator.film_transmitted_xyz(&film, cos_theta),
+        Table::Reflectivity | Table::Light(_) => integrator.film_xyz(&film, cos_theta),
+    }
 }
 
 /// `count` points spread uniformly over `0..=thickness_max_nm × 0..=1` by a fixed

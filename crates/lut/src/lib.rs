@@ -26,7 +26,7 @@ mod set;
 mod table;
 mod weights;
 
-pub use bake::{bake, bake_with_progress, progress_rows, spectral_samples};
+pub use bake::{bake, bake_point_sampled, bake_with_progress, progress_rows, spectral_samples};
 pub use config::{BakeConfig, BakeConfigBuilder, ConfigError, Light};
 pub use format::{Format, UnknownFormat};
 pub use load::LoadError;

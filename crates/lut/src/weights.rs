@@ -1,6 +1,7 @@
 //! Spectral weights for the fused bake kernel: one `(λ_k, n_film(λ_k), W_k)` list per
 //! table, so that a texel is `Σ_k W_k · R(d, cos θ, λ_k)` in one pass.
 
+use thinfilm::cells::CellWeights;
 use thinfilm::colorspace::{SRGB_FROM_XYZ, apply};
 use thinfilm::integrate::SpectralIntegrator;
 
@@ -14,6 +15,21 @@ pub(crate) struct Pass {
     pub wavelength_nm: Vec<f32>,
     pub n_film: Vec<f32>,
     pub weights: Vec<[f32; 3]>,
+    /// The same weights over cells, for the texels whose spectral lines are too narrow to
+    /// sample (`thinfilm::cells`); `None` without an even grid.
+    pub cells: Option<CellPass>,
+}
+
+/// A pass in cell form: cell means plus the emission lines sampled at their wavelength.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct CellPass {
+    /// The integrator's cells (for the thickness from which they are used).
+    pub cells: CellWeights,
+    pub n_film_edge: Vec<f64>,
+    pub n_film_cell: Vec<f64>,
+    pub weights: Vec<[f32; 3]>,
+    /// The lines alone, as a point pass (empty for a continuous spectrum).
+    pub lines: Box<Pass>,
 }
 
 /// The wavelengths at which `integrator` weighs anything (zero-weight samples, e.g. the
@@ -39,25 +55,55 @@ pub(crate) fn linear_srgb_white(integrator: &SpectralIntegrator) -> [f64; 3] {
 
 /// Builds a pass from per-sample linear-sRGB weights, dropping zero-weight samples.
 fn pass(config: &BakeConfig, integrator: &SpectralIntegrator, scale: [f64; 3]) -> Pass {
+    let samples = integrator.wavelengths_nm().iter().zip(integrator.weights());
+    let mut out = point_pass(config, samples, scale);
+    out.cells = integrator.cells().map(|cells| {
+        let n_at = |w: &f64| config.film_index.n_at(*w);
+        CellPass {
+            cells: cells.clone(),
+            n_film_edge: cells.edges_nm.iter().map(n_at).collect(),
+            n_film_cell: cells.centres_nm.iter().map(n_at).collect(),
+            weights: cells.weights.iter().map(|w| rgb_weight(w, scale)).collect(),
+            lines: Box::new(point_pass(
+                config,
+                cells.line_nm.iter().zip(&cells.line_weights),
+                scale,
+            )),
+        }
+    });
+    out
+}
+
+/// A point pass over `(wavelength, XYZ weight)` samples, without cells.
+fn point_pass<'a>(
+    config: &BakeConfig,
+    samples: impl Iterator<Item = (&'a f64, &'a [f64; 3])>,
+    scale: [f64; 3],
+) -> Pass {
     let mut out = Pass {
         wavelength_nm_f64: Vec::new(),
         wavelength_nm: Vec::new(),
         n_film: Vec::new(),
         weights: Vec::new(),
+        cells: None,
     };
-    for (&wavelength_nm, w) in integrator.wavelengths_nm().iter().zip(integrator.weights()) {
+    for (&wavelength_nm, w) in samples {
         if w.iter().all(|&c| c == 0.0) {
             continue;
         }
-        let rgb = apply(&SRGB_FROM_XYZ, *w);
         out.wavelength_nm_f64.push(wavelength_nm);
         out.wavelength_nm.push(wavelength_nm as f32);
         out.n_film
             .push(config.film_index.n_at(wavelength_nm) as f32);
-        out.weights
-            .push(std::array::from_fn(|c| (rgb[c] * scale[c]) as f32));
+        out.weights.push(rgb_weight(w, scale));
     }
     out
+}
+
+/// Linear-sRGB weight of an XYZ weight, scaled channel by channel, in f32.
+fn rgb_weight(xyz: &[f64; 3], scale: [f64; 3]) -> [f32; 3] {
+    let rgb = apply(&SRGB_FROM_XYZ, *xyz);
+    std::array::from_fn(|c| (rgb[c] * scale[c]) as f32)
 }
 
 /// The reflectivity pass: weights divided channel by channel by the reference white, so

@@ -151,6 +151,12 @@ impl Irradiance {
     pub(crate) fn is_finite(&self) -> bool {
         self.coeffs.iter().flatten().all(|c| c.is_finite())
     }
+
+    /// The nine coefficients in [`Irradiance::diffuse`]'s order (for the GPU backend).
+    #[cfg_attr(not(feature = "wgpu"), allow(dead_code))]
+    pub(crate) fn coeffs(&self) -> &[[f32; 3]; 9] {
+        &self.coeffs
+    }
 }
 
 fn accumulate(sum: &mut [[f64; 3]; 9], d: DVec3, radiance: [f32; 3], weight: f64) {

@@ -651,7 +651,7 @@ pub(crate) fn light_visibility(
 
 /// Width of the highlight filter in pixels: wide enough that the Gaussian's sum over the
 /// pixel grid ripples by 2·exp(−2π²σ²) ≈ 0.16 % with the sub-pixel offset.
-const HIGHLIGHT_SIGMA_PX: f32 = 0.6;
+pub(crate) const HIGHLIGHT_SIGMA_PX: f32 = 0.6;
 
 #[cfg(test)]
 mod tests {

@@ -24,11 +24,13 @@ const LIGHT_SEGMENTS: (usize, usize) = (16, 8);
 
 /// World-space opaque triangles with a material tag each.
 #[derive(Debug, Clone, Default)]
-struct Geometry {
-    positions: Vec<Vec3>,
-    attrs: Vec<[f32; ATTRS]>,
-    triangles: Vec<[u32; 3]>,
-    tags: Vec<u32>,
+pub(crate) struct Geometry {
+    pub positions: Vec<Vec3>,
+    /// Per vertex: normal x, y, z and texture u, v.
+    pub attrs: Vec<[f32; ATTRS]>,
+    pub triangles: Vec<[u32; 3]>,
+    /// Per triangle: the material index, or [`EMISSIVE`] with a light's index.
+    pub tags: Vec<u32>,
 }
 
 impl Geometry {
@@ -278,37 +280,7 @@ impl Renderer {
 
     /// Fills the world-space object and light-sphere geometry; returns the material table.
     fn tessellate<'s>(&mut self, scene: &'s RenderScene) -> Vec<&'s Material> {
-        self.objects.clear();
-        self.light_spheres.clear();
-        let mut materials = Vec::with_capacity(scene.objects.len());
-        for (k, object) in scene.objects.iter().enumerate() {
-            materials.push(object.material());
-            let tag = k as u32;
-            match object {
-                Object::Sphere {
-                    center, radius_m, ..
-                } => {
-                    let (s, r) = SPHERE_SEGMENTS;
-                    self.objects
-                        .push(&TriMesh::uv_sphere(*center, *radius_m, s, r), tag);
-                }
-                Object::Box {
-                    center,
-                    half_extents_m,
-                    ..
-                } => {
-                    self.objects
-                        .push(&TriMesh::cuboid(*center, *half_extents_m), tag);
-                }
-                Object::Mesh { mesh, .. } => self.objects.push(mesh, tag),
-            }
-        }
-        for (k, light) in scene.lights.iter().enumerate() {
-            let (s, r) = LIGHT_SEGMENTS;
-            let mesh = TriMesh::uv_sphere(light.position, light.radius_m, s, r);
-            self.light_spheres.push(&mesh, EMISSIVE | k as u32);
-        }
-        materials
+        tessellate(scene, &mut self.objects, &mut self.light_spheres)
     }
 
     /// Sets up bubble triangles: bubbles far to near, each bubble's back faces then front faces.
@@ -446,6 +418,42 @@ fn resolve(out: &mut [[f32; 3]], color: &[[f32; 3]], samples: usize) {
     }
 }
 
+/// Fills `objects` and `light_spheres` with the scene's world-space triangles (both
+/// backends draw these same triangles); returns the material table `objects`' tags index.
+pub(crate) fn tessellate<'s>(
+    scene: &'s RenderScene,
+    objects: &mut Geometry,
+    light_spheres: &mut Geometry,
+) -> Vec<&'s Material> {
+    objects.clear();
+    light_spheres.clear();
+    let mut materials = Vec::with_capacity(scene.objects.len());
+    for (k, object) in scene.objects.iter().enumerate() {
+        materials.push(object.material());
+        let tag = k as u32;
+        match object {
+            Object::Sphere {
+                center, radius_m, ..
+            } => {
+                let (s, r) = SPHERE_SEGMENTS;
+                objects.push(&TriMesh::uv_sphere(*center, *radius_m, s, r), tag);
+            }
+            Object::Box {
+                center,
+                half_extents_m,
+                ..
+            } => objects.push(&TriMesh::cuboid(*center, *half_extents_m), tag),
+            Object::Mesh { mesh, .. } => objects.push(mesh, tag),
+        }
+    }
+    for (k, light) in scene.lights.iter().enumerate() {
+        let (s, r) = LIGHT_SEGMENTS;
+        let mesh = TriMesh::uv_sphere(light.position, light.radius_m, s, r);
+        light_spheres.push(&mesh, EMISSIVE | k as u32);
+    }
+    materials
+}
+
 /// Bubble indices in drawing order, far to near, by the power distance `|c − e|² − r²` of
 /// each bubble's sphere (centre `c`, `r²` the mean squared vertex distance from it) to the
 /// eye `e`: for non-overlapping spheres, a sphere in front of another along any ray has
@@ -472,7 +480,7 @@ pub(crate) fn far_to_near(bubbles: &[BubbleMesh], eye: Vec3) -> Vec<usize> {
 
 /// Whether triangle `t` faces the eye, its outward side taken from the vertex normals
 /// (so the mesh's winding does not matter).
-fn is_front_facing(bubble: &BubbleMesh, t: [u32; 3], eye: Vec3) -> bool {
+pub(crate) fn is_front_facing(bubble: &BubbleMesh, t: [u32; 3], eye: Vec3) -> bool {
     let [a, b, c] = t.map(|i| bubble.positions[i as usize]);
     let geometric = (b - a).cross(c - a);
     let normals: Vec3 = t.iter().map(|&i| bubble.normals[i as usize]).sum();
@@ -486,7 +494,7 @@ fn is_front_facing(bubble: &BubbleMesh, t: [u32; 3], eye: Vec3) -> bool {
 
 /// Angle swept by the reflected direction per pixel across triangle `t` (radians), for
 /// anti-aliasing light highlights; clamped to `[1e-4, 0.5]`.
-fn reflection_rate(view: &View, bubble: &BubbleMesh, t: [u32; 3]) -> f32 {
+pub(crate) fn reflection_rate(view: &View, bubble: &BubbleMesh, t: [u32; 3]) -> f32 {
     let mut reflected = [Vec3::ZERO; 3];
     let mut pixels = [(0.0f32, 0.0f32); 3];
     for (k, &i) in t.iter().enumerate() {

@@ -34,7 +34,7 @@ fn filtered_square(x: f32, footprint: f32) -> f32 {
 }
 
 /// Footprints below this many checker cells along an axis count as flat (no extent).
-const FLAT_FOOTPRINT_CELLS: f32 = 1e-3;
+pub(crate) const FLAT_FOOTPRINT_CELLS: f32 = 1e-3;
 
 /// Albedo of `material` at world point `p` with mesh UV `uv`; a checker is box-filtered
 /// over `footprint`, the world-space extent (metres per axis) one pixel covers there

@@ -161,15 +161,10 @@ fn film_xyz<'py>(
                 .map(|i| {
                     let film = ThinFilm::symmetric(1.0, film_index, d[i]);
                     let incidence = Incidence::try_from_angle_deg(angle[i])?;
-                    let mut failure = None;
-                    let xyz = integrator.xyz(|w| match film.try_response_at(w, incidence) {
-                        Ok(resp) => resp.r(),
-                        Err(e) => {
-                            failure = Some(e);
-                            0.0
-                        }
-                    });
-                    failure.map_or(Ok(xyz), Err)
+                    // Checked here so that `film_xyz` (cell means near grazing, where the
+                    // film's spectral lines are too narrow to sample) cannot panic.
+                    film.try_response_at(550.0, incidence)?;
+                    Ok(integrator.film_xyz_at(&film, incidence))
                 })
                 .collect::<Result<_, OpticsError>>()
         })

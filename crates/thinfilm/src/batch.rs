@@ -24,6 +24,7 @@
 
 use crate::fresnel::{self, OpticsError};
 
+mod cells;
 mod kernel;
 mod term;
 
@@ -176,6 +177,129 @@ pub fn try_weighted_response_row(
     let out = RowOut { r: out_r, t: out_t };
     kernel::weighted_row::<true>(&terms, &half_weights, thickness_nm, out);
     Ok(())
+}
+
+/// One table's spectrum as cells ([`crate::cells`]) for [`try_weighted_cell_row`]:
+/// `edge_nm.len() == weights.len() + 1`, the other slices one entry per cell.
+#[derive(Clone, Copy, Debug)]
+pub struct CellSpectrum<'a> {
+    /// Cell edges in nm, strictly increasing.
+    pub edge_nm: &'a [f64],
+    /// The film's index at each edge.
+    pub n_film_edge: &'a [f64],
+    /// The film's index at each cell's node, for its Fresnel coefficients.
+    pub n_film_cell: &'a [f64],
+    /// Weight of each cell's mean reflectance.
+    pub weights: &'a [[f32; 3]],
+}
+
+/// For one incidence angle: `out[i] = Σ_c weights[c] · mean_c R(thickness_nm[i])`, the mean
+/// of the symmetric film's reflectance over cell c, exact however narrow its spectral lines
+/// (the f32 form of [`crate::cells::cell_mean_reflectance`], which it matches to about 1e-5).
+///
+/// # Errors
+/// [`OpticsError`] naming the bad input: `n_outside` or an index not finite and `> 0`,
+/// `cos_theta_outside` outside (0, 1], the film within reach of its critical angle at some
+/// edge (`cos² θ_t < 1e-4`), edges not finite, positive and increasing, a non-finite weight,
+/// a thickness not finite and `> 0`, or mismatched lengths. On error `out` is untouched.
+pub fn try_weighted_cell_row(
+    n_outside: f32,
+    cos_theta_outside: f32,
+    spectrum: &CellSpectrum<'_>,
+    thickness_nm: &[f32],
+    out: &mut [[f32; 3]],
+) -> Result<(), OpticsError> {
+    let (edge_q, row_cells) = cell_terms(n_outside as f64, cos_theta_outside as f64, spectrum)?;
+    check_len("out", out.len(), thickness_nm.len())?;
+    for &d in thickness_nm {
+        if !(d.is_finite() && d > 0.0) {
+            return Err(OpticsError::Thickness {
+                thickness_nm: d as f64,
+            });
+        }
+    }
+    let half_weights: Vec<[f32; 3]> = spectrum
+        .weights
+        .iter()
+        .map(|w| w.map(|x| 0.5 * x))
+        .collect();
+    let row = cells::CellRow {
+        edge_q: &edge_q,
+        cells: &row_cells,
+        half_weights: &half_weights,
+    };
+    cells::weighted_cell_row(&row, thickness_nm, out);
+    Ok(())
+}
+
+/// Validates a cell row and works out each edge's phase rate and each cell's constants.
+fn cell_terms(
+    n_outside: f64,
+    cos_outside: f64,
+    spectrum: &CellSpectrum<'_>,
+) -> Result<(Vec<term::Split>, Vec<cells::Cell>), OpticsError> {
+    fresnel::check_real_index("n_outside", n_outside)?;
+    if !(cos_outside > 0.0 && cos_outside <= 1.0) {
+        return Err(OpticsError::Cosine {
+            what: "cos_theta_outside (cell means need 0 < cos θ <= 1)",
+            value: cos_outside,
+        });
+    }
+    let k = spectrum.weights.len();
+    check_len("edge_nm", spectrum.edge_nm.len(), k + 1)?;
+    check_len("n_film_edge", spectrum.n_film_edge.len(), k + 1)?;
+    check_len("n_film_cell", spectrum.n_film_cell.len(), k)?;
+    let sin2 = 1.0 - cos_outside * cos_outside;
+    let cos_in_film = |n: f64| -> Result<f64, OpticsError> {
+        fresnel::check_real_index("n_film", n)?;
+        let cos2 = 1.0 - (n_outside / n).powi(2) * sin2;
+        if cos2 < crate::cells::MIN_COS2_IN_FILM {
+            return Err(OpticsError::Cosine {
+                what: "cos_theta_outside (the film is near its critical angle there)",
+                value: cos_outside,
+            });
+        }
+        Ok(cos2.sqrt())
+    };
+    let mut edge_q = Vec::with_capacity(k + 1);
+    let mut q = Vec::with_capacity(k + 1);
+    for (i, (&wavelength_nm, &n)) in spectrum
+        .edge_nm
+        .iter()
+        .zip(spectrum.n_film_edge)
+        .enumerate()
+    {
+        fresnel::check_wavelength(wavelength_nm)?;
+        if i > 0 && wavelength_nm <= spectrum.edge_nm[i - 1] {
+            return Err(OpticsError::NotFinite {
+                what: "edge_nm (must increase)",
+                index: i,
+                value: wavelength_nm,
+            });
+        }
+        let rate = 2.0 * n * cos_in_film(n)? / wavelength_nm;
+        q.push(rate);
+        edge_q.push(term::Split::of_f64(rate));
+    }
+    let mut row_cells = Vec::with_capacity(k);
+    for (c, (&n, w)) in spectrum
+        .n_film_cell
+        .iter()
+        .zip(spectrum.weights)
+        .enumerate()
+    {
+        if let Some(bad) = w.iter().find(|x| !x.is_finite()) {
+            return Err(not_finite("weights", c, *bad));
+        }
+        let cos1 = cos_in_film(n)?;
+        let (a_s, b_s) = crate::cells::line_area(n_outside * cos_outside, n * cos1);
+        let (a_p, b_p) = crate::cells::line_area(n_outside * cos1, n * cos_outside);
+        row_cells.push(cells::Cell {
+            area: [a_s, b_s, a_p, b_p].map(|x| x as f32),
+            inv_span: (1.0 / (std::f64::consts::PI * (q[c] - q[c + 1]))) as f32,
+        });
+    }
+    Ok((edge_q, row_cells))
 }
 
 /// The inputs of one weighted row.

@@ -12,6 +12,7 @@
 
 use std::fmt;
 
+use crate::cells::CellWeights;
 use crate::cmf::Observer;
 use crate::spectrum::Spectrum;
 
@@ -81,6 +82,7 @@ pub struct SpectralIntegrator {
     wavelength_nm: Vec<f64>,
     weight: Vec<[f64; 3]>,
     white_xyz: [f64; 3],
+    cells: Option<CellWeights>,
 }
 
 impl SpectralIntegrator {
@@ -117,12 +119,15 @@ impl SpectralIntegrator {
         if !(MIN_STEP_NM..=MAX_STEP_NM).contains(&step_nm) {
             return Err(IntegrateError::BadStep { step_nm });
         }
-        let mut samples = match quadrature {
-            Quadrature::PointSample => point_weights(observer, illuminant, step_nm),
+        let (mut samples, grid) = match quadrature {
+            Quadrature::PointSample => (point_weights(observer, illuminant, step_nm), None),
             Quadrature::Linear | Quadrature::Cubic | Quadrature::Quintic => {
-                basis_weights(observer, illuminant, step_nm, quadrature)
+                let (samples, spacing_nm) =
+                    basis_weights(observer, illuminant, step_nm, quadrature);
+                (samples, Some(spacing_nm))
             }
         };
+        let nodes = samples.len();
         samples.extend(
             illuminant
                 .lines()
@@ -136,11 +141,22 @@ impl SpectralIntegrator {
         if !(norm.is_finite() && norm > 0.0) {
             return Err(IntegrateError::NoVisiblePower);
         }
-        Ok(Self::from_samples(samples, norm))
+        let normalised = |s: &(f64, [f64; 3])| (s.0, s.1.map(|c| c / norm));
+        let cells = grid.map(|spacing_nm| {
+            let node_weights: Vec<[f64; 3]> =
+                samples[..nodes].iter().map(|s| normalised(s).1).collect();
+            let lines = samples[nodes..].iter().map(normalised).collect();
+            CellWeights::from_grid(Observer::MIN_NM, spacing_nm, &node_weights, lines)
+        });
+        Ok(Self::from_samples(samples, norm, cells))
     }
 
     /// Sorts, merges coincident wavelengths, drops zero weights and normalises.
-    fn from_samples(mut samples: Vec<(f64, [f64; 3])>, norm: f64) -> SpectralIntegrator {
+    fn from_samples(
+        mut samples: Vec<(f64, [f64; 3])>,
+        norm: f64,
+        cells: Option<CellWeights>,
+    ) -> SpectralIntegrator {
         samples.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut merged: Vec<(f64, [f64; 3])> = Vec::with_capacity(samples.len());
         for (w, v) in samples {
@@ -161,6 +177,7 @@ impl SpectralIntegrator {
             wavelength_nm,
             weight,
             white_xyz,
+            cells,
         }
     }
 
@@ -205,6 +222,12 @@ impl SpectralIntegrator {
     pub fn white_xyz(&self) -> [f64; 3] {
         self.white_xyz
     }
+
+    /// The same weights over cells around the grid's nodes, for films whose spectral lines
+    /// are too narrow to sample ([`crate::cells`]); `None` for point sampling.
+    pub fn cells(&self) -> Option<&CellWeights> {
+        self.cells.as_ref()
+    }
 }
 
 /// ∫E ȳ dλ: the CIE 1 nm summation of the continuous part plus the lines'
@@ -247,7 +270,7 @@ fn basis_weights(
     illuminant: &Spectrum,
     step_nm: f64,
     quadrature: Quadrature,
-) -> Vec<(f64, [f64; 3])> {
+) -> (Vec<(f64, [f64; 3])>, f64) {
     let span = Observer::MAX_NM - Observer::MIN_NM;
     let intervals = ((span / step_nm - 1e-9).ceil() as usize).max(1);
     let spacing_nm = span / intervals as f64;
@@ -268,11 +291,12 @@ fn basis_weights(
             (0..3).for_each(|i| weight[node][i] += b * e * c[i]);
         }
     }
-    weight
+    let samples = weight
         .into_iter()
         .enumerate()
         .map(|(k, v)| (Observer::MIN_NM + span * k as f64 / intervals as f64, v))
-        .collect()
+        .collect();
+    (samples, spacing_nm)
 }
 
 impl Quadrature {

@@ -22,7 +22,8 @@
 //! any thickness), [`dispersion`] (real models, each with its wavelength range), [`index`]
 //! (complex and tabulated n,k models), [`incidence`] (angle or sin θ, exact at grazing),
 //! and the f32 fast path [`batch`]. Colour, split pbrt-style:
-//! [`spectrum`], [`cmf`], [`illuminant`], [`integrate`], [`colorspace`], [`lab`].
+//! [`spectrum`], [`cmf`], [`illuminant`], [`integrate`] (with [`cells`], exact at grazing
+//! incidence), [`colorspace`], [`lab`].
 
 pub mod airy;
 pub mod batch;
@@ -32,6 +33,7 @@ pub mod incidence;
 pub mod index;
 pub mod tmm;
 
+pub mod cells;
 pub mod cmf;
 pub mod colorspace;
 pub mod illuminant;

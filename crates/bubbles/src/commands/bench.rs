@@ -55,7 +55,8 @@ pub fn run(args: Args) -> CliResult {
     let mut job = FrameJob::prepare(args.scene.as_deref(), &args.options)?;
     let mut report = String::new();
     report.push_str(&format!(
-        "threads: {}, samples: {}, reflection: {:?}, one solver step (dt = {:.6} s) per frame\n",
+        "backend: {}, threads: {}, samples: {}, reflection: {:?}, one solver step (dt = {:.6} s) per frame\n",
+        job.backend_name(),
         rayon::current_num_threads(),
         job.settings().samples,
         job.settings().reflection,

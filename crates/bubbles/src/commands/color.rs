@@ -133,9 +133,15 @@ impl FilmColour {
             ..ThinFilm::soap(0.0)
         };
         let cos_theta = angle_deg.to_radians().cos().clamp(0.0, 1.0);
-        let xyz = self
-            .integrator
-            .xyz(|w| film.try_response(w, cos_theta).map_or(f64::NAN, |r| r.r()));
+        // A valid film goes through `film_xyz`, exact at grazing incidence (cell means);
+        // anything else is sampled so that the failure surfaces as an error, not a panic.
+        let valid = film.validate().is_ok() && thickness_nm.is_finite() && thickness_nm >= 0.0;
+        let xyz = if valid {
+            self.integrator.film_xyz(&film, cos_theta)
+        } else {
+            self.integrator
+                .xyz(|w| film.try_response(w, cos_theta).map_or(f64::NAN, |r| r.r()))
+        };
         if xyz.iter().all(|c| c.is_finite()) {
             Ok(xyz)
         } else {

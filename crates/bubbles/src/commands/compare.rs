@@ -1,5 +1,5 @@
-//! `bubbles compare A.png B.png`: CIEDE2000 between two renders (mean, 95th percentile,
-//! maximum), optionally a heat map with a colour bar.
+//! `bubbles compare A.png B.png`: CIEDE2000 between two renders (mean, 95th and 99th
+//! percentiles, maximum), optionally a heat map with a colour bar.
 
 use crate::error::{CliError, CliResult};
 use std::path::{Path, PathBuf};
@@ -31,6 +31,8 @@ pub struct Stats {
     pub mean: f64,
     /// 95th percentile (nearest rank).
     pub p95: f64,
+    /// 99th percentile (nearest rank).
+    pub p99: f64,
     /// Largest ΔE2000.
     pub max: f64,
 }
@@ -63,20 +65,22 @@ pub fn run(args: Args) -> CliResult {
     }
     if args.json {
         println!(
-            "{{\"width\": {}, \"height\": {}, \"mean\": {}, \"p95\": {}, \"max\": {}}}",
+            "{{\"width\": {}, \"height\": {}, \"mean\": {}, \"p95\": {}, \"p99\": {}, \"max\": {}}}",
             a.width(),
             a.height(),
             stats.mean,
             stats.p95,
+            stats.p99,
             stats.max
         );
     } else {
         println!(
-            "ΔE2000 over {}x{} pixels: mean {:.3}, 95th percentile {:.3}, max {:.3}",
+            "ΔE2000 over {}x{} pixels: mean {:.3}, 95th percentile {:.3}, 99th percentile {:.3}, max {:.3}",
             a.width(),
             a.height(),
             stats.mean,
             stats.p95,
+            stats.p99,
             stats.max
         );
     }
@@ -108,21 +112,26 @@ pub fn delta_e_map(a: &[u8], b: &[u8]) -> Vec<f64> {
         .collect()
 }
 
-/// Mean, 95th percentile (nearest rank) and maximum; all zero for no pixels.
+/// Mean, 95th and 99th percentiles (nearest rank) and maximum; all zero for no pixels.
 pub fn stats(de: &[f64]) -> Stats {
     if de.is_empty() {
         return Stats {
             mean: 0.0,
             p95: 0.0,
+            p99: 0.0,
             max: 0.0,
         };
     }
     let mut sorted = de.to_vec();
     sorted.sort_by(f64::total_cmp);
-    let rank = ((0.95 * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len());
+    let percentile = |p: f64| {
+        let rank = ((p * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len());
+        sorted[rank - 1]
+    };
     Stats {
         mean: sorted.iter().sum::<f64>() / sorted.len() as f64,
-        p95: sorted[rank - 1],
+        p95: percentile(0.95),
+        p99: percentile(0.99),
         max: sorted[sorted.len() - 1],
     }
 }
@@ -265,7 +274,7 @@ mod tests {
     fn percentile_is_the_nearest_rank() {
         let de: Vec<f64> = (1..=100).map(f64::from).collect();
         let s = stats(&de);
-        assert_eq!((s.p95, s.max, s.mean), (95.0, 100.0, 50.5));
+        assert_eq!((s.p95, s.p99, s.max, s.mean), (95.0, 99.0, 100.0, 50.5));
     }
 
     #[test]

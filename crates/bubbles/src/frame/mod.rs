@@ -1,5 +1,6 @@
 //! One frame's work shared by `render` and `bench`: scene → solver → tables → renderer.
 
+mod gpu;
 pub mod progress;
 pub mod reference;
 
@@ -28,7 +29,8 @@ pub struct Options {
     /// Anti-aliasing samples per pixel: 1, 4, 8, 9 or 16 (default: the scene's, else 4).
     #[arg(long)]
     pub samples: Option<u32>,
-    /// Rendering backend: the real-time CPU rasteriser, or the spectral reference tracer.
+    /// Rendering backend: the real-time CPU rasteriser, the same frame on the GPU through
+    /// wgpu (needs a build with `--features wgpu`), or the spectral reference tracer.
     #[arg(long, value_enum, default_value_t = Backend::Cpu)]
     pub backend: Backend,
     #[command(flatten)]
@@ -60,6 +62,8 @@ pub enum Backend {
     /// The pure-CPU sorted-triangle renderer.
     #[default]
     Cpu,
+    /// The same pipeline on the GPU through wgpu (Vulkan; a build with `--features wgpu`).
+    Wgpu,
     /// The spectral reference ray tracer (slow; the truth the CPU backend is measured against).
     Reference,
 }
@@ -97,6 +101,8 @@ pub struct FrameJob {
     tables: FilmTables,
     settings: RenderSettings,
     renderer: Renderer,
+    /// The wgpu renderer when `--backend wgpu`.
+    gpu: Option<gpu::GpuBackend>,
     /// The film for the reference backend; `None` for the CPU backend.
     film_spec: Option<raster::reference::FilmSpec>,
     reference: reference::ReferenceOptions,
@@ -128,10 +134,15 @@ impl FrameJob {
         }
         let settings = settings(&scene, &render_scene, options)?;
         let film_spec = match options.backend {
-            Backend::Cpu => None,
+            Backend::Cpu | Backend::Wgpu => None,
             Backend::Reference => Some(scene.film_spec(&render_scene.lights)?),
         };
+        let gpu = match options.backend {
+            Backend::Wgpu => Some(gpu::GpuBackend::open()?),
+            Backend::Cpu | Backend::Reference => None,
+        };
         Ok(Self {
+            gpu,
             film_spec,
             reference: options.reference.clone(),
             reference_frame: Frame::default(),
@@ -163,6 +174,15 @@ impl FrameJob {
     /// Number of bubbles still alive.
     pub fn bubble_count(&self) -> usize {
         self.world.bubbles().len()
+    }
+
+    /// The backend in use, for reports (`"wgpu on <adapter>"` for the GPU backend).
+    pub fn backend_name(&self) -> String {
+        match (&self.gpu, &self.film_spec) {
+            (Some(gpu), _) => format!("wgpu on {}", gpu.adapter_name()),
+            (None, Some(_)) => "reference".to_string(),
+            (None, None) => "cpu".to_string(),
+        }
     }
 
     /// The render settings in force.
@@ -222,6 +242,11 @@ impl FrameJob {
             let settings = self.reference.settings(&self.settings);
             self.reference_frame = reference::render(&self.render_scene, spec, &settings, true)?;
             return Ok(&self.reference_frame);
+        }
+        if let Some(gpu) = &mut self.gpu {
+            return gpu
+                .render(&self.render_scene, &self.tables, &self.settings)
+                .map_err(|e| CliError::input(format!("{}: {e}", self.scene.origin)));
         }
         self.renderer
             .render(&self.render_scene, &self.tables, &self.settings)

@@ -2,6 +2,7 @@
 
 use super::Scene;
 use super::schema::{BubbleSpec, ObjectSpec};
+use super::values::{numbers, plain};
 use crate::error::CliError;
 use bubble_dynamics::{
     BubbleParams, Collider, DVec3, Gusts, Integrator, SimError, Wind, World, WorldParams,
@@ -20,14 +21,30 @@ impl Scene {
 
     /// The scene's name for each solver collider, in [`Scene::colliders`]'s order.
     fn collider_names(&self) -> Vec<String> {
-        let ground = self.file.ground.iter().map(|_| "the ground".to_string());
+        // Each name carries the keys that place the collider: a refusal caused by a
+        // bad ground height or box corner must name the key the user wrote.
+        let ground = self
+            .file
+            .ground
+            .iter()
+            .map(|g| format!("the ground (ground.height_m = {})", plain(g.height_m.get())));
         let objects = self.file.objects.iter().enumerate().filter_map(|(i, o)| {
-            let kind = match o {
-                ObjectSpec::Sphere { .. } => "sphere",
-                ObjectSpec::Box { .. } => "box",
+            let place = match o {
+                ObjectSpec::Sphere {
+                    center_m, radius_m, ..
+                } => format!(
+                    "sphere, center_m = {}, radius_m = {}",
+                    numbers(&center_m.get()),
+                    plain(radius_m.get())
+                ),
+                ObjectSpec::Box { min_m, max_m, .. } => format!(
+                    "box, min_m = {}, max_m = {}",
+                    numbers(&min_m.get()),
+                    numbers(&max_m.get())
+                ),
                 ObjectSpec::Mesh { .. } => return None,
             };
-            Some(format!("[[objects]] #{} ({kind})", i + 1))
+            Some(format!("[[objects]] #{} ({place})", i + 1))
         });
         let water = self
             .file

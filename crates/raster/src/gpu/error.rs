@@ -3,7 +3,7 @@
 use std::fmt;
 
 /// Why the wgpu backend failed.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum GpuError {
     /// No adapter (GPU or software Vulkan driver) was found.
     NoAdapter {
@@ -21,6 +21,10 @@ pub enum GpuError {
     },
     /// Mapping the read-back buffer failed.
     Readback(String),
+    /// The scene or settings are invalid (the same check as the CPU backend's).
+    Invalid(crate::RenderError),
+    /// The scene uses something the wgpu backend does not draw (named).
+    Unsupported(String),
 }
 
 impl fmt::Display for GpuError {
@@ -39,8 +43,19 @@ impl fmt::Display for GpuError {
                 size.0, size.1
             ),
             GpuError::Readback(reason) => write!(f, "reading the frame back failed: {reason}"),
+            GpuError::Invalid(e) => write!(f, "{e}"),
+            GpuError::Unsupported(what) => write!(
+                f,
+                "the wgpu backend does not support {what} yet; use --backend cpu"
+            ),
         }
     }
 }
 
 impl std::error::Error for GpuError {}
+
+impl From<crate::RenderError> for GpuError {
+    fn from(e: crate::RenderError) -> Self {
+        GpuError::Invalid(e)
+    }
+}

@@ -2,6 +2,10 @@
 //! backends share one source of truth: a shader names `{{SHARED_CONSTANTS}}` where the
 //! generated block goes.
 
+use super::scene_data::{
+    ENV_SKY, ENV_UNIFORM, NO_TABLE, PATTERN_CHECKER, PATTERN_SOLID, REFLECTION_CUBE,
+    REFLECTION_ENVIRONMENT,
+};
 use crate::frame::{
     ACES_DENOMINATOR, ACES_FROM_SRGB, ACES_INPUT_MAX, ACES_NUMERATOR, SRGB_FROM_ACES, SRGB_GAMMA,
     SRGB_LINEAR_MAX, SRGB_LINEAR_SLOPE, SRGB_OFFSET, SRGB_SCALE,
@@ -45,6 +49,32 @@ pub(super) fn shared_constants() -> String {
         ("SRGB_GAMMA", SRGB_GAMMA),
     ] {
         out += &format!("const {name}: f32 = {};\n", float(value));
+    }
+    out + &scene_constants()
+}
+
+/// The scene passes' constants: the CPU's highlight filter width and emissive tag bit, and
+/// the encodings `scene_data` packs the uniforms with.
+fn scene_constants() -> String {
+    let mut out = String::new();
+    for (name, value) in [
+        ("HIGHLIGHT_SIGMA_PX", crate::passes::HIGHLIGHT_SIGMA_PX),
+        ("PI", std::f32::consts::PI),
+        ("PATTERN_SOLID", PATTERN_SOLID),
+        ("PATTERN_CHECKER", PATTERN_CHECKER),
+        ("FLAT_FOOTPRINT_CELLS", crate::shading::FLAT_FOOTPRINT_CELLS),
+    ] {
+        out += &format!("const {name}: f32 = {};\n", float(value));
+    }
+    for (name, value) in [
+        ("EMISSIVE", crate::passes::EMISSIVE),
+        ("ENV_SKY", ENV_SKY),
+        ("ENV_UNIFORM", ENV_UNIFORM),
+        ("REFLECTION_CUBE", REFLECTION_CUBE),
+        ("REFLECTION_ENVIRONMENT", REFLECTION_ENVIRONMENT),
+        ("NO_TABLE", NO_TABLE),
+    ] {
+        out += &format!("const {name}: u32 = {value}u;\n");
     }
     out
 }

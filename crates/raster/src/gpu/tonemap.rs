@@ -64,6 +64,19 @@ impl Gpu {
             depth_or_array_layers: 1,
         };
         let hdr = self.upload_hdr(frame, size);
+        self.tone_map_texture(&hdr, size, exposure_ev, tonemap)
+    }
+
+    /// Tone-maps the HDR texture `hdr` (already written, or written by work submitted
+    /// before this call) into interleaved 8-bit sRGB, as [`Frame::to_srgb8`].
+    pub(super) fn tone_map_texture(
+        &self,
+        hdr: &wgpu::Texture,
+        size: wgpu::Extent3d,
+        exposure_ev: f32,
+        tonemap: ToneMap,
+    ) -> Result<Vec<u8>, GpuError> {
+        let (w, h) = (size.width, size.height);
         let ldr = self.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("ldr"),
             size,
@@ -104,7 +117,7 @@ impl Gpu {
             pass.set_bind_group(0, &bind, &[]);
             pass.dispatch_workgroups(w.div_ceil(GROUP_SIDE), h.div_ceil(GROUP_SIDE), 1);
         }
-        let rgba = self.read_back_rgba8(encoder, &ldr, size)?;
+        let rgba = self.read_back(encoder, &ldr, size, 4)?;
         Ok(rgba
             .chunks_exact(4)
             .flat_map(|p| [p[0], p[1], p[2]])
@@ -142,15 +155,16 @@ impl Gpu {
         texture
     }
 
-    /// Copies an RGBA8 texture into a mappable buffer and returns its rows without the
-    /// 256-byte row padding that texture-to-buffer copies require.
-    pub(super) fn read_back_rgba8(
+    /// Copies a texture of `texel_bytes` per texel into a mappable buffer and returns its
+    /// rows without the 256-byte row padding that texture-to-buffer copies require.
+    pub(super) fn read_back(
         &self,
         mut encoder: wgpu::CommandEncoder,
         texture: &wgpu::Texture,
         size: wgpu::Extent3d,
+        texel_bytes: u32,
     ) -> Result<Vec<u8>, GpuError> {
-        let row_bytes = size.width * 4;
+        let row_bytes = size.width * texel_bytes;
         let padded = row_bytes.next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
         let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("read back"),

@@ -1,0 +1,65 @@
+//! `--backend wgpu`: the wgpu renderer when the binary was built with the `wgpu` feature,
+//! else an error saying how to get it.
+
+use crate::error::CliError;
+use raster::{FilmTables, Frame, RenderScene, RenderSettings};
+
+/// The wgpu renderer (only with the `wgpu` feature).
+#[cfg(feature = "wgpu")]
+pub struct GpuBackend(raster::gpu::GpuRenderer);
+
+/// Stands in for the wgpu renderer in a build without the feature; never constructed.
+#[cfg(not(feature = "wgpu"))]
+pub enum GpuBackend {}
+
+#[cfg(feature = "wgpu")]
+impl GpuBackend {
+    /// Opens the first suitable adapter; without one, an input error (exit 2) naming the
+    /// driver package, `VK_DRIVER_FILES` and `--backend cpu`.
+    pub fn open() -> Result<Self, CliError> {
+        raster::gpu::GpuRenderer::new(raster::gpu::GpuOptions::default())
+            .map(GpuBackend)
+            .map_err(|e| CliError::input(format!("--backend wgpu: {e}")))
+    }
+
+    /// The adapter's name and driver.
+    pub fn adapter_name(&self) -> String {
+        self.0.gpu().adapter_name()
+    }
+
+    /// Renders one frame on the GPU and reads it back.
+    pub fn render(
+        &mut self,
+        scene: &RenderScene,
+        tables: &FilmTables,
+        settings: &RenderSettings,
+    ) -> Result<&Frame, raster::gpu::GpuError> {
+        self.0.render(scene, tables, settings)
+    }
+}
+
+#[cfg(not(feature = "wgpu"))]
+impl GpuBackend {
+    /// Always an input error (exit 2): this binary has no wgpu backend.
+    pub fn open() -> Result<Self, CliError> {
+        Err(CliError::input(
+            "--backend wgpu: this bubbles was built without the wgpu backend; rebuild it with \
+             `cargo build --release -p bubbles --features wgpu`, or use --backend cpu",
+        ))
+    }
+
+    /// Unreachable: no value of this type exists.
+    pub fn adapter_name(&self) -> String {
+        match *self {}
+    }
+
+    /// Unreachable: no value of this type exists.
+    pub fn render(
+        &mut self,
+        _: &RenderScene,
+        _: &FilmTables,
+        _: &RenderSettings,
+    ) -> Result<&Frame, std::convert::Infallible> {
+        match *self {}
+    }
+}

@@ -1,0 +1,117 @@
+//! `--backend wgpu` end to end against the CPU backend (the specification), issue 12.
+//!
+//! Runs with `cargo test -p bubbles --features wgpu --test cli_wgpu`. Without an adapter
+//! the image tests skip with a message, except under `CI=true`, where they fail.
+#![cfg(feature = "wgpu")]
+
+use std::path::Path;
+
+mod common;
+use common::{bubbles, stderr};
+
+/// Renders built-in `scene` at 400×400 to `out` with `backend`; `false` (skip) outside CI
+/// when the wgpu backend finds no adapter.
+fn render(scene: &str, backend: &str, out: &str, dir: &Path) -> bool {
+    let args = [
+        "render",
+        scene,
+        "--backend",
+        backend,
+        "--width",
+        "400",
+        "--height",
+        "400",
+        "--out",
+        out,
+    ];
+    let run = bubbles(&args, dir);
+    let err = stderr(&run);
+    if !run.status.success() && err.contains("no wgpu adapter") && std::env::var_os("CI").is_none()
+    {
+        eprintln!("skipped: {err}");
+        return false;
+    }
+    assert!(run.status.success(), "{backend}: {err}");
+    true
+}
+
+fn json_field(json: &str, key: &str) -> f64 {
+    let start = json.find(&format!("\"{key}\": ")).expect(key) + key.len() + 4;
+    let rest = &json[start..];
+    let end = rest.find([',', '}']).unwrap();
+    rest[..end].trim().parse().unwrap()
+}
+
+#[test]
+fn paper_through_wgpu_matches_the_cpu_backend_in_ciede2000() {
+    let dir = tempfile::tempdir().unwrap();
+    if !render("paper", "wgpu", "gpu.png", dir.path()) {
+        return;
+    }
+    assert!(render("paper", "cpu", "cpu.png", dir.path()));
+    let out = bubbles(&["compare", "cpu.png", "gpu.png", "--json"], dir.path());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json = String::from_utf8_lossy(&out.stdout);
+    eprintln!("paper, CPU vs wgpu: {json}");
+    let (mean, p99) = (json_field(&json, "mean"), json_field(&json, "p99"));
+    assert!(mean <= 0.5, "mean ΔE2000 {mean} > 0.5: {json}");
+    assert!(p99 <= 2.0, "99th percentile ΔE2000 {p99} > 2: {json}");
+}
+
+#[test]
+fn white_furnace_through_wgpu_stays_within_one_code_value_of_the_background() {
+    let dir = tempfile::tempdir().unwrap();
+    if !render("white-furnace", "wgpu", "gpu.png", dir.path()) {
+        return;
+    }
+    let img = image::open(dir.path().join("gpu.png")).unwrap().to_rgb8();
+    // The background: a uniform white environment, clamp tone curve.
+    let background = img.get_pixel(0, 0).0;
+    assert_eq!(background, [255; 3], "background");
+    let worst = img
+        .enumerate_pixels()
+        .flat_map(|(x, y, p)| (0..3).map(move |k| (x, y, background[k].abs_diff(p.0[k]))))
+        .max_by_key(|d| d.2)
+        .unwrap();
+    assert!(
+        worst.2 <= 1,
+        "pixel ({}, {}) is {} code values off",
+        worst.0,
+        worst.1,
+        worst.2
+    );
+}
+
+#[test]
+fn wgpu_without_an_adapter_is_an_input_error_naming_the_fix() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("no-such-icd.json");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_bubbles"))
+        .args([
+            "render",
+            "--backend",
+            "wgpu",
+            "--width",
+            "8",
+            "--height",
+            "8",
+        ])
+        .args(["--out", "x.png"])
+        .current_dir(dir.path())
+        .env("VK_DRIVER_FILES", &missing)
+        .env("VK_ICD_FILENAMES", &missing)
+        .output()
+        .unwrap();
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    for needle in [
+        "no wgpu adapter",
+        "VK_DRIVER_FILES",
+        "mesa-vulkan-drivers",
+        "--backend cpu",
+    ] {
+        assert!(err.contains(needle), "missing {needle:?} in: {err}");
+    }
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(!dir.path().join("x.png").exists(), "no image on failure");
+}

@@ -1,0 +1,526 @@
+//! [`GpuRenderer`]: one frame on the GPU, mirroring [`crate::Renderer::render`].
+
+use std::time::Instant;
+
+use wgpu::util::DeviceExt;
+
+use super::pipelines::{DEPTH_FORMAT, HDR_FORMAT, Layouts, Pipelines};
+use super::scene_data::{SceneData, VIEW_BYTES, check_supported, ground_triangles, view_bytes};
+use super::{Gpu, GpuError, GpuOptions};
+use crate::camera::View;
+use crate::cubemap::FACE_BASES;
+use crate::passes::GroundView;
+use crate::{
+    BubbleMesh, FilmTables, Frame, FrameTimings, ReflectionMode, RenderScene, RenderSettings,
+};
+
+/// Size `(width, height, layers)` and sample count of a cached texture.
+type TextureKey = ((u32, u32, u32), u32);
+
+/// Makes a texture: device, label, size and layers, samples.
+type MakeTexture = fn(&wgpu::Device, &str, (u32, u32, u32), u32) -> wgpu::Texture;
+
+/// Bytes between two views in the view uniform buffer (the dynamic-offset alignment).
+const VIEW_STRIDE: u64 = 256;
+
+/// Renders [`RenderScene`]s with wgpu, headless; the CPU backend is its specification.
+///
+/// # Guarantees
+/// Holds an open device with the scene pipelines compiled; every frame is read back to
+/// the CPU as a linear HDR [`Frame`].
+#[derive(Debug)]
+pub struct GpuRenderer {
+    gpu: Gpu,
+    layouts: Layouts,
+    pipelines: Vec<Pipelines>,
+    frame: Frame,
+    /// Render targets kept from frame to frame, by role, with their size and samples.
+    textures: Vec<(&'static str, TextureKey, wgpu::Texture)>,
+}
+
+/// The targets one view renders into.
+struct Target<'a> {
+    color: &'a wgpu::TextureView,
+    resolve: Option<&'a wgpu::TextureView>,
+    depth: &'a wgpu::TextureView,
+}
+
+impl GpuRenderer {
+    /// Opens the device (see [`Gpu::new`]) and compiles the pipelines.
+    pub fn new(options: GpuOptions) -> Result<GpuRenderer, GpuError> {
+        let gpu = Gpu::new(options)?;
+        let layouts = Layouts::new(&gpu.device);
+        Ok(GpuRenderer {
+            gpu,
+            layouts,
+            pipelines: Vec::new(),
+            frame: Frame::default(),
+            textures: Vec::new(),
+        })
+    }
+
+    /// The device.
+    pub fn gpu(&self) -> &Gpu {
+        &self.gpu
+    }
+
+    /// Renders one frame: cube maps, opaque scene, sorted bubble blend, resolve; the linear
+    /// HDR result is read back. Timings: `setup_s` is the CPU's packing, and the GPU's
+    /// work (submission to read-back) is `resolve_s`, which it cannot split further.
+    pub fn render(
+        &mut self,
+        scene: &RenderScene,
+        tables: &FilmTables,
+        settings: &RenderSettings,
+    ) -> Result<&Frame, GpuError> {
+        let start = Instant::now();
+        let (encoder, resolved, size) = self.encode(scene, tables, settings)?;
+        let setup_s = start.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let texels = self.gpu.read_back(encoder, &resolved, size, 8)?;
+        self.frame.width = settings.width;
+        self.frame.height = settings.height;
+        self.frame.rgb.clear();
+        self.frame.rgb.extend(texels.chunks_exact(8).map(|p| {
+            std::array::from_fn(|k| f16_to_f32(u16::from_le_bytes([p[2 * k], p[2 * k + 1]])))
+        }));
+        self.frame.timings = FrameTimings {
+            setup_s,
+            resolve_s: t.elapsed().as_secs_f64(),
+            ..FrameTimings::default()
+        };
+        Ok(&self.frame)
+    }
+
+    /// Renders one frame and tone-maps it on the GPU (the tone-map pass): interleaved 8-bit
+    /// sRGB, row-major, as [`Frame::to_srgb8`] of [`GpuRenderer::render`]'s frame.
+    pub fn render_srgb8(
+        &mut self,
+        scene: &RenderScene,
+        tables: &FilmTables,
+        settings: &RenderSettings,
+    ) -> Result<Vec<u8>, GpuError> {
+        let (encoder, resolved, size) = self.encode(scene, tables, settings)?;
+        self.gpu.queue.submit([encoder.finish()]);
+        self.gpu
+            .tone_map_texture(&resolved, size, settings.exposure_ev, settings.tonemap)
+    }
+
+    /// Records the frame's passes; returns the encoder and the resolved HDR texture.
+    fn encode(
+        &mut self,
+        scene: &RenderScene,
+        tables: &FilmTables,
+        settings: &RenderSettings,
+    ) -> Result<(wgpu::CommandEncoder, wgpu::Texture, wgpu::Extent3d), GpuError> {
+        settings.validate()?;
+        scene.validate(tables)?;
+        check_supported(scene, settings)?;
+        let (w, h) = (settings.width as u32, settings.height as u32);
+        self.gpu.check_size(w, h)?;
+        let view = scene.camera.view(settings.width, settings.height);
+        let max_side = self.gpu.device.limits().max_texture_dimension_2d;
+        let data = SceneData::new(scene, tables, settings, &view, max_side)?;
+        let face_size = match settings.reflection {
+            ReflectionMode::DynamicCubeMap { face_size } => Some(face_size),
+            _ => None,
+        };
+        let face_views = face_size.map_or(Vec::new(), |n| cube_face_views(scene, n));
+        if let Some(n) = face_size {
+            self.gpu.check_size(n as u32 + 2, n as u32 + 2)?;
+            let max_layers = self.gpu.device.limits().max_texture_array_layers as usize;
+            if face_views.len() > max_layers {
+                return Err(GpuError::Unsupported(format!(
+                    "{} bubbles with dynamic cube maps (this device holds {} cube faces, \
+                     6 per bubble)",
+                    scene.bubbles.len(),
+                    max_layers
+                )));
+            }
+        }
+        let m = face_size.map_or(1, |n| n as u32 + 2);
+        let layers = if face_size.is_some() {
+            6 * scene.bubbles.len().max(1) as u32
+        } else {
+            1
+        };
+        let samples = settings.samples;
+        let cubes = self.texture("cube faces", ((m, m, layers), 1), hdr_texture);
+        let face_depth = self.texture("face depth", ((m, m, 1), 1), depth_texture);
+        let resolved = self.texture("frame", ((w, h, 1), 1), hdr_texture);
+        let msaa =
+            (samples > 1).then(|| self.texture("frame samples", ((w, h, 1), samples), hdr_texture));
+        let depth = self.texture("depth", ((w, h, 1), samples), depth_texture);
+        let mut views = vec![view];
+        views.extend(&face_views);
+        let (view_buffer, ground, ground_draws) = self.view_buffers(scene, &views);
+        let device = &self.gpu.device;
+        let buffer = |label, contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
+        let scene_uniform = buffer("scene", &data.scene, wgpu::BufferUsages::UNIFORM);
+        let materials = buffer("materials", &data.materials, wgpu::BufferUsages::STORAGE);
+        let lights = buffer("lights", &data.lights, wgpu::BufferUsages::STORAGE);
+        let lut_info = buffer("lut info", &data.lut_info, wgpu::BufferUsages::STORAGE);
+        let vertex = wgpu::BufferUsages::VERTEX;
+        let objects = (data.all_vertices > 0).then(|| buffer("objects", &data.objects, vertex));
+        let bubbles = (!data.bubbles.is_empty()).then(|| buffer("bubbles", &data.bubbles, vertex));
+        let view_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("views"),
+            layout: &self.layouts.view,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &view_buffer,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(VIEW_BYTES),
+                }),
+            }],
+        });
+        let scene_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene"),
+            layout: &self.layouts.scene,
+            entries: &[
+                bind(0, scene_uniform.as_entire_binding()),
+                bind(1, materials.as_entire_binding()),
+                bind(2, lights.as_entire_binding()),
+            ],
+        });
+        let lut_texture = self.lut_texture(&data.luts);
+        let bubble_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("bubble tables"),
+            layout: &self.layouts.bubble,
+            entries: &[
+                bind(
+                    0,
+                    wgpu::BindingResource::TextureView(
+                        &lut_texture.create_view(&Default::default()),
+                    ),
+                ),
+                bind(1, lut_info.as_entire_binding()),
+                bind(
+                    2,
+                    wgpu::BindingResource::TextureView(&cubes.create_view(
+                        &wgpu::TextureViewDescriptor {
+                            dimension: Some(wgpu::TextureViewDimension::D2Array),
+                            ..Default::default()
+                        },
+                    )),
+                ),
+            ],
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        let single = self.pipelines_for(1);
+        let face_depth = face_depth.create_view(&Default::default());
+        for (k, _) in face_views.iter().enumerate() {
+            let layer = cubes.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_array_layer: k as u32,
+                array_layer_count: Some(1),
+                ..Default::default()
+            });
+            let target = Target {
+                color: &layer,
+                resolve: None,
+                depth: &face_depth,
+            };
+            let mut pass = begin(&mut encoder, &target);
+            let offset = (VIEW_STRIDE * (k as u64 + 1)) as u32;
+            pass.set_bind_group(0, &view_group, &[offset]);
+            pass.set_bind_group(1, &scene_group, &[]);
+            let ground = (&ground, ground_draws[k + 1].clone());
+            draw_opaque(
+                &mut pass,
+                &self.pipelines[single],
+                ground,
+                objects.as_ref(),
+                data.object_vertices,
+            );
+        }
+        let main = self.pipelines_for(samples);
+        let resolved_view = resolved.create_view(&Default::default());
+        let msaa_view = msaa.as_ref().map(|t| t.create_view(&Default::default()));
+        let depth = depth.create_view(&Default::default());
+        let target = match &msaa_view {
+            Some(v) => Target {
+                color: v,
+                resolve: Some(&resolved_view),
+                depth: &depth,
+            },
+            None => Target {
+                color: &resolved_view,
+                resolve: None,
+                depth: &depth,
+            },
+        };
+        {
+            let p = &self.pipelines[main];
+            let mut pass = begin(&mut encoder, &target);
+            pass.set_bind_group(0, &view_group, &[0]);
+            pass.set_bind_group(1, &scene_group, &[]);
+            let ground = (&ground, ground_draws[0].clone());
+            draw_opaque(&mut pass, p, ground, objects.as_ref(), data.all_vertices);
+            if let Some(bubbles) = &bubbles {
+                pass.set_bind_group(2, &bubble_group, &[]);
+                pass.set_vertex_buffer(0, bubbles.slice(..));
+                // Per side of each bubble: dest ← dest ⊙ T, then dest ← dest + added light,
+                // which is the CPU's dest ⊙ T + add where a side's triangles do not overlap.
+                for range in &data.bubble_draws {
+                    pass.set_pipeline(&p.transmit);
+                    pass.draw(range.clone(), 0..1);
+                    pass.set_pipeline(&p.add);
+                    pass.draw(range.clone(), 0..1);
+                }
+            }
+        }
+        let size = wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        };
+        Ok((encoder, resolved, size))
+    }
+
+    /// The texture of `role` with `key`, made on first use and when its key changes.
+    fn texture(&mut self, role: &'static str, key: TextureKey, make: MakeTexture) -> wgpu::Texture {
+        if let Some((_, k, t)) = self.textures.iter().find(|(r, ..)| *r == role) {
+            if *k == key {
+                return t.clone();
+            }
+        }
+        let texture = make(&self.gpu.device, role, key.0, key.1);
+        self.textures.retain(|(r, ..)| *r != role);
+        self.textures.push((role, key, texture.clone()));
+        texture
+    }
+
+    /// Index of the pipelines for `samples`, compiled on first use.
+    fn pipelines_for(&mut self, samples: u32) -> usize {
+        if let Some(i) = self.pipelines.iter().position(|p| p.samples == samples) {
+            return i;
+        }
+        self.pipelines
+            .push(Pipelines::new(&self.gpu.device, &self.layouts, samples));
+        self.pipelines.len() - 1
+    }
+
+    /// Every view's `View` uniform, `VIEW_STRIDE` bytes apart; the ground triangles of
+    /// every view in one vertex buffer, and each view's vertex range in it.
+    fn view_buffers(
+        &self,
+        scene: &RenderScene,
+        views: &[View],
+    ) -> (wgpu::Buffer, wgpu::Buffer, Vec<std::ops::Range<u32>>) {
+        let mut bytes = Vec::with_capacity(views.len() * VIEW_STRIDE as usize);
+        let mut ground_bytes: Vec<u8> = Vec::new();
+        let mut ranges = Vec::with_capacity(views.len());
+        for v in views {
+            let ground = scene.ground.as_ref().and_then(|g| GroundView::new(g, v));
+            bytes.extend(view_bytes(v, ground.as_ref()));
+            bytes.resize(bytes.len().next_multiple_of(VIEW_STRIDE as usize), 0);
+            let start = (ground_bytes.len() / 12) as u32;
+            for vertex in ground.map_or(Vec::new(), |g| ground_triangles(v, &g)) {
+                ground_bytes.extend(vertex.iter().flat_map(|x| x.to_le_bytes()));
+            }
+            ranges.push(start..(ground_bytes.len() / 12) as u32);
+        }
+        // A vertex buffer may not be empty.
+        ground_bytes.resize(ground_bytes.len().max(12), 0);
+        let buffer = |label, contents: &[u8], usage| {
+            self.gpu
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage,
+                })
+        };
+        (
+            buffer("views", &bytes, wgpu::BufferUsages::UNIFORM),
+            buffer("ground", &ground_bytes, wgpu::BufferUsages::VERTEX),
+            ranges,
+        )
+    }
+
+    /// The stacked LUT tables as an Rgba32Float texture.
+    fn lut_texture(&self, (width, height, texels): &(u32, u32, Vec<u8>)) -> wgpu::Texture {
+        self.gpu.device.create_texture_with_data(
+            &self.gpu.queue,
+            &wgpu::TextureDescriptor {
+                label: Some("luts"),
+                size: wgpu::Extent3d {
+                    width: *width,
+                    height: *height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba32Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            texels,
+        )
+    }
+}
+
+/// The six face views of each bubble's cube map, exactly as the CPU's `render_cube_maps`:
+/// from the bubble's centre, one texel wider on each side for the border ring.
+fn cube_face_views(scene: &RenderScene, face_size: usize) -> Vec<View> {
+    let m = face_size + 2;
+    let wide = m as f32 / face_size as f32;
+    let mut views = Vec::with_capacity(6 * scene.bubbles.len());
+    for center in scene.bubbles.iter().map(BubbleMesh::center) {
+        for (major, s_axis, t_axis) in FACE_BASES {
+            views.push(View::new(
+                center,
+                [major, s_axis, -t_axis],
+                (wide, wide),
+                (m, m),
+                scene.camera.near_m(),
+            ));
+        }
+    }
+    views
+}
+
+fn begin<'e>(encoder: &'e mut wgpu::CommandEncoder, target: &Target<'_>) -> wgpu::RenderPass<'e> {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: None,
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: target.color,
+            depth_slice: None,
+            resolve_target: target.resolve,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: target.depth,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(0.0),
+                store: wgpu::StoreOp::Discard,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}
+
+/// Sky, the view's ground triangles, then the first `vertices` object vertices.
+fn draw_opaque(
+    pass: &mut wgpu::RenderPass<'_>,
+    p: &Pipelines,
+    (ground, ground_range): (&wgpu::Buffer, std::ops::Range<u32>),
+    objects: Option<&wgpu::Buffer>,
+    vertices: u32,
+) {
+    pass.set_pipeline(&p.sky);
+    pass.draw(0..3, 0..1);
+    if !ground_range.is_empty() {
+        pass.set_pipeline(&p.ground);
+        pass.set_vertex_buffer(0, ground.slice(..));
+        pass.draw(ground_range, 0..1);
+    }
+    if let (Some(objects), true) = (objects, vertices > 0) {
+        pass.set_pipeline(&p.objects);
+        pass.set_vertex_buffer(0, objects.slice(..));
+        pass.draw(0..vertices, 0..1);
+    }
+}
+
+fn bind(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry { binding, resource }
+}
+
+fn hdr_texture(
+    device: &wgpu::Device,
+    label: &str,
+    (width, height, layers): (u32, u32, u32),
+    samples: u32,
+) -> wgpu::Texture {
+    let mut usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+    if samples == 1 {
+        usage |= wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+    }
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: layers,
+        },
+        mip_level_count: 1,
+        sample_count: samples,
+        dimension: wgpu::TextureDimension::D2,
+        format: HDR_FORMAT,
+        usage,
+        view_formats: &[],
+    })
+}
+
+fn depth_texture(
+    device: &wgpu::Device,
+    label: &str,
+    (width, height, _): (u32, u32, u32),
+    samples: u32,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: samples,
+        dimension: wgpu::TextureDimension::D2,
+        format: DEPTH_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        view_formats: &[],
+    })
+}
+
+/// An IEEE half-precision value as f32 (exact: every f16 is an f32).
+pub(super) fn f16_to_f32(h: u16) -> f32 {
+    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
+    let exponent = i32::from((h >> 10) & 0x1f);
+    let mantissa = f32::from(h & 0x3ff);
+    sign * match exponent {
+        0 => mantissa * (-24f32).exp2(),
+        31 if mantissa == 0.0 => f32::INFINITY,
+        31 => f32::NAN,
+        e => (1.0 + mantissa / 1024.0) * ((e - 15) as f32).exp2(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn f16_decoding_matches_known_values() {
+        for (bits, want) in [
+            (0x0000u16, 0.0f32),
+            (0x3c00, 1.0),
+            (0xc000, -2.0),
+            (0x3555, 0.333_251_95),
+            (0x7bff, 65504.0),
+            (0x0001, 5.960_464_5e-8),
+            (0x0400, 6.103_515_6e-5),
+        ] {
+            assert_eq!(f16_to_f32(bits), want, "{bits:#06x}");
+        }
+        assert_eq!(f16_to_f32(0x7c00), f32::INFINITY);
+        assert!(f16_to_f32(0x7e00).is_nan());
+    }
+}

@@ -1,0 +1,404 @@
+//! The scene as the shaders read it: uniform and storage buffer bytes laid out as the
+//! structs of `scene.wgsl`, vertex streams, and the stacked LUT texture. Pure CPU code.
+
+use glam::Vec3;
+
+use super::GpuError;
+use crate::camera::View;
+use crate::passes::GroundView;
+use crate::renderer::{Geometry, far_to_near, is_front_facing, reflection_rate, tessellate};
+use crate::{
+    Environment, FilmTables, Light, Material, Pattern, ReflectionMode, RenderScene, RenderSettings,
+};
+
+/// `Material.specular.w` of a solid albedo.
+pub(super) const PATTERN_SOLID: f32 = 0.0;
+/// `Material.specular.w` of a checkerboard.
+pub(super) const PATTERN_CHECKER: f32 = 1.0;
+/// `Scene.env_kind` of a procedural sky.
+pub(super) const ENV_SKY: u32 = 0;
+/// `Scene.env_kind` of a uniform environment.
+pub(super) const ENV_UNIFORM: u32 = 1;
+/// `Scene.reflection` of dynamic cube maps.
+pub(super) const REFLECTION_CUBE: u32 = 0;
+/// `Scene.reflection` of the static environment.
+pub(super) const REFLECTION_ENVIRONMENT: u32 = 1;
+/// `Scene.transmittance_table` when `T = 1 − R`.
+pub(super) const NO_TABLE: u32 = u32::MAX;
+
+/// Bytes of the WGSL `View` struct.
+pub(super) const VIEW_BYTES: u64 = 9 * 16;
+/// Bytes of one object vertex: position, normal, tag.
+pub(super) const OBJECT_VERTEX_BYTES: u64 = 28;
+/// Bytes of one bubble vertex: position, normal, thickness, pixel angle, bubble index.
+pub(super) const BUBBLE_VERTEX_BYTES: u64 = 36;
+
+/// Little-endian bytes for a GPU buffer.
+#[derive(Debug, Default)]
+pub(super) struct Bytes(pub Vec<u8>);
+
+impl Bytes {
+    fn f32(&mut self, x: f32) -> &mut Self {
+        self.0.extend_from_slice(&x.to_le_bytes());
+        self
+    }
+
+    fn u32(&mut self, x: u32) -> &mut Self {
+        self.0.extend_from_slice(&x.to_le_bytes());
+        self
+    }
+
+    fn vec4(&mut self, xyz: [f32; 3], w: f32) -> &mut Self {
+        for x in xyz {
+            self.f32(x);
+        }
+        self.f32(w)
+    }
+}
+
+/// The WGSL `View` of `view`, with the ground plane's constants when it is drawn.
+pub(super) fn view_bytes(view: &View, ground: Option<&GroundView<'_>>) -> Vec<u8> {
+    let mut b = Bytes::default();
+    for axis in [view.eye, view.forward, view.right, view.up] {
+        b.vec4(axis.to_array(), 0.0);
+    }
+    b.vec4(
+        [view.tan_half_x, view.tan_half_y, view.x_per_px],
+        view.y_per_px,
+    );
+    b.vec4([view.width as f32, view.height as f32, view.near_m], 0.0);
+    match ground {
+        Some(g) => {
+            b.vec4([g.c, g.gx, g.gy], g.inv_height);
+            b.vec4(g.ddx.to_array(), g.normal.y);
+            b.vec4(g.ddy.to_array(), 1.0);
+        }
+        None => {
+            b.vec4([0.0; 3], 0.0)
+                .vec4([0.0; 3], 0.0)
+                .vec4([0.0; 3], 0.0);
+        }
+    }
+    debug_assert_eq!(b.0.len() as u64, VIEW_BYTES);
+    b.0
+}
+
+/// The ground plane's visible part of `view` as a triangle list of `(ndc x, ndc y, depth)`:
+/// the screen rectangle clipped, in pixel space, to where the plane's inverse depth `1/t`
+/// lies in `(0, 1/near]` (the CPU's per-sample test `1/t > 0`), with depth `near/t`.
+///
+/// Clipping here rather than by the GPU's depth clip gives every internal edge of the
+/// polygon the same two vertices in both triangles, so coverage stays watertight.
+pub(super) fn ground_triangles(view: &View, g: &GroundView<'_>) -> Vec<[f32; 3]> {
+    let (w, h) = (view.width as f32, view.height as f32);
+    let inv_depth = |p: [f32; 2]| g.inv_depth(p[0], p[1]);
+    let mut poly = vec![[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]];
+    poly = clip(&poly, inv_depth);
+    poly = clip(&poly, |p| 1.0 / view.near_m - inv_depth(p));
+    let vertex = |p: [f32; 2]| {
+        let z = (view.near_m * inv_depth(p)).clamp(0.0, 1.0);
+        [2.0 * p[0] / w - 1.0, 1.0 - 2.0 * p[1] / h, z]
+    };
+    let mut out = Vec::new();
+    for k in 1..poly.len().saturating_sub(1) {
+        out.extend([vertex(poly[0]), vertex(poly[k]), vertex(poly[k + 1])]);
+    }
+    out
+}
+
+/// The convex polygon `poly` cut to where the affine `f` is ≥ 0 (Sutherland–Hodgman).
+fn clip(poly: &[[f32; 2]], f: impl Fn([f32; 2]) -> f32) -> Vec<[f32; 2]> {
+    let mut out = Vec::with_capacity(poly.len() + 1);
+    for (k, &a) in poly.iter().enumerate() {
+        let b = poly[(k + 1) % poly.len()];
+        let (fa, fb) = (f(a), f(b));
+        if fa >= 0.0 {
+            out.push(a);
+        }
+        if (fa >= 0.0) != (fb >= 0.0) {
+            let t = fa / (fa - fb);
+            out.push([a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t]);
+        }
+    }
+    out
+}
+
+/// Everything of a frame that the shaders read, packed.
+#[derive(Debug, Default)]
+pub(super) struct SceneData {
+    /// The WGSL `Scene` uniform.
+    pub scene: Vec<u8>,
+    /// `array<Material>`: the objects' materials, then the ground's.
+    pub materials: Vec<u8>,
+    /// `array<Light>`.
+    pub lights: Vec<u8>,
+    /// Object triangles (three vertices each), then the light spheres'.
+    pub objects: Vec<u8>,
+    /// Vertices of the objects alone (what cube faces draw).
+    pub object_vertices: u32,
+    /// Vertices of objects and light spheres.
+    pub all_vertices: u32,
+    /// Bubble triangles in drawing order.
+    pub bubbles: Vec<u8>,
+    /// Vertex ranges of the bubble draws, in order: far to near, back faces then front.
+    pub bubble_draws: Vec<std::ops::Range<u32>>,
+    /// The LUT texture: `(width, height, Rgba32Float texels)`.
+    pub luts: LutTexture,
+    /// `array<LutInfo>`.
+    pub lut_info: Vec<u8>,
+}
+
+/// Why the wgpu backend cannot draw `what` (it draws the scenes the built-in scenes use).
+fn unsupported(what: impl Into<String>) -> GpuError {
+    GpuError::Unsupported(what.into())
+}
+
+/// Refuses what the wgpu backend does not draw yet, naming it.
+pub(super) fn check_supported(
+    scene: &RenderScene,
+    settings: &RenderSettings,
+) -> Result<(), GpuError> {
+    if !matches!(settings.samples, 1 | 4) {
+        return Err(unsupported(format!(
+            "samples = {} (the wgpu backend renders 1 or 4)",
+            settings.samples
+        )));
+    }
+    if let ReflectionMode::SphereMap(_) = settings.reflection {
+        return Err(unsupported("reflection mode sphere-map"));
+    }
+    match scene.environment {
+        Environment::Sky(_) | Environment::Uniform(_) => {}
+        Environment::Equirect(_) => return Err(unsupported("an equirect environment image")),
+        Environment::CubeFaces(_) => return Err(unsupported("a cube-face environment")),
+    }
+    let ground = scene.ground.iter().map(|g| &g.material);
+    for m in scene.objects.iter().map(|o| o.material()).chain(ground) {
+        if let Pattern::Textured { .. } = m.pattern {
+            return Err(unsupported("a textured material"));
+        }
+    }
+    Ok(())
+}
+
+impl SceneData {
+    /// Packs `scene` for the main view `view` (bubbles sorted and split by side for its eye).
+    pub(super) fn new(
+        scene: &RenderScene,
+        tables: &FilmTables,
+        settings: &RenderSettings,
+        view: &View,
+        max_texture_side: u32,
+    ) -> Result<SceneData, GpuError> {
+        let mut objects = Geometry::default();
+        let mut light_spheres = Geometry::default();
+        let mut materials = tessellate(scene, &mut objects, &mut light_spheres);
+        let ground_material = materials.len() as u32;
+        if let Some(g) = &scene.ground {
+            materials.push(&g.material);
+        }
+        let mut object_bytes = Bytes::default();
+        push_geometry(&mut object_bytes, &objects);
+        let object_vertices = (object_bytes.0.len() as u64 / OBJECT_VERTEX_BYTES) as u32;
+        if settings.draw_lights {
+            push_geometry(&mut object_bytes, &light_spheres);
+        }
+        let all_vertices = (object_bytes.0.len() as u64 / OBJECT_VERTEX_BYTES) as u32;
+        let (bubbles, bubble_draws) = bubble_vertices(scene, view);
+        let (luts, lut_info, first_light) = stack_tables(tables, max_texture_side)?;
+        // A light without a table of its own uses the reflectivity (table 0).
+        let light_tables: Vec<u32> = scene
+            .lights
+            .iter()
+            .map(|l| l.light_lut.map_or(0, |i| first_light + i as u32))
+            .collect();
+        let face_size = match settings.reflection {
+            ReflectionMode::DynamicCubeMap { face_size } => face_size as u32,
+            _ => 0,
+        };
+        Ok(SceneData {
+            scene: scene_bytes(
+                scene,
+                &settings.reflection,
+                face_size,
+                ground_material,
+                tables,
+            ),
+            materials: material_bytes(&materials),
+            lights: light_bytes(&scene.lights, &light_tables),
+            objects: object_bytes.0,
+            object_vertices,
+            all_vertices,
+            bubbles,
+            bubble_draws,
+            luts,
+            lut_info,
+        })
+    }
+}
+
+fn scene_bytes(
+    scene: &RenderScene,
+    reflection: &ReflectionMode,
+    face_size: u32,
+    ground_material: u32,
+    tables: &FilmTables,
+) -> Vec<u8> {
+    let mut b = Bytes::default();
+    let ambient = scene.irradiance.plus_uniform(scene.ambient_rgb);
+    for c in ambient.coeffs() {
+        b.vec4(*c, 0.0);
+    }
+    let (env_kind, sky, uniform) = match &scene.environment {
+        Environment::Uniform(rgb) => (ENV_UNIFORM, crate::Sky::default(), *rgb),
+        Environment::Sky(sky) => (ENV_SKY, *sky, [0.0; 3]),
+        // check_supported refused the others.
+        _ => (ENV_UNIFORM, crate::Sky::default(), [0.0; 3]),
+    };
+    b.u32(env_kind).u32(scene.lights.len() as u32);
+    b.u32(match reflection {
+        ReflectionMode::DynamicCubeMap { .. } => REFLECTION_CUBE,
+        _ => REFLECTION_ENVIRONMENT,
+    });
+    // Table 0 is the reflectivity, 1 the transmittance when there is one.
+    b.u32(if tables.transmittance.is_some() {
+        1
+    } else {
+        NO_TABLE
+    });
+    b.vec4(sky.zenith_rgb, 0.0)
+        .vec4(sky.horizon_rgb, 0.0)
+        .vec4(sky.nadir_rgb, 0.0);
+    let sun = sky.sun_direction.normalize_or(Vec3::Y);
+    // The same f32 expression as `Sky::radiance`'s threshold.
+    b.vec4(sun.to_array(), sky.sun_radius_deg.to_radians().cos());
+    let sun_on = sky.sun_rgb != [0.0; 3];
+    b.vec4(sky.sun_rgb, if sun_on { 1.0 } else { 0.0 });
+    b.vec4(uniform, 0.0);
+    let height = scene.ground.as_ref().map_or(0.0, |g| g.height_m);
+    b.u32(ground_material).f32(height).u32(face_size).u32(0);
+    b.0
+}
+
+fn material_bytes(materials: &[&Material]) -> Vec<u8> {
+    let mut b = Bytes::default();
+    for m in materials {
+        let (a, bb, scale, kind) = match &m.pattern {
+            Pattern::Checker { a, b, scale_m } => (*a, *b, *scale_m, PATTERN_CHECKER),
+            Pattern::Solid(c) => (*c, *c, 1.0, PATTERN_SOLID),
+            // check_supported refused textures.
+            Pattern::Textured { .. } => ([0.0; 3], [0.0; 3], 1.0, PATTERN_SOLID),
+        };
+        b.vec4(a, scale)
+            .vec4(bb, m.shininess)
+            .vec4(m.specular, kind);
+    }
+    if materials.is_empty() {
+        b.vec4([0.0; 3], 1.0)
+            .vec4([0.0; 3], 1.0)
+            .vec4([0.0; 3], 0.0);
+    }
+    b.0
+}
+
+fn light_bytes(lights: &[Light], tables: &[u32]) -> Vec<u8> {
+    let mut b = Bytes::default();
+    for (l, &table) in lights.iter().zip(tables) {
+        b.vec4(l.position.to_array(), l.radius_m)
+            .vec4(l.radiance, table as f32)
+            .vec4(l.highlight_gain(), 0.0);
+    }
+    if lights.is_empty() {
+        b.vec4([0.0; 3], 0.0)
+            .vec4([0.0; 3], 0.0)
+            .vec4([0.0; 3], 0.0);
+    }
+    b.0
+}
+
+/// Appends `g`'s triangles as three vertices each (position, normal, tag).
+fn push_geometry(b: &mut Bytes, g: &Geometry) {
+    for (t, &tag) in g.triangles.iter().zip(&g.tags) {
+        for i in t.map(|i| i as usize) {
+            let p = g.positions[i];
+            let a = g.attrs[i];
+            b.f32(p.x).f32(p.y).f32(p.z);
+            b.f32(a[0]).f32(a[1]).f32(a[2]);
+            b.u32(tag);
+        }
+    }
+}
+
+/// Bubble vertices in the CPU's drawing order (renderer.rs `setup_bubbles`): bubbles far
+/// to near, each bubble's back faces then its front faces; one draw range per side.
+fn bubble_vertices(scene: &RenderScene, view: &View) -> (Vec<u8>, Vec<std::ops::Range<u32>>) {
+    let mut b = Bytes::default();
+    let mut draws = Vec::new();
+    let mut start = 0u32;
+    for k in far_to_near(&scene.bubbles, view.eye) {
+        let bubble = &scene.bubbles[k];
+        for front in [false, true] {
+            for t in &bubble.triangles {
+                if is_front_facing(bubble, *t, view.eye) != front {
+                    continue;
+                }
+                let rate = reflection_rate(view, bubble, *t);
+                for i in t.map(|i| i as usize) {
+                    let (p, n) = (bubble.positions[i], bubble.normals[i]);
+                    b.f32(p.x).f32(p.y).f32(p.z).f32(n.x).f32(n.y).f32(n.z);
+                    b.f32(bubble.thickness_nm[i]).f32(rate).u32(k as u32);
+                }
+            }
+            let end = (b.0.len() as u64 / BUBBLE_VERTEX_BYTES) as u32;
+            if end > start {
+                draws.push(start..end);
+            }
+            start = end;
+        }
+    }
+    (b.0, draws)
+}
+
+/// The stacked LUT texture `(width, height, texels)`.
+type LutTexture = (u32, u32, Vec<u8>);
+
+/// The tables stacked in rows of one Rgba32Float texture (reflectivity, transmittance if
+/// any, then the light tables), their `LutInfo`s, and the index of the first light table.
+fn stack_tables(
+    tables: &FilmTables,
+    max_side: u32,
+) -> Result<(LutTexture, Vec<u8>, u32), GpuError> {
+    let mut list = vec![&tables.reflectivity];
+    list.extend(tables.transmittance.as_ref());
+    let first_light = list.len() as u32;
+    list.extend(&tables.lights);
+    let width = list.iter().map(|t| t.width()).max().unwrap_or(2);
+    let height: usize = list.iter().map(|t| t.height()).sum();
+    if width > max_side as usize || height > max_side as usize {
+        return Err(GpuError::TooLarge {
+            size: (width as u32, height as u32),
+            max_side,
+        });
+    }
+    let mut texels = Bytes::default();
+    let mut info = Bytes::default();
+    let mut row0 = 0usize;
+    for t in &list {
+        for row in t.texels().chunks_exact(t.width()) {
+            for c in row {
+                texels.vec4(*c, 1.0);
+            }
+            for _ in t.width()..width {
+                texels.vec4([0.0; 3], 0.0);
+            }
+        }
+        // The same f32 expression as `LutSampler::new`'s `d_scale`.
+        let d_scale = (t.width() - 1) as f32 / t.thickness_max_nm();
+        info.f32(row0 as f32)
+            .f32(t.width() as f32)
+            .f32(t.height() as f32)
+            .f32(d_scale);
+        row0 += t.height();
+    }
+    Ok(((width as u32, height as u32, texels.0), info.0, first_light))
+}
