@@ -46,11 +46,12 @@ impl Scene {
             };
             Some(format!("[[objects]] #{} ({place})", i + 1))
         });
-        let water = self
-            .file
-            .water
-            .iter()
-            .map(|_| "the water's rest plane".to_string());
+        let water = self.file.water.iter().map(|w| {
+            format!(
+                "the water's rest plane (water.rest_height_m = {})",
+                plain(w.rest_height_m.get())
+            )
+        });
         ground.chain(objects).chain(water).collect()
     }
 
