@@ -3,7 +3,7 @@
 use std::path::Path;
 
 mod common;
-use common::bubbles;
+use common::{bubbles, json_field};
 
 fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
@@ -12,13 +12,6 @@ fn text(bytes: &[u8]) -> String {
 fn write_png(dir: &Path, name: &str, w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 3]) {
     let img = image::RgbImage::from_fn(w, h, |x, y| image::Rgb(f(x, y)));
     img.save(dir.join(name)).unwrap();
-}
-
-fn json_field(json: &str, key: &str) -> f64 {
-    let start = json.find(&format!("\"{key}\": ")).expect(key) + key.len() + 4;
-    let rest = &json[start..];
-    let end = rest.find([',', '}']).unwrap();
-    rest[..end].trim().parse().unwrap()
 }
 
 #[test]

@@ -7,7 +7,7 @@
 use std::path::Path;
 
 mod common;
-use common::{bubbles, stderr};
+use common::{bubbles, json_field, stderr};
 
 /// Renders built-in `scene` at 400×400 to `out` with `backend`; `false` (skip) outside CI
 /// when the wgpu backend finds no adapter.
@@ -33,13 +33,6 @@ fn render(scene: &str, backend: &str, out: &str, dir: &Path) -> bool {
     }
     assert!(run.status.success(), "{backend}: {err}");
     true
-}
-
-fn json_field(json: &str, key: &str) -> f64 {
-    let start = json.find(&format!("\"{key}\": ")).expect(key) + key.len() + 4;
-    let rest = &json[start..];
-    let end = rest.find([',', '}']).unwrap();
-    rest[..end].trim().parse().unwrap()
 }
 
 #[test]

@@ -108,6 +108,24 @@ fn rt<'py>(
     Ok((r.into_pyarray(py), t.into_pyarray(py)))
 }
 
+/// The film's index (checked with the outside medium) and copies of the three arrays.
+fn film_inputs(
+    thickness_nm: &PyReadonlyArray1<'_, f64>,
+    angle_deg: &PyReadonlyArray1<'_, f64>,
+    wavelength_nm: &PyReadonlyArray1<'_, f64>,
+    n_film: f64,
+    n_outside: f64,
+) -> PyResult<(RefractiveIndex, Vec<f64>, Vec<f64>, Vec<f64>)> {
+    let film_index = RefractiveIndex::constant(n_film).map_err(value_error)?;
+    ThinFilm::new(n_outside, film_index, n_outside.into(), 0.0).map_err(value_error)?;
+    Ok((
+        film_index,
+        copy(thickness_nm),
+        copy(angle_deg),
+        copy(wavelength_nm),
+    ))
+}
+
 /// `(R, T)` of symmetric films `n_outside | n_film | n_outside`, all arrays equally long.
 #[pyfunction]
 fn film_rt<'py>(
@@ -118,9 +136,8 @@ fn film_rt<'py>(
     n_film: f64,
     n_outside: f64,
 ) -> PyResult<Pair<'py>> {
-    let film_index = RefractiveIndex::constant(n_film).map_err(value_error)?;
-    ThinFilm::new(n_outside, film_index, n_outside.into(), 0.0).map_err(value_error)?;
-    let (d, angle, wl) = (copy(&thickness_nm), copy(&angle_deg), copy(&wavelength_nm));
+    let (film_index, d, angle, wl) =
+        film_inputs(&thickness_nm, &angle_deg, &wavelength_nm, n_film, n_outside)?;
     let (r, t) = py
         .allow_threads(|| {
             par_rt(d.len(), |i| {
@@ -145,9 +162,8 @@ fn film_rt_fast<'py>(
     n_film: f64,
     n_outside: f64,
 ) -> PyResult<Pair<'py>> {
-    let film_index = RefractiveIndex::constant(n_film).map_err(value_error)?;
-    ThinFilm::new(n_outside, film_index, n_outside.into(), 0.0).map_err(value_error)?;
-    let (d, angle, wl) = (copy(&thickness_nm), copy(&angle_deg), copy(&wavelength_nm));
+    let (film_index, d, angle, wl) =
+        film_inputs(&thickness_nm, &angle_deg, &wavelength_nm, n_film, n_outside)?;
     let film = FastFilm {
         n_outside,
         film_index,

@@ -34,3 +34,11 @@ pub fn bubbles_piped(args: &[&str], stdin: &str) -> Output {
 pub fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
+
+/// The number under `key` in `bubbles compare --json` output.
+pub fn json_field(json: &str, key: &str) -> f64 {
+    let start = json.find(&format!("\"{key}\": ")).expect(key) + key.len() + 4;
+    let rest = &json[start..];
+    let end = rest.find([',', '}']).unwrap();
+    rest[..end].trim().parse().unwrap()
+}
