@@ -350,15 +350,18 @@ struct BubbleOut {
     @location(2) @interpolate(perspective, centroid) thickness_nm: f32,
     @location(3) @interpolate(flat) pixel_angle_rad: f32,
     @location(4) @interpolate(flat) bubble: u32,
-    // The normal at the pixel centre (not the centroid), whose screen derivatives are the
-    // CPU's plane derivatives of the interpolated normal.
-    @location(5) normal_centre: vec3<f32>,
+    // normal/w and 1/w interpolated affinely in screen space: their differences between
+    // neighbouring pixels are exactly the CPU's plane derivatives (`SetupTri::attrs`,
+    // `inv_w`), from which the normal's derivative follows as on the CPU.
+    @location(5) @interpolate(linear, center) normal_over_w: vec3<f32>,
+    @location(6) @interpolate(linear, center) inv_w: f32,
 }
 
 @vertex
 fn vs_bubble(in: BubbleIn) -> BubbleOut {
-    return BubbleOut(clip_of(in.position), in.position, in.normal, in.thickness_nm,
-        in.pixel_angle_rad, in.bubble, in.normal);
+    let clip = clip_of(in.position);
+    return BubbleOut(clip, in.position, in.normal, in.thickness_nm, in.pixel_angle_rad,
+        in.bubble, in.normal / clip.w, 1.0 / clip.w);
 }
 
 // lut_sampler.rs `split`: lower sample index and the upper one's weight on an axis of n.
@@ -637,8 +640,13 @@ fn fs_bubble_transmit(in: BubbleOut) -> @location(0) vec4<f32> {
 // The additive pass, blended (One, One): dest ← dest + R ⊙ env(reflect) + highlights.
 @fragment
 fn fs_bubble_add(in: BubbleOut) -> @location(0) vec4<f32> {
-    // passes.rs `BubbleCtx::reflection_derivatives`; derivatives need uniform control flow.
-    let dn_raw = array<vec3<f32>, 2>(dpdxFine(in.normal_centre), dpdyFine(in.normal_centre));
+    // passes.rs `BubbleCtx::reflection_derivatives`: ∂n = (∂(n/w) − n·∂(1/w))·w. Derivatives
+    // need uniform control flow, so they come first.
+    let w = 1.0 / in.inv_w;
+    let n_centre = in.normal_over_w * w;
+    let dn_raw = array<vec3<f32>, 2>(
+        (dpdxFine(in.normal_over_w) - n_centre * dpdxFine(in.inv_w)) * w,
+        (dpdyFine(in.normal_over_w) - n_centre * dpdyFine(in.inv_w)) * w);
     let f = film_of(in);
     let r = film_reflectivity(f);
     let reflected = f.v - f.n * (2.0 * f.c);
