@@ -171,15 +171,17 @@ fn figures() -> bool {
     fig2 && chart && paper && furnace && sodium && gallery
 }
 
-/// The gallery scenes of docs/gallery.md (seed 000 Figs. 5–7 and the demo): a still
-/// and a short animated PNG of each, plus a GIF preview of the wind scene.
+/// The gallery scenes of docs/gallery.md (seed 000 Figs. 5–7, the demo and seed 002's
+/// pond): a still and a short animated PNG of each, a GIF preview of the wind scene, and
+/// the pond at two times for docs/water.md.
 fn gallery() -> bool {
-    const GALLERY: [(&str, &str, &str, &str); 4] = [
+    const GALLERY: [(&str, &str, &str, &str); 5] = [
         // scene, still time (s), animation length (s), fps
         ("wind", "0.2", "1.2", "15"),
         ("plane-collision", "0.15", "1.2", "15"),
         ("bubble-collision", "0.12", "1", "20"),
         ("demo", "0.5", "2", "10"),
+        ("pond", "1", "2", "10"),
     ];
     let dir = "docs/figures/gallery";
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
@@ -212,6 +214,13 @@ fn gallery() -> bool {
             "200",
             "--height",
             "150",
+        ]);
+    }
+    for time_s in ["0.5", "2"] {
+        let still = format!("{dir}/pond_t{time_s}s.png");
+        ok &= bubbles(&[
+            "render", "pond", "--out", &still, "--time-s", time_s, "--width", "400", "--height",
+            "300",
         ]);
     }
     let gif = format!("{dir}/wind.gif");

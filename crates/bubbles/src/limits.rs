@@ -49,6 +49,13 @@ pub const MAX_LIGHTS: usize = 64;
 /// Opaque triangles in one scene, after tessellation (a sphere is 2304).
 pub const MAX_OPAQUE_TRIANGLES: u64 = 4_000_000;
 
+/// Slices along one side of the water grid (a 512 × 512 grid has 263 169 vertices and
+/// 524 288 triangles, drawn twice a frame: once seen, once in its reflection cube map).
+pub const MAX_WATER_SLICES: usize = 512;
+
+/// Waves and ripples on the water, together.
+pub const MAX_WATER_PERTURBATIONS: usize = 64;
+
 /// Pixels of one decoded image (environment, texture, cube face), checked before decoding.
 pub const MAX_IMAGE_PIXELS: u64 = 64 << 20;
 
@@ -68,6 +75,8 @@ pub const HELP: &str = "Limits (a larger request is refused with exit code 2):
   bubbles per scene                           1000 (1000000 vertices in all)
   objects per scene                           1000 (4000000 triangles in all)
   lights per scene                            64
+  water slices per side                       1..=512
+  water waves and ripples                     64
   pixels of one image file                    67108864
   bytes of one scene, OBJ or CSV file         67108864
   planned memory of one run                   3 GiB";
@@ -124,6 +133,10 @@ mod tests {
             );
         }
         assert!(HELP.contains(&format!("0..={MAX_SUBDIVISIONS}")));
+        assert!(HELP.contains(&format!("1..={MAX_WATER_SLICES}")));
+        assert!(HELP.contains(&format!(
+            "ripples                     {MAX_WATER_PERTURBATIONS}"
+        )));
         assert!(HELP.contains(&format!("{} GiB", MEMORY_BUDGET_BYTES >> 30)));
     }
 

@@ -117,3 +117,34 @@ fn wgpu_without_an_adapter_is_an_input_error_naming_the_fix() {
     assert!(!err.contains("panicked"), "{err}");
     assert!(!dir.path().join("x.png").exists(), "no image on failure");
 }
+
+/// The wgpu backend has no water pass: `pond` must be refused by name, never drawn
+/// without its water (found when water and wgpu landed in the same session).
+#[test]
+fn pond_through_wgpu_is_refused_naming_the_water() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "render",
+        "pond",
+        "--backend",
+        "wgpu",
+        "--width",
+        "16",
+        "--height",
+        "12",
+        "--out",
+        "x.png",
+    ];
+    let out = bubbles(&args, dir.path());
+    let err = stderr(&out);
+    if err.contains("no wgpu adapter") && std::env::var_os("CI").is_none() {
+        eprintln!("skipped: {err}");
+        return;
+    }
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("water") && err.contains("--backend cpu"),
+        "{err}"
+    );
+    assert!(!dir.path().join("x.png").exists(), "no image on failure");
+}

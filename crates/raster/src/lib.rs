@@ -41,6 +41,8 @@ mod settings;
 mod shading;
 mod spheremap;
 mod texture;
+mod water;
+mod water_pass;
 
 pub use camera::{Camera, DEFAULT_NEAR_M};
 pub use cubemap::{CubeMap, MAX_FACE_SIZE};
@@ -58,3 +60,4 @@ pub use settings::{
 };
 pub use spheremap::SphereMap;
 pub use texture::Texture;
+pub use water::{WATER_IOR, WaterSurface, refract, sphere_map_direction, sphere_map_uv};

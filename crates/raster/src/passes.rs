@@ -11,6 +11,7 @@ use crate::lod::reflection_derivatives;
 use crate::lut_sampler::LutSampler;
 use crate::raster::{ATTRS, Plane, SamplePattern, SetupTri, for_each_covered_in_row};
 use crate::shading::{ground_albedo, lit, object_albedo};
+use crate::water_pass::{WATER, WaterShading, shade_water};
 use crate::{
     CubeMap, Environment, Ground, Irradiance, Light, Material, Pattern, ReflectionFilter, SphereMap,
 };
@@ -126,6 +127,8 @@ pub(crate) struct OpaqueCtx<'a> {
     pub materials: &'a [&'a Material],
     pub tris: &'a [SetupTri],
     pub bins: &'a Bins,
+    /// How water triangles are shaded (`None` draws them black).
+    pub water: Option<WaterShading<'a>>,
 }
 
 impl OpaqueCtx<'_> {
@@ -368,6 +371,9 @@ impl OpaqueCtx<'_> {
     fn shade(&self, tri: &SetupTri, px: f32, py: f32) -> [f32; 3] {
         if tri.tag & EMISSIVE != 0 {
             return self.lights[(tri.tag & !EMISSIVE) as usize].radiance;
+        }
+        if tri.tag & WATER != 0 {
+            return shade_water(self, tri, px, py);
         }
         let (inv_w, a) = tri.interpolate(px, py);
         let d = self.view.ray(px, py);
@@ -725,6 +731,7 @@ mod tests {
             materials: &[],
             tris: &[],
             bins: &bins,
+            water: None,
         };
         let mut checked = 0;
         for y in (0..100).step_by(7) {

@@ -11,6 +11,7 @@ use crate::camera::View;
 use crate::cubemap::FACE_BASES;
 use crate::passes::{Bins, BubbleCtx, EMISSIVE, GroundView, OpaqueCtx, Reflection, STRIP_ROWS};
 use crate::raster::{ATTRS, ClipVertex, SamplePattern, SetupTri, setup_triangle};
+use crate::water_pass::{WaterPass, setup_water};
 use crate::{
     BubbleMesh, CubeMap, Environment, FilmTables, Frame, Material, Object, ReflectionFilter,
     ReflectionMode, RenderError, RenderScene, RenderSettings, TriMesh,
@@ -95,6 +96,7 @@ pub struct Renderer {
     /// The environment rendered into cube faces, reused while the environment is unchanged
     /// (kept only for the cheap-to-compare procedural kinds).
     env_cube: Option<(Environment, CubeMap)>,
+    water: WaterPass,
     filter: ReflectionFilter,
 }
 
@@ -120,6 +122,12 @@ impl Renderer {
         self.cube_maps.get(index)
     }
 
+    /// The water's reflection cube map (seen from the eye mirrored in its rest plane)
+    /// rendered in the last frame, if any.
+    pub fn water_cube_map(&self) -> Option<&CubeMap> {
+        self.water.cube()
+    }
+
     /// Renders one frame: opaque scene, per-bubble cube maps, sorted bubble blend, resolve.
     pub fn render(
         &mut self,
@@ -140,6 +148,9 @@ impl Renderer {
         if settings.draw_lights {
             self.light_spheres.setup(&view, &mut self.opaque_tris);
         }
+        if let Some(w) = &scene.water {
+            setup_water(w, &view, &mut self.opaque_tris);
+        }
         self.opaque_bins.build(&self.opaque_tris, strips);
         self.setup_bubbles(scene, &view);
         self.bubble_bins.build(&self.bubble_tris, strips);
@@ -149,7 +160,10 @@ impl Renderer {
         if let ReflectionMode::DynamicCubeMap { face_size } = settings.reflection {
             self.render_cube_maps(scene, &materials, face_size);
         }
-        let cube_maps_s = t.elapsed().as_secs_f64();
+        let mut cube_maps_s = t.elapsed().as_secs_f64();
+        if let Some(w) = &scene.water {
+            self.water.prepare_tables(w.ior);
+        }
 
         let t = Instant::now();
         let ambient = scene.irradiance.plus_uniform(scene.ambient_rgb);
@@ -157,7 +171,7 @@ impl Renderer {
             .ground
             .as_ref()
             .and_then(|g| GroundView::new(g, &view));
-        let opaque = OpaqueCtx {
+        let mut opaque = OpaqueCtx {
             view,
             pattern,
             env: &scene.environment,
@@ -168,6 +182,7 @@ impl Renderer {
             materials: &materials,
             tris: &self.opaque_tris,
             bins: &self.opaque_bins,
+            water: None,
         };
         let reflections: Vec<Reflection<'_>> = (0..scene.bubbles.len())
             .map(|b| match &settings.reflection {
@@ -198,6 +213,27 @@ impl Renderer {
             tris: &self.bubble_tris,
             bins: &self.bubble_bins,
         };
+        if scene.water.is_some() {
+            let t = Instant::now();
+            if let ReflectionMode::DynamicCubeMap { face_size } = settings.reflection {
+                let env_cube = self.env_cube.as_ref().map(|(_, c)| c);
+                let (objects, lights) = (&self.objects, &self.light_spheres);
+                let setup = |v: &View, out: &mut Vec<SetupTri>| {
+                    objects.setup(v, out);
+                    if settings.draw_lights {
+                        lights.setup(v, out);
+                    }
+                };
+                let pass = &mut self.water;
+                pass.render_cube(scene, face_size, &opaque, &bubbles, env_cube, &setup);
+            }
+            cube_maps_s += t.elapsed().as_secs_f64();
+        }
+        let water_pass = &self.water;
+        opaque.water = scene
+            .water
+            .as_ref()
+            .map(|w| water_pass.shading(w, scene, settings));
         let (w, h) = (settings.width, settings.height);
         self.frame.width = w;
         self.frame.height = h;
@@ -250,26 +286,7 @@ impl Renderer {
     /// Sets up bubble triangles: bubbles far to near, each bubble's back faces then front faces.
     fn setup_bubbles(&mut self, scene: &RenderScene, view: &View) {
         self.bubble_tris.clear();
-        for k in far_to_near(&scene.bubbles, view.eye) {
-            let bubble = &scene.bubbles[k];
-            for front in [false, true] {
-                for t in &bubble.triangles {
-                    if is_front_facing(bubble, *t, view.eye) == front {
-                        let tri = t.map(|i| {
-                            let i = i as usize;
-                            let n = bubble.normals[i];
-                            clip_vertex(
-                                view,
-                                bubble.positions[i],
-                                [n.x, n.y, n.z, bubble.thickness_nm[i], 0.0],
-                            )
-                        });
-                        let extra = reflection_rate(view, bubble, *t);
-                        setup_triangle(view, tri, k as u32, extra, |s| self.bubble_tris.push(s));
-                    }
-                }
-            }
-        }
+        setup_bubble_tris(scene, view, &mut self.bubble_tris);
     }
 
     /// Renders each bubble's six cube faces (the scene without bubbles or light spheres).
@@ -325,6 +342,7 @@ impl Renderer {
                 materials,
                 tris: &scratch.tris,
                 bins: &scratch.bins,
+                water: None,
             };
             let rows = STRIP_ROWS * m;
             // Strips of a face run in parallel too: twelve faces alone balance poorly.
@@ -352,6 +370,30 @@ impl Renderer {
             self.env_cube = CubeMap::from_environment(env, face_size)
                 .ok()
                 .map(|c| (env.clone(), c));
+        }
+    }
+}
+
+/// Sets up bubble triangles: bubbles far to near, each bubble's back faces then front faces.
+pub(crate) fn setup_bubble_tris(scene: &RenderScene, view: &View, out: &mut Vec<SetupTri>) {
+    for k in far_to_near(&scene.bubbles, view.eye) {
+        let bubble = &scene.bubbles[k];
+        for front in [false, true] {
+            for t in &bubble.triangles {
+                if is_front_facing(bubble, *t, view.eye) == front {
+                    let tri = t.map(|i| {
+                        let i = i as usize;
+                        let n = bubble.normals[i];
+                        clip_vertex(
+                            view,
+                            bubble.positions[i],
+                            [n.x, n.y, n.z, bubble.thickness_nm[i], 0.0],
+                        )
+                    });
+                    let extra = reflection_rate(view, bubble, *t);
+                    setup_triangle(view, tri, k as u32, extra, |s| out.push(s));
+                }
+            }
         }
     }
 }

@@ -6,7 +6,7 @@ use lut::Lut;
 
 use crate::environment::check_rgb;
 use crate::mesh::{check_triangles, check_vertices};
-use crate::{Camera, Environment, Irradiance, RenderError, Texture, TriMesh};
+use crate::{Camera, Environment, Irradiance, RenderError, Texture, TriMesh, WaterSurface};
 
 /// How a surface's albedo varies over it.
 #[derive(Debug, Clone, PartialEq)]
@@ -62,7 +62,7 @@ impl Material {
         }
     }
 
-    fn validate(&self, what: &str) -> Result<(), RenderError> {
+    pub(crate) fn validate(&self, what: &str) -> Result<(), RenderError> {
         check_rgb(&format!("{what} specular"), self.specular)?;
         if !(self.shininess.is_finite() && self.shininess >= 0.0) {
             return Err(RenderError::scene(
@@ -274,6 +274,8 @@ pub struct RenderScene {
     pub lights: Vec<Light>,
     /// Bubble films, blended over the opaque scene.
     pub bubbles: Vec<BubbleMesh>,
+    /// Optional water surface, drawn with the opaque scene.
+    pub water: Option<WaterSurface>,
 }
 
 impl RenderScene {
@@ -288,6 +290,7 @@ impl RenderScene {
             objects: Vec::new(),
             lights: Vec::new(),
             bubbles: Vec::new(),
+            water: None,
         }
     }
 
@@ -372,6 +375,9 @@ impl RenderScene {
         }
         for (k, b) in self.bubbles.iter().enumerate() {
             b.validate(k)?;
+        }
+        if let Some(w) = &self.water {
+            w.validate()?;
         }
         Ok(())
     }

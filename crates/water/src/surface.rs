@@ -44,6 +44,7 @@ pub struct Surface {
     perturbations: Vec<Perturbation>,
     waves: Vec<WaveTable>,
     ripples: Vec<RippleTable>,
+    /// One row's summed heights and slopes (scratch of [`Surface::evaluate`]).
     heights: Vec<f32>,
     slopes: Vec<[f32; 2]>,
     mesh: WaterMesh,
@@ -74,8 +75,8 @@ impl Surface {
             perturbations,
             waves,
             ripples,
-            heights: vec![0.0; nx * nz],
-            slopes: vec![[0.0; 2]; nx * nz],
+            heights: vec![0.0; nx],
+            slopes: vec![[0.0; 2]; nx],
             mesh: WaterMesh {
                 normals: vec![Vec3::Y; positions.len()],
                 positions,
@@ -115,34 +116,39 @@ impl Surface {
 
     /// The mesh at time `t_s`: heights summed over the perturbations and analytic normals
     /// `normalize(−∂y/∂x, 1, −∂y/∂z)`, in f32. Reuses its buffers.
+    ///
+    /// Row by row: the sums of one row stay in a row-long scratch (in L1 cache) while
+    /// every perturbation adds to it, then become that row's positions and normals.
     pub fn evaluate(&mut self, t_s: f64) -> &WaterMesh {
-        self.heights.fill(0.0);
-        self.slopes.fill([0.0; 2]);
         let [nx, _] = self.grid.vertices();
-        for table in &self.waves {
-            add_wave(
-                table,
-                &self.grid,
-                nx,
-                t_s,
-                &mut self.heights,
-                &mut self.slopes,
-            );
-        }
-        for table in &self.ripples {
-            add_ripple(table, t_s, &mut self.heights, &mut self.slopes);
-        }
+        self.heights.resize(nx, 0.0);
+        self.slopes.resize(nx, [0.0; 2]);
+        let ripple_frames: Vec<RippleFrame> = self
+            .ripples
+            .iter()
+            .map(|r| RippleFrame::at(r, t_s))
+            .collect();
         let rest = self.grid.rest_height_m() as f32;
         let mesh = &mut self.mesh;
-        for (((p, n), h), s) in mesh
+        let rows = mesh
             .positions
-            .iter_mut()
-            .zip(&mut mesh.normals)
-            .zip(&self.heights)
-            .zip(&self.slopes)
-        {
-            p.y = rest + h;
-            *n = Vec3::new(-s[0], 1.0, -s[1]).normalize();
+            .chunks_exact_mut(nx)
+            .zip(mesh.normals.chunks_exact_mut(nx));
+        for (j, (p_row, n_row)) in rows.enumerate() {
+            let (heights, slopes) = (&mut self.heights[..], &mut self.slopes[..]);
+            heights.fill(0.0);
+            slopes.fill([0.0; 2]);
+            for table in &self.waves {
+                add_wave_row(table, self.grid.z_m(j), t_s, heights, slopes);
+            }
+            for (table, frame) in self.ripples.iter().zip(&ripple_frames) {
+                let row = &table.vertices[j * nx..(j + 1) * nx];
+                add_ripple_row(frame, row, heights, slopes);
+            }
+            for (((p, n), h), s) in p_row.iter_mut().zip(n_row).zip(&*heights).zip(&*slopes) {
+                p.y = rest + h;
+                *n = Vec3::new(-s[0], 1.0, -s[1]).normalize();
+            }
         }
         &self.mesh
     }
@@ -186,11 +192,11 @@ fn ripple_table(ripple: Ripple, xs: &[f64], zs: &[f64]) -> RippleTable {
     RippleTable { ripple, vertices }
 }
 
-/// Adds one wave: per row `B = k·j·z − ωt`, then `sin(A + B)` from the column table.
-fn add_wave(
+/// Adds one wave to the row at `z_m`: `B = k·j·z − ωt` once, then `sin(A + B)` from the
+/// column table.
+fn add_wave_row(
     table: &WaveTable,
-    grid: &Grid,
-    nx: usize,
+    z_m: f64,
     t_s: f64,
     heights: &mut [f32],
     slopes: &mut [[f32; 2]],
@@ -200,41 +206,54 @@ fn add_wave(
     let a = w.amplitude_m() as f32;
     let ak = (w.amplitude_m() * w.k_per_m()) as f32;
     let (aki, akj) = (ak * di as f32, ak * dj as f32);
-    for (j, (h_row, s_row)) in heights
-        .chunks_exact_mut(nx)
-        .zip(slopes.chunks_exact_mut(nx))
-        .enumerate()
+    let b = w.k_per_m() * dj * z_m - w.omega_rad_per_s() * t_s;
+    let (sb, cb) = b.sin_cos();
+    let (sb, cb) = (sb as f32, cb as f32);
+    for ((h, s), col) in heights
+        .iter_mut()
+        .zip(slopes.iter_mut())
+        .zip(&table.columns)
     {
-        let b = w.k_per_m() * dj * grid.z_m(j) - w.omega_rad_per_s() * t_s;
-        let (sb, cb) = b.sin_cos();
-        let (sb, cb) = (sb as f32, cb as f32);
-        for ((h, s), col) in h_row.iter_mut().zip(s_row.iter_mut()).zip(&table.columns) {
-            let sin_phase = col[0] * cb + col[1] * sb;
-            let cos_phase = col[1] * cb - col[0] * sb;
-            *h += a * sin_phase;
-            s[0] += aki * cos_phase;
-            s[1] += akj * cos_phase;
+        let sin_phase = col[0] * cb + col[1] * sb;
+        let cos_phase = col[1] * cb - col[0] * sb;
+        *h += a * sin_phase;
+        s[0] += aki * cos_phase;
+        s[1] += akj * cos_phase;
+    }
+}
+
+/// A ripple's factors at one time: the rotation by `ωt`, faded by `e^(−βt)`.
+#[derive(Debug, Clone, Copy)]
+struct RippleFrame {
+    sin_wt: f32,
+    cos_wt: f32,
+    k: f32,
+    alpha: f32,
+}
+
+impl RippleFrame {
+    fn at(table: &RippleTable, t_s: f64) -> RippleFrame {
+        let r = &table.ripple;
+        let fade = (-r.decay_per_s() * t_s).exp();
+        let (st, ct) = (r.omega_rad_per_s() * t_s).sin_cos();
+        RippleFrame {
+            sin_wt: (st * fade) as f32,
+            cos_wt: (ct * fade) as f32,
+            k: r.k_per_m() as f32,
+            alpha: r.decay_per_m() as f32,
         }
     }
 }
 
-/// Adds one ripple: rotates the tabulated `sin kr`, `cos kr` back by `ωt`.
-fn add_ripple(table: &RippleTable, t_s: f64, heights: &mut [f32], slopes: &mut [[f32; 2]]) {
-    let r = &table.ripple;
-    let fade = (-r.decay_per_s() * t_s).exp();
-    let (st, ct) = (r.omega_rad_per_s() * t_s).sin_cos();
-    let (st, ct) = ((st * fade) as f32, (ct * fade) as f32);
-    let (k, alpha) = (r.k_per_m() as f32, r.decay_per_m() as f32);
-    for ((h, s), v) in heights
-        .iter_mut()
-        .zip(slopes.iter_mut())
-        .zip(&table.vertices)
-    {
+/// Adds one ripple to a row: rotates the tabulated `sin kr`, `cos kr` back by `ωt`.
+fn add_ripple_row(f: &RippleFrame, row: &[[f32; 4]], heights: &mut [f32], slopes: &mut [[f32; 2]]) {
+    let (st, ct) = (f.sin_wt, f.cos_wt);
+    for ((h, s), v) in heights.iter_mut().zip(slopes.iter_mut()).zip(row) {
         let [a_sin_kr, a_cos_kr, ux, uz] = *v;
         let a_sin_phase = a_sin_kr * ct - a_cos_kr * st;
         let a_cos_phase = a_cos_kr * ct + a_sin_kr * st;
         *h += a_sin_phase;
-        let dy_dr = k * a_cos_phase - alpha * a_sin_phase;
+        let dy_dr = f.k * a_cos_phase - f.alpha * a_sin_phase;
         s[0] += dy_dr * ux;
         s[1] += dy_dr * uz;
     }

@@ -113,6 +113,8 @@ pub struct FrameJob {
     film_spec: Option<raster::reference::FilmSpec>,
     reference: reference::ReferenceOptions,
     reference_frame: Frame,
+    /// The water's geometry, evaluated at the solver's time each frame.
+    water: Option<water::Surface>,
 }
 
 impl FrameJob {
@@ -129,6 +131,14 @@ impl FrameJob {
         let luts = scene.bake_tables(width, height)?;
         let mut render_scene = scene.render_scene()?;
         render_scene.lights = scene.raster_lights(&luts)?;
+        render_scene.water = scene.water_optics()?;
+        let water = scene.water_surface()?;
+        if water.is_some() && options.backend == Backend::Reference {
+            return Err(CliError::input(format!(
+                "{}: the reference backend does not draw water yet: use --backend cpu",
+                scene.origin
+            )));
+        }
         let settings = settings(&scene, &render_scene, options)?;
         let film_spec = match options.backend {
             Backend::Cpu | Backend::Wgpu => None,
@@ -149,6 +159,7 @@ impl FrameJob {
             render_scene,
             settings,
             renderer: Renderer::new(),
+            water,
         })
     }
 
@@ -160,6 +171,11 @@ impl FrameJob {
     /// Simulated time so far, in seconds.
     pub fn time_s(&self) -> f64 {
         self.world.time_s()
+    }
+
+    /// Dynamic cube maps a frame renders: one per bubble, one for the water.
+    fn cube_maps(&self) -> usize {
+        self.bubble_count() + usize::from(self.water.is_some())
     }
 
     /// Number of bubbles still alive.
@@ -218,9 +234,17 @@ impl FrameJob {
         self.world.dt_s()
     }
 
-    /// Renders the current state.
+    /// Renders the current state: the bubbles and the water at the solver's time.
     pub fn render(&mut self) -> Result<&Frame, CliError> {
         self.render_scene.bubbles = bubble_meshes(&self.world);
+        if let (Some(surface), Some(out)) = (&mut self.water, &mut self.render_scene.water) {
+            let mesh = surface.evaluate(self.world.time_s());
+            out.positions.clone_from(&mesh.positions);
+            out.normals.clone_from(&mesh.normals);
+            if out.triangles.len() != mesh.triangles.len() {
+                out.triangles.clone_from(&mesh.triangles);
+            }
+        }
         if let Some(spec) = &self.film_spec {
             let settings = self.reference.settings(&self.settings);
             self.reference_frame = reference::render(&self.render_scene, spec, &settings, true)?;
@@ -294,7 +318,7 @@ impl FrameJob {
     /// # Errors
     /// When the new size's buffers pass the memory limit.
     pub fn set_size(&mut self, width: usize, height: usize) -> Result<(), CliError> {
-        check_memory(self.bubble_count(), &self.settings, width, height)?;
+        check_memory(self.cube_maps(), &self.settings, width, height)?;
         self.settings.width = width;
         self.settings.height = height;
         Ok(())
@@ -374,7 +398,9 @@ fn settings(
     settings
         .validate()
         .map_err(|e| CliError::input(e.to_string()))?;
-    check_memory(scene.file.bubbles.len(), &settings, width, height)?;
+    // One cube map per bubble, and one for the water's reflections.
+    let cube_maps = scene.file.bubbles.len() + usize::from(scene.file.water.is_some());
+    check_memory(cube_maps, &settings, width, height)?;
     Ok(settings)
 }
 

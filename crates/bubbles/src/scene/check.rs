@@ -38,6 +38,9 @@ impl Scene {
         if let Some(g) = &f.ground {
             self.check_material(&g.material)?;
         }
+        if let Some(w) = &f.water {
+            self.check_material(&w.floor)?;
+        }
         if triangles > limits::MAX_OPAQUE_TRIANGLES {
             return Err(self.error(format!(
                 "the objects have {triangles} triangles in all, above the limit of {} (see --help)",

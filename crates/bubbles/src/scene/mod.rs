@@ -7,6 +7,7 @@ pub mod schema;
 mod to_dynamics;
 mod to_raster;
 mod to_reference;
+mod to_water;
 pub mod values;
 
 use crate::error::CliError;
@@ -18,7 +19,7 @@ pub use to_dynamics::sim_error;
 pub use to_raster::bubble_meshes;
 
 /// Built-in scenes, by name, with their TOML source.
-pub const BUILTINS: [(&str, &str); 7] = [
+pub const BUILTINS: [(&str, &str); 8] = [
     ("paper", include_str!("../../scenes/paper.toml")),
     (
         "white-furnace",
@@ -35,6 +36,7 @@ pub const BUILTINS: [(&str, &str); 7] = [
     ),
     ("demo", include_str!("../../scenes/demo.toml")),
     ("demo-white", include_str!("../../scenes/demo-white.toml")),
+    ("pond", include_str!("../../scenes/pond.toml")),
 ];
 
 /// Name of the scene used when none is given.

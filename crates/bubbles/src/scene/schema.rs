@@ -4,12 +4,13 @@
 //! line and column rather than a silently ignored setting.
 
 use super::values::{
-    Acceleration, Bounds, BubbleRadius, Coordinate, Count, CubeMapSize, Damping, Direction,
-    Elasticity, Evaporation, Exposure, FieldOfView, FilmIndex, FilmThickness, GustSpeed,
-    InitialScale, Intensity, LightRadius, Luminance, LutAngleSamples, LutThicknessSamples,
-    MeshScale, MolarMass, Num, Num3, ObjectRadius, PatternScale, Radiance, Reflectance,
-    RuptureThickness, Samples, Seconds, Shininess, SloshSpeed, Speed, Subdivisions, SurfaceTension,
-    TimeStep, Variation, Viscosity,
+    Absorption, Acceleration, AngularSpeed, Bounds, BubbleRadius, Coordinate, Count, CubeMapSize,
+    Damping, DecayPerMetre, DecayPerSecond, Direction, Direction2, Elasticity, Evaporation,
+    Exposure, FieldOfView, FilmIndex, FilmThickness, GustSpeed, InitialScale, Intensity,
+    LightRadius, Luminance, LutAngleSamples, LutThicknessSamples, MeshScale, MolarMass, Num, Num3,
+    ObjectRadius, PatternScale, Radiance, Reflectance, RuptureThickness, Samples, Seconds,
+    Shininess, SloshSpeed, Speed, Subdivisions, SurfaceTension, TimeStep, Variation, Viscosity,
+    WaterDepth, WaterIndex, WaterSlices, WaveAmplitude, Wavelength,
 };
 use serde::Deserialize;
 
@@ -34,6 +35,9 @@ pub struct SceneFile {
     /// Small spherical lights.
     #[serde(default)]
     pub lights: Vec<LightSpec>,
+    /// Optional water surface (seed 002): a perturbed grid over a pool floor.
+    #[serde(default)]
+    pub water: Option<WaterSpec>,
     /// The soap bubbles.
     #[serde(default)]
     pub bubbles: Vec<BubbleSpec>,
@@ -294,6 +298,91 @@ fn d65() -> String {
 }
 fn light_luminance() -> Num<Luminance> {
     num(20.0)
+}
+
+/// A water surface: a grid on the XZ plane perturbed by waves and ripples, drawn with
+/// reflection and refraction onto a floor, and a collider (its rest plane) for bubbles.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WaterSpec {
+    /// Corner of the grid with the smallest X and Z, m.
+    pub min_m: [Num<Coordinate>; 2],
+    /// Corner of the grid with the largest X and Z, m.
+    pub max_m: [Num<Coordinate>; 2],
+    /// Slices along X and along Z (each side has one vertex more).
+    #[serde(default = "water_slices")]
+    pub slices: [Count<WaterSlices>; 2],
+    /// Height of the unperturbed surface, m.
+    #[serde(default = "finite_zero")]
+    pub rest_height_m: Num<Coordinate>,
+    /// Refractive index of the water.
+    #[serde(default = "water_ior")]
+    pub ior: Num<WaterIndex>,
+    /// Depth of the floor below the rest plane, m.
+    #[serde(default = "floor_depth")]
+    pub floor_depth_m: Num<WaterDepth>,
+    /// The floor's appearance (default: tiles).
+    #[serde(default)]
+    pub floor: MaterialSpec,
+    /// Beer–Lambert absorption per metre of water, per channel (default: clear water).
+    #[serde(default = "clear_water")]
+    pub absorption_per_m: Num3<Absorption>,
+    /// Directional sine waves.
+    #[serde(default)]
+    pub waves: Vec<WaveSpec>,
+    /// Circular ripples.
+    #[serde(default)]
+    pub ripples: Vec<RippleSpec>,
+}
+
+fn water_slices() -> [Count<WaterSlices>; 2] {
+    [Count::new(128).expect("128 slices are in range"); 2]
+}
+fn water_ior() -> Num<WaterIndex> {
+    num(1.333)
+}
+fn floor_depth() -> Num<WaterDepth> {
+    num(0.5)
+}
+fn clear_water() -> Num3<Absorption> {
+    // Pure water absorbs red most: about 0.45, 0.06 and 0.02 per metre at 650, 550, 450 nm.
+    rgb([0.45, 0.06, 0.02])
+}
+
+/// A directional wave `a·sin(k(x·i + z·j) − ωt)`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WaveSpec {
+    /// Amplitude, m.
+    pub amplitude_m: Num<WaveAmplitude>,
+    /// Wavelength `2π/k`, m.
+    pub wavelength_m: Num<Wavelength>,
+    /// Direction of travel `(i, j)` on the XZ plane (normalised).
+    pub direction: Direction2,
+    /// Angular frequency ω, rad/s (default: deep-water dispersion with surface tension).
+    #[serde(default)]
+    pub omega_rad_per_s: Option<Num<AngularSpeed>>,
+}
+
+/// A circular ripple `a·e^(−αr)·e^(−βt)·sin(kr − ωt)` around a centre.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RippleSpec {
+    /// Amplitude at the centre at t = 0, m.
+    pub amplitude_m: Num<WaveAmplitude>,
+    /// Wavelength, m.
+    pub wavelength_m: Num<Wavelength>,
+    /// Centre (X, Z), m.
+    pub center_m: [Num<Coordinate>; 2],
+    /// Fading with distance α, 1/m (0: none).
+    #[serde(default)]
+    pub decay_per_m: Option<Num<DecayPerMetre>>,
+    /// Fading with time β, 1/s (0: none).
+    #[serde(default)]
+    pub decay_per_s: Option<Num<DecayPerSecond>>,
+    /// Angular frequency ω, rad/s (default: deep-water dispersion with surface tension).
+    #[serde(default)]
+    pub omega_rad_per_s: Option<Num<AngularSpeed>>,
 }
 
 /// One soap bubble.

@@ -9,7 +9,8 @@ use bubble_dynamics::{
 };
 
 impl Scene {
-    /// Builds the solver's world: the bubbles, the ground and box/sphere objects as colliders.
+    /// Builds the solver's world: the bubbles, the ground, box/sphere objects and the
+    /// water's rest plane as colliders.
     pub fn dynamics_world(&self) -> Result<World, CliError> {
         let bubbles = self.file.bubbles.iter().map(bubble_params).collect();
         World::try_new(self.world_params()?, bubbles).map_err(|e| {
@@ -45,7 +46,13 @@ impl Scene {
             };
             Some(format!("[[objects]] #{} ({place})", i + 1))
         });
-        ground.chain(objects).collect()
+        let water = self.file.water.iter().map(|w| {
+            format!(
+                "the water's rest plane (water.rest_height_m = {})",
+                plain(w.rest_height_m.get())
+            )
+        });
+        ground.chain(objects).chain(water).collect()
     }
 
     fn world_params(&self) -> Result<WorldParams, CliError> {
@@ -100,7 +107,14 @@ impl Scene {
             // Meshes are drawn but do not collide: the solver has no mesh collider.
             ObjectSpec::Mesh { .. } => None,
         });
-        ground.chain(objects).collect()
+        // Bubbles bounce on the water's rest plane, everywhere (the solver's planes are
+        // infinite): a wave's height is not felt.
+        let water = self
+            .file
+            .water
+            .iter()
+            .map(|w| Collider::ground(w.rest_height_m.get()));
+        ground.chain(objects).chain(water).collect()
     }
 }
 

@@ -69,7 +69,7 @@ impl Scene {
         })
     }
 
-    fn material(&self, spec: &MaterialSpec) -> Result<Material, CliError> {
+    pub(super) fn material(&self, spec: &MaterialSpec) -> Result<Material, CliError> {
         Ok(match spec {
             MaterialSpec::Checker { a, b, scale_m } => {
                 Material::checker(rgb(a.get()), rgb(b.get()), scale_m.get() as f32)

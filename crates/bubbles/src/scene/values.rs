@@ -39,6 +39,14 @@ pub struct Num3<B>([f64; 3], PhantomData<B>);
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Direction([f64; 3]);
 
+/// A direction on the horizontal XZ plane: two components in `-1e6..=1e6`, of length at
+/// least `1e-6` (normalised where it is used).
+///
+/// # Guarantees
+/// Both components are finite with `|c| <= 1e6`, and the length is `>= 1e-6`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Direction2([f64; 2]);
+
 /// A whole number inside `B`'s range.
 ///
 /// # Guarantees
@@ -113,6 +121,20 @@ impl Direction {
     }
 }
 
+impl Direction2 {
+    /// Checks `value`, returning `None` when it breaks the guarantee.
+    pub fn new(value: [f64; 2]) -> Option<Self> {
+        let finite = value.iter().all(|c| c.is_finite() && c.abs() <= 1e6);
+        let length_sq: f64 = value.iter().map(|c| c * c).sum();
+        (finite && length_sq >= 1e-12).then_some(Self(value))
+    }
+
+    /// The checked components.
+    pub fn get(self) -> [f64; 2] {
+        self.0
+    }
+}
+
 // Manual impls: derives would demand `B: Clone` etc. of the marker types.
 macro_rules! plain_value_impls {
     ($name:ident) => {
@@ -175,6 +197,19 @@ impl<'de> Deserialize<'de> for Direction {
             D::Error::custom(format!(
                 "{} is not a direction: components in -1e6..=1e6, length at least 1e-6",
                 numbers(&value)
+            ))
+        })
+    }
+}
+
+impl<'de> Deserialize<'de> for Direction2 {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let value = <[f64; 2]>::deserialize(d)?;
+        Self::new(value).ok_or_else(|| {
+            D::Error::custom(format!(
+                "[{}, {}] is not a direction: components in -1e6..=1e6, length at least 1e-6",
+                plain(value[0]),
+                plain(value[1])
             ))
         })
     }
@@ -283,6 +318,25 @@ bounds! {
     LutAngleSamples: 2.0, crate::limits::MAX_LUT_ANGLE_SAMPLES as f64, "rows";
     /// Anti-aliasing samples (1, 4, 8, 9 or 16; the set is checked later).
     Samples: 1.0, 16.0, "";
+    /// Water grid slices along one side.
+    WaterSlices: 1.0, crate::limits::MAX_WATER_SLICES as f64, "";
+    /// Refractive index of the water (air is 1).
+    WaterIndex: 1.0, 4.0, "";
+    /// Depth of the pool floor below the water's rest plane.
+    WaterDepth: 1e-4, 1e4, "m";
+    /// Beer–Lambert absorption of the water, per channel.
+    Absorption: 0.0, 1e4, "1/m";
+    /// Amplitude of a wave or ripple (with at most `MAX_WATER_PERTURBATIONS` of them,
+    /// the surface stays within the scene's coordinates).
+    WaveAmplitude: 0.0, 10.0, "m";
+    /// Wavelength of a wave or ripple.
+    Wavelength: 1e-3, 1e4, "m";
+    /// Angular frequency of a wave or ripple.
+    AngularSpeed: 1e-6, 1e4, "rad/s";
+    /// A ripple's fading with distance from its centre.
+    DecayPerMetre: 0.0, 1e4, "1/m";
+    /// A ripple's fading with time.
+    DecayPerSecond: 0.0, 1e4, "1/s";
 }
 
 #[cfg(test)]

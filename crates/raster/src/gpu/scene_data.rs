@@ -171,6 +171,9 @@ pub(super) fn check_supported(
     if let ReflectionMode::SphereMap(_) = settings.reflection {
         return Err(unsupported("reflection mode sphere-map"));
     }
+    if scene.water.is_some() {
+        return Err(unsupported("a water surface (the [water] section)"));
+    }
     match scene.environment {
         Environment::Sky(_) | Environment::Uniform(_) => {}
         Environment::Equirect(_) => return Err(unsupported("an equirect environment image")),

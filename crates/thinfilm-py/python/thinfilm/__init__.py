@@ -37,13 +37,20 @@ def rt(n, d_nm, wavelength_nm, angle_deg, pol="u"):
     return r.reshape(shape), t.reshape(shape)
 
 
-def film_rt(thickness_nm, angle_deg, wavelength_nm, n_film=1.33, n_outside=1.0):
+def film_rt(thickness_nm, angle_deg, wavelength_nm, n_film=1.33, n_outside=1.0, fast=False):
     """``(R, T)`` of a free-standing film ``n_outside | n_film | n_outside`` (unpolarised).
 
-    All three arrays broadcast together; exact Airy sum of all orders, in parallel.
+    All three arrays broadcast together: the exact Airy sum of all orders in f64, in
+    parallel (about 1e-15, for comparisons with tmm). ``fast=True`` runs thinfilm's f32
+    batch kernel instead (SIMD, in parallel; the kernel is within 2e-7 for inputs f32 holds
+    exactly). Rounding the inputs to f32 moves the phase by up to 6e-8 of itself, which for
+    films up to 5 um stays within 5e-5 in R and T (worst near grazing incidence and for
+    high-index films, where the fringes are sharp); R + T = 1 holds to 4e-7. Points f32
+    cannot hold always take the exact path.
     """
     shape, (d, angle, wl) = _flat(thickness_nm, angle_deg, wavelength_nm)
-    r, t = _native.film_rt(d, angle, wl, float(n_film), float(n_outside))
+    native = _native.film_rt_fast if fast else _native.film_rt
+    r, t = native(d, angle, wl, float(n_film), float(n_outside))
     return r.reshape(shape), t.reshape(shape)
 
 
