@@ -47,8 +47,10 @@ fn paper_through_wgpu_matches_the_cpu_backend_in_ciede2000() {
     let json = String::from_utf8_lossy(&out.stdout);
     eprintln!("paper, CPU vs wgpu: {json}");
     let (mean, p99) = (json_field(&json, "mean"), json_field(&json, "p99"));
-    assert!(mean <= 0.5, "mean ΔE2000 {mean} > 0.5: {json}");
-    assert!(p99 <= 2.0, "99th percentile ΔE2000 {p99} > 2: {json}");
+    // With the cube footprint filter ported the rims agree too: lavapipe measured mean
+    // 0.053, p99 0.76; the GPU's taps all at level 0 gave p99 0.94, one level-0 tap 1.95.
+    assert!(mean <= 0.25, "mean ΔE2000 {mean} > 0.25: {json}");
+    assert!(p99 <= 0.9, "99th percentile ΔE2000 {p99} > 0.9: {json}");
 }
 
 #[test]

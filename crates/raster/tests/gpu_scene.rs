@@ -148,11 +148,9 @@ fn gpu_frame_matches_the_cpu_backend_in_ciede2000() {
     }
 }
 
-/// The GPU reads cube maps with one bilinear tap (the footprint filter of `lod.rs` is not
-/// ported yet): against the CPU's bilinear mode only sample patterns and rounding differ.
-#[test]
-fn gpu_cube_lookup_matches_the_cpu_bilinear_lookup() {
-    let Some(mut gpu) = gpu() else { return };
+/// The test scene's frame with dynamic cube maps read in `filter` mode: the CPU's and the
+/// GPU's, as sRGB bytes.
+fn cube_frames(gpu: &mut GpuRenderer, filter: raster::ReflectionFilter) -> (Vec<u8>, Vec<u8>) {
     let (scene, tables) = (scene(), tables());
     let s = settings(
         200,
@@ -161,14 +159,63 @@ fn gpu_cube_lookup_matches_the_cpu_bilinear_lookup() {
         ReflectionMode::DynamicCubeMap { face_size: 48 },
     );
     let mut cpu = Renderer::new();
-    cpu.set_reflection_filter(raster::ReflectionFilter::Bilinear);
+    cpu.set_reflection_filter(filter);
+    gpu.set_reflection_filter(filter);
     let cpu = cpu
         .render(&scene, &tables, &s)
         .unwrap()
         .to_srgb8(s.exposure_ev, s.tonemap);
-    let (mean, p99) = delta_e(&cpu, &gpu.render_srgb8(&scene, &tables, &s).unwrap());
+    (cpu, gpu.render_srgb8(&scene, &tables, &s).unwrap())
+}
+
+fn per_pixel_delta_e(a: &[u8], b: &[u8]) -> Vec<f64> {
+    a.chunks_exact(3)
+        .zip(b.chunks_exact(3))
+        .map(|(p, q)| ciede2000(lab_of(p), lab_of(q)))
+        .collect()
+}
+
+/// In the bilinear mode only sample patterns and rounding differ.
+#[test]
+fn gpu_cube_lookup_matches_the_cpu_bilinear_lookup() {
+    let Some(mut gpu) = gpu() else { return };
+    let (cpu, gpu) = cube_frames(&mut gpu, raster::ReflectionFilter::Bilinear);
+    let (mean, p99) = delta_e(&cpu, &gpu);
     eprintln!("cube maps vs the CPU's bilinear lookup: mean ΔE2000 {mean:.3}, p99 {p99:.3}");
     assert!(mean <= 0.1 && p99 <= 1.0, "mean {mean}, p99 {p99}");
+}
+
+/// The footprint filter (mip chain built on the GPU from its own faces, LOD and
+/// anisotropic taps in WGSL) against the CPU's, where it matters: on the pixels where the
+/// CPU's footprint and bilinear lookups differ (ΔE > 1, the rims), the GPU must sit much
+/// nearer the CPU's footprint frame than the bilinear one does.
+#[test]
+fn gpu_cube_lookup_matches_the_cpu_footprint_lookup() {
+    let Some(mut gpu) = gpu() else { return };
+    let (cpu_bilinear, gpu_bilinear) = cube_frames(&mut gpu, raster::ReflectionFilter::Bilinear);
+    let (cpu, got) = cube_frames(&mut gpu, raster::ReflectionFilter::Footprint);
+    let (mean, p99) = delta_e(&cpu, &got);
+    let filter_effect = per_pixel_delta_e(&cpu, &cpu_bilinear);
+    let error = per_pixel_delta_e(&cpu, &got);
+    let rims: Vec<usize> = (0..error.len())
+        .filter(|&i| filter_effect[i] > 1.0)
+        .collect();
+    assert!(rims.len() >= 50, "only {} rim pixels", rims.len());
+    let mean_over = |de: &[f64]| rims.iter().map(|&i| de[i]).sum::<f64>() / rims.len() as f64;
+    let (rim_error, rim_effect) = (mean_over(&error), mean_over(&filter_effect));
+    // What the backends' faces and sampling alone leave (both bilinear), for the record.
+    let floor = mean_over(&per_pixel_delta_e(&cpu_bilinear, &gpu_bilinear));
+    eprintln!(
+        "cube maps vs the CPU's footprint lookup: mean ΔE2000 {mean:.3}, p99 {p99:.3}; on \
+         {} rim pixels {rim_error:.3} (the bilinear lookup: {rim_effect:.3}; both backends \
+         bilinear: {floor:.3})",
+        rims.len()
+    );
+    assert!(mean <= 0.1 && p99 <= 1.0, "mean {mean}, p99 {p99}");
+    assert!(
+        rim_error <= 0.2 * rim_effect,
+        "rims: GPU ΔE {rim_error} from the CPU's footprint lookup, bilinear {rim_effect}"
+    );
 }
 
 #[test]

@@ -14,6 +14,14 @@ pub(super) struct Layouts {
     pub view: wgpu::BindGroupLayout,
     pub scene: wgpu::BindGroupLayout,
     pub bubble: wgpu::BindGroupLayout,
+    /// The cube mip chain's compute passes (group 3: faces, chain, step).
+    pub mip: wgpu::BindGroupLayout,
+    /// Copies level 0 from the faces into the chain.
+    pub mip_copy: wgpu::ComputePipeline,
+    /// Box-filters one level into the next.
+    pub mip_downsample: wgpu::ComputePipeline,
+    /// Refills one level's borders from the neighbouring faces.
+    pub mip_borders: wgpu::ComputePipeline,
     opaque: wgpu::PipelineLayout,
     bubbles: wgpu::PipelineLayout,
     module: wgpu::ShaderModule,
@@ -22,7 +30,10 @@ pub(super) struct Layouts {
 fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
-        visibility: wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
+        // Compute too: the cube mip passes read the scene uniform.
+        visibility: wgpu::ShaderStages::VERTEX
+            | wgpu::ShaderStages::FRAGMENT
+            | wgpu::ShaderStages::COMPUTE,
         ty,
         count: None,
     }
@@ -78,6 +89,28 @@ impl Layouts {
                 entry(0, texture(wgpu::TextureViewDimension::D2)),
                 entry(1, storage()),
                 entry(2, texture(wgpu::TextureViewDimension::D2Array)),
+                entry(3, storage()),
+            ],
+        );
+        let compute = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty,
+            count: None,
+        };
+        let mip = layout(
+            "cube mips",
+            &[
+                compute(0, texture(wgpu::TextureViewDimension::D2Array)),
+                compute(
+                    1,
+                    wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: false },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                ),
+                compute(2, uniform),
             ],
         );
         let pipeline_layout = |groups: &[Option<&wgpu::BindGroupLayout>]| {
@@ -95,10 +128,25 @@ impl Layouts {
                 with_shared_constants(include_str!("scene.wgsl")).into(),
             ),
         });
+        let mips = pipeline_layout(&[None, Some(&scene), None, Some(&mip)]);
+        let compute_pipeline = |entry| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&mips),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
         Layouts {
             view,
             scene,
             bubble,
+            mip_copy: compute_pipeline("cs_mip_copy"),
+            mip_downsample: compute_pipeline("cs_mip_downsample"),
+            mip_borders: compute_pipeline("cs_mip_borders"),
+            mip,
             opaque,
             bubbles,
             module,

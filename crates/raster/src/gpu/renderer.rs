@@ -11,7 +11,8 @@ use crate::camera::View;
 use crate::cubemap::FACE_BASES;
 use crate::passes::GroundView;
 use crate::{
-    BubbleMesh, FilmTables, Frame, FrameTimings, ReflectionMode, RenderScene, RenderSettings,
+    BubbleMesh, CubeMap, FilmTables, Frame, FrameTimings, ReflectionFilter, ReflectionMode,
+    RenderScene, RenderSettings,
 };
 
 /// Size `(width, height, layers)` and sample count of a cached texture.
@@ -36,6 +37,8 @@ pub struct GpuRenderer {
     frame: Frame,
     /// Render targets kept from frame to frame, by role, with their size and samples.
     textures: Vec<(&'static str, TextureKey, wgpu::Texture)>,
+    /// How bubbles read their dynamic cube maps.
+    filter: ReflectionFilter,
 }
 
 /// The targets one view renders into.
@@ -56,7 +59,14 @@ impl GpuRenderer {
             pipelines: Vec::new(),
             frame: Frame::default(),
             textures: Vec::new(),
+            filter: ReflectionFilter::default(),
         })
+    }
+
+    /// Chooses how bubbles read their dynamic cube maps, as
+    /// [`crate::Renderer::set_reflection_filter`] (default: the footprint filter).
+    pub fn set_reflection_filter(&mut self, filter: ReflectionFilter) {
+        self.filter = filter;
     }
 
     /// The device.
@@ -120,7 +130,7 @@ impl GpuRenderer {
         self.gpu.check_size(w, h)?;
         let view = scene.camera.view(settings.width, settings.height);
         let max_side = self.gpu.device.limits().max_texture_dimension_2d;
-        let data = SceneData::new(scene, tables, settings, &view, max_side)?;
+        let data = SceneData::new(scene, tables, settings, &view, max_side, self.filter)?;
         let face_size = match settings.reflection {
             ReflectionMode::DynamicCubeMap { face_size } => Some(face_size),
             _ => None,
@@ -190,6 +200,28 @@ impl GpuRenderer {
                 bind(2, lights.as_entire_binding()),
             ],
         });
+        let mip_floats = face_size.map_or(3, |n| {
+            3 * CubeMap::stored_texels(n) as u64 * scene.bubbles.len().max(1) as u64
+        });
+        let limits = device.limits();
+        let max_bytes = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
+        if 4 * mip_floats > max_bytes {
+            return Err(GpuError::Unsupported(format!(
+                "{} bubbles with cube maps of {} texels (their mip chains take {} bytes, \
+                 this device binds at most {max_bytes})",
+                scene.bubbles.len(),
+                face_size.unwrap_or(0),
+                4 * mip_floats
+            )));
+        }
+        let mips = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("cube mips"),
+            size: 4 * mip_floats,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
         let lut_texture = self.lut_texture(&data.luts);
         let bubble_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("bubble tables"),
@@ -211,6 +243,7 @@ impl GpuRenderer {
                         },
                     )),
                 ),
+                bind(3, mips.as_entire_binding()),
             ],
         });
         let mut encoder = device.create_command_encoder(&Default::default());
@@ -240,6 +273,9 @@ impl GpuRenderer {
                 objects.as_ref(),
                 data.object_vertices,
             );
+        }
+        if let Some(n) = face_size {
+            self.encode_mips(&mut encoder, (&cubes, &mips), &scene_group, n, layers);
         }
         let main = self.pipelines_for(samples);
         let resolved_view = resolved.create_view(&Default::default());
@@ -283,6 +319,72 @@ impl GpuRenderer {
             depth_or_array_layers: 1,
         };
         Ok((encoder, resolved, size))
+    }
+
+    /// The mip chain of every bubble's cube map, built on the GPU from the faces it just
+    /// rendered, exactly as the CPU's `CubeMap::build_mips` builds it from its own.
+    ///
+    /// Why compute passes into a storage buffer rather than a mip-mapped texture: the CPU's
+    /// level `k` is `N >> k` texels plus a one-texel border, which a texture's mip chain of
+    /// `N + 2` (halving the bordered size) cannot hold, and its borders are refilled from
+    /// the neighbouring faces at every level, which a hardware mip generator does not do.
+    /// Reading the faces back to build the chain on the CPU would stall the frame on a
+    /// copy; the passes are O(level-0 texels) on the device, and a buffer laid out like
+    /// `CubeMap`'s levels is read with the same index arithmetic as the CPU's.
+    fn encode_mips(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        (faces, mips): (&wgpu::Texture, &wgpu::Buffer),
+        scene_group: &wgpu::BindGroup,
+        face_size: usize,
+        layers: u32,
+    ) {
+        let device = &self.gpu.device;
+        let faces = faces.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let sizes: Vec<usize> =
+            std::iter::successors(Some(face_size), |&n| (n > 1).then_some(n / 2)).collect();
+        let groups: Vec<wgpu::BindGroup> = (0..sizes.len())
+            .map(|level| {
+                let step = [
+                    level as u32,
+                    sizes[level.saturating_sub(1)] as u32,
+                    sizes[level] as u32,
+                    0,
+                ];
+                let bytes: Vec<u8> = step.iter().flat_map(|x| x.to_le_bytes()).collect();
+                let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("mip step"),
+                    contents: &bytes,
+                    usage: wgpu::BufferUsages::UNIFORM,
+                });
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("cube mips"),
+                    layout: &self.layouts.mip,
+                    entries: &[
+                        bind(0, wgpu::BindingResource::TextureView(&faces)),
+                        bind(1, mips.as_entire_binding()),
+                        bind(2, uniform.as_entire_binding()),
+                    ],
+                })
+            })
+            .collect();
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_bind_group(1, scene_group, &[]);
+        let groups_of = |texels: usize| (texels as u32).div_ceil(8);
+        let m = groups_of(face_size + 2);
+        pass.set_pipeline(&self.layouts.mip_copy);
+        pass.set_bind_group(3, &groups[0], &[]);
+        pass.dispatch_workgroups(m, m, layers);
+        for (level, &n) in sizes.iter().enumerate().skip(1) {
+            pass.set_bind_group(3, &groups[level], &[]);
+            pass.set_pipeline(&self.layouts.mip_downsample);
+            pass.dispatch_workgroups(groups_of(n), groups_of(n), layers);
+            pass.set_pipeline(&self.layouts.mip_borders);
+            pass.dispatch_workgroups(groups_of(n + 2), groups_of(n + 2), layers);
+        }
     }
 
     /// The texture of `role` with `key`, made on first use and when its key changes.

@@ -77,6 +77,9 @@ struct LutInfo {
 @group(2) @binding(0) var luts: texture_2d<f32>;
 @group(2) @binding(1) var<storage, read> lut_info: array<LutInfo>;
 @group(2) @binding(2) var cubes: texture_2d_array<f32>;
+// Every bubble's cube mip chain, laid out as cubemap.rs `CubeMap`'s levels: per bubble,
+// per level (level 0 first), six bordered (n + 2)² faces of packed RGB (see `cube_mips`).
+@group(2) @binding(3) var<storage, read> cube_mips: array<f32>;
 
 // ---- shared functions ------------------------------------------------------------------
 
@@ -347,12 +350,18 @@ struct BubbleOut {
     @location(2) @interpolate(perspective, centroid) thickness_nm: f32,
     @location(3) @interpolate(flat) pixel_angle_rad: f32,
     @location(4) @interpolate(flat) bubble: u32,
+    // normal/w and 1/w interpolated affinely in screen space: their differences between
+    // neighbouring pixels are exactly the CPU's plane derivatives (`SetupTri::attrs`,
+    // `inv_w`), from which the normal's derivative follows as on the CPU.
+    @location(5) @interpolate(linear, center) normal_over_w: vec3<f32>,
+    @location(6) @interpolate(linear, center) inv_w: f32,
 }
 
 @vertex
 fn vs_bubble(in: BubbleIn) -> BubbleOut {
-    return BubbleOut(clip_of(in.position), in.position, in.normal, in.thickness_nm,
-        in.pixel_angle_rad, in.bubble);
+    let clip = clip_of(in.position);
+    return BubbleOut(clip, in.position, in.normal, in.thickness_nm, in.pixel_angle_rad,
+        in.bubble, in.normal / clip.w, 1.0 / clip.w);
 }
 
 // lut_sampler.rs `split`: lower sample index and the upper one's weight on an axis of n.
@@ -420,12 +429,40 @@ fn face_coordinates(dir: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(0.0);
 }
 
-// cubemap.rs `CubeMap::sample`: seamless bilinear lookup in bubble `bubble`'s bordered
-// faces (layers 6·bubble .. 6·bubble + 5, each (N + 2)² texels). Every cube lookup of the
-// backend goes through this one function.
-fn cube_sample(bubble: u32, dir: vec3<f32>) -> vec3<f32> {
-    let fst = face_coordinates(dir);
-    let n = f32(scene.cube_face_size);
+// Face size of level `level` of the chain: the face halved (rounded down) `level` times.
+fn mip_size(level: u32) -> u32 {
+    return scene.cube_face_size >> level;
+}
+
+// cubemap.rs `CubeMap::levels`: ⌊log2 N⌋ + 1.
+fn mip_levels() -> u32 {
+    return firstLeadingBit(scene.cube_face_size) + 1u;
+}
+
+// Floats from the start of a bubble's chain to level `level`.
+fn mip_offset(level: u32) -> u32 {
+    var off = 0u;
+    for (var k = 0u; k < level; k++) {
+        let m = mip_size(k) + 2u;
+        off += 18u * m * m;
+    }
+    return off;
+}
+
+// Float index of bordered texel (x, y) of face `face`, level `level`, bubble `bubble`.
+fn mip_index(bubble: u32, level: u32, face: u32, x: u32, y: u32) -> u32 {
+    let m = mip_size(level) + 2u;
+    return bubble * mip_offset(mip_levels()) + mip_offset(level) + 3u * ((face * m + y) * m + x);
+}
+
+fn mip_texel(i: u32) -> vec3<f32> {
+    return vec3<f32>(cube_mips[i], cube_mips[i + 1u], cube_mips[i + 2u]);
+}
+
+// cubemap.rs `Level::bilinear`: seamless bilinear tap of one level at (s, t), borders
+// included.
+fn cube_level_bilinear(bubble: u32, level: u32, fst: vec3<f32>) -> vec3<f32> {
+    let n = f32(mip_size(level));
     let m = n + 2.0;
     let fx = clamp((fst.y + 1.0) * 0.5 * n + 0.5, 0.0, m - 1.0);
     let fy = clamp((fst.z + 1.0) * 0.5 * n + 0.5, 0.0, m - 1.0);
@@ -433,19 +470,107 @@ fn cube_sample(bubble: u32, dir: vec3<f32>) -> vec3<f32> {
     let y0 = min(floor(fy), m - 2.0);
     let tx = fx - x0;
     let ty = fy - y0;
-    let layer = i32(bubble * 6u + u32(fst.x));
-    let xy = vec2<i32>(i32(x0), i32(y0));
-    let a = textureLoad(cubes, xy, layer, 0).xyz;
-    let b = textureLoad(cubes, xy + vec2<i32>(1, 0), layer, 0).xyz;
-    let c = textureLoad(cubes, xy + vec2<i32>(0, 1), layer, 0).xyz;
-    let d = textureLoad(cubes, xy + vec2<i32>(1, 1), layer, 0).xyz;
+    let i = mip_index(bubble, level, u32(fst.x), u32(x0), u32(y0));
+    let row = 3u * u32(m);
+    let a = mip_texel(i);
+    let b = mip_texel(i + 3u);
+    let c = mip_texel(i + row);
+    let d = mip_texel(i + row + 3u);
     let top = a + (b - a) * tx;
     let bottom = c + (d - c) * tx;
     return top + (bottom - top) * ty;
 }
 
-fn reflection(bubble: u32, dir: vec3<f32>) -> vec3<f32> {
+// cubemap.rs `CubeMap::sample`: one bilinear tap of level 0 (the CPU's bilinear mode).
+fn cube_sample(bubble: u32, dir: vec3<f32>) -> vec3<f32> {
+    return cube_level_bilinear(bubble, 0u, face_coordinates(dir));
+}
+
+// lod.rs `cube_lod`.
+fn cube_lod(footprint_rad: f32, s: f32, t: f32) -> f32 {
+    let q = 1.0 + s * s + t * t;
+    let q34 = sqrt(q) * sqrt(sqrt(q));
+    let texels = footprint_rad * f32(scene.cube_face_size) * 0.5 * q34;
+    if (texels > MIN_FOOTPRINT_TEXELS) {
+        return max(log2(texels) + LOD_BIAS, 0.0);
+    }
+    return 0.0;
+}
+
+// cubemap.rs `CubeMap::sample_trilinear`.
+fn cube_trilinear(bubble: u32, dir: vec3<f32>, footprint_rad: f32) -> vec3<f32> {
+    let fst = face_coordinates(dir);
+    let last = mip_levels() - 1u;
+    let lod = min(cube_lod(footprint_rad, fst.y, fst.z), f32(last));
+    let l0 = u32(lod);
+    let frac = lod - f32(l0);
+    let a = cube_level_bilinear(bubble, l0, fst);
+    if (frac <= 0.0 || l0 == last) {
+        return a;
+    }
+    let b = cube_level_bilinear(bubble, l0 + 1u, fst);
+    return a + (b - a) * frac;
+}
+
+// cubemap.rs `CubeMap::sample_footprint` with lod.rs `anisotropic_taps`.
+fn cube_footprint(bubble: u32, dir: vec3<f32>, da: vec3<f32>, db: vec3<f32>) -> vec3<f32> {
+    var major = da;
+    var minor = db;
+    if (dot(da, da) < dot(db, db)) {
+        major = db;
+        minor = da;
+    }
+    let scale = length(dir);
+    let major_rad = length(major);
+    let minor_rad = length(minor);
+    let ratio = major_rad / max(minor_rad, 1e-12);
+    // NaN or ≤ 1 → one tap.
+    var taps = 1u;
+    if (ratio > 1.0) {
+        taps = u32(min(ceil(ratio), f32(MAX_ANISOTROPY)));
+    }
+    let footprint = max(major_rad / f32(taps), minor_rad);
+    if (taps == 1u) {
+        return cube_trilinear(bubble, dir, footprint);
+    }
+    var sum = vec3<f32>(0.0);
+    for (var i = 0u; i < taps; i++) {
+        let offset = (f32(i) + 0.5) / f32(taps) - 0.5;
+        sum += cube_trilinear(bubble, dir + major * (offset * scale), footprint);
+    }
+    return sum / f32(taps);
+}
+
+// lod.rs `reflection_derivatives`: change per pixel of the unit reflected direction, from
+// the view ray `d`, its change per pixel `dd`, the interpolated normal and its change.
+fn reflection_derivatives(d: vec3<f32>, dd: array<vec3<f32>, 2>, n_raw: vec3<f32>,
+    dn_raw: array<vec3<f32>, 2>) -> array<vec3<f32>, 2> {
+    let d_len = length(d);
+    let n_len = length(n_raw);
+    let v = d / d_len;
+    let n_hat = n_raw / n_len;
+    let sign = select(1.0, -1.0, dot(v, n_hat) > 0.0);
+    let n = n_hat * sign;
+    let c = dot(v, n);
+    var out: array<vec3<f32>, 2>;
+    for (var k = 0; k < 2; k++) {
+        let dv = (dd[k] - v * dot(v, dd[k])) / d_len;
+        let dn = (dn_raw[k] - n_hat * dot(n_hat, dn_raw[k])) * (sign / n_len);
+        let dc = dot(dv, n) + dot(v, dn);
+        let dr = dv - (n * dc + dn * c) * 2.0;
+        let finite = all(abs(dr) < vec3<f32>(3.0e38));
+        out[k] = select(vec3<f32>(0.0), dr, finite);
+    }
+    return out;
+}
+
+// passes.rs `Reflection::sample`: footprint-filtered, or one bilinear tap in the CPU's
+// bilinear mode. Every cube lookup of the backend goes through here.
+fn reflection(bubble: u32, dir: vec3<f32>, derivatives: array<vec3<f32>, 2>) -> vec3<f32> {
     if (scene.reflection == REFLECTION_CUBE) {
+        return cube_footprint(bubble, dir, derivatives[0], derivatives[1]);
+    }
+    if (scene.reflection == REFLECTION_CUBE_BILINEAR) {
         return cube_sample(bubble, dir);
     }
     return env_radiance(dir);
@@ -515,10 +640,22 @@ fn fs_bubble_transmit(in: BubbleOut) -> @location(0) vec4<f32> {
 // The additive pass, blended (One, One): dest ← dest + R ⊙ env(reflect) + highlights.
 @fragment
 fn fs_bubble_add(in: BubbleOut) -> @location(0) vec4<f32> {
+    // passes.rs `BubbleCtx::reflection_derivatives`: ∂n = (∂(n/w) − n·∂(1/w))·w. Derivatives
+    // need uniform control flow, so they come first.
+    let w = 1.0 / in.inv_w;
+    let n_centre = in.normal_over_w * w;
+    let dn_raw = array<vec3<f32>, 2>(
+        (dpdxFine(in.normal_over_w) - n_centre * dpdxFine(in.inv_w)) * w,
+        (dpdyFine(in.normal_over_w) - n_centre * dpdyFine(in.inv_w)) * w);
     let f = film_of(in);
     let r = film_reflectivity(f);
     let reflected = f.v - f.n * (2.0 * f.c);
-    var add = r * reflection(in.bubble, reflected);
+    let rel = in.world - view.eye.xyz;
+    let dd = array<vec3<f32>, 2>(view.right.xyz * view.tan_half_per_px.z,
+        -view.up.xyz * view.tan_half_per_px.w);
+    let derivatives = reflection_derivatives(rel / dot(rel, view.forward.xyz), dd, in.normal,
+        dn_raw);
+    var add = r * reflection(in.bubble, reflected, derivatives);
     for (var i = 0u; i < scene.light_count; i++) {
         let light = lights[i];
         let vis = light_visibility(light, in.world, reflected, in.pixel_angle_rad);
@@ -528,4 +665,105 @@ fn fs_bubble_add(in: BubbleOut) -> @location(0) vec4<f32> {
         }
     }
     return vec4<f32>(add, 1.0);
+}
+
+// ---- cube mip chain ------------------------------------------------------------------------
+//
+// cubemap.rs `CubeMap::build_mips` on the faces the GPU rendered: level 0 copied from the
+// face texture (borders included, as rendered), then per level the box filter of
+// `Level::downsample_from` and the border refill of `Level::fill_borders_from_neighbours`.
+// Each is one dispatch over (x, y, bubble·6 + face); the level's parameters are a uniform.
+
+struct MipStep {
+    // level written, face size of the level read, face size of the level written, 0
+    level_sizes: vec4<u32>,
+}
+
+@group(3) @binding(0) var faces_in: texture_2d_array<f32>;
+@group(3) @binding(1) var<storage, read_write> mips_out: array<f32>;
+@group(3) @binding(2) var<uniform> mip_step: MipStep;
+
+fn mip_out_index(layer: u32, level: u32, x: u32, y: u32) -> u32 {
+    return mip_index(layer / 6u, level, layer % 6u, x, y);
+}
+
+fn store_mip(i: u32, c: vec3<f32>) {
+    mips_out[i] = c.x;
+    mips_out[i + 1u] = c.y;
+    mips_out[i + 2u] = c.z;
+}
+
+fn load_mip(i: u32) -> vec3<f32> {
+    return vec3<f32>(mips_out[i], mips_out[i + 1u], mips_out[i + 2u]);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn cs_mip_copy(@builtin(global_invocation_id) id: vec3<u32>) {
+    let m = scene.cube_face_size + 2u;
+    if (id.x >= m || id.y >= m) {
+        return;
+    }
+    let c = textureLoad(faces_in, vec2<i32>(id.xy), i32(id.z), 0).xyz;
+    store_mip(mip_out_index(id.z, 0u, id.x, id.y), c);
+}
+
+// cubemap.rs `box_weights` of output texel `i`: the first source texel, its count and
+// per source texel `j` the overlap over the output's width (`box_weight`).
+fn box_span(i: u32, n: u32, n_out: u32) -> vec2<u32> {
+    let ratio = f32(n) / f32(n_out);
+    let lo = f32(i) * ratio;
+    let hi = f32(i + 1u) * ratio;
+    return vec2<u32>(u32(floor(lo)), min(u32(ceil(hi)), n));
+}
+
+fn box_weight(i: u32, j: u32, n: u32, n_out: u32) -> f32 {
+    let ratio = f32(n) / f32(n_out);
+    let lo = f32(i) * ratio;
+    let hi = f32(i + 1u) * ratio;
+    return max(min(hi, f32(j + 1u)) - max(lo, f32(j)), 0.0) / ratio;
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn cs_mip_downsample(@builtin(global_invocation_id) id: vec3<u32>) {
+    let level = mip_step.level_sizes.x;
+    let n = mip_step.level_sizes.y;
+    let n_out = mip_step.level_sizes.z;
+    if (id.x >= n_out || id.y >= n_out) {
+        return;
+    }
+    let sy = box_span(id.y, n, n_out);
+    let sx = box_span(id.x, n, n_out);
+    var sum = vec3<f32>(0.0);
+    for (var j = sy.x; j < sy.y; j++) {
+        let vy = box_weight(id.y, j, n, n_out);
+        for (var i = sx.x; i < sx.y; i++) {
+            let vx = box_weight(id.x, i, n, n_out);
+            sum += load_mip(mip_out_index(id.z, level - 1u, i + 1u, j + 1u)) * (vx * vy);
+        }
+    }
+    store_mip(mip_out_index(id.z, level, id.x + 1u, id.y + 1u), sum);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn cs_mip_borders(@builtin(global_invocation_id) id: vec3<u32>) {
+    let level = mip_step.level_sizes.x;
+    let n = mip_step.level_sizes.z;
+    let m = n + 2u;
+    if (id.x >= m || id.y >= m) {
+        return;
+    }
+    if (id.x != 0u && id.y != 0u && id.x != m - 1u && id.y != m - 1u) {
+        return;
+    }
+    let face = id.z % 6u;
+    let nf = f32(n);
+    let s = (2.0 * f32(id.x) - 1.0) / nf - 1.0;
+    let t = (2.0 * f32(id.y) - 1.0) / nf - 1.0;
+    let dir = FACE_MAJOR[face] + FACE_S[face] * s + FACE_T[face] * t;
+    let g = face_coordinates(dir);
+    let x = min(u32(max((g.y + 1.0) * 0.5 * nf, 0.0)), n - 1u);
+    let y = min(u32(max((g.z + 1.0) * 0.5 * nf, 0.0)), n - 1u);
+    let layer = id.z - face + u32(g.x);
+    let c = load_mip(mip_out_index(layer, level, x + 1u, y + 1u));
+    store_mip(mip_out_index(id.z, level, id.x, id.y), c);
 }

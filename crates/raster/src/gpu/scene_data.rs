@@ -8,7 +8,8 @@ use crate::camera::View;
 use crate::passes::GroundView;
 use crate::renderer::{Geometry, far_to_near, is_front_facing, reflection_rate, tessellate};
 use crate::{
-    Environment, FilmTables, Light, Material, Pattern, ReflectionMode, RenderScene, RenderSettings,
+    Environment, FilmTables, Light, Material, Pattern, ReflectionFilter, ReflectionMode,
+    RenderScene, RenderSettings,
 };
 
 /// `Material.specular.w` of a solid albedo.
@@ -23,6 +24,9 @@ pub(super) const ENV_UNIFORM: u32 = 1;
 pub(super) const REFLECTION_CUBE: u32 = 0;
 /// `Scene.reflection` of the static environment.
 pub(super) const REFLECTION_ENVIRONMENT: u32 = 1;
+/// `Scene.reflection` of dynamic cube maps read with one bilinear tap
+/// ([`crate::ReflectionFilter::Bilinear`]).
+pub(super) const REFLECTION_CUBE_BILINEAR: u32 = 2;
 /// `Scene.transmittance_table` when `T = 1 − R`.
 pub(super) const NO_TABLE: u32 = u32::MAX;
 
@@ -192,6 +196,7 @@ impl SceneData {
         settings: &RenderSettings,
         view: &View,
         max_texture_side: u32,
+        filter: ReflectionFilter,
     ) -> Result<SceneData, GpuError> {
         let mut objects = Geometry::default();
         let mut light_spheres = Geometry::default();
@@ -223,6 +228,7 @@ impl SceneData {
             scene: scene_bytes(
                 scene,
                 &settings.reflection,
+                filter,
                 face_size,
                 ground_material,
                 tables,
@@ -243,6 +249,7 @@ impl SceneData {
 fn scene_bytes(
     scene: &RenderScene,
     reflection: &ReflectionMode,
+    filter: ReflectionFilter,
     face_size: u32,
     ground_material: u32,
     tables: &FilmTables,
@@ -259,8 +266,11 @@ fn scene_bytes(
         _ => (ENV_UNIFORM, crate::Sky::default(), [0.0; 3]),
     };
     b.u32(env_kind).u32(scene.lights.len() as u32);
-    b.u32(match reflection {
-        ReflectionMode::DynamicCubeMap { .. } => REFLECTION_CUBE,
+    b.u32(match (reflection, filter) {
+        (ReflectionMode::DynamicCubeMap { .. }, ReflectionFilter::Footprint) => REFLECTION_CUBE,
+        (ReflectionMode::DynamicCubeMap { .. }, ReflectionFilter::Bilinear) => {
+            REFLECTION_CUBE_BILINEAR
+        }
         _ => REFLECTION_ENVIRONMENT,
     });
     // Table 0 is the reflectivity, 1 the transmittance when there is one.

@@ -4,12 +4,14 @@
 
 use super::scene_data::{
     ENV_SKY, ENV_UNIFORM, NO_TABLE, PATTERN_CHECKER, PATTERN_SOLID, REFLECTION_CUBE,
-    REFLECTION_ENVIRONMENT,
+    REFLECTION_CUBE_BILINEAR, REFLECTION_ENVIRONMENT,
 };
+use crate::cubemap::FACE_BASES;
 use crate::frame::{
     ACES_DENOMINATOR, ACES_FROM_SRGB, ACES_INPUT_MAX, ACES_NUMERATOR, SRGB_FROM_ACES, SRGB_GAMMA,
     SRGB_LINEAR_MAX, SRGB_LINEAR_SLOPE, SRGB_OFFSET, SRGB_SCALE,
 };
+use crate::lod::{LOD_BIAS, MAX_ANISOTROPY, MIN_FOOTPRINT_TEXELS};
 
 /// The marker a WGSL source puts where the shared constants go.
 const MARKER: &str = "{{SHARED_CONSTANTS}}";
@@ -63,6 +65,8 @@ fn scene_constants() -> String {
         ("PATTERN_SOLID", PATTERN_SOLID),
         ("PATTERN_CHECKER", PATTERN_CHECKER),
         ("FLAT_FOOTPRINT_CELLS", crate::shading::FLAT_FOOTPRINT_CELLS),
+        ("LOD_BIAS", LOD_BIAS),
+        ("MIN_FOOTPRINT_TEXELS", MIN_FOOTPRINT_TEXELS),
     ] {
         out += &format!("const {name}: f32 = {};\n", float(value));
     }
@@ -72,9 +76,19 @@ fn scene_constants() -> String {
         ("ENV_UNIFORM", ENV_UNIFORM),
         ("REFLECTION_CUBE", REFLECTION_CUBE),
         ("REFLECTION_ENVIRONMENT", REFLECTION_ENVIRONMENT),
+        ("REFLECTION_CUBE_BILINEAR", REFLECTION_CUBE_BILINEAR),
         ("NO_TABLE", NO_TABLE),
+        ("MAX_ANISOTROPY", MAX_ANISOTROPY as u32),
     ] {
         out += &format!("const {name}: u32 = {value}u;\n");
+    }
+    // cubemap.rs `FACE_BASES`: major, s and t axes of each face.
+    for (name, pick) in [("FACE_MAJOR", 0usize), ("FACE_S", 1), ("FACE_T", 2)] {
+        let axes: Vec<String> = FACE_BASES
+            .iter()
+            .map(|b| vec3(&[b.0, b.1, b.2][pick].to_array()))
+            .collect();
+        out += &format!("const {name} = array<vec3<f32>, 6>({});\n", axes.join(", "));
     }
     out
 }
