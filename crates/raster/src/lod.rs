@@ -6,7 +6,7 @@
 //! with one bilinear tap of the full-resolution cube map, everything it sweeps over aliases.
 //! The mip level whose texels are as wide as the pixel's footprint averages it instead.
 
-use glam::Vec3;
+use glam::Vec3A;
 
 /// Levels added to the computed level of detail: −log2 √3. A bilinear tap of a level
 /// whose texels are `T` wide (box-averaged from level 0) is a box of width `T` convolved
@@ -64,31 +64,36 @@ pub(crate) fn anisotropic_taps(major_rad: f32, minor_rad: f32) -> (usize, f32) {
 /// `n_raw` is the interpolated (unnormalised) normal and `dn_raw` its change per pixel.
 /// The normal is turned to face the viewer as the shading does. Exact derivatives of
 /// `r = v − 2(v·n)n` with `v = d/|d|`, `n = ±n_raw/|n_raw|`; zero where not finite.
+/// (`Vec3A`: lane-wise the same operations as `Vec3`, in fewer instructions.)
 #[inline]
 pub(crate) fn reflection_derivatives(
-    d: Vec3,
-    dd: [Vec3; 2],
-    n_raw: Vec3,
-    dn_raw: [Vec3; 2],
-) -> [Vec3; 2] {
+    d: Vec3A,
+    dd: [Vec3A; 2],
+    n_raw: Vec3A,
+    dn_raw: [Vec3A; 2],
+) -> [Vec3A; 2] {
     let (d_len, n_len) = (d.length(), n_raw.length());
     let v = d / d_len;
     let n_hat = n_raw / n_len;
     let sign = if v.dot(n_hat) > 0.0 { -1.0 } else { 1.0 };
     let n = n_hat * sign;
     let c = v.dot(n);
-    std::array::from_fn(|k| {
-        let dv = (dd[k] - v * v.dot(dd[k])) / d_len;
-        let dn = (dn_raw[k] - n_hat * n_hat.dot(dn_raw[k])) * (sign / n_len);
+    // A literal pair, not `array::from_fn`, whose closure does not inline here.
+    let along = |dd: Vec3A, dn_raw: Vec3A| {
+        let dv = (dd - v * v.dot(dd)) / d_len;
+        let dn = (dn_raw - n_hat * n_hat.dot(dn_raw)) * (sign / n_len);
         let dc = dv.dot(n) + v.dot(dn);
         let dr = dv - (n * dc + dn * c) * 2.0;
-        if dr.is_finite() { dr } else { Vec3::ZERO }
-    })
+        if dr.is_finite() { dr } else { Vec3A::ZERO }
+    };
+    [along(dd[0], dn_raw[0]), along(dd[1], dn_raw[1])]
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    // The derivatives take `Vec3A`; these tests read as plain vectors.
+    use glam::Vec3A as Vec3;
     use proptest::prelude::*;
 
     fn reflect(d: Vec3, n_raw: Vec3) -> Vec3 {
