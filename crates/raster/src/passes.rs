@@ -9,7 +9,7 @@ use crate::camera::View;
 use crate::ground::{SPAN, ground_span, span_supported};
 use crate::lod::reflection_derivatives;
 use crate::lut_sampler::LutSampler;
-use crate::raster::{ATTRS, Plane, SamplePattern, SetupTri, for_each_covered_in_row};
+use crate::raster::{ATTRS, NO_SURFACE, Plane, SamplePattern, SetupTri, for_each_covered_in_row};
 use crate::shading::{ground_albedo, lit, object_albedo};
 use crate::water_pass::{WATER, WaterShading, shade_water};
 use crate::{
@@ -460,24 +460,61 @@ pub(crate) struct BubbleCtx<'a> {
     pub bins: &'a Bins,
 }
 
+/// One pixel's shading by the last surface that covered it only in part.
+#[derive(Debug, Clone, Copy)]
+struct SharedShade {
+    surface: u32,
+    /// Samples of the pixel that surface's triangles have covered so far.
+    covered: u32,
+    t_rgb: [f32; 3],
+    add: [f32; 3],
+}
+
+impl SharedShade {
+    const EMPTY: Self = Self {
+        surface: NO_SURFACE,
+        covered: 0,
+        t_rgb: [0.0; 3],
+        add: [0.0; 3],
+    };
+}
+
+thread_local! {
+    /// Per-thread [`SharedShade`] of each pixel of the strip being blended.
+    static SHARED_SHADES: std::cell::RefCell<Vec<SharedShade>> =
+        const { std::cell::RefCell::new(Vec::new()) };
+}
+
 impl BubbleCtx<'_> {
     /// Blends every bubble triangle touching strip `strip` over its samples, in order.
     pub fn render_strip(&self, strip: usize, color: &mut [[f32; 3]], depth: &[f32]) {
         let y0 = strip * STRIP_ROWS;
         let rows = color.len() / (self.view.width * self.pattern.count);
-        for &t in self.bins.strip(strip) {
-            let tri = &self.tris[t as usize];
-            // The default 4-sample pattern gets fixed-length sample loops (same arithmetic).
-            if self.pattern.count == 4 {
-                self.blend_triangle::<4>(tri, y0, rows, color, depth);
-            } else {
-                self.blend_triangle::<0>(tri, y0, rows, color, depth);
+        SHARED_SHADES.with_borrow_mut(|shared| {
+            shared.clear();
+            shared.resize(rows * self.view.width, SharedShade::EMPTY);
+            for &t in self.bins.strip(strip) {
+                let tri = &self.tris[t as usize];
+                // The default 4-sample pattern gets fixed-length sample loops (same arithmetic).
+                if self.pattern.count == 4 {
+                    self.blend_triangle::<4>(tri, y0, rows, color, depth, shared);
+                } else {
+                    self.blend_triangle::<0>(tri, y0, rows, color, depth, shared);
+                }
             }
-        }
+        });
     }
 
     /// Blends one triangle over rows `y0 .. y0 + rows`; `N` is the sample count, or 0 for
     /// the pattern's own.
+    ///
+    /// A pixel the triangle covers only in part is shaded once per surface: the triangles
+    /// of one smooth surface (same [`SetupTri::surface`]) tile it without overlap, so when
+    /// this one covers samples disjoint from those its neighbours already covered, it
+    /// reuses their shading (from a point under a pixel away on the same surface, as
+    /// multisampling already shades every sample of a pixel at one point). Overlapping
+    /// coverage means another layer (a fold): it is shaded afresh. This halves the
+    /// shading work at small triangles' edges, where most bubble pixels lie.
     #[inline(always)]
     fn blend_triangle<const N: usize>(
         &self,
@@ -486,6 +523,7 @@ impl BubbleCtx<'_> {
         rows: usize,
         color: &mut [[f32; 3]],
         depth: &[f32],
+        shared: &mut [SharedShade],
     ) {
         let s_count = if N == 0 { self.pattern.count } else { N };
         let width = self.view.width;
@@ -498,9 +536,11 @@ impl BubbleCtx<'_> {
         let dz = &dz[..s_count];
         let ya = (tri.bbox[1] as usize).max(y0);
         let yb = (tri.bbox[3] as usize).min(y0 + rows);
+        let shares = tri.surface != NO_SURFACE;
         for py in ya..yb {
             for_each_covered_in_row(tri, &self.pattern, py as i32, |px, mask| {
-                let base = ((py - y0) * width + px as usize) * s_count;
+                let pixel = (py - y0) * width + px as usize;
+                let base = pixel * s_count;
                 let z = tri
                     .inv_w
                     .at(px as f32 + 0.5 - tri.ox, py as f32 + 0.5 - tri.oy);
@@ -512,13 +552,29 @@ impl BubbleCtx<'_> {
                 if pass == 0 {
                     return;
                 }
-                // Shade at the centre when the triangle covers the pixel, else at a covered sample.
-                let (ox, oy) = if mask == full {
-                    (0.5, 0.5)
+                let (t_rgb, add) = if mask == full {
+                    // Shade at the centre when the triangle covers the pixel.
+                    let (t_rgb, add, _) = self.shade(tri, px as f32 + 0.5, py as f32 + 0.5);
+                    (t_rgb, add)
                 } else {
-                    self.pattern.offset_f32(pass.trailing_zeros() as usize)
+                    let entry = &mut shared[pixel];
+                    if shares && entry.surface == tri.surface && entry.covered & mask == 0 {
+                        entry.covered |= mask;
+                        (entry.t_rgb, entry.add)
+                    } else {
+                        // Else at a covered sample.
+                        let (ox, oy) = self.pattern.offset_f32(pass.trailing_zeros() as usize);
+                        let shade = self.shade(tri, px as f32 + ox, py as f32 + oy);
+                        *entry = SharedShade {
+                            // A highlight varies within a pixel: never shared.
+                            surface: if shade.2 { tri.surface } else { NO_SURFACE },
+                            covered: mask,
+                            t_rgb: shade.0,
+                            add: shade.1,
+                        };
+                        (shade.0, shade.1)
+                    }
                 };
-                let (t_rgb, add) = self.shade(tri, px as f32 + ox, py as f32 + oy);
                 for (s, c) in color[base..base + s_count].iter_mut().enumerate() {
                     if pass & (1 << s) != 0 {
                         for k in 0..3 {
@@ -530,13 +586,15 @@ impl BubbleCtx<'_> {
         }
     }
 
-    /// Transmittance and added radiance of the film at pixel-space point `(px, py)`.
+    /// Transmittance and added radiance of the film at pixel-space point `(px, py)`, and
+    /// whether they may be shared with the rest of the pixel: no light's highlight reaches
+    /// within [`SHARE_MARGIN_PX`] of it.
     ///
     /// The vector arithmetic runs in `Vec3A` lanes: the same IEEE operations in the same
     /// order as `Vec3`'s (glam sums dot products x, y, then z in both), so results are
     /// bit-identical, in fewer instructions.
     #[inline]
-    fn shade(&self, tri: &SetupTri, px: f32, py: f32) -> ([f32; 3], [f32; 3]) {
+    fn shade(&self, tri: &SetupTri, px: f32, py: f32) -> ([f32; 3], [f32; 3], bool) {
         let (inv_w, a) = tri.interpolate(px, py);
         let thickness_nm = a[3].max(0.0);
         let (ax, ay) = self.view.ray_coefficients(px, py);
@@ -567,9 +625,15 @@ impl BubbleCtx<'_> {
         let reflected = Vec3::from(reflected);
         let env = reflection.sample(reflected, derivatives, self.filter);
         let mut add = [r_rgb[0] * env[0], r_rgb[1] * env[1], r_rgb[2] * env[2]];
+        let mut shareable = true;
         if !self.lights.is_empty() {
             let p = self.view.eye + Vec3::from(d / inv_w);
             for (light, table) in self.lights.iter().zip(self.light_tables) {
+                // Beyond the widened reach the visibility below is exactly 0.
+                if !within_reach(light, p, reflected, tri.extra, SHARE_MARGIN_PX) {
+                    continue;
+                }
+                shareable = false;
                 let vis = light_visibility(light, p, reflected, tri.extra);
                 if vis > 0.0 {
                     let l = table.sample(thickness_nm, cos_theta);
@@ -580,7 +644,7 @@ impl BubbleCtx<'_> {
                 }
             }
         }
-        (t_rgb, add)
+        (t_rgb, add, shareable)
     }
 
     /// Change of the unit reflected direction per pixel along x and y at the point with
@@ -655,6 +719,31 @@ pub(crate) fn light_visibility(
     } else {
         ((alpha - gamma) / w + 0.5).clamp(0.0, 1.0)
     }
+}
+
+/// How far (in pixels of reflected-direction turn) a shading may be reused from the
+/// point it was computed at: two points of one pixel are at most √2 pixels apart.
+const SHARE_MARGIN_PX: f32 = 2.0;
+
+/// Whether `reflected` from `p` passes within the reach of [`light_visibility`]'s filter
+/// around `light`, widened by `margin_px` pixels; where it does not, the visibility is 0.
+#[inline]
+fn within_reach(
+    light: &Light,
+    p: Vec3,
+    reflected: Vec3,
+    pixel_angle_rad: f32,
+    margin_px: f32,
+) -> bool {
+    let to_light = light.position - p;
+    let dist = to_light.length();
+    if dist <= light.radius_m {
+        return true;
+    }
+    let cos_gamma = reflected.dot(to_light) / dist;
+    let w = pixel_angle_rad.max(1e-5);
+    let reach = std::f32::consts::PI * (light.radius_m / dist) + (2.5 + margin_px) * w;
+    1.0 - cos_gamma <= 0.5 * reach * reach
 }
 
 /// Width of the highlight filter in pixels: wide enough that the Gaussian's sum over the

@@ -66,6 +66,9 @@ impl Edge {
     }
 }
 
+/// [`SetupTri::surface`] of a triangle that shares its shading with no other.
+pub(crate) const NO_SURFACE: u32 = u32::MAX;
+
 /// A triangle ready to rasterise.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub(crate) struct SetupTri {
@@ -83,6 +86,10 @@ pub(crate) struct SetupTri {
     pub tag: u32,
     /// Caller's extra payload (e.g. the angular size of a pixel in reflected directions).
     pub extra: f32,
+    /// Caller's surface id: consecutive triangles with the same `surface` are one smooth
+    /// surface (a bubble's front or back layer), whose partial coverages of one pixel may
+    /// share a shading (`BubbleCtx`). [`NO_SURFACE`] shares with nothing.
+    pub surface: u32,
 }
 
 impl SetupTri {
@@ -341,6 +348,7 @@ fn setup_clipped(view: &View, tri: &[ClipVertex; 3], tag: u32, extra: f32) -> Op
         attrs,
         tag,
         extra,
+        surface: NO_SURFACE,
     })
 }
 

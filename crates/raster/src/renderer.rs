@@ -391,7 +391,11 @@ pub(crate) fn setup_bubble_tris(scene: &RenderScene, view: &View, out: &mut Vec<
                         )
                     });
                     let extra = reflection_rate(view, bubble, *t);
-                    setup_triangle(view, tri, k as u32, extra, |s| out.push(s));
+                    // One surface per bubble and facing: the back layer, then the front.
+                    let surface = 2 * k as u32 + u32::from(front);
+                    setup_triangle(view, tri, k as u32, extra, |s| {
+                        out.push(SetupTri { surface, ..s });
+                    });
                 }
             }
         }
