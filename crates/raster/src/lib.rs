@@ -56,7 +56,8 @@ pub use mesh::TriMesh;
 pub use renderer::Renderer;
 pub use scene::{BubbleMesh, FilmTables, Ground, Light, Material, Object, Pattern, RenderScene};
 pub use settings::{
-    MAX_IMAGE_SIDE, ReflectionFilter, ReflectionMode, RenderSettings, SAMPLE_COUNTS, ToneMap,
+    MAX_IMAGE_SIDE, PartialShading, ReflectionFilter, ReflectionMode, RenderSettings,
+    SAMPLE_COUNTS, ToneMap,
 };
 pub use spheremap::SphereMap;
 pub use texture::Texture;

@@ -13,7 +13,8 @@ use crate::raster::{ATTRS, NO_SURFACE, Plane, SamplePattern, SetupTri, for_each_
 use crate::shading::{ground_albedo, lit, object_albedo};
 use crate::water_pass::{WATER, WaterShading, shade_water};
 use crate::{
-    CubeMap, Environment, Ground, Irradiance, Light, Material, Pattern, ReflectionFilter, SphereMap,
+    CubeMap, Environment, Ground, Irradiance, Light, Material, PartialShading, Pattern,
+    ReflectionFilter, SphereMap,
 };
 
 /// Rows per strip (the unit of parallel work).
@@ -456,6 +457,8 @@ pub(crate) struct BubbleCtx<'a> {
     pub reflections: &'a [Reflection<'a>],
     /// How cube maps are read.
     pub filter: ReflectionFilter,
+    /// How pixels a triangle covers in part are shaded.
+    pub partial: PartialShading,
     pub tris: &'a [SetupTri],
     pub bins: &'a Bins,
 }
@@ -536,7 +539,7 @@ impl BubbleCtx<'_> {
         let dz = &dz[..s_count];
         let ya = (tri.bbox[1] as usize).max(y0);
         let yb = (tri.bbox[3] as usize).min(y0 + rows);
-        let shares = tri.surface != NO_SURFACE;
+        let shares = tri.surface != NO_SURFACE && self.partial == PartialShading::PerSurface;
         for py in ya..yb {
             for_each_covered_in_row(tri, &self.pattern, py as i32, |px, mask| {
                 let pixel = (py - y0) * width + px as usize;

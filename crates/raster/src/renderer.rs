@@ -13,8 +13,8 @@ use crate::passes::{Bins, BubbleCtx, EMISSIVE, GroundView, OpaqueCtx, Reflection
 use crate::raster::{ATTRS, ClipVertex, SamplePattern, SetupTri, setup_triangle};
 use crate::water_pass::{WaterPass, setup_water};
 use crate::{
-    BubbleMesh, CubeMap, Environment, FilmTables, Frame, Material, Object, ReflectionFilter,
-    ReflectionMode, RenderError, RenderScene, RenderSettings, TriMesh,
+    BubbleMesh, CubeMap, Environment, FilmTables, Frame, Material, Object, PartialShading,
+    ReflectionFilter, ReflectionMode, RenderError, RenderScene, RenderSettings, TriMesh,
 };
 
 /// Slices and stacks of a tessellated [`Object::Sphere`].
@@ -98,6 +98,7 @@ pub struct Renderer {
     env_cube: Option<(Environment, CubeMap)>,
     water: WaterPass,
     filter: ReflectionFilter,
+    partial: PartialShading,
 }
 
 impl Renderer {
@@ -110,6 +111,12 @@ impl Renderer {
     /// footprint; bilinear is the unfiltered lookup, kept to measure the filter against).
     pub fn set_reflection_filter(&mut self, filter: ReflectionFilter) {
         self.filter = filter;
+    }
+
+    /// Chooses how bubble pixels covered in part by a triangle are shaded from the next
+    /// frame on (default: once per surface; per triangle is kept to measure it against).
+    pub fn set_partial_shading(&mut self, partial: PartialShading) {
+        self.partial = partial;
     }
 
     /// The last rendered frame.
@@ -210,6 +217,7 @@ impl Renderer {
             light_tables: &light_tables,
             reflections: &reflections,
             filter: self.filter,
+            partial: self.partial,
             tris: &self.bubble_tris,
             bins: &self.bubble_bins,
         };

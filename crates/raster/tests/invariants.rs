@@ -8,8 +8,8 @@ use std::sync::Arc;
 use common::{bubble, draining, lossless_tables, paper_scene, settings, synthetic_reflectivity};
 use proptest::prelude::*;
 use raster::{
-    Camera, Environment, FilmTables, Frame, Ground, Light, Lut, Material, Object, ReflectionMode,
-    RenderScene, RenderSettings, Renderer, SphereMap, ToneMap, TriMesh, Vec3,
+    Camera, Environment, FilmTables, Frame, Ground, Light, Lut, Material, Object, PartialShading,
+    ReflectionMode, RenderScene, RenderSettings, Renderer, SphereMap, ToneMap, TriMesh, Vec3,
 };
 
 fn render(scene: &RenderScene, tables: &FilmTables, settings: &RenderSettings) -> Frame {
@@ -326,4 +326,60 @@ proptest! {
         let frame = render(&scene, &tables, &settings(24, 20, samples, ReflectionMode::DynamicCubeMap { face_size: 8 }));
         prop_assert!(all_finite(&frame).is_ok(), "{:?}", all_finite(&frame));
     }
+}
+
+/// Renders `scene` with partly covered pixels shaded per surface and per triangle.
+fn both_partial_shadings(scene: &RenderScene, settings: &RenderSettings) -> (Frame, Frame) {
+    let tables = FilmTables::from_reflectivity(synthetic_reflectivity());
+    let mut renderer = Renderer::new();
+    let shared = renderer.render(scene, &tables, settings).unwrap().clone();
+    renderer.set_partial_shading(PartialShading::PerTriangle);
+    let per_triangle = renderer.render(scene, &tables, settings).unwrap().clone();
+    (shared, per_triangle)
+}
+
+#[test]
+fn one_sample_has_no_partly_covered_pixels_so_both_partial_shadings_agree_exactly() {
+    let mode = ReflectionMode::DynamicCubeMap { face_size: 32 };
+    let (shared, per_triangle) = both_partial_shadings(&paper_scene(), &settings(96, 96, 1, mode));
+    assert_eq!(max_diff(&shared, &per_triangle).0, 0.0);
+}
+
+#[test]
+fn per_surface_shading_changes_only_bubble_edge_pixels_and_little() {
+    let scene = paper_scene();
+    let s = settings(
+        160,
+        160,
+        4,
+        ReflectionMode::DynamicCubeMap { face_size: 32 },
+    );
+    let (shared, per_triangle) = both_partial_shadings(&scene, &s);
+    let mut no_bubbles = scene.clone();
+    no_bubbles.bubbles.clear();
+    let background = render(&no_bubbles, &lossless_tables(), &s);
+    let (mut changed, mut rel_sum) = (0usize, 0.0f64);
+    for k in 0..shared.rgb().len() {
+        let (a, b) = (shared.rgb()[k], per_triangle.rgb()[k]);
+        if a == b {
+            continue;
+        }
+        // Only pixels a bubble covers may change.
+        assert_ne!(
+            per_triangle.rgb()[k],
+            background.rgb()[k],
+            "pixel ({}, {}) changed but shows no bubble",
+            k % 160,
+            k / 160
+        );
+        changed += 1;
+        let luminance = |c: [f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+        rel_sum += f64::from((luminance(a) - luminance(b)).abs() / luminance(b).max(1e-3));
+    }
+    let mean_rel = rel_sum / changed.max(1) as f64;
+    eprintln!("{changed} pixels changed, mean relative luminance change {mean_rel:.4}");
+    // Shading is shared at all (most bubble pixels at these sizes are edge pixels) ...
+    assert!(changed > 300, "only {changed} pixels changed");
+    // ... and each shared shading sits less than a pixel from the one it replaces.
+    assert!(mean_rel < 0.02, "mean relative luminance change {mean_rel}");
 }
