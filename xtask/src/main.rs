@@ -4,11 +4,14 @@ use std::process::{Command, ExitCode};
 
 mod docs_check;
 mod reference_figures;
+mod speed_ratio;
 
 const USAGE: &str = "usage: cargo xtask <figures|bench|ci|docs-check>
   figures     regenerate the PNG figures under docs/figures/
               (--reference: instead, the slow measured table of docs/reference.md)
   bench       run every crate's criterion benches, then `bubbles bench` (frame breakdown)
+              (--ratio [--rounds N] [--baseline BIN]: instead, the reference-to-frame speed
+              ratio of docs/reference.md, interleaved in N rounds, default 3)
   ci          run what .ci/run runs (fmt, clippy, tests, docs-check)
   docs-check  check that every figure block in docs/ names the command that reproduces it";
 
@@ -21,6 +24,7 @@ fn main() -> ExitCode {
                 && reference_figures::run(&root, &reference_figures::bubbles_binary(&root))
         }
         Some("figures") => figures(),
+        Some("bench") if std::env::args().any(|a| a == "--ratio") => ratio(),
         Some("bench") => bench(),
         Some("ci") => ci(),
         Some("docs-check") => docs_check::run(),
@@ -46,6 +50,33 @@ fn cargo(args: &[&str]) -> bool {
         .current_dir(root)
         .status()
         .is_ok_and(|s| s.success())
+}
+
+/// `bench --ratio`: builds the release binary and times the reference against the frame.
+fn ratio() -> bool {
+    let args: Vec<String> = std::env::args().collect();
+    let value = |flag: &str| {
+        args.iter()
+            .position(|a| a == flag)
+            .and_then(|i| args.get(i + 1))
+    };
+    let rounds = match value("--rounds").map(|r| r.parse::<usize>()) {
+        None => 3,
+        Some(Ok(n)) if (1..=100).contains(&n) => n,
+        Some(_) => {
+            eprintln!("--rounds takes a count from 1 to 100");
+            return false;
+        }
+    };
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let baseline = value("--baseline").map(std::path::PathBuf::from);
+    cargo(&["build", "--release", "-p", "bubbles"])
+        && speed_ratio::run(
+            &root,
+            &reference_figures::bubbles_binary(&root),
+            baseline.as_deref(),
+            rounds,
+        )
 }
 
 /// Criterion benches of the library crates, then the whole-frame breakdown of the CLI.

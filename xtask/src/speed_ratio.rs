@@ -1,0 +1,138 @@
+//! `cargo xtask bench --ratio`: seed 000's Fig. 4 speed ratio on this machine. Times the
+//! spectral reference's `paper` at 400 × 400 and the CPU backend's frame, interleaved in
+//! rounds so that both see the same machine state, and prints a markdown table.
+//!
+//! CPU time comes from the kernel's account of reaped children (`/proc/self/stat`), so a
+//! frame's CPU time is that of a 210-frame bench minus a 10-frame one, over 200 frames:
+//! start-up (table bake, simulation to t) cancels.
+
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::Instant;
+
+const SIZE: &str = "400x400";
+
+/// Runs `rounds` rounds with `bubbles` (and `baseline`, another binary, when given).
+pub fn run(root: &Path, bubbles: &Path, baseline: Option<&Path>, rounds: usize) -> bool {
+    println!(
+        "| round | reference CPU-s (wall s) | CPU frame CPU-ms (wall ms, sim ms) | ratio, CPU time |{}",
+        if baseline.is_some() {
+            " baseline frame CPU-ms | baseline ratio |"
+        } else {
+            ""
+        }
+    );
+    println!(
+        "|---|---|---|---|{}",
+        if baseline.is_some() { "---|---|" } else { "" }
+    );
+    for round in 1..=rounds {
+        let Some((ref_cpu_s, ref_wall_s)) = timed(root, bubbles, &reference_args()) else {
+            return false;
+        };
+        let Some(frame) = frame_cost(root, bubbles) else {
+            return false;
+        };
+        let mut row = format!(
+            "| {round} | {ref_cpu_s:.2} ({ref_wall_s:.2}) | {:.2} ({:.2}, {:.2}) | {:.0}× |",
+            frame.cpu_ms,
+            frame.wall_ms,
+            frame.sim_ms,
+            ref_cpu_s * 1e3 / frame.cpu_ms
+        );
+        if let Some(base) = baseline {
+            let Some(b) = frame_cost(root, base) else {
+                return false;
+            };
+            row += &format!(" {:.2} | {:.0}× |", b.cpu_ms, ref_cpu_s * 1e3 / b.cpu_ms);
+        }
+        println!("{row}");
+    }
+    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+    println!("\nload average after the last round: {}", load.trim());
+    true
+}
+
+fn reference_args() -> Vec<String> {
+    let out = std::env::temp_dir().join("xtask-ratio-reference.png");
+    [
+        "render",
+        "paper",
+        "--backend",
+        "reference",
+        "--width",
+        "400",
+        "--height",
+        "400",
+    ]
+    .map(String::from)
+    .into_iter()
+    .chain(["--out".into(), out.to_string_lossy().into_owned()])
+    .collect()
+}
+
+/// One CPU frame's cost: CPU time, and the bench's own wall-time columns.
+struct Frame {
+    cpu_ms: f64,
+    wall_ms: f64,
+    sim_ms: f64,
+}
+
+fn frame_cost(root: &Path, bubbles: &Path) -> Option<Frame> {
+    let bench =
+        |frames: &str| ["bench", "paper", "--size", SIZE, "--frames", frames].map(String::from);
+    let (long_s, _) = timed(root, bubbles, &bench("210"))?;
+    let (short_s, _) = timed(root, bubbles, &bench("10"))?;
+    // The bench's table: `size sim cube opaque bubbles other frame fps`.
+    let out = Command::new(bubbles)
+        .args(bench("100"))
+        .current_dir(root)
+        .output()
+        .ok()?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    let cols: Vec<f64> = text
+        .lines()
+        .find(|l| l.starts_with(SIZE))?
+        .split_whitespace()
+        .skip(1)
+        .filter_map(|c| c.parse().ok())
+        .collect();
+    Some(Frame {
+        cpu_ms: (long_s - short_s) / 200.0 * 1e3,
+        wall_ms: *cols.get(5)?,
+        sim_ms: *cols.first()?,
+    })
+}
+
+/// Runs `bubbles args`, returning its CPU time (user + system, children reaped) and wall
+/// time in seconds.
+fn timed(root: &Path, bubbles: &Path, args: &[String]) -> Option<(f64, f64)> {
+    eprintln!("$ bubbles {}", args.join(" "));
+    let before = children_cpu_s()?;
+    let start = Instant::now();
+    let status = Command::new(bubbles)
+        .args(args)
+        .current_dir(root)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .ok()?;
+    let wall = start.elapsed().as_secs_f64();
+    if !status.success() {
+        eprintln!("bubbles {} failed: {status}", args.join(" "));
+        return None;
+    }
+    Some((children_cpu_s()? - before, wall))
+}
+
+/// User + system time of this process's reaped children (`cutime + cstime`, fields 16 and
+/// 17 of `/proc/self/stat`), in seconds; Linux's clock tick is 1/100 s.
+fn children_cpu_s() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the parenthesised command name, which may hold spaces.
+    let rest = stat.rsplit_once(')')?.1;
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    // `rest` starts at field 3 (state), so field k is at index k − 3.
+    let ticks = |k: usize| fields.get(k - 3)?.parse::<f64>().ok();
+    Some((ticks(16)? + ticks(17)?) / 100.0)
+}
