@@ -467,6 +467,8 @@ pub(crate) struct BubbleCtx<'a> {
 #[derive(Debug, Clone, Copy)]
 struct SharedShade {
     surface: u32,
+    /// Mesh vertices of the triangle that computed the shading.
+    mesh_vertices: [u32; 3],
     /// Samples of the pixel that surface's triangles have covered so far.
     covered: u32,
     t_rgb: [f32; 3],
@@ -476,10 +478,25 @@ struct SharedShade {
 impl SharedShade {
     const EMPTY: Self = Self {
         surface: NO_SURFACE,
+        mesh_vertices: [0; 3],
         covered: 0,
         t_rgb: [0.0; 3],
         add: [0.0; 3],
     };
+
+    /// Whether `tri`, covering samples `mask`, may take this shading: same surface, a
+    /// mesh neighbour of the triangle that computed it (one shared vertex), and none of
+    /// the samples already covered. Overlap, or no shared vertex, means another sheet
+    /// of the surface (a fold, or its edge) seen in the same pixel.
+    #[inline(always)]
+    fn fits(&self, tri: &SetupTri, mask: u32) -> bool {
+        self.surface == tri.surface
+            && self.covered & mask == 0
+            && self
+                .mesh_vertices
+                .iter()
+                .any(|v| tri.mesh_vertices.contains(v))
+    }
 }
 
 thread_local! {
@@ -513,11 +530,12 @@ impl BubbleCtx<'_> {
     ///
     /// A pixel the triangle covers only in part is shaded once per surface: the triangles
     /// of one smooth surface (same [`SetupTri::surface`]) tile it without overlap, so when
-    /// this one covers samples disjoint from those its neighbours already covered, it
-    /// reuses their shading (from a point under a pixel away on the same surface, as
-    /// multisampling already shades every sample of a pixel at one point). Overlapping
-    /// coverage means another layer (a fold): it is shaded afresh. This halves the
-    /// shading work at small triangles' edges, where most bubble pixels lie.
+    /// this one is a mesh neighbour of the triangle that shaded the pixel and covers
+    /// samples disjoint from those already covered, it reuses that shading (from a point
+    /// under a pixel away on the same surface, as multisampling already shades every
+    /// sample of a pixel at one point). Anything else may be another sheet (a fold) and is
+    /// shaded afresh ([`SharedShade::fits`]). On `paper` this saves about a third of the
+    /// shadings: most bubble pixels lie on small triangles' edges.
     #[inline(always)]
     fn blend_triangle<const N: usize>(
         &self,
@@ -560,23 +578,8 @@ impl BubbleCtx<'_> {
                     let (t_rgb, add, _) = self.shade(tri, px as f32 + 0.5, py as f32 + 0.5);
                     (t_rgb, add)
                 } else {
-                    let entry = &mut shared[pixel];
-                    if shares && entry.surface == tri.surface && entry.covered & mask == 0 {
-                        entry.covered |= mask;
-                        (entry.t_rgb, entry.add)
-                    } else {
-                        // Else at a covered sample.
-                        let (ox, oy) = self.pattern.offset_f32(pass.trailing_zeros() as usize);
-                        let shade = self.shade(tri, px as f32 + ox, py as f32 + oy);
-                        *entry = SharedShade {
-                            // A highlight varies within a pixel: never shared.
-                            surface: if shade.2 { tri.surface } else { NO_SURFACE },
-                            covered: mask,
-                            t_rgb: shade.0,
-                            add: shade.1,
-                        };
-                        (shade.0, shade.1)
-                    }
+                    let at = (px as f32, py as f32);
+                    self.shade_partial(tri, at, mask, pass, shares, &mut shared[pixel])
                 };
                 for (s, c) in color[base..base + s_count].iter_mut().enumerate() {
                     if pass & (1 << s) != 0 {
@@ -587,6 +590,37 @@ impl BubbleCtx<'_> {
                 }
             });
         }
+    }
+
+    /// Shading of a pixel whose top-left corner is `at` and whose samples `mask` the
+    /// triangle covers in part (`pass` of them in front of the opaque scene): the shading
+    /// `entry` holds when the triangle's surface may share it, else a fresh one at the
+    /// first passing sample, which `entry` then keeps for the surface's other triangles.
+    #[inline(always)]
+    fn shade_partial(
+        &self,
+        tri: &SetupTri,
+        at: (f32, f32),
+        mask: u32,
+        pass: u32,
+        shares: bool,
+        entry: &mut SharedShade,
+    ) -> ([f32; 3], [f32; 3]) {
+        if shares && entry.fits(tri, mask) {
+            entry.covered |= mask;
+            return (entry.t_rgb, entry.add);
+        }
+        let (ox, oy) = self.pattern.offset_f32(pass.trailing_zeros() as usize);
+        let (t_rgb, add, shareable) = self.shade(tri, at.0 + ox, at.1 + oy);
+        *entry = SharedShade {
+            // A highlight varies within a pixel: never shared.
+            surface: if shareable { tri.surface } else { NO_SURFACE },
+            mesh_vertices: tri.mesh_vertices,
+            covered: mask,
+            t_rgb,
+            add,
+        };
+        (t_rgb, add)
     }
 
     /// Transmittance and added radiance of the film at pixel-space point `(px, py)`, and

@@ -90,6 +90,9 @@ pub(crate) struct SetupTri {
     /// surface (a bubble's front or back layer), whose partial coverages of one pixel may
     /// share a shading (`BubbleCtx`). [`NO_SURFACE`] shares with nothing.
     pub surface: u32,
+    /// The surface mesh's vertex indices of this triangle (its pieces after clipping keep
+    /// them): triangles that share one are neighbours on the surface.
+    pub mesh_vertices: [u32; 3],
 }
 
 impl SetupTri {
@@ -349,6 +352,7 @@ fn setup_clipped(view: &View, tri: &[ClipVertex; 3], tag: u32, extra: f32) -> Op
         tag,
         extra,
         surface: NO_SURFACE,
+        mesh_vertices: [0; 3],
     })
 }
 

@@ -402,7 +402,11 @@ pub(crate) fn setup_bubble_tris(scene: &RenderScene, view: &View, out: &mut Vec<
                     // One surface per bubble and facing: the back layer, then the front.
                     let surface = 2 * k as u32 + u32::from(front);
                     setup_triangle(view, tri, k as u32, extra, |s| {
-                        out.push(SetupTri { surface, ..s });
+                        out.push(SetupTri {
+                            surface,
+                            mesh_vertices: *t,
+                            ..s
+                        });
                     });
                 }
             }

@@ -383,3 +383,50 @@ fn per_surface_shading_changes_only_bubble_edge_pixels_and_little() {
     // ... and each shared shading sits less than a pixel from the one it replaces.
     assert!(mean_rel < 0.02, "mean relative luminance change {mean_rel}");
 }
+
+/// Two flat films facing the camera (which looks straight down), one behind the other, in
+/// one mesh: a fold, so both sheets are the same bubble layer. The far one (listed first, so
+/// blended first) is 300 nm thick, the near one 550 nm; each square is two triangles split
+/// along the same diagonal. A dark ground shows through them and the bright zenith sky is
+/// what they reflect, so the two sheets' films look different.
+fn folded_film_scene() -> RenderScene {
+    let camera = Camera::look_at(Vec3::new(0.0, 3.0, 0.0), Vec3::ZERO, Vec3::NEG_Z, 40.0);
+    let mut scene = RenderScene::new(camera, Environment::Sky(raster::Sky::default()));
+    scene.ground = Some(Ground {
+        height_m: 0.0,
+        material: Material::checker([0.02; 3], [0.02; 3], 1.0),
+    });
+    let mut film = raster::BubbleMesh {
+        positions: Vec::new(),
+        normals: Vec::new(),
+        thickness_nm: Vec::new(),
+        triangles: Vec::new(),
+    };
+    for (y, thickness_nm) in [(0.5, 300.0), (1.0, 550.0)] {
+        let first = film.positions.len() as u32;
+        for (x, z) in [(-0.6, -0.6), (0.6, -0.6), (0.6, 0.6), (-0.6, 0.6)] {
+            film.positions.push(Vec3::new(x, y, z));
+            film.normals.push(Vec3::Y);
+            film.thickness_nm.push(thickness_nm);
+        }
+        film.triangles.push([first, first + 1, first + 2]);
+        film.triangles.push([first, first + 2, first + 3]);
+    }
+    scene.bubbles.push(film);
+    scene
+}
+
+#[test]
+fn a_fold_within_one_layer_is_shaded_per_sheet_not_shared_across_it() {
+    let s = settings(120, 120, 4, ReflectionMode::StaticEnvironment);
+    let (shared, per_triangle) = both_partial_shadings(&folded_film_scene(), &s);
+    // Within one flat sheet of uniform thickness the shading barely varies across a pixel;
+    // the other sheet's shading differs by far more (its film is another colour).
+    let (worst, at) = max_diff(&shared, &per_triangle);
+    assert!(
+        worst < 2e-3,
+        "pixel ({}, {}) differs by {worst}: a sheet reused the other sheet's shading",
+        at % 120,
+        at / 120
+    );
+}
