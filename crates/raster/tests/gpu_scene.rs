@@ -32,6 +32,14 @@ fn gpu() -> Option<GpuRenderer> {
     }
 }
 
+/// The CPU renderer shading partly covered pixels once per triangle, as the GPU does, so
+/// the two are compared like for like.
+fn cpu_renderer() -> Renderer {
+    let mut cpu = Renderer::new();
+    cpu.set_partial_shading(raster::PartialShading::PerTriangle);
+    cpu
+}
+
 fn lab_of(px: &[u8]) -> Lab {
     let linear = [0, 1, 2].map(|c| srgb_decode(f64::from(px[c]) / 255.0));
     lab_from_xyz(
@@ -102,7 +110,7 @@ fn gpu_frame_matches_the_cpu_backend_in_ciede2000() {
     ] {
         for samples in [1, 4] {
             let s = settings(200, 150, samples, reflection.clone());
-            let cpu = Renderer::new()
+            let cpu = cpu_renderer()
                 .render(&scene, &tables, &s)
                 .unwrap()
                 .to_srgb8(s.exposure_ev, s.tonemap);
@@ -158,7 +166,7 @@ fn cube_frames(gpu: &mut GpuRenderer, filter: raster::ReflectionFilter) -> (Vec<
         1,
         ReflectionMode::DynamicCubeMap { face_size: 48 },
     );
-    let mut cpu = Renderer::new();
+    let mut cpu = cpu_renderer();
     cpu.set_reflection_filter(filter);
     gpu.set_reflection_filter(filter);
     let cpu = cpu
@@ -283,7 +291,7 @@ fn gpu_bubble_reads_the_lut_at_the_cpu_texel_centres() {
         .push(common::bubble(Vec3::ZERO, 0.6, 4, |n| 500.0 + 450.0 * n.y));
     let tables = coarse_tables();
     let s = settings(120, 120, 1, ReflectionMode::StaticEnvironment);
-    let cpu = Renderer::new()
+    let cpu = cpu_renderer()
         .render(&scene, &tables, &s)
         .unwrap()
         .to_srgb8(s.exposure_ev, s.tonemap);
