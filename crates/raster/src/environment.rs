@@ -43,13 +43,7 @@ impl Sky {
     #[inline]
     pub fn radiance(&self, dir: Vec3) -> [f32; 3] {
         let d = dir.normalize_or(Vec3::Y);
-        let mut out = if d.y >= 0.0 {
-            // Cubic falloff keeps the horizon band bright and narrow, like a real clear sky.
-            let s = 1.0 - d.y;
-            lerp3(self.zenith_rgb, self.horizon_rgb, s * s * s)
-        } else {
-            lerp3(self.horizon_rgb, self.nadir_rgb, (-d.y * 10.0).min(1.0))
-        };
+        let mut out = self.gradient(d.y);
         if self.sun_rgb != [0.0; 3] {
             let sun = self.sun_direction.normalize_or(Vec3::Y);
             if d.dot(sun) >= self.sun_radius_deg.to_radians().cos() {
@@ -59,6 +53,19 @@ impl Sky {
             }
         }
         out
+    }
+
+    /// The sky without its sun, along a unit direction whose y component is `y`.
+    #[inline(always)]
+    pub(crate) fn gradient(&self, y: f32) -> [f32; 3] {
+        // Both branches are cheap and pure, so a loop over `y` vectorises with a select.
+        if y >= 0.0 {
+            // Cubic falloff keeps the horizon band bright and narrow, like a real clear sky.
+            let s = 1.0 - y;
+            lerp3(self.zenith_rgb, self.horizon_rgb, s * s * s)
+        } else {
+            lerp3(self.horizon_rgb, self.nadir_rgb, (-y * 10.0).min(1.0))
+        }
     }
 
     fn validate(&self) -> Result<(), RenderError> {

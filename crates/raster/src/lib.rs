@@ -39,6 +39,7 @@ mod renderer;
 mod scene;
 mod settings;
 mod shading;
+mod sky_span;
 mod spheremap;
 mod texture;
 mod water;

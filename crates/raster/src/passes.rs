@@ -6,11 +6,12 @@
 use glam::{Vec3, Vec3A};
 
 use crate::camera::View;
-use crate::ground::{SPAN, ground_span, span_supported};
+use crate::ground::{SPAN, ground_span, pixel_f32, span_supported};
 use crate::lod::reflection_derivatives;
 use crate::lut_sampler::LutSampler;
 use crate::raster::{ATTRS, NO_SURFACE, Plane, SamplePattern, SetupTri, for_each_covered_in_row};
 use crate::shading::{ground_albedo, lit, object_albedo};
+use crate::sky_span::sky_span;
 use crate::water_pass::{WATER, WaterShading, shade_water};
 use crate::{
     CubeMap, Environment, Ground, Irradiance, Light, Material, PartialShading, Pattern,
@@ -172,29 +173,48 @@ impl OpaqueCtx<'_> {
         let min_dz = dz.iter().copied().fold(f32::INFINITY, f32::min);
         let max_dz = dz.iter().copied().fold(f32::NEG_INFINITY, f32::max);
         let mut centre = [[0.0f32; 3]; SPAN];
+        let mut sky = [[0.0f32; 3]; SPAN];
+        // Inverse depth of the ground at each pixel centre; −1 (behind) without a ground.
+        let mut z = [-1.0f32; SPAN];
         for row in 0..rows {
             let y = y0 + row;
             let cy = y as f32 + 0.5;
             for x0 in (0..width).step_by(SPAN) {
                 let n = SPAN.min(width - x0);
+                let z = &mut z[..n];
+                if let Some(g) = &self.ground {
+                    for (i, z) in z.iter_mut().enumerate() {
+                        *z = g.inv_depth(pixel_f32(x0 + i) + 0.5, cy);
+                    }
+                }
                 // Centres seeing the ground form one contiguous run (inverse depth is affine).
-                let run = self.ground_run(y, x0, n);
+                let run = positive_run(z);
                 if let (Some(g), Some((a, b))) = (fast, run) {
                     ground_span(self, g, y, x0 + a, &mut centre[a..b]);
                 }
-                for (i, c) in centre.iter().enumerate().take(n) {
+                // The environment outside the run, by the span kernel unless precomputed;
+                // pixels inside it that see some sky (the horizon's) look it up one by one.
+                let (a, b) = run.unwrap_or((n, n));
+                let texels = self.sky_texels.map(|t| &t[y * width + x0..][..n]);
+                if texels.is_none() {
+                    sky_span(&self.view, self.env, y, x0, &mut sky[..a]);
+                    sky_span(&self.view, self.env, y, x0 + b, &mut sky[b..n]);
+                }
+                let sky_at = |i: usize| match texels {
+                    Some(t) => t[i],
+                    None if i < a || i >= b => sky[i],
+                    None => self.sky(x0 + i, y),
+                };
+                // The pixels whose centres the span kernel shaded.
+                let (ga, gb) = fast.and(run).unwrap_or((0, 0));
+                for (i, (c, &z)) in centre.iter().zip(z.iter()).enumerate() {
                     let x = x0 + i;
                     let base = (row * width + x) * s_count;
                     let (color, depth) = (
                         &mut color[base..base + s_count],
                         &mut depth[base..base + s_count],
                     );
-                    let z = self
-                        .ground
-                        .as_ref()
-                        .map_or(-1.0, |g| g.inv_depth(x as f32 + 0.5, cy));
-                    let in_run =
-                        matches!((fast, run), (Some(_), Some((a, b))) if (a..b).contains(&i));
+                    let in_run = ga <= i && i < gb;
                     if in_run && z + min_dz > 0.0 {
                         // Every sample on the ground, shaded at the centre by the span kernel.
                         color.fill(*c);
@@ -203,34 +223,26 @@ impl OpaqueCtx<'_> {
                         }
                     } else if z + max_dz <= 0.0 {
                         // Every sample sees the environment.
-                        color.fill(self.sky(x, y));
+                        color.fill(sky_at(i));
                         depth.fill(0.0);
                     } else {
-                        self.background_pixel(x, y, in_run.then_some(*c), color, depth);
+                        let centre = in_run.then_some(*c);
+                        self.background_pixel(x, y, centre, sky_at(i), color, depth);
                     }
                 }
             }
         }
     }
 
-    /// The pixels `i` of `x0 .. x0 + n` on row `y` whose centres see the ground, as `a..b`.
-    fn ground_run(&self, y: usize, x0: usize, n: usize) -> Option<(usize, usize)> {
-        let g = self.ground.as_ref()?;
-        let cy = y as f32 + 0.5;
-        let sees = |i: usize| g.inv_depth((x0 + i) as f32 + 0.5, cy) > 0.0;
-        let a = (0..n).find(|&i| sees(i))?;
-        let b = (a..n).find(|&i| !sees(i)).unwrap_or(n);
-        Some((a, b))
-    }
-
-    /// Fills one pixel's samples with ground or environment; `centre` is the ground radiance
-    /// at the pixel centre when already computed.
+    /// Fills one pixel's samples with ground or environment `sky`; `centre` is the ground
+    /// radiance at the pixel centre when already computed.
     #[inline]
     fn background_pixel(
         &self,
         x: usize,
         y: usize,
         centre: Option<[f32; 3]>,
+        sky: [f32; 3],
         color: &mut [[f32; 3]],
         depth: &mut [f32],
     ) {
@@ -252,11 +264,6 @@ impl OpaqueCtx<'_> {
         } else {
             depth.fill(0.0);
         }
-        let sky = if ground_mask != full {
-            self.sky(x, y)
-        } else {
-            [0.0; 3]
-        };
         let ground = if ground_mask == 0 {
             [0.0; 3]
         } else if let (true, Some(c)) = (ground_mask == full, centre) {
@@ -409,6 +416,16 @@ fn surface_footprint(view: &View, d: Vec3, t: f32, n: Vec3) -> [f32; 3] {
         dx.z.abs() + dy.z.abs(),
     ]
     .map(|f| if f < 1e6 { f } else { 1e6 })
+}
+
+/// The first run `a..b` of positive values in `z`, if any (NaN is not positive).
+fn positive_run(z: &[f32]) -> Option<(usize, usize)> {
+    let a = z.iter().position(|&z| z > 0.0)?;
+    let b = z[a..]
+        .iter()
+        .position(|&z| z <= 0.0 || z.is_nan())
+        .map_or(z.len(), |k| a + k);
+    Some((a, b))
 }
 
 /// Where one bubble's reflections come from.
@@ -823,6 +840,14 @@ mod tests {
     }
 
     #[test]
+    fn positive_run_is_the_first_run_of_positive_values() {
+        assert_eq!(positive_run(&[-1.0, 0.0, 2.0, 3.0, 0.0, 4.0]), Some((2, 4)));
+        assert_eq!(positive_run(&[1.0, f32::NAN, 1.0]), Some((0, 1)));
+        assert_eq!(positive_run(&[-1.0, 1.0]), Some((1, 2)));
+        assert_eq!(positive_run(&[0.0, -0.0, f32::NAN]), None);
+    }
+
+    #[test]
     fn ground_span_kernel_matches_the_scalar_ground() {
         use crate::{Camera, Ground, Material};
         let camera = Camera::look_at(
@@ -871,7 +896,10 @@ mod tests {
         for y in (0..100).step_by(7) {
             for x0 in (0..150).step_by(SPAN) {
                 let n = SPAN.min(150 - x0);
-                let Some((a, b)) = ctx.ground_run(y, x0, n) else {
+                let z: Vec<f32> = (0..n)
+                    .map(|i| g.inv_depth((x0 + i) as f32 + 0.5, y as f32 + 0.5))
+                    .collect();
+                let Some((a, b)) = positive_run(&z) else {
                     continue;
                 };
                 let mut out = [[0.0; 3]; SPAN];
