@@ -11,6 +11,7 @@ use std::path::Path;
 
 use glam::{Vec3, Vec4};
 
+use crate::index_f32::index_f32;
 use crate::lod::{anisotropic_taps, cube_lod};
 use crate::texture::{check_texels, read_linear_rgb};
 use crate::{Environment, RenderError};
@@ -178,7 +179,7 @@ impl CubeMap {
         if major_lod <= 0.0 {
             return self.levels[0].bilinear(face, s, t);
         }
-        let last = (self.levels.len() - 1) as f32;
+        let last = index_f32(self.levels.len() - 1);
         let (taps, footprint_rad) = anisotropic_taps(major_rad, minor.length());
         if taps == 1 {
             // One tap filters over the major axis itself: its level is the one just computed.
@@ -188,11 +189,11 @@ impl CubeMap {
         let step = major * dir.length();
         let mut sum = Vec4::ZERO;
         for i in 0..taps {
-            let offset = (i as f32 + 0.5) / taps as f32 - 0.5;
+            let offset = (index_f32(i) + 0.5) / index_f32(taps) - 0.5;
             let (face, s, t) = face_coordinates(dir + step * offset);
             sum += self.trilinear(face, s, t, lod);
         }
-        rgb(sum / taps as f32)
+        rgb(sum / index_f32(taps))
     }
 
     /// Seamless trilinear tap at face coordinates `(s, t)` and level `lod` in
@@ -200,8 +201,8 @@ impl CubeMap {
     #[inline(always)]
     fn trilinear(&self, face: usize, s: f32, t: f32, lod: f32) -> Vec4 {
         // lod is in [0, last]: the conversion is exact.
-        let l0 = lod as usize;
-        let frac = lod - l0 as f32;
+        let l0 = lod as i32 as usize;
+        let frac = lod - index_f32(l0);
         let (u, v) = ((s + 1.0) * 0.5, (t + 1.0) * 0.5);
         let a = self.levels[l0].bilinear4(face, u, v);
         if frac <= 0.0 || l0 + 1 == self.levels.len() {
@@ -287,9 +288,9 @@ impl Level {
     /// result is bit-identical to the scalar blend, in a third of the arithmetic.
     #[inline(always)]
     fn bilinear4(&self, face: usize, u: f32, v: f32) -> Vec4 {
-        let n = self.face_size as f32;
+        let n = index_f32(self.face_size);
         let m = self.face_size + 2;
-        let hi = (m - 1) as f32;
+        let hi = index_f32(m - 1);
         // Interior texel i has its centre at s = (2i + 1)/N − 1 and is stored at i + 1, so
         // `u·N + 1/2` is in [1/2, N + 1/2]; the bounds only catch NaN (→ 0) and rounding.
         let fx = (u * n + 0.5).max(0.0).min(hi);
@@ -297,8 +298,8 @@ impl Level {
         // fx, fy are in [0, m − 1] (m ≤ 8194): i32 conversion is exact and cheaper than usize's.
         let x0 = (fx as i32 as usize).min(m - 2);
         let y0 = (fy as i32 as usize).min(m - 2);
-        let tx = fx - x0 as f32;
-        let ty = fy - y0 as f32;
+        let tx = fx - index_f32(x0);
+        let ty = fy - index_f32(y0);
         let base = self.face_offset(face) + y0 * m + x0;
         // Four floats from each texel: its RGB and the next texel's red, which is ignored
         // (the padding texel keeps the last one in bounds). One bounds check for all four.

@@ -2,18 +2,12 @@
 //! pixel centres along one row, written as straight-line f32 code over small arrays so the
 //! compiler can keep it in SIMD registers. Other ground materials use the scalar path.
 
+use crate::index_f32::index_f32;
 use crate::passes::{GroundView, OpaqueCtx};
 use crate::{Light, Pattern};
 
 /// Pixels per kernel call.
 pub(crate) const SPAN: usize = 64;
-
-/// Pixel coordinate `x` as `f32`, through `i32`: exact for any image size (< 2²⁴), and
-/// `i32`'s conversion vectorises where `usize`'s does not.
-#[inline(always)]
-pub(crate) fn pixel_f32(x: usize) -> f32 {
-    x as i32 as f32
-}
 
 /// Whether [`ground_span`] handles this ground (solid or checker albedo, no specular lobe).
 pub(crate) fn span_supported(g: &GroundView<'_>) -> bool {
@@ -76,7 +70,7 @@ pub(crate) fn ground_span(
     let mut px = [0.0f32; SPAN];
     let mut pz = [0.0f32; SPAN];
     for i in 0..n {
-        let x = pixel_f32(x0 + i);
+        let x = index_f32(x0 + i);
         let (dx, dz) = (d0.x + ddx.x * x, d0.z + ddx.z * x);
         let inv_t = (g.c + g.gx * (x + 0.5) + g.gy * cy).max(1e-30);
         let t = 1.0 / inv_t;

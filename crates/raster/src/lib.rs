@@ -27,6 +27,7 @@ mod frame;
 #[cfg(feature = "wgpu")]
 pub mod gpu;
 mod ground;
+mod index_f32;
 mod irradiance;
 mod lod;
 mod lut_sampler;

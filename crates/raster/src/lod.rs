@@ -8,6 +8,8 @@
 
 use glam::Vec3A;
 
+use crate::index_f32::index_f32;
+
 /// Levels added to the computed level of detail: −log2 √3. A bilinear tap of a level
 /// whose texels are `T` wide (box-averaged from level 0) is a box of width `T` convolved
 /// with a tent of half-width `T`, a kernel of standard deviation `T/2`; the pixel's own
@@ -30,7 +32,7 @@ pub(crate) const MIN_FOOTPRINT_TEXELS: f32 = 1.0;
 pub(crate) fn cube_lod(footprint_rad: f32, face_size: usize, s: f32, t: f32) -> f32 {
     let q = 1.0 + s * s + t * t;
     let q34 = q.sqrt() * q.sqrt().sqrt();
-    let texels = footprint_rad * face_size as f32 * 0.5 * q34;
+    let texels = footprint_rad * index_f32(face_size) * 0.5 * q34;
     // NaN compares false: it reads level 0, as a zero footprint would.
     if texels > MIN_FOOTPRINT_TEXELS {
         (texels.log2() + LOD_BIAS).max(0.0)
@@ -55,7 +57,7 @@ pub(crate) fn anisotropic_taps(major_rad: f32, minor_rad: f32) -> (usize, f32) {
     // Rounded: below 1.5 one tap (isotropic, as wide as the longer axis). NaN → one tap;
     // the float-to-int conversion saturates.
     let taps = ((ratio + 0.5) as usize).clamp(1, MAX_ANISOTROPY);
-    (taps, (major_rad / taps as f32).max(minor_rad))
+    (taps, (major_rad / index_f32(taps)).max(minor_rad))
 }
 
 /// Change per pixel of the unit reflected direction along screen x and y.

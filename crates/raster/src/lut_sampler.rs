@@ -3,6 +3,7 @@
 
 use lut::Lut;
 
+use crate::index_f32::index_f32;
 use crate::texture::bilerp;
 
 /// A borrowed view of a table, prepared for fast sampling.
@@ -29,7 +30,7 @@ impl<'a> LutSampler<'a> {
     #[inline(always)]
     pub fn sample(&self, thickness_nm: f32, cos_theta: f32) -> [f32; 3] {
         let (i0, tx) = split(thickness_nm * self.d_scale, self.width);
-        let (j0, ty) = split(cos_theta * (self.height - 1) as f32, self.height);
+        let (j0, ty) = split(cos_theta * index_f32(self.height - 1), self.height);
         let row0 = j0 * self.width + i0;
         let row1 = row0 + self.width;
         let (a, b) = (self.texels[row0], self.texels[row0 + 1]);
@@ -41,11 +42,11 @@ impl<'a> LutSampler<'a> {
 /// Lower sample index and weight of the upper one along an axis of `n >= 2` samples.
 #[inline(always)]
 fn split(x: f32, n: usize) -> (usize, f32) {
-    let x = x.clamp(0.0, (n - 1) as f32);
+    let x = x.clamp(0.0, index_f32(n - 1));
     let x = if x.is_nan() { 0.0 } else { x };
     // x is in [0, n − 1] and n indexes memory, so the cheaper i32 conversion is exact.
     let i0 = (x as i32 as usize).min(n - 2);
-    (i0, x - i0 as f32)
+    (i0, x - index_f32(i0))
 }
 
 #[cfg(test)]

@@ -6,7 +6,8 @@
 use glam::{Vec3, Vec3A};
 
 use crate::camera::View;
-use crate::ground::{SPAN, ground_span, pixel_f32, span_supported};
+use crate::ground::{SPAN, ground_span, span_supported};
+use crate::index_f32::index_f32;
 use crate::lod::reflection_derivatives;
 use crate::lut_sampler::LutSampler;
 use crate::raster::{ATTRS, NO_SURFACE, Plane, SamplePattern, SetupTri, for_each_covered_in_row};
@@ -184,7 +185,7 @@ impl OpaqueCtx<'_> {
                 let z = &mut z[..n];
                 if let Some(g) = &self.ground {
                     for (i, z) in z.iter_mut().enumerate() {
-                        *z = g.inv_depth(pixel_f32(x0 + i) + 0.5, cy);
+                        *z = g.inv_depth(index_f32(x0 + i) + 0.5, cy);
                     }
                 }
                 // Centres seeing the ground form one contiguous run (inverse depth is affine).

@@ -7,7 +7,8 @@
 
 use crate::Environment;
 use crate::camera::View;
-use crate::ground::{SPAN, pixel_f32};
+use crate::ground::SPAN;
+use crate::index_f32::index_f32;
 
 /// Environment radiance along the view rays through the centres of pixels
 /// `x0 .. x0 + out.len()` of row `y`, written to `out`.
@@ -31,7 +32,7 @@ pub(crate) fn sky_span(view: &View, env: &Environment, y: usize, x0: usize, out:
     let (f, r, u) = (view.forward, view.right, view.up);
     let mut unit_y = [0.0f32; SPAN];
     for (i, uy) in unit_y[..n].iter_mut().enumerate() {
-        let (ax, _) = view.ray_coefficients(pixel_f32(x0 + i) + 0.5, cy);
+        let (ax, _) = view.ray_coefficients(index_f32(x0 + i) + 0.5, cy);
         // `View::ray`'s sums, then `Vec3::normalize_or(Vec3::Y)`'s y, lane by lane.
         let d = [
             f.x + r.x * ax + u.x * ay,

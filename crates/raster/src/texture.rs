@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use crate::RenderError;
+use crate::index_f32::index_f32;
 
 /// A linear-light RGB f32 image, row 0 at the top.
 ///
@@ -124,7 +125,7 @@ impl Texture {
 /// Texel pair and weight for a repeating axis of `n` texels (texel centres at `(i + 0.5) / n`).
 #[inline]
 fn split_repeat(t: f32, n: usize) -> (usize, usize, f32) {
-    let x = t * n as f32 - 0.5;
+    let x = t * index_f32(n) - 0.5;
     let x = if x.is_finite() { x } else { 0.0 };
     let f = x.floor();
     let i0 = (f as i64).rem_euclid(n as i64) as usize;
@@ -135,11 +136,11 @@ fn split_repeat(t: f32, n: usize) -> (usize, usize, f32) {
 /// Texel pair and weight for a clamped axis of `n` texels.
 #[inline]
 fn split_clamp(t: f32, n: usize) -> (usize, usize, f32) {
-    let x = (t * n as f32 - 0.5).clamp(0.0, (n - 1) as f32);
+    let x = (t * index_f32(n) - 0.5).clamp(0.0, index_f32(n - 1));
     let x = if x.is_nan() { 0.0 } else { x };
     let i0 = x as usize;
     let i1 = (i0 + 1).min(n - 1);
-    (i0, i1, x - i0 as f32)
+    (i0, i1, x - index_f32(i0))
 }
 
 /// The sRGB decoding curve (IEC 61966-2-1) for one channel in `[0, 1]`.
