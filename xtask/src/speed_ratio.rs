@@ -1,6 +1,7 @@
 //! `cargo xtask bench --ratio`: seed 000's Fig. 4 speed ratio on this machine. Times the
 //! spectral reference's `paper` at 400 × 400 and the CPU backend's frame, interleaved in
-//! rounds so that both see the same machine state, and prints a markdown table.
+//! rounds so that both see the same machine state, and prints a markdown table and the
+//! median ratio. With `--baseline`, the two binaries' frames alternate in order by round.
 //!
 //! CPU time comes from the kernel's account of reaped children (`/proc/self/stat`), so a
 //! frame's CPU time is that of a 210-frame bench minus a 10-frame one, over 200 frames:
@@ -26,13 +27,27 @@ pub fn run(root: &Path, bubbles: &Path, baseline: Option<&Path>, rounds: usize) 
         "|---|---|---|---|{}",
         if baseline.is_some() { "---|---|" } else { "" }
     );
+    let (mut ratios, mut base_ratios) = (Vec::new(), Vec::new());
     for round in 1..=rounds {
         let Some((ref_cpu_s, ref_wall_s)) = timed(root, bubbles, &reference_args()) else {
             return false;
         };
-        let Some(frame) = frame_cost(root, bubbles) else {
-            return false;
+        // Odd rounds time the binary first, even rounds the baseline: whichever runs
+        // right after the reference would otherwise always meet the same machine state.
+        let order: Vec<&Path> = match baseline {
+            Some(base) if round % 2 == 0 => vec![base, bubbles],
+            Some(base) => vec![bubbles, base],
+            None => vec![bubbles],
         };
+        let mut frames = Vec::new();
+        for bin in order {
+            let Some(f) = frame_cost(root, bin) else {
+                return false;
+            };
+            frames.push((bin, f));
+        }
+        let frame = &frames.iter().find(|(b, _)| *b == bubbles).expect("timed").1;
+        ratios.push(ref_cpu_s * 1e3 / frame.cpu_ms);
         let mut row = format!(
             "| {round} | {ref_cpu_s:.2} ({ref_wall_s:.2}) | {:.2} ({:.2}, {:.2}) | {:.0}× |",
             frame.cpu_ms,
@@ -41,16 +56,33 @@ pub fn run(root: &Path, bubbles: &Path, baseline: Option<&Path>, rounds: usize) 
             ref_cpu_s * 1e3 / frame.cpu_ms
         );
         if let Some(base) = baseline {
-            let Some(b) = frame_cost(root, base) else {
-                return false;
-            };
+            let b = &frames.iter().find(|(b, _)| *b == base).expect("timed").1;
+            base_ratios.push(ref_cpu_s * 1e3 / b.cpu_ms);
             row += &format!(" {:.2} | {:.0}× |", b.cpu_ms, ref_cpu_s * 1e3 / b.cpu_ms);
         }
         println!("{row}");
     }
+    println!(
+        "\nmedian ratio over {rounds} rounds: {:.0}×",
+        median(&mut ratios)
+    );
+    if baseline.is_some() {
+        println!("baseline median ratio: {:.0}×", median(&mut base_ratios));
+    }
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
     println!("\nload average after the last round: {}", load.trim());
     true
+}
+
+/// The middle value (the mean of the two middle ones for an even count).
+fn median(values: &mut [f64]) -> f64 {
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    match n {
+        0 => f64::NAN,
+        _ if n % 2 == 1 => values[n / 2],
+        _ => (values[n / 2 - 1] + values[n / 2]) / 2.0,
+    }
 }
 
 fn reference_args() -> Vec<String> {
@@ -135,4 +167,16 @@ fn children_cpu_s() -> Option<f64> {
     // `rest` starts at field 3 (state), so field k is at index k − 3.
     let ticks = |k: usize| fields.get(k - 3)?.parse::<f64>().ok();
     Some((ticks(16)? + ticks(17)?) / 100.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_is_the_middle_value_or_the_mean_of_the_two_middle_ones() {
+        assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
+        assert!(median(&mut []).is_nan());
+    }
 }

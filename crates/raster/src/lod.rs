@@ -208,7 +208,10 @@ mod tests {
             }
             x *= 1.0137;
         }
-        assert!(worst < 2e-7, "worst error {worst:e} (relative, or absolute below 1)");
+        assert!(
+            worst < 2e-7,
+            "worst error {worst:e} (relative, or absolute below 1)"
+        );
         assert_eq!(log2_at_least_one(1.0), 0.0);
         assert_eq!(log2_at_least_one(1024.0), 10.0);
         assert_eq!(log2_at_least_one(f32::INFINITY), 128.0);
