@@ -201,7 +201,7 @@ mod tests {
         let mut worst = 0.0f64;
         let mut x = 1.0f32;
         while x < 1e30 {
-            for y in [x, x.next_up(), x * 1.414_213_5, x * 1.000_37] {
+            for y in [x, x.next_up(), x * std::f32::consts::SQRT_2, x * 1.000_37] {
                 let exact = f64::from(y).log2();
                 let err = (f64::from(log2_at_least_one(y)) - exact).abs() / exact.max(1.0);
                 worst = worst.max(err);
