@@ -689,11 +689,12 @@ impl BubbleCtx<'_> {
             let p = self.view.eye + Vec3::from(d / inv_w);
             for (light, table) in self.lights.iter().zip(self.light_tables) {
                 // Beyond the widened reach the visibility below is exactly 0.
-                if !within_reach(light, p, reflected, tri.extra, SHARE_MARGIN_PX) {
+                let sight = LightSight::new(light, p, reflected);
+                if !sight.within_reach(light, tri.extra, SHARE_MARGIN_PX) {
                     continue;
                 }
                 shareable = false;
-                let vis = light_visibility(light, p, reflected, tri.extra);
+                let vis = sight.visibility(light, reflected, tri.extra);
                 if vis > 0.0 {
                     let l = table.sample(thickness_nm, cos_theta);
                     let gain = light.highlight_gain();
@@ -736,83 +737,98 @@ impl BubbleCtx<'_> {
     }
 }
 
-/// Fraction of a pixel's reflected rays (unit `reflected` at its centre) that hit `light`,
-/// given the angle the reflected direction sweeps per pixel, `pixel_angle_rad`.
-///
-/// A light of angular radius α at angle γ from `reflected` is filtered by a Gaussian of
-/// σ = 0.6 pixel in reflected directions: `vis = α²/(2s²) · exp(−γ²/2s²)` with
-/// `s² = σ² + α²/4` (the disc's own variance), whose integral over directions is the
-/// light's solid angle πα² for every α; and a normalised Gaussian this wide sums to one
-/// over the pixel grid at any sub-pixel offset (within 0.2 %), so a highlight's energy
-/// in the image is the light's power, whatever its radius. Lights wider than 2σ (whose
-/// peak reaches 1) get a one-pixel linear ramp across the disc's rim instead, within
-/// 6 % of the same energy and with a sharp edge.
-#[inline]
-pub(crate) fn light_visibility(
-    light: &Light,
-    p: Vec3,
-    reflected: Vec3,
-    pixel_angle_rad: f32,
-) -> f32 {
-    let to_light = light.position - p;
-    let dist = to_light.length();
-    if dist <= light.radius_m {
-        return 1.0;
-    }
-    let cos_gamma = reflected.dot(to_light) / dist;
-    let sin_alpha = light.radius_m / dist;
-    let w = pixel_angle_rad.max(1e-5);
-    // asin x ≤ πx/2 bounds α; 1 − cos γ ≤ γ²/2, so this rejects only rays beyond both
-    // the Gaussian's 4 s and the ramp's reach (most rays, cheaply).
-    let reach = std::f32::consts::PI * sin_alpha + 2.5 * w;
-    if 1.0 - cos_gamma > 0.5 * reach * reach {
-        return 0.0;
-    }
-    let alpha = sin_alpha.asin();
-    // atan2 keeps small angles exact where acos(cos γ) would round them to 3e-4 rad.
-    let gamma = reflected.cross(to_light).length().atan2(cos_gamma * dist);
-    let sigma = HIGHLIGHT_SIGMA_PX * w;
-    if alpha <= 2.0 * sigma {
-        let s2 = sigma * sigma + 0.25 * alpha * alpha;
-        alpha * alpha / (2.0 * s2) * (-gamma * gamma / (2.0 * s2)).exp()
-    } else {
-        ((alpha - gamma) / w + 0.5).clamp(0.0, 1.0)
-    }
-}
+/// Width of the highlight filter in pixels: wide enough that the Gaussian's sum over the
+/// pixel grid ripples by 2·exp(−2π²σ²) ≈ 0.16 % with the sub-pixel offset.
+pub(crate) const HIGHLIGHT_SIGMA_PX: f32 = 0.6;
 
 /// How far (in pixels of reflected-direction turn) a shading may be reused from the
 /// point it was computed at: two points of one pixel are at most √2 pixels apart.
 const SHARE_MARGIN_PX: f32 = 2.0;
 
-/// Whether `reflected` from `p` passes within the reach of [`light_visibility`]'s filter
-/// around `light`, widened by `margin_px` pixels; where it does not, the visibility is 0.
-#[inline]
-fn within_reach(
-    light: &Light,
-    p: Vec3,
-    reflected: Vec3,
-    pixel_angle_rad: f32,
-    margin_px: f32,
-) -> bool {
-    let to_light = light.position - p;
-    let dist = to_light.length();
-    if dist <= light.radius_m {
-        return true;
-    }
-    let cos_gamma = reflected.dot(to_light) / dist;
-    let w = pixel_angle_rad.max(1e-5);
-    let reach = std::f32::consts::PI * (light.radius_m / dist) + (2.5 + margin_px) * w;
-    1.0 - cos_gamma <= 0.5 * reach * reach
+/// Where a light lies from a shaded point, as its highlight ([`LightSight::visibility`]) and
+/// the sharing test ([`LightSight::within_reach`]) both need it, computed once per light
+/// and point.
+struct LightSight {
+    to_light: Vec3,
+    dist: f32,
+    /// Cosine of the angle between the reflected direction and the light's centre.
+    cos_gamma: f32,
 }
 
-/// Width of the highlight filter in pixels: wide enough that the Gaussian's sum over the
-/// pixel grid ripples by 2·exp(−2π²σ²) ≈ 0.16 % with the sub-pixel offset.
-pub(crate) const HIGHLIGHT_SIGMA_PX: f32 = 0.6;
+impl LightSight {
+    #[inline]
+    fn new(light: &Light, p: Vec3, reflected: Vec3) -> Self {
+        let to_light = light.position - p;
+        let dist = to_light.length();
+        Self {
+            to_light,
+            dist,
+            cos_gamma: reflected.dot(to_light) / dist,
+        }
+    }
+
+    /// Whether the reflected direction passes within the reach of
+    /// [`LightSight::visibility`]'s filter, widened by `margin_px` pixels; where it does not,
+    /// the visibility is 0. A point inside the light is always within reach.
+    ///
+    /// asin x ≤ πx/2 bounds the light's angular radius and 1 − cos γ ≤ γ²/2, so this
+    /// rejects only rays beyond both the Gaussian's 4 s and the ramp's reach (most rays,
+    /// cheaply).
+    #[inline]
+    fn within_reach(&self, light: &Light, pixel_angle_rad: f32, margin_px: f32) -> bool {
+        if self.dist <= light.radius_m {
+            return true;
+        }
+        let w = pixel_angle_rad.max(1e-5);
+        let reach = std::f32::consts::PI * (light.radius_m / self.dist) + (2.5 + margin_px) * w;
+        1.0 - self.cos_gamma <= 0.5 * reach * reach
+    }
+
+    /// Fraction of a pixel's reflected rays (unit `reflected` at its centre) that hit `light`,
+    /// given the angle the reflected direction sweeps per pixel, `pixel_angle_rad`.
+    ///
+    /// A light of angular radius α at angle γ from `reflected` is filtered by a Gaussian of
+    /// σ = 0.6 pixel in reflected directions: `vis = α²/(2s²) · exp(−γ²/2s²)` with
+    /// `s² = σ² + α²/4` (the disc's own variance), whose integral over directions is the
+    /// light's solid angle πα² for every α; and a normalised Gaussian this wide sums to one
+    /// over the pixel grid at any sub-pixel offset (within 0.2 %), so a highlight's energy
+    /// in the image is the light's power, whatever its radius. Lights wider than 2σ (whose
+    /// peak reaches 1) get a one-pixel linear ramp across the disc's rim instead, within
+    /// 6 % of the same energy and with a sharp edge.
+    #[inline]
+    fn visibility(&self, light: &Light, reflected: Vec3, pixel_angle_rad: f32) -> f32 {
+        if self.dist <= light.radius_m {
+            return 1.0;
+        }
+        if !self.within_reach(light, pixel_angle_rad, 0.0) {
+            return 0.0;
+        }
+        let w = pixel_angle_rad.max(1e-5);
+        let alpha = (light.radius_m / self.dist).asin();
+        // atan2 keeps small angles exact where acos(cos γ) would round them to 3e-4 rad.
+        let gamma = reflected
+            .cross(self.to_light)
+            .length()
+            .atan2(self.cos_gamma * self.dist);
+        let sigma = HIGHLIGHT_SIGMA_PX * w;
+        if alpha <= 2.0 * sigma {
+            let s2 = sigma * sigma + 0.25 * alpha * alpha;
+            alpha * alpha / (2.0 * s2) * (-gamma * gamma / (2.0 * s2)).exp()
+        } else {
+            ((alpha - gamma) / w + 0.5).clamp(0.0, 1.0)
+        }
+    }
+}
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::raster::SamplePattern;
+
+    /// The highlight filter from point `p`, as the shader computes it.
+    fn light_visibility(light: &Light, p: Vec3, reflected: Vec3, w: f32) -> f32 {
+        LightSight::new(light, p, reflected).visibility(light, reflected, w)
+    }
 
     #[test]
     fn light_visibility_is_one_inside_zero_outside_and_half_on_the_rim() {

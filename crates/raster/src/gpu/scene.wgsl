@@ -1,7 +1,7 @@
 // The frame's passes in WGSL, each a port of the CPU backend (the specification):
 // background sky (passes.rs `OpaqueCtx::sky`), ground plane (`shade_ground`), opaque
 // objects and light spheres (`OpaqueCtx::shade`, shading.rs `lit`), and the bubble film
-// (`BubbleCtx::shade`, `light_visibility`). Constants shared with Rust are injected below.
+// (`BubbleCtx::shade`, `LightSight::visibility`). Constants shared with Rust are injected below.
 
 {{SHARED_CONSTANTS}}
 
@@ -576,7 +576,7 @@ fn reflection(bubble: u32, dir: vec3<f32>, derivatives: array<vec3<f32>, 2>) -> 
     return env_radiance(dir);
 }
 
-// passes.rs `light_visibility`: the highlight filter (see its documentation).
+// passes.rs `LightSight::visibility`: the highlight filter (see its documentation).
 fn light_visibility(light: Light, p: vec3<f32>, reflected: vec3<f32>, pixel_angle_rad: f32) -> f32 {
     let to_light = light.position.xyz - p;
     let dist = length(to_light);
