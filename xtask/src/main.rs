@@ -60,16 +60,26 @@ fn ratio() -> bool {
             .position(|a| a == flag)
             .and_then(|i| args.get(i + 1))
     };
-    let rounds = match value("--rounds").map(|r| r.parse::<usize>()) {
+    for flag in ["--rounds", "--baseline"] {
+        if args.iter().any(|a| a == flag) && value(flag).is_none() {
+            eprintln!("{flag} needs a value");
+            return false;
+        }
+    }
+    let rounds = match value("--rounds").map(|r| (r, r.parse::<usize>())) {
         None => 3,
-        Some(Ok(n)) if (1..=100).contains(&n) => n,
-        Some(_) => {
-            eprintln!("--rounds takes a count from 1 to 100");
+        Some((_, Ok(n))) if (1..=100).contains(&n) => n,
+        Some((r, _)) => {
+            eprintln!("--rounds {r}: takes a count from 1 to 100");
             return false;
         }
     };
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let baseline = value("--baseline").map(std::path::PathBuf::from);
+    if let Some(b) = baseline.as_deref().filter(|b| !b.is_file()) {
+        eprintln!("--baseline {}: no such file", b.display());
+        return false;
+    }
     cargo(&["build", "--release", "-p", "bubbles"])
         && speed_ratio::run(
             &root,

@@ -142,13 +142,19 @@ fn timed(root: &Path, bubbles: &Path, args: &[String]) -> Option<(f64, f64)> {
     eprintln!("$ bubbles {}", args.join(" "));
     let before = children_cpu_s()?;
     let start = Instant::now();
-    let status = Command::new(bubbles)
+    let status = match Command::new(bubbles)
         .args(args)
         .current_dir(root)
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .status()
-        .ok()?;
+    {
+        Ok(status) => status,
+        Err(e) => {
+            eprintln!("cannot run {}: {e}", bubbles.display());
+            return None;
+        }
+    };
     let wall = start.elapsed().as_secs_f64();
     if !status.success() {
         eprintln!("bubbles {} failed: {status}", args.join(" "));
