@@ -22,6 +22,23 @@ fn substrate() -> impl Strategy<Value = Complex64> {
     ]
 }
 
+/// Tolerance on T = 1 for a vanishing film at incidence cosine `c`: the transmission
+/// factors carry the cosine ratio, whose rounding grows as ε/c towards grazing (measured:
+/// |1 − T| ≤ 2.1 ε/c for c < 1e-3 over 400 k random films of this test's ranges), so a
+/// fixed 1e-12 failed at c = 1e-6 (CI, 2026-11-23).
+fn grazing_t_tolerance(c: f64) -> f64 {
+    1e-12 + 8.0 * f64::EPSILON / c
+}
+
+/// The case CI's proptest found: T = 1 − 3.0e-10 at cos θ = 1e-6, within ε/c's rounding.
+#[test]
+fn vanishing_film_at_grazing_incidence_transmits_all_within_rounding() {
+    let c = 1e-6;
+    let resp = film(1.0, 2.2866607251805418, re(1.0), 0.0).response(360.0, c);
+    assert_close("R", resp.r(), 0.0, 1e-14);
+    assert_close("T", resp.t(), 1.0, grazing_t_tolerance(c));
+}
+
 proptest! {
     #![proptest_config(config())]
 
@@ -82,7 +99,7 @@ proptest! {
     ) {
         let resp = film(n0, n1, re(n0), 0.0).response(l, c);
         assert_close("R", resp.r(), 0.0, 1e-14);
-        assert_close("T", resp.t(), 1.0, 1e-12);
+        assert_close("T", resp.t(), 1.0, grazing_t_tolerance(c));
     }
 
     #[test]
