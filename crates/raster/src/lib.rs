@@ -1,9 +1,9 @@
-//! Pure-CPU sorted-triangle blend renderer for thin-film soap bubbles (seed 000 §4).
+//! The CPU sorted-triangle blend renderer for thin-film soap bubbles (seed 000 §4), the
+//! specification the other backends are measured against, with its wgpu port in [`gpu`]
+//! (the `wgpu` cargo feature).
 //!
-//! Knows triangles, textures and blending; takes bubble meshes with per-vertex thickness
-//! and baked [`lut::Lut`] tables. It knows no physics.
-//!
-//! A frame ([`Renderer::render`]):
+//! It draws a [`RenderScene`] (the scene crate, `render_scene`, re-exported here) with
+//! baked [`FilmTables`]. A frame ([`Renderer::render`]):
 //! 1. the opaque scene — [`Environment`], optional [`Ground`] plane, [`Object`]s lit by
 //!    [`Light`]s and by the environment's [`Irradiance`] — rasterised with a depth buffer into an HDR sample buffer;
 //! 2. per bubble, a dynamic [`CubeMap`] of that scene from the bubble's centre
@@ -12,55 +12,26 @@
 //!    `dest = dest ⊙ T(d, cos θ) + R(d, cos θ) ⊙ env(reflect) + Σ light highlights`;
 //! 4. samples averaged into a linear [`Frame`], written as tone-mapped PNG or EXR.
 //!
-//! Rasterisation uses fixed-point edge functions with a top-left fill rule, near-plane
+//! Rasterisation (`raster`) uses fixed-point edge functions with a top-left fill rule, near-plane
 //! and guard-band clipping, and perspective-correct attributes. Rows are split into
-//! strips rendered in parallel with rayon; output is bit-identical at any thread count.
-//! A GPU backend could sit behind a cargo feature and reuse the scene types unchanged.
+//! strips (`strip`) rendered in parallel with rayon by the passes (`passes`); output is
+//! bit-identical at any thread count. What each pixel must equal (shading, LUT and cube-map
+//! sampling, highlights, tone curve) lives in the scene crate, shared with [`gpu`].
 
 #![warn(missing_docs)]
 
-mod camera;
-mod cubemap;
-mod environment;
-mod error;
-mod frame;
-#[cfg(feature = "wgpu")]
 pub mod gpu;
-mod ground;
-mod index_f32;
-mod irradiance;
-mod lod;
-mod lut_sampler;
-mod mesh;
-mod obj;
 mod passes;
 mod raster;
-pub mod reference;
 mod renderer;
-mod scene;
-mod settings;
-mod shading;
-mod sky_span;
-mod spheremap;
-mod texture;
-mod water;
-mod water_pass;
+mod strip;
 
-pub use camera::{Camera, DEFAULT_NEAR_M};
-pub use cubemap::{CubeMap, MAX_FACE_SIZE};
-pub use environment::{Environment, Sky};
-pub use error::RenderError;
-pub use frame::{Frame, FrameTimings, linear_to_srgb, tone_map};
-pub use glam::{Mat3, Vec3};
-pub use irradiance::Irradiance;
-pub use lut::Lut;
-pub use mesh::TriMesh;
 pub use renderer::Renderer;
-pub use scene::{BubbleMesh, FilmTables, Ground, Light, Material, Object, Pattern, RenderScene};
-pub use settings::{
-    MAX_IMAGE_SIDE, PartialShading, ReflectionFilter, ReflectionMode, RenderSettings,
-    SAMPLE_COUNTS, ToneMap,
+
+pub use render_scene::{
+    BubbleMesh, Camera, CubeMap, DEFAULT_NEAR_M, Environment, FilmTables, Frame, FrameTimings,
+    Ground, Irradiance, Light, Lut, MAX_FACE_SIZE, MAX_IMAGE_SIDE, Mat3, Material, Object,
+    PartialShading, Pattern, ReflectionFilter, ReflectionMode, RenderError, RenderScene,
+    RenderSettings, SAMPLE_COUNTS, Sky, SphereMap, Texture, ToneMap, TriMesh, Vec3, WATER_IOR,
+    WaterSurface, linear_to_srgb, refract, sphere_map_direction, sphere_map_uv, tone_map,
 };
-pub use spheremap::SphereMap;
-pub use texture::Texture;
-pub use water::{WATER_IOR, WaterSurface, refract, sphere_map_direction, sphere_map_uv};

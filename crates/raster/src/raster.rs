@@ -2,13 +2,12 @@
 //! fixed-point edge functions with the top-left fill rule, sample patterns, and the
 //! screen-space planes that give perspective-correct attributes.
 
-use crate::camera::View;
+use glam::Vec3;
+use render_scene::camera::View;
+use render_scene::tessellate::{ATTRS, Geometry};
 
 /// Sub-pixel precision of snapped vertices: 1/256 pixel.
 pub(crate) const SUBPIXEL: i64 = 256;
-
-/// Interpolated attributes per vertex (normal xyz, then two more: uv or thickness).
-pub(crate) const ATTRS: usize = 5;
 
 /// A vertex in clip space: `x`, `y` scaled by the field of view, `w` the view depth.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -471,11 +470,31 @@ fn reachable(
     (x0 + lo as i32, x0 + hi as i32)
 }
 
+/// World-space point `p` with attributes `attrs` in `view`'s clip space.
+pub(crate) fn clip_vertex(view: &View, p: Vec3, attrs: [f32; ATTRS]) -> ClipVertex {
+    let [x, y, w] = view.clip(p);
+    ClipVertex { x, y, w, attrs }
+}
+
+/// Clips and sets up every triangle of `geometry` for `view`, appending to `out` in order.
+pub(crate) fn setup_geometry(geometry: &Geometry, view: &View, out: &mut Vec<SetupTri>) {
+    for (t, &tag) in geometry.triangles.iter().zip(&geometry.tags) {
+        let tri = t.map(|i| {
+            clip_vertex(
+                view,
+                geometry.positions[i as usize],
+                geometry.attrs[i as usize],
+            )
+        });
+        setup_triangle(view, tri, tag, 0.0, |s| out.push(s));
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Camera;
     use glam::Vec3;
+    use render_scene::Camera;
 
     fn screen_view(w: usize, h: usize) -> View {
         Camera::look_at(Vec3::ZERO, -Vec3::Z, Vec3::Y, 90.0).view(w, h)

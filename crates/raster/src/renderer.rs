@@ -3,71 +3,24 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
-use crate::lut_sampler::LutSampler;
 use glam::Vec3;
 use rayon::prelude::*;
-
-use crate::camera::View;
-use crate::cubemap::FACE_BASES;
-use crate::passes::{Bins, BubbleCtx, EMISSIVE, GroundView, OpaqueCtx, Reflection, STRIP_ROWS};
-use crate::raster::{ATTRS, ClipVertex, SamplePattern, SetupTri, setup_triangle};
-use crate::water_pass::{WaterPass, setup_water};
-use crate::{
-    BubbleMesh, CubeMap, Environment, FilmTables, Frame, Material, Object, PartialShading,
-    ReflectionFilter, ReflectionMode, RenderError, RenderScene, RenderSettings, TriMesh,
+use render_scene::camera::View;
+use render_scene::cubemap::FACE_BASES;
+use render_scene::ground_view::GroundView;
+use render_scene::lut_sampler::LutSampler;
+use render_scene::reflection::Reflection;
+use render_scene::tessellate::{Geometry, tessellate};
+use render_scene::{
+    BubbleMesh, CubeMap, Environment, FilmTables, Frame, FrameTimings, Material, PartialShading,
+    ReflectionFilter, ReflectionMode, RenderError, RenderScene, RenderSettings,
 };
 
-/// Slices and stacks of a tessellated [`Object::Sphere`].
-const SPHERE_SEGMENTS: (usize, usize) = (48, 24);
-/// Slices and stacks of a drawn light sphere.
-const LIGHT_SEGMENTS: (usize, usize) = (16, 8);
-
-/// World-space opaque triangles with a material tag each.
-#[derive(Debug, Clone, Default)]
-pub(crate) struct Geometry {
-    pub positions: Vec<Vec3>,
-    /// Per vertex: normal x, y, z and texture u, v.
-    pub attrs: Vec<[f32; ATTRS]>,
-    pub triangles: Vec<[u32; 3]>,
-    /// Per triangle: the material index, or [`EMISSIVE`] with a light's index.
-    pub tags: Vec<u32>,
-}
-
-impl Geometry {
-    fn clear(&mut self) {
-        self.positions.clear();
-        self.attrs.clear();
-        self.triangles.clear();
-        self.tags.clear();
-    }
-
-    fn push(&mut self, mesh: &TriMesh, tag: u32) {
-        let base = self.positions.len() as u32;
-        self.positions.extend_from_slice(&mesh.positions);
-        for (k, n) in mesh.normals.iter().enumerate() {
-            let uv = mesh.uvs.get(k).copied().unwrap_or([0.0; 2]);
-            self.attrs.push([n.x, n.y, n.z, uv[0], uv[1]]);
-        }
-        for t in &mesh.triangles {
-            self.triangles.push(t.map(|i| i + base));
-            self.tags.push(tag);
-        }
-    }
-
-    /// Clips and sets up every triangle for `view`, appending to `out` in order.
-    fn setup(&self, view: &View, out: &mut Vec<SetupTri>) {
-        for (t, &tag) in self.triangles.iter().zip(&self.tags) {
-            let tri =
-                t.map(|i| clip_vertex(view, self.positions[i as usize], self.attrs[i as usize]));
-            setup_triangle(view, tri, tag, 0.0, |s| out.push(s));
-        }
-    }
-}
-
-fn clip_vertex(view: &View, p: Vec3, attrs: [f32; ATTRS]) -> ClipVertex {
-    let [x, y, w] = view.clip(p);
-    ClipVertex { x, y, w, attrs }
-}
+use crate::passes::bubble::{BubbleCtx, setup_bubble_tris};
+use crate::passes::opaque::OpaqueCtx;
+use crate::passes::water::{WaterPass, setup_water};
+use crate::raster::{SamplePattern, SetupTri, setup_geometry};
+use crate::strip::{Bins, STRIP_ROWS};
 
 /// Per cube face: its triangles and depth buffer, reused across frames.
 #[derive(Debug, Clone, Default)]
@@ -143,7 +96,8 @@ impl Renderer {
         settings: &RenderSettings,
     ) -> Result<&Frame, RenderError> {
         settings.validate()?;
-        scene.validate(tables)?;
+        scene.validate()?;
+        tables.validate_for(scene)?;
         let start = Instant::now();
         let view = scene.camera.view(settings.width, settings.height);
         let pattern = SamplePattern::new(settings.samples);
@@ -151,9 +105,9 @@ impl Renderer {
         let strips = settings.height.div_ceil(STRIP_ROWS);
 
         self.opaque_tris.clear();
-        self.objects.setup(&view, &mut self.opaque_tris);
+        setup_geometry(&self.objects, &view, &mut self.opaque_tris);
         if settings.draw_lights {
-            self.light_spheres.setup(&view, &mut self.opaque_tris);
+            setup_geometry(&self.light_spheres, &view, &mut self.opaque_tris);
         }
         if let Some(w) = &scene.water {
             setup_water(w, &view, &mut self.opaque_tris);
@@ -227,9 +181,9 @@ impl Renderer {
                 let env_cube = self.env_cube.as_ref().map(|(_, c)| c);
                 let (objects, lights) = (&self.objects, &self.light_spheres);
                 let setup = |v: &View, out: &mut Vec<SetupTri>| {
-                    objects.setup(v, out);
+                    setup_geometry(objects, v, out);
                     if settings.draw_lights {
-                        lights.setup(v, out);
+                        setup_geometry(lights, v, out);
                     }
                 };
                 let pass = &mut self.water;
@@ -243,14 +197,11 @@ impl Renderer {
             .as_ref()
             .map(|w| water_pass.shading(w, scene, settings));
         let (w, h) = (settings.width, settings.height);
-        self.frame.width = w;
-        self.frame.height = h;
-        self.frame.rgb.resize(w * h, [0.0; 3]);
         let phase_ns = [(); 3].map(|_| AtomicU64::new(0));
         // Each strip runs opaque → bubbles → resolve on a per-thread sample buffer, so its
         // samples stay in cache and never travel to memory.
         self.frame
-            .rgb
+            .resize_pixels(w, h)
             .par_chunks_mut(STRIP_ROWS * w)
             .enumerate()
             .for_each(|(s, out)| {
@@ -276,7 +227,7 @@ impl Renderer {
         let cpu = phase_ns.map(|a| a.into_inner() as f64);
         let total: f64 = cpu.iter().sum::<f64>().max(1.0);
         let [opaque_s, bubbles_s, resolve_s] = cpu.map(|c| wall_s * c / total);
-        self.frame.timings = crate::FrameTimings {
+        self.frame.timings = FrameTimings {
             setup_s,
             cube_maps_s,
             opaque_s,
@@ -332,7 +283,7 @@ impl Renderer {
                 scene.camera.near_m(),
             );
             scratch.tris.clear();
-            objects.setup(&view, &mut scratch.tris);
+            setup_geometry(objects, &view, &mut scratch.tris);
             let strips = m.div_ceil(STRIP_ROWS);
             scratch.bins.build(&scratch.tris, strips);
             scratch.depth.resize(m * m, 0.0);
@@ -382,38 +333,6 @@ impl Renderer {
     }
 }
 
-/// Sets up bubble triangles: bubbles far to near, each bubble's back faces then front faces.
-pub(crate) fn setup_bubble_tris(scene: &RenderScene, view: &View, out: &mut Vec<SetupTri>) {
-    for k in far_to_near(&scene.bubbles, view.eye) {
-        let bubble = &scene.bubbles[k];
-        for front in [false, true] {
-            for t in &bubble.triangles {
-                if is_front_facing(bubble, *t, view.eye) == front {
-                    let tri = t.map(|i| {
-                        let i = i as usize;
-                        let n = bubble.normals[i];
-                        clip_vertex(
-                            view,
-                            bubble.positions[i],
-                            [n.x, n.y, n.z, bubble.thickness_nm[i], 0.0],
-                        )
-                    });
-                    let extra = reflection_rate(view, bubble, *t);
-                    // One surface per bubble and facing: the back layer, then the front.
-                    let surface = 2 * k as u32 + u32::from(front);
-                    setup_triangle(view, tri, k as u32, extra, |s| {
-                        out.push(SetupTri {
-                            surface,
-                            mesh_vertices: *t,
-                            ..s
-                        });
-                    });
-                }
-            }
-        }
-    }
-}
-
 thread_local! {
     /// Per-thread sample colour and depth of the strip being rendered, reused across frames.
     static STRIP_SCRATCH: std::cell::RefCell<(Vec<[f32; 3]>, Vec<f32>)> =
@@ -431,217 +350,5 @@ fn resolve(out: &mut [[f32; 3]], color: &[[f32; 3]], samples: usize) {
             }
         }
         *o = sum.map(|s| s * scale);
-    }
-}
-
-/// Fills `objects` and `light_spheres` with the scene's world-space triangles (both
-/// backends draw these same triangles); returns the material table `objects`' tags index.
-pub(crate) fn tessellate<'s>(
-    scene: &'s RenderScene,
-    objects: &mut Geometry,
-    light_spheres: &mut Geometry,
-) -> Vec<&'s Material> {
-    objects.clear();
-    light_spheres.clear();
-    let mut materials = Vec::with_capacity(scene.objects.len());
-    for (k, object) in scene.objects.iter().enumerate() {
-        materials.push(object.material());
-        let tag = k as u32;
-        match object {
-            Object::Sphere {
-                center, radius_m, ..
-            } => {
-                let (s, r) = SPHERE_SEGMENTS;
-                objects.push(&TriMesh::uv_sphere(*center, *radius_m, s, r), tag);
-            }
-            Object::Box {
-                center,
-                half_extents_m,
-                ..
-            } => objects.push(&TriMesh::cuboid(*center, *half_extents_m), tag),
-            Object::Mesh { mesh, .. } => objects.push(mesh, tag),
-        }
-    }
-    for (k, light) in scene.lights.iter().enumerate() {
-        let (s, r) = LIGHT_SEGMENTS;
-        let mesh = TriMesh::uv_sphere(light.position, light.radius_m, s, r);
-        light_spheres.push(&mesh, EMISSIVE | k as u32);
-    }
-    materials
-}
-
-/// Bubble indices in drawing order, far to near, by the power distance `|c − e|² − r²` of
-/// each bubble's sphere (centre `c`, `r²` the mean squared vertex distance from it) to the
-/// eye `e`: for non-overlapping spheres, a sphere in front of another along any ray has
-/// the smaller power distance, whatever their sizes (the centre distance alone is not).
-pub(crate) fn far_to_near(bubbles: &[BubbleMesh], eye: Vec3) -> Vec<usize> {
-    let mut order: Vec<(f64, usize)> = bubbles
-        .iter()
-        .enumerate()
-        .map(|(k, b)| {
-            let c = b.center().as_dvec3();
-            let r2 = b
-                .positions
-                .iter()
-                .map(|p| (p.as_dvec3() - c).length_squared())
-                .sum::<f64>()
-                / b.positions.len().max(1) as f64;
-            ((c - eye.as_dvec3()).length_squared() - r2, k)
-        })
-        .collect();
-    // Stable, far first; NaN-free because the scene was validated.
-    order.sort_by(|a, b| b.0.total_cmp(&a.0));
-    order.into_iter().map(|(_, k)| k).collect()
-}
-
-/// Whether triangle `t` faces the eye, its outward side taken from the vertex normals
-/// (so the mesh's winding does not matter).
-pub(crate) fn is_front_facing(bubble: &BubbleMesh, t: [u32; 3], eye: Vec3) -> bool {
-    let [a, b, c] = t.map(|i| bubble.positions[i as usize]);
-    let geometric = (b - a).cross(c - a);
-    let normals: Vec3 = t.iter().map(|&i| bubble.normals[i as usize]).sum();
-    let outward = if geometric.dot(normals) < 0.0 {
-        -geometric
-    } else {
-        geometric
-    };
-    outward.dot(eye - a) > 0.0
-}
-
-/// Angle swept by the reflected direction per pixel across triangle `t` (radians), for
-/// anti-aliasing light highlights; clamped to `[1e-4, 0.5]`.
-pub(crate) fn reflection_rate(view: &View, bubble: &BubbleMesh, t: [u32; 3]) -> f32 {
-    let mut reflected = [Vec3::ZERO; 3];
-    let mut pixels = [(0.0f32, 0.0f32); 3];
-    for (k, &i) in t.iter().enumerate() {
-        let p = bubble.positions[i as usize];
-        let [x, y, w] = view.clip(p);
-        if w <= view.near_m {
-            return 0.5;
-        }
-        pixels[k] = view.pixel_of_clip(x, y, w);
-        let v = (p - view.eye).normalize_or_zero();
-        let mut n = bubble.normals[i as usize].normalize_or_zero();
-        if v.dot(n) > 0.0 {
-            n = -n;
-        }
-        reflected[k] = v - n * (2.0 * v.dot(n));
-    }
-    let mut rate = 1e-4f32;
-    for k in 0..3 {
-        let j = (k + 1) % 3;
-        let (dx, dy) = (pixels[j].0 - pixels[k].0, pixels[j].1 - pixels[k].1);
-        let len_px = (dx * dx + dy * dy).sqrt();
-        if len_px > 1e-3 {
-            rate = rate.max((reflected[j] - reflected[k]).length() / len_px);
-        }
-    }
-    if rate.is_finite() { rate.min(0.5) } else { 0.5 }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use proptest::prelude::*;
-
-    /// An icosahedron inscribed in the sphere: its vertex mean is the centre exactly.
-    fn icosahedron(center: Vec3, radius_m: f32) -> BubbleMesh {
-        let phi = (1.0 + 5f32.sqrt()) / 2.0;
-        let mut positions = Vec::new();
-        for (a, b) in [(1.0, phi), (-1.0, phi), (1.0, -phi), (-1.0, -phi)] {
-            for v in [
-                Vec3::new(0.0, a, b),
-                Vec3::new(a, b, 0.0),
-                Vec3::new(b, 0.0, a),
-            ] {
-                positions.push(center + v.normalize() * radius_m);
-            }
-        }
-        let normals = positions.iter().map(|p| *p - center).collect();
-        BubbleMesh {
-            thickness_nm: vec![500.0; positions.len()],
-            positions,
-            normals,
-            triangles: Vec::new(),
-        }
-    }
-
-    /// Distance along unit `dir` from the origin to where it enters the sphere, if it does.
-    fn entry(dir: Vec3, center: Vec3, radius_m: f32) -> Option<f32> {
-        let b = dir.dot(center);
-        let h2 = center.length_squared() - b * b;
-        let t = b - (radius_m * radius_m - h2).sqrt();
-        (h2 < radius_m * radius_m && t > 0.0).then_some(t)
-    }
-
-    #[test]
-    fn large_bubble_in_front_of_a_small_one_with_a_nearer_centre_is_drawn_last() {
-        // The large bubble's centre (1.2 m) is farther than the small one's (1.19 m), yet
-        // along the ray at 56° the large one spans 0.57–0.77 m and the small one starts at
-        // 1.09 m: sorting by centre distance drew the large one first.
-        let large = (Vec3::new(0.0, 0.0, -1.2), 1.0);
-        let a = 56f32.to_radians();
-        let small = (Vec3::new(a.sin(), 0.0, -a.cos()) * 1.19, 0.1);
-        assert!(
-            large.0.distance(small.0) > large.1 + small.1,
-            "they overlap"
-        );
-        let ray = Vec3::new(a.sin(), 0.0, -a.cos());
-        assert!(entry(ray, large.0, large.1).unwrap() < entry(ray, small.0, small.1).unwrap());
-        let bubbles = [icosahedron(large.0, large.1), icosahedron(small.0, small.1)];
-        assert_eq!(far_to_near(&bubbles, Vec3::ZERO), vec![1, 0]);
-    }
-
-    proptest! {
-        #[test]
-        fn a_bubble_in_front_along_any_ray_is_drawn_later(
-            c0 in prop::array::uniform3(-3.0f32..3.0),
-            c1 in prop::array::uniform3(-3.0f32..3.0),
-            r0 in 0.05f32..1.5,
-            r1 in 0.05f32..1.5,
-            t in 0.0f32..1.0,
-        ) {
-            let (c0, c1) = (Vec3::from(c0), Vec3::from(c1));
-            // Non-overlapping spheres, the eye (origin) outside both.
-            prop_assume!(c0.distance(c1) > (r0 + r1) * 1.001);
-            prop_assume!(c0.length() > r0 * 1.001 && c1.length() > r1 * 1.001);
-            // A ray through a point between the two centres often hits both.
-            let dir = c0.lerp(c1, t).normalize();
-            if let (Some(e0), Some(e1)) = (entry(dir, c0, r0), entry(dir, c1, r1)) {
-                prop_assume!((e0 - e1).abs() > 1e-3);
-                let order = far_to_near(&[icosahedron(c0, r0), icosahedron(c1, r1)], Vec3::ZERO);
-                let nearer = if e0 < e1 { 0 } else { 1 };
-                prop_assert_eq!(order[1], nearer, "entries {} and {}", e0, e1);
-            }
-        }
-
-        #[test]
-        fn a_small_bubble_behind_the_rim_of_a_large_one_is_drawn_first(
-            radius_m in 0.5f32..2.0,
-            distance in 1.05f32..3.0,
-            small in 0.02f32..0.3,
-            angle_offset in -0.15f32..0.15,
-            depth in 0.85f32..1.05,
-            aim in prop::array::uniform2(-1.0f32..1.0),
-        ) {
-            // Where centre distance fails: a small bubble about as far as the large one's
-            // centre, seen just inside the large one's silhouette.
-            let c0 = Vec3::new(0.0, 0.0, -radius_m * distance);
-            let r1 = small * radius_m;
-            let theta = (1.0 / distance).asin() + angle_offset;
-            let c1 = Vec3::new(theta.sin(), 0.0, -theta.cos()) * (c0.length() * depth);
-            if c0.distance(c1) <= (radius_m + r1) * 1.001 || c1.length() <= r1 * 1.001 {
-                return Ok(());
-            }
-            let dir = (c1 + Vec3::new(aim[0], aim[1], 0.0) * r1).normalize();
-            if let (Some(e0), Some(e1)) = (entry(dir, c0, radius_m), entry(dir, c1, r1)) {
-                let order = far_to_near(
-                    &[icosahedron(c0, radius_m), icosahedron(c1, r1)],
-                    Vec3::ZERO,
-                );
-                let nearer = if e0 < e1 { 0 } else { 1 };
-                prop_assert_eq!(order[1], nearer, "entries {} and {}", e0, e1);
-            }
-        }
     }
 }

@@ -135,7 +135,7 @@ pub struct FrameJob {
     /// The wgpu renderer when `--backend wgpu`.
     gpu: Option<gpu::GpuBackend>,
     /// The film for the reference backend; `None` for the CPU backend.
-    film_spec: Option<raster::reference::FilmSpec>,
+    film_spec: Option<reference_tracer::FilmSpec>,
     reference: reference::ReferenceOptions,
     reference_frame: Frame,
     /// The water's geometry, evaluated at the solver's time each frame.

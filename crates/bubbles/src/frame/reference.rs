@@ -2,8 +2,8 @@
 //! its own options and a progress bar with an ETA.
 
 use crate::error::CliError;
-use raster::reference::{FilmSpec, ReferenceSettings, Reflections, render_reference};
 use raster::{Frame, RenderScene, RenderSettings};
+use reference_tracer::{FilmSpec, ReferenceSettings, Reflections, render_reference};
 
 /// Options of the reference backend (ignored by the CPU backend).
 #[derive(Debug, Clone, clap::Args)]

@@ -1,9 +1,9 @@
-//! Scene → the reference tracer's [`raster::reference::FilmSpec`]: the film, the
+//! Scene → the reference tracer's [`reference_tracer::FilmSpec`]: the film, the
 //! reference illuminant and each light's own spectrum, as the LUT bake sees them.
 
 use super::Scene;
 use crate::error::CliError;
-use raster::reference::FilmSpec;
+use reference_tracer::FilmSpec;
 
 /// The medium around the bubbles: the LUT bakes against air.
 const N_AIR: f64 = 1.0;

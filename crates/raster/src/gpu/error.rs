@@ -1,5 +1,8 @@
 //! [`GpuError`]: why the wgpu backend could not start or finish a frame.
 
+// Without the `wgpu` feature only the naga layout test uses this module.
+#![cfg_attr(not(feature = "wgpu"), allow(dead_code))]
+
 use std::fmt;
 
 /// Why the wgpu backend failed.
@@ -22,7 +25,7 @@ pub enum GpuError {
     /// Mapping the read-back buffer failed.
     Readback(String),
     /// The scene or settings are invalid (the same check as the CPU backend's).
-    Invalid(crate::RenderError),
+    Invalid(render_scene::RenderError),
     /// The scene uses something the wgpu backend does not draw (named).
     Unsupported(String),
 }
@@ -54,8 +57,8 @@ impl fmt::Display for GpuError {
 
 impl std::error::Error for GpuError {}
 
-impl From<crate::RenderError> for GpuError {
-    fn from(e: crate::RenderError) -> Self {
+impl From<render_scene::RenderError> for GpuError {
+    fn from(e: render_scene::RenderError) -> Self {
         GpuError::Invalid(e)
     }
 }

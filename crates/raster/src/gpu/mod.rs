@@ -1,4 +1,4 @@
-//! The wgpu backend (cargo feature `wgpu`): [`GpuRenderer`] draws a [`crate::RenderScene`]
+//! The wgpu backend (cargo feature `wgpu`): `GpuRenderer` draws a [`render_scene::RenderScene`]
 //! headless, as seed 000 §4.4 on the GPU: per-bubble dynamic cube maps, the opaque scene
 //! with a depth buffer into a multisampled linear HDR target, bubbles sorted far to near
 //! (back faces, then front faces) in a multiplicative and an additive blend pass, then
@@ -7,16 +7,30 @@
 //! The CPU backend is the specification: every shader function names the Rust function it
 //! ports. Constants the two must share (tone curve, sRGB encoding, highlight filter, tag
 //! bits) are injected into the WGSL from the Rust constants, never retyped; see
-//! `shader_source`. Sorting, side classification and tessellation reuse the CPU's Rust.
+//! `shader_source`. Sorting, side classification and tessellation come from the scene crate
+//! (`render_scene::bubble_order`, `render_scene::tessellate`), as the CPU renderer's do.
+//!
+//! **Invariant:** this module imports the scene crate and never the CPU renderer's modules
+//! (`tests/layout.rs` checks it). Its pure-CPU half (`scene_data`, `shader_source`, `error`)
+//! compiles without the feature, so `cargo test` checks the generated WGSL with naga and
+//! the packed struct sizes against it without a GPU or wgpu.
 
+#[cfg(feature = "wgpu")]
 mod context;
 mod error;
+#[cfg(test)]
+mod naga_layout;
+#[cfg(feature = "wgpu")]
 mod pipelines;
+#[cfg(feature = "wgpu")]
 mod renderer;
 mod scene_data;
 mod shader_source;
+#[cfg(feature = "wgpu")]
 mod tonemap;
 
+#[cfg(feature = "wgpu")]
 pub use context::{Gpu, GpuOptions};
 pub use error::GpuError;
+#[cfg(feature = "wgpu")]
 pub use renderer::GpuRenderer;

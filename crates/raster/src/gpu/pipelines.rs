@@ -1,7 +1,7 @@
 //! The scene passes' bind group layouts and render pipelines (one set per sample count).
 
 use super::scene_data::{BUBBLE_VERTEX_BYTES, OBJECT_VERTEX_BYTES, VIEW_BYTES};
-use super::shader_source::with_shared_constants;
+use super::shader_source::scene_wgsl;
 
 /// Colour format of the HDR targets (frame and cube faces): blendable and resolvable.
 pub(super) const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -124,9 +124,7 @@ impl Layouts {
         let bubbles = pipeline_layout(&[Some(&view), Some(&scene), Some(&bubble)]);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("scene"),
-            source: wgpu::ShaderSource::Wgsl(
-                with_shared_constants(include_str!("scene.wgsl")).into(),
-            ),
+            source: wgpu::ShaderSource::Wgsl(scene_wgsl().into()),
         });
         let mips = pipeline_layout(&[None, Some(&scene), None, Some(&mip)]);
         let compute_pipeline = |entry| {

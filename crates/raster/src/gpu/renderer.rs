@@ -7,10 +7,10 @@ use wgpu::util::DeviceExt;
 use super::pipelines::{DEPTH_FORMAT, HDR_FORMAT, Layouts, Pipelines};
 use super::scene_data::{SceneData, VIEW_BYTES, check_supported, ground_triangles, view_bytes};
 use super::{Gpu, GpuError, GpuOptions};
-use crate::camera::View;
-use crate::cubemap::FACE_BASES;
-use crate::passes::GroundView;
-use crate::{
+use render_scene::camera::View;
+use render_scene::cubemap::FACE_BASES;
+use render_scene::ground_view::GroundView;
+use render_scene::{
     BubbleMesh, CubeMap, FilmTables, Frame, FrameTimings, ReflectionFilter, ReflectionMode,
     RenderScene, RenderSettings,
 };
@@ -88,12 +88,10 @@ impl GpuRenderer {
         let setup_s = start.elapsed().as_secs_f64();
         let t = Instant::now();
         let texels = self.gpu.read_back(encoder, &resolved, size, 8)?;
-        self.frame.width = settings.width;
-        self.frame.height = settings.height;
-        self.frame.rgb.clear();
-        self.frame.rgb.extend(texels.chunks_exact(8).map(|p| {
-            std::array::from_fn(|k| f16_to_f32(u16::from_le_bytes([p[2 * k], p[2 * k + 1]])))
-        }));
+        let rgb = self.frame.resize_pixels(settings.width, settings.height);
+        for (px, p) in rgb.iter_mut().zip(texels.chunks_exact(8)) {
+            *px = std::array::from_fn(|k| f16_to_f32(u16::from_le_bytes([p[2 * k], p[2 * k + 1]])));
+        }
         self.frame.timings = FrameTimings {
             setup_s,
             resolve_s: t.elapsed().as_secs_f64(),
@@ -124,7 +122,8 @@ impl GpuRenderer {
         settings: &RenderSettings,
     ) -> Result<(wgpu::CommandEncoder, wgpu::Texture, wgpu::Extent3d), GpuError> {
         settings.validate()?;
-        scene.validate(tables)?;
+        scene.validate()?;
+        tables.validate_for(scene)?;
         check_supported(scene, settings)?;
         let (w, h) = (settings.width as u32, settings.height as u32);
         self.gpu.check_size(w, h)?;

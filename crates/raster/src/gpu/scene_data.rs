@@ -1,15 +1,19 @@
 //! The scene as the shaders read it: uniform and storage buffer bytes laid out as the
 //! structs of `scene.wgsl`, vertex streams, and the stacked LUT texture. Pure CPU code.
 
+// Without the `wgpu` feature only the naga layout test uses this module.
+#![cfg_attr(not(feature = "wgpu"), allow(dead_code))]
+
 use glam::Vec3;
 
 use super::GpuError;
-use crate::camera::View;
-use crate::passes::GroundView;
-use crate::renderer::{Geometry, far_to_near, is_front_facing, reflection_rate, tessellate};
-use crate::{
+use render_scene::bubble_order::{far_to_near, is_front_facing, reflection_rate};
+use render_scene::camera::View;
+use render_scene::ground_view::GroundView;
+use render_scene::tessellate::{Geometry, tessellate};
+use render_scene::{
     Environment, FilmTables, Light, Material, Pattern, ReflectionFilter, ReflectionMode,
-    RenderScene, RenderSettings,
+    RenderScene, RenderSettings, Sky,
 };
 
 /// `Material.specular.w` of a solid albedo.
@@ -25,7 +29,7 @@ pub(super) const REFLECTION_CUBE: u32 = 0;
 /// `Scene.reflection` of the static environment.
 pub(super) const REFLECTION_ENVIRONMENT: u32 = 1;
 /// `Scene.reflection` of dynamic cube maps read with one bilinear tap
-/// ([`crate::ReflectionFilter::Bilinear`]).
+/// ([`ReflectionFilter::Bilinear`]).
 pub(super) const REFLECTION_CUBE_BILINEAR: u32 = 2;
 /// `Scene.transmittance_table` when `T = 1 − R`.
 pub(super) const NO_TABLE: u32 = u32::MAX;
@@ -260,10 +264,10 @@ fn scene_bytes(
         b.vec4(*c, 0.0);
     }
     let (env_kind, sky, uniform) = match &scene.environment {
-        Environment::Uniform(rgb) => (ENV_UNIFORM, crate::Sky::default(), *rgb),
+        Environment::Uniform(rgb) => (ENV_UNIFORM, Sky::default(), *rgb),
         Environment::Sky(sky) => (ENV_SKY, *sky, [0.0; 3]),
         // check_supported refused the others.
-        _ => (ENV_UNIFORM, crate::Sky::default(), [0.0; 3]),
+        _ => (ENV_UNIFORM, Sky::default(), [0.0; 3]),
     };
     b.u32(env_kind).u32(scene.lights.len() as u32);
     b.u32(match (reflection, filter) {

@@ -2,16 +2,27 @@
 //! backends share one source of truth: a shader names `{{SHARED_CONSTANTS}}` where the
 //! generated block goes.
 
+// Without the `wgpu` feature only the naga layout test uses this module.
+#![cfg_attr(not(feature = "wgpu"), allow(dead_code))]
+
 use super::scene_data::{
     ENV_SKY, ENV_UNIFORM, NO_TABLE, PATTERN_CHECKER, PATTERN_SOLID, REFLECTION_CUBE,
     REFLECTION_CUBE_BILINEAR, REFLECTION_ENVIRONMENT,
 };
-use crate::cubemap::FACE_BASES;
-use crate::frame::{
-    ACES_DENOMINATOR, ACES_FROM_SRGB, ACES_INPUT_MAX, ACES_NUMERATOR, SRGB_FROM_ACES, SRGB_GAMMA,
-    SRGB_LINEAR_MAX, SRGB_LINEAR_SLOPE, SRGB_OFFSET, SRGB_SCALE,
+use render_scene::shader_constants::{
+    ACES_DENOMINATOR, ACES_NUMERATOR, FACE_BASES, SCENE_SCALARS, SCENE_WORDS, TONE_MATRICES,
+    TONE_SCALARS,
 };
-use crate::lod::{LOD_BIAS, MAX_ANISOTROPY, MIN_FOOTPRINT_TEXELS};
+
+/// The scene shader (`scene.wgsl`) with the shared constants in place.
+pub(super) fn scene_wgsl() -> String {
+    with_shared_constants(include_str!("scene.wgsl"))
+}
+
+/// The tone-map shader (`tonemap.wgsl`) with the shared constants in place.
+pub(super) fn tonemap_wgsl() -> String {
+    with_shared_constants(include_str!("tonemap.wgsl"))
+}
 
 /// The marker a WGSL source puts where the shared constants go.
 const MARKER: &str = "{{SHARED_CONSTANTS}}";
@@ -27,11 +38,10 @@ pub(super) fn with_shared_constants(source: &str) -> String {
 
 /// The WGSL declarations of every constant the CPU backend shares with the shaders.
 pub(super) fn shared_constants() -> String {
-    let mut out = String::from("// Generated from raster's Rust constants: do not edit.\n");
-    for (name, rows) in [
-        ("ACES_FROM_SRGB", ACES_FROM_SRGB),
-        ("SRGB_FROM_ACES", SRGB_FROM_ACES),
-    ] {
+    let mut out = String::from(
+        "// Generated from render_scene::shader_constants and scene_data: do not edit.\n",
+    );
+    for (name, rows) in TONE_MATRICES {
         for (k, row) in rows.iter().enumerate() {
             out += &format!("const {name}_ROW{k} = {};\n", vec3(row));
         }
@@ -42,44 +52,33 @@ pub(super) fn shared_constants() -> String {
         float(ACES_NUMERATOR[1])
     );
     out += &format!("const ACES_DENOMINATOR = {};\n", vec3(&ACES_DENOMINATOR));
-    for (name, value) in [
-        ("ACES_INPUT_MAX", ACES_INPUT_MAX),
-        ("SRGB_LINEAR_MAX", SRGB_LINEAR_MAX),
-        ("SRGB_LINEAR_SLOPE", SRGB_LINEAR_SLOPE),
-        ("SRGB_SCALE", SRGB_SCALE),
-        ("SRGB_OFFSET", SRGB_OFFSET),
-        ("SRGB_GAMMA", SRGB_GAMMA),
-    ] {
+    for (name, value) in TONE_SCALARS {
         out += &format!("const {name}: f32 = {};\n", float(value));
     }
     out + &scene_constants()
 }
 
-/// The scene passes' constants: the CPU's highlight filter width and emissive tag bit, and
-/// the encodings `scene_data` packs the uniforms with.
+/// The scene passes' constants: the CPU's (`render_scene::shader_constants`) and the
+/// encodings `scene_data` packs the uniforms with.
 fn scene_constants() -> String {
     let mut out = String::new();
-    for (name, value) in [
-        ("HIGHLIGHT_SIGMA_PX", crate::passes::HIGHLIGHT_SIGMA_PX),
+    let packing_scalars = [
         ("PI", std::f32::consts::PI),
         ("PATTERN_SOLID", PATTERN_SOLID),
         ("PATTERN_CHECKER", PATTERN_CHECKER),
-        ("FLAT_FOOTPRINT_CELLS", crate::shading::FLAT_FOOTPRINT_CELLS),
-        ("LOD_BIAS", LOD_BIAS),
-        ("MIN_FOOTPRINT_TEXELS", MIN_FOOTPRINT_TEXELS),
-    ] {
+    ];
+    for (name, value) in SCENE_SCALARS.into_iter().chain(packing_scalars) {
         out += &format!("const {name}: f32 = {};\n", float(value));
     }
-    for (name, value) in [
-        ("EMISSIVE", crate::passes::EMISSIVE),
+    let packing_words = [
         ("ENV_SKY", ENV_SKY),
         ("ENV_UNIFORM", ENV_UNIFORM),
         ("REFLECTION_CUBE", REFLECTION_CUBE),
         ("REFLECTION_ENVIRONMENT", REFLECTION_ENVIRONMENT),
         ("REFLECTION_CUBE_BILINEAR", REFLECTION_CUBE_BILINEAR),
         ("NO_TABLE", NO_TABLE),
-        ("MAX_ANISOTROPY", MAX_ANISOTROPY as u32),
-    ] {
+    ];
+    for (name, value) in SCENE_WORDS.into_iter().chain(packing_words) {
         out += &format!("const {name}: u32 = {value}u;\n");
     }
     // cubemap.rs `FACE_BASES`: major, s and t axes of each face.

@@ -1,8 +1,8 @@
 //! The last pass: linear HDR frame → tone-mapped 8-bit sRGB, read back to the CPU.
 
-use super::shader_source::with_shared_constants;
+use super::shader_source::tonemap_wgsl;
 use super::{Gpu, GpuError};
-use crate::{Frame, ToneMap};
+use render_scene::{Frame, ToneMap};
 
 /// Work-group side of the compute shader (`@workgroup_size(8, 8)`).
 const GROUP_SIDE: u32 = 8;
@@ -16,7 +16,7 @@ pub(super) struct ToneMapPass {
 
 impl ToneMapPass {
     pub(super) fn new(device: &wgpu::Device) -> ToneMapPass {
-        let source = with_shared_constants(include_str!("tonemap.wgsl"));
+        let source = tonemap_wgsl();
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("tonemap"),
             source: wgpu::ShaderSource::Wgsl(source.into()),

@@ -3,8 +3,8 @@
 
 use std::collections::HashMap;
 
-use raster::Vec3;
-use raster::{
+use render_scene::Vec3;
+use render_scene::{
     BubbleMesh, Camera, Environment, FilmTables, Frame, Ground, Irradiance, Light, Lut, Material,
     Object, ReflectionMode, RenderScene, RenderSettings, Sky,
 };

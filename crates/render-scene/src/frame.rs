@@ -1,0 +1,335 @@
+//! [`Frame`]: the linear HDR result, its timings, tone mapping and PNG/EXR output.
+
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+use crate::{RenderError, ToneMap};
+
+/// Wall-clock seconds spent in each phase of a frame.
+///
+/// The opaque, bubble and resolve phases run fused, strip by strip (so each strip's samples
+/// stay in cache); their wall time is split between them by their shares of CPU time.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct FrameTimings {
+    /// Validation, tessellation, triangle setup and binning.
+    pub setup_s: f64,
+    /// Rendering the dynamic cube maps (zero in the other reflection modes).
+    pub cube_maps_s: f64,
+    /// Environment, ground and opaque objects of the main view.
+    pub opaque_s: f64,
+    /// The bubble blend pass.
+    pub bubbles_s: f64,
+    /// Averaging the samples of each pixel.
+    pub resolve_s: f64,
+}
+
+impl FrameTimings {
+    /// Sum of all phases.
+    pub fn total_s(&self) -> f64 {
+        self.setup_s + self.cube_maps_s + self.opaque_s + self.bubbles_s + self.resolve_s
+    }
+}
+
+/// A rendered image: linear HDR RGB radiance, row-major, row 0 at the top.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Frame {
+    width: usize,
+    height: usize,
+    rgb: Vec<[f32; 3]>,
+    /// How long each phase took.
+    pub timings: FrameTimings,
+}
+
+impl Frame {
+    /// A frame holding `rgb` (row-major, row 0 at the top), or `None` unless
+    /// `rgb.len() == width * height` with both sides non-zero.
+    ///
+    /// # Guarantees
+    /// The returned frame's pixel count matches its size; its timings are zero.
+    pub fn try_from_rgb(width: usize, height: usize, rgb: Vec<[f32; 3]>) -> Option<Frame> {
+        let matches = width > 0 && height > 0 && width.checked_mul(height) == Some(rgb.len());
+        matches.then(|| Frame {
+            width,
+            height,
+            rgb,
+            timings: FrameTimings::default(),
+        })
+    }
+
+    /// Resizes the frame to `width × height` pixels, keeping its allocation, and returns
+    /// its pixels (row-major) for a renderer to overwrite; the old contents are unspecified.
+    pub fn resize_pixels(&mut self, width: usize, height: usize) -> &mut [[f32; 3]] {
+        self.width = width;
+        self.height = height;
+        self.rgb.resize(width * height, [0.0; 3]);
+        &mut self.rgb
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// Linear HDR pixels, row-major.
+    pub fn rgb(&self) -> &[[f32; 3]] {
+        &self.rgb
+    }
+
+    /// The pixel at column `x`, row `y`.
+    ///
+    /// # Panics
+    /// Panics if `x >= width` or `y >= height`.
+    pub fn pixel(&self, x: usize, y: usize) -> [f32; 3] {
+        assert!(
+            x < self.width && y < self.height,
+            "pixel ({x}, {y}) out of range"
+        );
+        self.rgb[y * self.width + x]
+    }
+
+    /// Tone-mapped 8-bit sRGB, interleaved RGB, row-major.
+    pub fn to_srgb8(&self, exposure_ev: f32, tonemap: ToneMap) -> Vec<u8> {
+        let scale = exposure_ev.exp2();
+        let mut out = Vec::with_capacity(self.rgb.len() * 3);
+        for px in &self.rgb {
+            let mapped = tone_map(px.map(|c| c * scale), tonemap);
+            out.extend(mapped.map(|c| (linear_to_srgb(c) * 255.0 + 0.5) as u8));
+        }
+        out
+    }
+
+    /// Writes the tone-mapped image as an 8-bit sRGB PNG (temporary file, then rename).
+    pub fn write_png(
+        &self,
+        path: impl AsRef<Path>,
+        exposure_ev: f32,
+        tonemap: ToneMap,
+    ) -> Result<(), RenderError> {
+        let bytes = self.to_srgb8(exposure_ev, tonemap);
+        let (w, h) = (self.width as u32, self.height as u32);
+        write_atomically(path.as_ref(), |file| {
+            let encoder = image::codecs::png::PngEncoder::new(BufWriter::new(file));
+            image::ImageEncoder::write_image(encoder, &bytes, w, h, image::ExtendedColorType::Rgb8)
+                .map_err(|e| e.to_string())
+        })
+    }
+
+    /// Writes the linear HDR radiance as a 32-bit float EXR (temporary file, then rename).
+    pub fn write_exr(&self, path: impl AsRef<Path>) -> Result<(), RenderError> {
+        let floats: Vec<f32> = self.rgb.iter().flatten().copied().collect();
+        let (w, h) = (self.width as u32, self.height as u32);
+        write_atomically(path.as_ref(), |file| {
+            let mut writer = BufWriter::new(file);
+            let encoder = image::codecs::openexr::OpenExrEncoder::new(&mut writer);
+            image::ImageEncoder::write_image(
+                encoder,
+                &bytemuck_f32(&floats),
+                w,
+                h,
+                image::ExtendedColorType::Rgb32F,
+            )
+            .map_err(|e| e.to_string())?;
+            writer.flush().map_err(|e| e.to_string())
+        })
+    }
+}
+
+/// The f32 samples as native-endian bytes, as `image` expects for float formats.
+fn bytemuck_f32(floats: &[f32]) -> Vec<u8> {
+    floats.iter().flat_map(|f| f.to_ne_bytes()).collect()
+}
+
+/// Writes through a temporary file in the target's directory, renamed over the target only on success.
+fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut std::fs::File) -> Result<(), String>,
+) -> Result<(), RenderError> {
+    let err = |message: String| RenderError::Write {
+        path: path.to_path_buf(),
+        message,
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".raster-").suffix(".tmp");
+    // Temporary files are private (0600); the finished image should be readable like any other.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
+    let mut tmp = builder.tempfile_in(dir).map_err(|e| err(e.to_string()))?;
+    write(tmp.as_file_mut()).map_err(err)?;
+    tmp.as_file_mut()
+        .sync_all()
+        .map_err(|e| err(e.to_string()))?;
+    tmp.persist(path).map_err(|e| err(e.error.to_string()))?;
+    Ok(())
+}
+
+/// Applies the tone curve to linear RGB, giving display-linear values in `[0, 1]`.
+pub fn tone_map(rgb: [f32; 3], tonemap: ToneMap) -> [f32; 3] {
+    let rgb = rgb.map(|c| if c.is_nan() { 0.0 } else { c.max(0.0) });
+    match tonemap {
+        ToneMap::Clamp => rgb.map(|c| c.min(1.0)),
+        ToneMap::Reinhard => rgb.map(|c| if c.is_infinite() { 1.0 } else { c / (1.0 + c) }),
+        ToneMap::AcesFitted => aces_fitted(rgb),
+    }
+}
+
+/// sRGB → ACES AP1-ish input matrix of Stephen Hill's fit (shared with the wgpu backend).
+pub const ACES_FROM_SRGB: [[f32; 3]; 3] = [
+    [0.59719, 0.35458, 0.04823],
+    [0.07600, 0.90834, 0.01566],
+    [0.02840, 0.13383, 0.83777],
+];
+/// Its output matrix back to linear sRGB.
+pub const SRGB_FROM_ACES: [[f32; 3]; 3] = [
+    [1.60475, -0.53108, -0.07367],
+    [-0.10208, 1.10813, -0.00605],
+    [-0.00327, -0.07276, 1.07602],
+];
+/// RRT+ODT rational fit `(x (x + a0) − a1) / (x (b0 x + b1) + b2)`: `[a0, a1]`.
+pub const ACES_NUMERATOR: [f32; 2] = [0.024_578_6, 0.000_090_537];
+/// Its denominator's `[b0, b1, b2]`.
+pub const ACES_DENOMINATOR: [f32; 3] = [0.983_729, 0.432_951, 0.238_081];
+/// Inputs are clamped here first, so the rational fit never sees infinity.
+pub const ACES_INPUT_MAX: f32 = 1e6;
+/// sRGB encoding (IEC 61966-2-1): below this linear value the curve is linear...
+pub const SRGB_LINEAR_MAX: f32 = 0.003_130_8;
+/// ...with this slope; above it `scale · c^(1/gamma) − offset`.
+pub const SRGB_LINEAR_SLOPE: f32 = 12.92;
+/// The encoding's power-law scale.
+pub const SRGB_SCALE: f32 = 1.055;
+/// The encoding's power-law offset.
+pub const SRGB_OFFSET: f32 = 0.055;
+/// The encoding's gamma.
+pub const SRGB_GAMMA: f32 = 2.4;
+
+/// Stephen Hill's ACES fit: sRGB → ACES AP1-ish input matrix, RRT+ODT rational fit, back.
+fn aces_fitted(rgb: [f32; 3]) -> [f32; 3] {
+    let [a0, a1] = ACES_NUMERATOR;
+    let [b0, b1, b2] = ACES_DENOMINATOR;
+    let rgb = rgb.map(|c| c.min(ACES_INPUT_MAX));
+    let v = mat3_mul(&ACES_FROM_SRGB, rgb);
+    let v = v.map(|x| {
+        let a = x * (x + a0) - a1;
+        let b = x * (b0 * x + b1) + b2;
+        a / b
+    });
+    mat3_mul(&SRGB_FROM_ACES, v).map(|c| c.clamp(0.0, 1.0))
+}
+
+fn mat3_mul(m: &[[f32; 3]; 3], v: [f32; 3]) -> [f32; 3] {
+    m.map(|row| row[0] * v[0] + row[1] * v[1] + row[2] * v[2])
+}
+
+/// The sRGB encoding curve (IEC 61966-2-1) for one channel in `[0, 1]`.
+pub fn linear_to_srgb(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= SRGB_LINEAR_MAX {
+        c * SRGB_LINEAR_SLOPE
+    } else {
+        SRGB_SCALE * c.powf(1.0 / SRGB_GAMMA) - SRGB_OFFSET
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::texture::srgb_to_linear;
+
+    fn frame(rgb: Vec<[f32; 3]>, width: usize) -> Frame {
+        Frame {
+            width,
+            height: rgb.len() / width,
+            rgb,
+            timings: FrameTimings::default(),
+        }
+    }
+
+    #[test]
+    fn srgb_curves_invert_each_other() {
+        for k in 0..=100 {
+            let x = k as f32 / 100.0;
+            let back = srgb_to_linear(linear_to_srgb(x));
+            assert!((back - x).abs() < 1e-5, "{x}: off by {}", back - x);
+        }
+    }
+
+    #[test]
+    fn tone_maps_are_monotone_bounded_and_nan_free() {
+        for tm in [ToneMap::Clamp, ToneMap::Reinhard, ToneMap::AcesFitted] {
+            let mut prev = -1.0;
+            for k in 0..200 {
+                let x = (k as f32 * 0.1).exp2() * 1e-4;
+                let y = tone_map([x; 3], tm)[1];
+                assert!(
+                    (0.0..=1.0).contains(&y) && y >= prev,
+                    "{tm:?} at {x}: {y} after {prev}"
+                );
+                prev = y;
+            }
+            for bad in [f32::NAN, f32::INFINITY, -1.0] {
+                assert!(
+                    tone_map([bad; 3], tm)
+                        .iter()
+                        .all(|c| (0.0..=1.0).contains(c)),
+                    "{tm:?} {bad}"
+                );
+            }
+        }
+        // Reinhard of 1 is exactly one half.
+        assert_eq!(tone_map([1.0; 3], ToneMap::Reinhard), [0.5; 3]);
+    }
+
+    #[test]
+    fn frame_from_rgb_checks_its_size() {
+        assert!(Frame::try_from_rgb(2, 2, vec![[0.0; 3]; 3]).is_none());
+        assert!(Frame::try_from_rgb(0, 0, Vec::new()).is_none());
+        assert_eq!(
+            Frame::try_from_rgb(2, 1, vec![[0.0; 3]; 2])
+                .unwrap()
+                .width(),
+            2
+        );
+    }
+
+    #[test]
+    fn exposure_doubles_per_stop() {
+        let f = frame(vec![[0.1, 0.2, 0.05]], 1);
+        let a = f.to_srgb8(1.0, ToneMap::Clamp);
+        let b = frame(vec![[0.2, 0.4, 0.1]], 1).to_srgb8(0.0, ToneMap::Clamp);
+        assert_eq!(a, b);
+    }
+
+    #[test]
+    fn png_and_exr_round_trip_and_errors_name_the_path() {
+        let dir = tempfile::tempdir().unwrap();
+        let f = frame(vec![[0.0, 0.5, 1.0], [2.0, 0.25, 0.125]], 2);
+        let png = dir.path().join("out.png");
+        f.write_png(&png, 0.0, ToneMap::Clamp).unwrap();
+        let img = image::open(&png).unwrap().to_rgb8();
+        assert_eq!(img.as_raw(), &f.to_srgb8(0.0, ToneMap::Clamp));
+        let exr = dir.path().join("out.exr");
+        f.write_exr(&exr).unwrap();
+        let back = image::open(&exr).unwrap().to_rgb32f();
+        let flat: Vec<f32> = f.rgb.iter().flatten().copied().collect();
+        assert_eq!(back.as_raw(), &flat);
+        let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(leftovers.len(), 2, "temporary files left: {leftovers:?}");
+        let bad = dir.path().join("no/such/dir/out.png");
+        let msg = f
+            .write_png(&bad, 0.0, ToneMap::Clamp)
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("no/such/dir"), "{msg}");
+    }
+}
