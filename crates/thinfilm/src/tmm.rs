@@ -16,6 +16,8 @@ use crate::incidence::Incidence;
 use crate::index::IndexModel;
 use num_complex::Complex64;
 
+mod incoherent;
+
 /// One homogeneous layer of a stack.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Layer {
@@ -23,6 +25,9 @@ pub struct Layer {
     pub index: IndexModel,
     /// Physical thickness in nm.
     pub thickness_nm: f64,
+    /// `false` for an incoherent layer (thick compared with the light's coherence length,
+    /// such as a substrate slide): intensities add across it instead of amplitudes.
+    pub coherent: bool,
 }
 
 impl Layer {
@@ -31,6 +36,16 @@ impl Layer {
         Layer {
             index: index.into(),
             thickness_nm,
+            coherent: true,
+        }
+    }
+
+    /// An incoherent layer (see [`Layer::coherent`]): its multiple reflections add in
+    /// intensity, as in Byrnes' `inc_tmm`; only its absorption depends on its thickness.
+    pub fn incoherent(index: impl Into<IndexModel>, thickness_nm: f64) -> Layer {
+        Layer {
+            coherent: false,
+            ..Layer::new(index, thickness_nm)
         }
     }
 
@@ -62,6 +77,8 @@ struct Media {
     n0: f64,
     layers: Vec<(Complex64, f64)>,
     n_sub: Complex64,
+    /// Positions in `layers` of the incoherent layers, front to back.
+    incoherent: Vec<usize>,
 }
 
 impl Stack {
@@ -125,6 +142,9 @@ impl Stack {
         incidence: Incidence,
     ) -> Result<Amplitudes, OpticsError> {
         let media = self.media(wavelength_nm)?;
+        if let Some(&k) = media.incoherent.first() {
+            return Err(OpticsError::Incoherent { layer: k + 1 });
+        }
         if incidence.cos() == 0.0 {
             let (r_s, r_p, t) = if media.all_equal() {
                 (0.0, 0.0, 1.0)
@@ -171,6 +191,9 @@ impl Stack {
         if incidence.cos() == 0.0 {
             return Ok(Response::grazing(media.all_equal()));
         }
+        if !media.incoherent.is_empty() {
+            return Ok(media.incoherent_response(wavelength_nm, incidence));
+        }
         let s = media.solve(Polarisation::S, wavelength_nm, incidence);
         let p = media.solve(Polarisation::P, wavelength_nm, incidence);
         Ok(Response {
@@ -208,10 +231,14 @@ impl Stack {
             .iter()
             .map(|layer| Ok((checked(&layer.index, "layer index")?, layer.thickness_nm)))
             .collect::<Result<_, OpticsError>>()?;
+        let incoherent = (self.layers.iter().enumerate())
+            .filter_map(|(k, layer)| (!layer.coherent).then_some(k))
+            .collect();
         Ok(Media {
             n0: self.n_incident,
             layers,
             n_sub: checked(&self.n_substrate, "n_substrate")?,
+            incoherent,
         })
     }
 }
@@ -230,24 +257,66 @@ impl Media {
     }
 
     /// Requires `incidence.cos() > 0`.
+    fn solve(&self, pol: Polarisation, wavelength_nm: f64, incidence: Incidence) -> Solution {
+        let block = Block {
+            entry: Complex64::new(self.n0, 0.0),
+            layers: &self.layers,
+            reversed: false,
+            exit: self.n_sub,
+        };
+        block.solve(pol, self.n0, wavelength_nm, incidence)
+    }
+}
+
+/// Coherent layers between two semi-infinite media: the whole stack, or (with incoherent
+/// layers) the run of coherent layers between two incoherent media.
+struct Block<'a> {
+    /// The medium light arrives from (complex when it is an absorbing incoherent layer).
+    entry: Complex64,
+    /// The coherent layers, front to back as stored.
+    layers: &'a [(Complex64, f64)],
+    /// Light meets `layers` back to front (the block seen from its exit side).
+    reversed: bool,
+    /// The medium light leaves into.
+    exit: Complex64,
+}
+
+impl Block<'_> {
+    /// Requires `incidence.cos() > 0`; `n0` is the real incident medium of the whole stack
+    /// (its `n0 sin θ` is the same in every medium, Snell).
     ///
     /// `[B, C] = M_1 ⋯ M_N [1, y_sub]` is carried as `e^{L} [B', C']` with `[B', C']` of
     /// modulus ≤ 1: each layer's matrix is applied divided by `e^{Im δ}` (its largest
     /// possible growth) and the product renormalised, the scales summed into `L`. Then
     /// `r` is scale-free, `t = 2 y0 e^{−L} / (y0 B' + C')` and `T` carries `e^{−2L}`.
-    fn solve(&self, pol: Polarisation, wavelength_nm: f64, incidence: Incidence) -> Solution {
+    /// From an absorbing entry medium `T = |t|² Re y_sub / Re y0`: Byrnes' power ratio
+    /// for incoherent media, the flux of the forward wave alone.
+    fn solve(
+        &self,
+        pol: Polarisation,
+        n0: f64,
+        wavelength_nm: f64,
+        incidence: Incidence,
+    ) -> Solution {
         let k_per_nm = std::f64::consts::TAU / wavelength_nm;
         let admittance = |n: Complex64, q: Complex64| match pol {
             Polarisation::S => q,
             Polarisation::P => q / (n * n),
         };
-        let n0 = Complex64::new(self.n0, 0.0);
-        let y0 = admittance(n0, n0 * incidence.cos());
-        let y_sub = admittance(self.n_sub, incidence.normal_index(self.n0, self.n_sub));
+        let y0 = admittance(self.entry, incidence.normal_index(n0, self.entry));
+        let y_sub = admittance(self.exit, incidence.normal_index(n0, self.exit));
         let mut field = (Complex64::new(1.0, 0.0), y_sub);
         let mut log_scale = 0.0;
-        for &(n, thickness_nm) in self.layers.iter().rev() {
-            let q = incidence.normal_index(self.n0, n);
+        // The matrices multiply from the exit side towards the entry side.
+        let count = self.layers.len();
+        for step in 0..count {
+            let at = if self.reversed {
+                step
+            } else {
+                count - 1 - step
+            };
+            let (n, thickness_nm) = self.layers[at];
+            let q = incidence.normal_index(n0, n);
             let y = admittance(n, q);
             let delta = k_per_nm * thickness_nm * q;
             let (cos_d, sin_d, sinc_d) = scaled_trig(delta);
@@ -272,11 +341,20 @@ impl Media {
         let (b, c) = field;
         let den = y0 * b + c;
         let shrink = (-log_scale).exp();
+        let transmittance = if y0.im == 0.0 {
+            // Divided factor by factor: |den|² alone underflows a hair from grazing.
+            4.0 * (y0.re / den.norm()) * (y_sub.re / den.norm()) * shrink * shrink
+        } else if y0.re > 0.0 {
+            let ratio = y0.norm() / den.norm() * shrink;
+            4.0 * ratio * ratio * (y_sub.re / y0.re)
+        } else {
+            // An evanescent entry medium carries no power towards the block.
+            0.0
+        };
         Solution {
             r: divide(y0 * b - c, den),
             t: divide(2.0 * y0, den) * shrink,
-            // Divided factor by factor: |den|² alone underflows a hair from grazing.
-            transmittance: 4.0 * (y0.re / den.norm()) * (y_sub.re / den.norm()) * shrink * shrink,
+            transmittance,
         }
     }
 }

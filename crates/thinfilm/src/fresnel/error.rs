@@ -88,6 +88,11 @@ pub enum OpticsError {
         /// The rejected value.
         value: f64,
     },
+    /// Amplitudes asked of a stack with an incoherent layer, which has only intensities.
+    Incoherent {
+        /// The first incoherent layer, 1-based.
+        layer: usize,
+    },
 }
 
 impl fmt::Display for OpticsError {
@@ -149,6 +154,11 @@ impl fmt::Display for OpticsError {
             OpticsError::NotFinite { what, index, value } => {
                 write!(f, "{what}[{index}] = {value} is not a valid value")
             }
+            OpticsError::Incoherent { layer } => write!(
+                f,
+                "layer {layer} is incoherent: a stack with incoherent layers has intensities \
+                 (R, T), not amplitudes"
+            ),
         }
     }
 }
