@@ -282,3 +282,48 @@ fn bad_refractive_index_is_rejected() {
 fn partial_single_query_flags_are_rejected() {
     rejects(&["--thickness-nm", "5"], "", &["--angle-deg"]);
 }
+
+#[test]
+fn incoherent_slide_in_a_stack_is_the_closed_form_sum_of_intensities() {
+    // A bare 1 mm slide: R = R1 + T1² R1 / (1 − R1²) for each polarisation, R1 from the
+    // single interface; its thickness does not matter when it does not absorb.
+    let text = stdout(&run(
+        &["--stack", "1.0 | 1.52 @ 1e6 incoherent | 1.0"],
+        "angle_deg,wavelength_nm\n0,550\n45,600\n",
+    ));
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("angle_deg,wavelength_nm,r_s,r_p,r,t,a"));
+    for (line, angle) in lines.zip([0.0, 45.0]) {
+        let v: Vec<f64> = line.split(',').map(|f| f.parse().unwrap()).collect();
+        let cos = f64::to_radians(angle).cos();
+        let one = thinfilm::Interface::new(1.0, thinfilm::Complex64::new(1.52, 0.0))
+            .unwrap()
+            .response(cos);
+        for (r, r1) in [(v[2], one.r_s), (v[3], one.r_p)] {
+            let t1 = 1.0 - r1;
+            let closed = r1 + t1 * t1 * r1 / (1.0 - r1 * r1);
+            assert!((r - closed).abs() < 1e-14, "angle {angle}: {r} vs {closed}");
+        }
+        assert!(
+            v[6].abs() < 1e-14,
+            "a lossless slide absorbs nothing: a = {}",
+            v[6]
+        );
+    }
+}
+
+#[test]
+fn misspelt_incoherent_marker_is_rejected_naming_it() {
+    rejects(
+        &[
+            "--stack",
+            "1.0 | 1.52 @ 1e6 incoherant | 1.0",
+            "--angle-deg",
+            "0",
+            "--wavelength-nm",
+            "550",
+        ],
+        "",
+        &["medium 2", "1e6 incoherant"],
+    );
+}

@@ -62,8 +62,10 @@ pub struct Args {
     )]
     n_film: Option<f64>,
     /// A multilayer stack, e.g. "1.0 | 1.38 @ 100 | 2.1 @ 60 | 0.18+3.4i": media from the
-    /// incidence side, inner layers as `index @ thickness_nm`; an index is a number, a+bi,
-    /// `water` or a `wavelength_nm,n,k` CSV file. CSV on stdin then gives
+    /// incidence side, inner layers as `index @ thickness_nm`, or `index @ thickness_nm
+    /// incoherent` for a layer whose reflections add in intensity (a 1 mm slide:
+    /// `1.52 @ 1e6 incoherent`); an index is a number, a+bi, `water` or a
+    /// `wavelength_nm,n,k` CSV file. CSV on stdin then gives
     /// `angle_deg,wavelength_nm[,thickness_nm]`.
     #[arg(long, value_name = "STACK")]
     stack: Option<String>,

@@ -5,6 +5,8 @@
 //! `index @ thickness_nm`. An index is a real number (`1.38`), a complex one with `κ ≥ 0`
 //! (`0.18+3.4i`), `water` (IAPWS, 200–1100 nm), or the path of a `wavelength_nm,n,k` CSV
 //! table. The incidence medium must be a real number (its power flux must be defined).
+//! A layer followed by the word `incoherent` (`1.52 @ 1e6 incoherent`, a 1 mm slide) adds
+//! its multiple reflections in intensity, not amplitude (Byrnes' `inc_tmm`).
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -49,14 +51,20 @@ pub fn parse_stack(text: &str) -> Result<Stack, CliError> {
             return Err(bad(k, format!("`{medium}` is not `index @ thickness_nm`")));
         };
         let index = parse_index(index.trim()).map_err(|e| bad(k, e))?;
-        let thickness = thickness.trim();
+        let (thickness, coherent) = match thickness.trim().rsplit_once(char::is_whitespace) {
+            Some((d, word)) if word.eq_ignore_ascii_case("incoherent") => (d.trim(), false),
+            _ => (thickness.trim(), true),
+        };
         let thickness_nm = parse_real(thickness).filter(|d| *d >= 0.0).ok_or_else(|| {
             bad(
                 k,
                 format!("thickness `{thickness}` is not a number >= 0 nm"),
             )
         })?;
-        layers.push(Layer::new(index, thickness_nm));
+        layers.push(Layer {
+            coherent,
+            ..Layer::new(index, thickness_nm)
+        });
     }
     let substrate = parse_index(media[last]).map_err(|e| bad(last, e))?;
     Stack::new(n_incident, layers, substrate)
@@ -213,11 +221,22 @@ mod tests {
     }
 
     #[test]
+    fn incoherent_word_marks_a_layer() {
+        let stack = parse_stack("1.0 | 1.33 @ 300 | 1.52 @ 1e6 INCOHERENT | 1.0").unwrap();
+        let flags: Vec<bool> = stack.layers.iter().map(|l| l.coherent).collect();
+        assert_eq!(flags, [true, false]);
+        assert_eq!(stack.layers[1].thickness_nm, 1e6);
+        let err = parse_stack("1.0 | 1.52 @ 1e6 incoherant | 1.0").unwrap_err();
+        assert!(err.to_string().contains("1e6 incoherant"), "{err}");
+    }
+
+    #[test]
     fn stack_syntax_gives_the_layers_in_order() {
         let stack = parse_stack("1.0 | 1.38 @ 100 | 2.1 @ 60 | 0.18+3.4i").unwrap();
         assert_eq!(stack.n_incident, 1.0);
         let d: Vec<f64> = stack.layers.iter().map(|l| l.thickness_nm).collect();
         assert_eq!(d, [100.0, 60.0]);
+        assert!(stack.layers.iter().all(|layer| layer.coherent));
         assert_eq!(
             stack.n_substrate.as_constant(),
             Some(Complex64::new(0.18, 3.4))
