@@ -11,6 +11,7 @@ use rayon::prelude::*;
 use thinfilm::airy::ThinFilm;
 use thinfilm::colorspace::{SRGB_FROM_XYZ, apply, srgb_encode};
 use thinfilm::dispersion::RefractiveIndex;
+use thinfilm::grid::{FilmGrid, Polarisation as GridPol};
 use thinfilm::{Complex64, Incidence, Layer, Observer, OpticsError, SpectralIntegrator, Stack};
 
 /// Points per rayon task: small enough to balance, large enough to amortise.
@@ -66,8 +67,10 @@ fn par_rt(
 }
 
 /// `(R, T)` of a stack (`n` from the incidence medium to the substrate, `d_nm` the inner
-/// layers) at each `(wavelength_nm[i], angle_deg[i])`.
+/// layers, `coherent` one flag per inner layer: `false` adds its intensities) at each
+/// `(wavelength_nm[i], angle_deg[i])`.
 #[pyfunction]
+#[pyo3(signature = (n, d_nm, wavelength_nm, angle_deg, pol, coherent))]
 fn rt<'py>(
     py: Python<'py>,
     n: Vec<Complex64>,
@@ -75,6 +78,7 @@ fn rt<'py>(
     wavelength_nm: PyReadonlyArray1<'py, f64>,
     angle_deg: PyReadonlyArray1<'py, f64>,
     pol: &str,
+    coherent: Vec<bool>,
 ) -> PyResult<Pair<'py>> {
     let pol = pol_from(pol)?;
     if n.len() != d_nm.len() + 2 {
@@ -90,10 +94,21 @@ fn rt<'py>(
             "n[0] = {n0} must be real: the incidence medium cannot absorb"
         )));
     }
+    if coherent.len() != d_nm.len() {
+        return Err(PyValueError::new_err(format!(
+            "coherent has {} flags and d_nm {} thicknesses: one flag per inner layer",
+            coherent.len(),
+            d_nm.len()
+        )));
+    }
     let layers = n[1..n.len() - 1]
         .iter()
         .zip(&d_nm)
-        .map(|(&index, &d)| Layer::new(index, d))
+        .zip(&coherent)
+        .map(|((&index, &d), &coherent)| Layer {
+            coherent,
+            ..Layer::new(index, d)
+        })
         .collect();
     let stack = Stack::new(n0.re, layers, n[n.len() - 1]).map_err(value_error)?;
     let (wl, angle) = (copy(&wavelength_nm), copy(&angle_deg));
@@ -247,6 +262,58 @@ impl FastFilm {
     }
 }
 
+/// `(R, T)` of the symmetric film on the outer product `thickness_nm × angle_deg ×
+/// wavelength_nm`, flattened thickness-major (or angle-major, `(angle, thickness,
+/// wavelength)`, with `angle_major`): [`thinfilm::grid::FilmGrid`] computes the Fresnel
+/// terms once per (angle, wavelength), then the rows in parallel.
+#[pyfunction]
+fn film_rt_grid<'py>(
+    py: Python<'py>,
+    thickness_nm: PyReadonlyArray1<'py, f64>,
+    angle_deg: PyReadonlyArray1<'py, f64>,
+    wavelength_nm: PyReadonlyArray1<'py, f64>,
+    n_film: f64,
+    n_outside: f64,
+    pol: &str,
+    angle_major: bool,
+) -> PyResult<Pair<'py>> {
+    let pol = match pol_from(pol)? {
+        Pol::S => GridPol::S,
+        Pol::P => GridPol::P,
+        Pol::Mean => GridPol::Unpolarised,
+    };
+    let (d, angle, wl) = (copy(&thickness_nm), copy(&angle_deg), copy(&wavelength_nm));
+    let (r, t) = py
+        .allow_threads(|| {
+            let grid = FilmGrid::try_new(n_outside, n_film, &angle, &wl)?;
+            let row = grid.len();
+            let (mut r, mut t) = (vec![0.0; d.len() * row], vec![0.0; d.len() * row]);
+            if row == 0 {
+            } else if angle_major {
+                // One task per angle: its (thickness, wavelength) block, a run per thickness.
+                let runs = wl.len();
+                r.par_chunks_mut(d.len() * runs)
+                    .zip(t.par_chunks_mut(d.len() * runs))
+                    .enumerate()
+                    .try_for_each(|(a, (r, t))| {
+                        let runs_r = r.chunks_mut(runs).zip(t.chunks_mut(runs));
+                        for ((r, t), &d) in runs_r.zip(&d) {
+                            grid.try_fill_cells(d, a * runs, pol, r, t)?;
+                        }
+                        Ok::<_, OpticsError>(())
+                    })?;
+            } else {
+                r.par_chunks_mut(row)
+                    .zip(t.par_chunks_mut(row))
+                    .zip(d.par_iter())
+                    .try_for_each(|((r, t), &d)| grid.try_fill(d, pol, r, t))?;
+            }
+            Ok::<_, OpticsError>((r, t))
+        })
+        .map_err(value_error)?;
+    Ok((r.into_pyarray(py), t.into_pyarray(py)))
+}
+
 /// XYZ (perfect reflector at Y = 1) of soap films in air, flattened `[x0, y0, z0, x1, ...]`.
 #[pyfunction]
 fn film_xyz<'py>(
@@ -317,6 +384,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rt, m)?)?;
     m.add_function(wrap_pyfunction!(film_rt, m)?)?;
     m.add_function(wrap_pyfunction!(film_rt_fast, m)?)?;
+    m.add_function(wrap_pyfunction!(film_rt_grid, m)?)?;
     m.add_function(wrap_pyfunction!(film_xyz, m)?)?;
     m.add_function(wrap_pyfunction!(xyz_to_srgb, m)?)?;
     Ok(())

@@ -21,7 +21,7 @@
 //! Optics: [`fresnel`], [`airy`] (exact single film), [`tmm`] (N-layer stacks, exact for
 //! any thickness), [`dispersion`] (real models, each with its wavelength range), [`index`]
 //! (complex and tabulated n,k models), [`incidence`] (angle or sin θ, exact at grazing),
-//! and the f32 fast path [`batch`]. Colour, split pbrt-style:
+//! the exact film grid [`grid`] and the f32 fast path [`batch`]. Colour, split pbrt-style:
 //! [`spectrum`], [`cmf`], [`illuminant`], [`integrate`] (with [`cells`], exact at grazing
 //! incidence), [`colorspace`], [`lab`].
 
@@ -29,6 +29,7 @@ pub mod airy;
 pub mod batch;
 pub mod dispersion;
 pub mod fresnel;
+pub mod grid;
 pub mod incidence;
 pub mod index;
 pub mod tmm;

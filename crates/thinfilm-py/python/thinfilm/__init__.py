@@ -9,7 +9,7 @@ import numpy as np
 
 from . import _native
 
-__all__ = ["rt", "film_rt", "film_xyz", "xyz_to_srgb"]
+__all__ = ["rt", "film_rt", "film_rt_grid", "film_xyz", "xyz_to_srgb"]
 
 
 def _flat(*arrays):
@@ -22,18 +22,71 @@ def _flat(*arrays):
     return shape, [np.ascontiguousarray(p).ravel() for p in parts]
 
 
-def rt(n, d_nm, wavelength_nm, angle_deg, pol="u"):
+def rt(n, d_nm, wavelength_nm, angle_deg, pol="u", coherent=None):
     """Reflectance and transmittance ``(R, T)`` of a multilayer stack.
 
     ``n`` lists every medium's index from the incidence medium to the substrate (complex
     allowed, ``n + ik`` with ``k >= 0``; the first must be real), ``d_nm`` the inner layers'
     thicknesses: the order of ``tmm.coh_tmm`` without its infinite ends. ``pol`` is "s", "p"
     or "u" (unpolarised mean). ``wavelength_nm`` and ``angle_deg`` broadcast together.
+
+    ``coherent`` marks each inner layer: ``True`` (the default for all) adds its multiple
+    reflections in amplitude, ``False`` in intensity, for a layer thicker than the light's
+    coherence length such as a 1 mm glass slide (``tmm.inc_tmm`` with ``c_list`` "c"/"i";
+    the semi-infinite ends are always incoherent). For example a 300 nm film on a slide:
+    ``rt([1, 1.33, 1.52, 1], [300, 1e6], wl, 0, coherent=[True, False])``.
     """
     n = [complex(x) for x in np.atleast_1d(n)]
     d_nm = [float(x) for x in np.atleast_1d(d_nm)] if np.size(d_nm) else []
+    if coherent is None:
+        flags = [True] * len(d_nm)
+    else:
+        flags = []
+        for k, flag in enumerate(np.atleast_1d(coherent).tolist() if np.size(coherent) else []):
+            if not isinstance(flag, (bool, int)) or flag not in (0, 1):
+                raise ValueError(f"coherent[{k}] = {flag!r} is not True or False")
+            flags.append(bool(flag))
     shape, (wl, angle) = _flat(wavelength_nm, angle_deg)
-    r, t = _native.rt(n, d_nm, wl, angle, pol)
+    r, t = _native.rt(n, d_nm, wl, angle, pol, flags)
+    return r.reshape(shape), t.reshape(shape)
+
+
+def _axes(*arrays):
+    """For arrays that form an outer product (each has at most one axis longer than 1, and
+    no two share one), each one's 1-d values and the position of its axis (-1 if none);
+    otherwise None."""
+    parts = [np.asarray(a, dtype=np.float64) for a in arrays]
+    ndim = max(p.ndim for p in parts)
+    values, positions = [], []
+    for p in parts:
+        long = [k for k, size in enumerate(p.shape) if size > 1]
+        if len(long) > 1:
+            return None
+        values.append(np.ascontiguousarray(p).ravel())
+        positions.append(ndim - p.ndim + long[0] if long else -1)
+    taken = [k for k in positions if k >= 0]
+    if len(set(taken)) != len(taken):
+        return None
+    return values, positions
+
+
+def film_rt_grid(thickness_nm, angle_deg, wavelength_nm, n_film=1.33, n_outside=1.0, pol="u"):
+    """``(R, T)`` of the film ``n_outside | n_film | n_outside`` on the grid of three 1-d axes,
+    shape ``(len(thickness_nm), len(angle_deg), len(wavelength_nm))``.
+
+    Exact in f64 (the closed-form Airy sum of all orders, within 1e-14 of the transfer
+    matrix): the Fresnel terms are computed once per (angle, wavelength), then each
+    thickness costs a sine per point, in parallel. ``pol`` is "s", "p" or "u" (the mean).
+    ``film_rt`` takes this path by itself when its arguments form such a grid.
+    """
+    axes = [np.ascontiguousarray(np.atleast_1d(np.asarray(a, dtype=np.float64))) for a in
+            (thickness_nm, angle_deg, wavelength_nm)]
+    for name, a in zip(("thickness_nm", "angle_deg", "wavelength_nm"), axes):
+        if a.ndim != 1:
+            raise ValueError(f"{name} has shape {a.shape}: film_rt_grid takes 1-d axes")
+    d, angle, wl = axes
+    r, t = _native.film_rt_grid(d, angle, wl, float(n_film), float(n_outside), str(pol), False)
+    shape = (d.size, angle.size, wl.size)
     return r.reshape(shape), t.reshape(shape)
 
 
@@ -47,7 +100,29 @@ def film_rt(thickness_nm, angle_deg, wavelength_nm, n_film=1.33, n_outside=1.0, 
     films up to 5 um stays within 5e-5 in R and T (worst near grazing incidence and for
     high-index films, where the fringes are sharp); R + T = 1 holds to 4e-7. Points f32
     cannot hold always take the exact path.
+
+    When the three arrays form an outer product (as ``d[:, None, None]``,
+    ``angle[None, :, None]``, ``wl[None, None, :]`` in any order), the exact path runs on
+    :func:`film_rt_grid`, about 50 times faster, and ``fast=True`` takes it too (it is
+    faster than the f32 kernel there, and exact).
     """
+    axes = _axes(thickness_nm, angle_deg, wavelength_nm)
+    if axes is not None:
+        try:
+            shape = np.broadcast_shapes(*(np.shape(a) for a in (thickness_nm, angle_deg, wavelength_nm)))
+        except ValueError as err:
+            raise ValueError(f"arguments do not broadcast together: {err}") from None
+    if axes is not None and len(shape) >= 1:
+        (d, angle, wl), positions = axes
+        order = [int(k) for k in np.argsort(positions, kind="stable")]
+        # The native call writes thickness- or angle-major directly; other orders transpose.
+        angle_major = order == [1, 0, 2]
+        r, t = _native.film_rt_grid(d, angle, wl, float(n_film), float(n_outside), "u", angle_major)
+        if angle_major or order == [0, 1, 2]:
+            return r.reshape(shape), t.reshape(shape)
+        r = np.transpose(r.reshape(d.size, angle.size, wl.size), order).reshape(shape)
+        t = np.transpose(t.reshape(d.size, angle.size, wl.size), order).reshape(shape)
+        return r, t
     shape, (d, angle, wl) = _flat(thickness_nm, angle_deg, wavelength_nm)
     native = _native.film_rt_fast if fast else _native.film_rt
     r, t = native(d, angle, wl, float(n_film), float(n_outside))
