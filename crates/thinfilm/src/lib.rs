@@ -29,6 +29,7 @@ pub mod airy;
 pub mod batch;
 pub mod dispersion;
 pub mod fresnel;
+pub mod graded;
 pub mod grid;
 pub mod incidence;
 pub mod index;

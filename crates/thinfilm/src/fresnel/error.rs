@@ -88,6 +88,11 @@ pub enum OpticsError {
         /// The rejected value.
         value: f64,
     },
+    /// A graded-index layer's tolerance that is invalid or not reached (named in `reason`).
+    Graded {
+        /// What is wrong.
+        reason: String,
+    },
     /// Amplitudes asked of a stack with an incoherent layer, which has only intensities.
     Incoherent {
         /// The first incoherent layer, 1-based.
@@ -154,6 +159,7 @@ impl fmt::Display for OpticsError {
             OpticsError::NotFinite { what, index, value } => {
                 write!(f, "{what}[{index}] = {value} is not a valid value")
             }
+            OpticsError::Graded { reason } => write!(f, "graded layer: {reason}"),
             OpticsError::Incoherent { layer } => write!(
                 f,
                 "layer {layer} is incoherent: a stack with incoherent layers has intensities \
