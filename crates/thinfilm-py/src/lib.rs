@@ -287,7 +287,7 @@ fn film_rt_grid<'py>(
         .allow_threads(|| {
             let grid = FilmGrid::try_new(n_outside, n_film, &angle, &wl)?;
             let row = grid.len();
-            let (mut r, mut t) = (vec![0.0; d.len() * row], vec![0.0; d.len() * row]);
+            let (mut r, mut t) = (zeroed(d.len() * row), zeroed(d.len() * row));
             if row == 0 {
             } else if angle_major {
                 // One task per angle: its (thickness, wavelength) block, a run per thickness.
@@ -312,6 +312,36 @@ fn film_rt_grid<'py>(
         })
         .map_err(value_error)?;
     Ok((r.into_pyarray(py), t.into_pyarray(py)))
+}
+
+/// A zeroed output buffer; on Linux a large one asks for transparent huge pages before it
+/// is first touched, so that filling it costs a few page faults rather than one per 4 KiB
+/// (measured: touching 16 MB of fresh pages took longer than computing the 1 M-point grid).
+fn zeroed(len: usize) -> Vec<f64> {
+    let v = vec![0.0; len];
+    #[cfg(target_os = "linux")]
+    {
+        const HUGE: usize = 2 << 20;
+        let bytes = len * std::mem::size_of::<f64>();
+        if bytes >= 2 * HUGE {
+            let start = v.as_ptr() as usize;
+            let aligned = start.next_multiple_of(HUGE);
+            let end = (start + bytes) / HUGE * HUGE;
+            if end > aligned {
+                // SAFETY: the range lies inside `v`'s allocation, which outlives the call;
+                // madvise only changes how the kernel backs the pages, never their contents
+                // (fresh zero pages stay zero), and its failure is harmless.
+                unsafe {
+                    libc::madvise(
+                        aligned as *mut libc::c_void,
+                        end - aligned,
+                        libc::MADV_HUGEPAGE,
+                    );
+                }
+            }
+        }
+    }
+    v
 }
 
 /// XYZ (perfect reflector at Y = 1) of soap films in air, flattened `[x0, y0, z0, x1, ...]`.
