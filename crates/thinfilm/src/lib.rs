@@ -28,6 +28,7 @@
 pub mod airy;
 pub mod batch;
 pub mod dispersion;
+pub mod fit;
 pub mod fresnel;
 pub mod graded;
 pub mod grid;
