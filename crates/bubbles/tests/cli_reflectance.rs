@@ -327,3 +327,101 @@ fn misspelt_incoherent_marker_is_rejected_naming_it() {
         &["medium 2", "1e6 incoherant"],
     );
 }
+
+// `bubbles fit` (here beside the reflectance it inverts): a spectrum written by
+// `bubbles reflectance --stack` is fitted back.
+
+fn fit(args: &[&str], stdin: &str) -> Output {
+    common::bubbles_piped(&[&["fit"], args].concat(), stdin)
+}
+
+#[test]
+fn fit_recovers_the_thickness_that_reflectance_wrote() {
+    let mut query = String::from("angle_deg,wavelength_nm\n");
+    for k in 0..=100 {
+        query.push_str(&format!("10,{}\n", 420 + 4 * k));
+    }
+    let stack = "1.0 | 1.46 @ 812.5 | 3.88+0.02i";
+    let spectrum = stdout(&common::bubbles_piped(
+        &["reflectance", "--stack", stack],
+        &query,
+    ));
+    // Keep wavelength_nm and the unpolarised r (columns 2 and 5).
+    let mut csv = String::from("wavelength_nm,r\n");
+    for line in spectrum.lines().skip(1) {
+        let v: Vec<&str> = line.split(',').collect();
+        csv.push_str(&format!("{},{}\n", v[1], v[4]));
+    }
+    let out = stdout(&fit(
+        &[
+            "--spectrum",
+            "-",
+            "--stack",
+            stack,
+            "--angle-deg",
+            "10",
+            "--max-nm",
+            "3000",
+        ],
+        &csv,
+    ));
+    let mut lines = out.lines();
+    assert_eq!(
+        lines.next(),
+        Some(
+            "thickness_nm,low_nm,high_nm,sigma_nm,systematic_nm,offset,rms_residual,runner_up_nm,runner_up_rms"
+        )
+    );
+    let v: Vec<f64> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(|f| f.parse().unwrap())
+        .collect();
+    assert!((v[0] - 812.5).abs() < 1e-3, "{v:?}");
+    assert!(v[1] <= 812.5 + 1e-3 && 812.5 - 1e-3 <= v[2], "{v:?}");
+}
+
+#[test]
+fn fit_rejects_bad_input_with_exit_2_naming_it() {
+    let spectrum = "wavelength_nm,r\n400,0.1\n500,0.2\n600,0.3\n";
+    for (args, stdin, needle) in [
+        (
+            vec!["--spectrum", "-"],
+            "wavelength_nm,r\n400,0.1\n500,x\n",
+            "x",
+        ),
+        (vec!["--spectrum", "-", "--angle-deg", "95"], spectrum, "95"),
+        (
+            vec!["--spectrum", "-", "--min-nm", "9", "--max-nm", "1"],
+            spectrum,
+            "[9, 1]",
+        ),
+        (
+            vec![
+                "--spectrum",
+                "-",
+                "--stack",
+                "1 | 1.46 @ 0 | 3.9",
+                "--vary-layer",
+                "2",
+            ],
+            spectrum,
+            "--vary-layer 2",
+        ),
+        (
+            vec!["--spectrum", "/nonexistent/s.csv"],
+            "",
+            "/nonexistent/s.csv",
+        ),
+    ] {
+        let output = fit(&args, stdin);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(output.stdout.is_empty());
+        assert!(
+            stderr.contains(needle),
+            "{args:?}: {stderr:?} lacks {needle:?}"
+        );
+    }
+}

@@ -10,7 +10,7 @@
 //! Stack input columns: `angle_deg,wavelength_nm[,thickness_nm]`; output adds the
 //! absorbed fraction `a = 1 − r − t`.
 
-mod stack;
+pub(crate) mod stack;
 
 use std::fmt::Write as _;
 use std::io::{Read as _, Write as _};
