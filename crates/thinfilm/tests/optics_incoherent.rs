@@ -295,8 +295,8 @@ proptest! {
     ) {
         // R + T + A = 1 with 0 ≤ A ≤ 1; without absorption A = 0 to rounding. Incoherent
         // layers absorb weakly (κ ≤ 1e-3): Byrnes' forward-flux convention, which the model
-        // follows, lets R + T exceed 1 by O(κ²) (measured up to 0.05 at κ = 0.01 near
-        // grazing, and R + T = 1.6 for an incoherent 10 nm metal; docs/physics.md).
+        // follows, lets R + T exceed 1 by O(κ²) (measured up to 0.02 at κ = 0.01, and
+        // R + T = 1.6 for an incoherent 10 nm metal; docs/physics.md).
         let mut layers = b0.clone();
         layers.push(Layer::incoherent(Complex64::new(n1, k1), d1));
         layers.extend_from_slice(&b1);
