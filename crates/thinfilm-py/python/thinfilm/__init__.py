@@ -9,7 +9,7 @@ import numpy as np
 
 from . import _native
 
-__all__ = ["rt", "film_rt", "film_rt_grid", "fit_thickness", "film_xyz", "xyz_to_srgb"]
+__all__ = ["rt", "graded_rt", "film_rt", "film_rt_grid", "fit_thickness", "film_xyz", "xyz_to_srgb"]
 
 
 def _flat(*arrays):
@@ -68,6 +68,36 @@ def _axes(*arrays):
     if len(set(taken)) != len(taken):
         return None
     return values, positions
+
+
+def graded_rt(n, d_nm, layer, profile, wavelength_nm, angle_deg, pol="u", tolerance=1e-9):
+    """``(R, T, error_bound)`` of a stack (as :func:`rt`) whose inner layer ``layer``
+    (0-based) has an index graded with depth.
+
+    ``profile`` is ``("linear", n_front, n_back)`` or ``("exponential", n_front, n_back)``
+    over ``d_nm[layer]`` (linear: complex allowed, n and k alike; exponential: real), or an
+    array of rows ``(z_nm, n, k)`` from the layer's front face (z = 0) to its back (the last
+    z is its thickness). Each point slices the layer at midpoints, doubling the slices
+    until the Richardson estimate of the remaining error, returned as ``error_bound``, is
+    within ``tolerance``. ``wavelength_nm`` and ``angle_deg`` broadcast together.
+    """
+    n = [complex(x) for x in np.atleast_1d(n)]
+    d_nm = [float(x) for x in np.atleast_1d(d_nm)] if np.size(d_nm) else []
+    if isinstance(layer, bool) or not isinstance(layer, (int, np.integer)) or layer < 0:
+        raise ValueError(f"layer = {layer!r} is not an index >= 0 into d_nm")
+    front = back = 1.0
+    table = []
+    if isinstance(profile, tuple) and len(profile) == 3 and isinstance(profile[0], str):
+        kind, front, back = profile[0], complex(profile[1]), complex(profile[2])
+    else:
+        rows = np.asarray(profile, dtype=np.float64)
+        if rows.ndim != 2 or rows.shape[1] != 3:
+            raise ValueError(f"profile of shape {rows.shape} is not rows of (z_nm, n, k)")
+        kind, table = "table", [tuple(map(float, row)) for row in rows]
+    shape, (wl, angle) = _flat(wavelength_nm, angle_deg)
+    r, t, e = _native.graded_rt(n, d_nm, int(layer), kind, complex(front), complex(back), table,
+                                wl, angle, pol, float(tolerance))
+    return r.reshape(shape), t.reshape(shape), e.reshape(shape)
 
 
 def film_rt_grid(thickness_nm, angle_deg, wavelength_nm, n_film=1.33, n_outside=1.0, pol="u"):

@@ -5,7 +5,7 @@ from typing import Sequence, TypedDict
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["rt", "film_rt", "film_rt_grid", "fit_thickness", "film_xyz", "xyz_to_srgb"]
+__all__ = ["rt", "graded_rt", "film_rt", "film_rt_grid", "fit_thickness", "film_xyz", "xyz_to_srgb"]
 
 def rt(
     n: Sequence[complex] | ArrayLike,
@@ -17,6 +17,18 @@ def rt(
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Reflectance and transmittance ``(R, T)`` of a multilayer stack (incoherent layers
     where ``coherent`` says False)."""
+
+def graded_rt(
+    n: Sequence[complex] | ArrayLike,
+    d_nm: Sequence[float] | ArrayLike,
+    layer: int,
+    profile: tuple[str, complex, complex] | ArrayLike,
+    wavelength_nm: ArrayLike,
+    angle_deg: ArrayLike,
+    pol: str = "u",
+    tolerance: float = 1e-9,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """``(R, T, error_bound)`` of a stack whose inner layer ``layer`` is graded-index."""
 
 def film_rt(
     thickness_nm: ArrayLike,
