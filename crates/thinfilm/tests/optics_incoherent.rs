@@ -44,7 +44,7 @@ fn bare_lossless_slab_is_the_closed_form_sum_of_intensities() {
                 1e-15,
             );
         }
-        // Head-on: R = 2 R1 / (1 + R1), the textbook 8.0 % of a glass plate.
+        // Head-on: R = 2 R1 / (1 + R1), 8.2 % for a plate of n = 1.52.
         if cos == 1.0 {
             let r1 = one.r_s;
             assert_close("2 R1 / (1 + R1)", resp.r(), 2.0 * r1 / (1.0 + r1), 1e-15);
