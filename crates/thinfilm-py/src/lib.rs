@@ -18,6 +18,11 @@ use thinfilm::{Complex64, Incidence, Layer, Observer, OpticsError, SpectralInteg
 const CHUNK: usize = 1024;
 
 type Pair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
+type Triple<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+);
 
 fn value_error(err: OpticsError) -> PyErr {
     PyValueError::new_err(err.to_string())
@@ -267,6 +272,7 @@ impl FastFilm {
 /// wavelength)`, with `angle_major`): [`thinfilm::grid::FilmGrid`] computes the Fresnel
 /// terms once per (angle, wavelength), then the rows in parallel.
 #[pyfunction]
+#[allow(clippy::too_many_arguments)]
 fn film_rt_grid<'py>(
     py: Python<'py>,
     thickness_nm: PyReadonlyArray1<'py, f64>,
@@ -413,11 +419,7 @@ fn graded_rt<'py>(
     angle_deg: PyReadonlyArray1<'py, f64>,
     pol: &str,
     tolerance: f64,
-) -> PyResult<(
-    Bound<'py, PyArray1<f64>>,
-    Bound<'py, PyArray1<f64>>,
-    Bound<'py, PyArray1<f64>>,
-)> {
+) -> PyResult<Triple<'py>> {
     use thinfilm::graded::{GradedLayer, Profile};
     let pol = pol_from(pol)?;
     if n.len() != d_nm.len() + 2 || layer >= d_nm.len() {
