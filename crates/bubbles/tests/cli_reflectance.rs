@@ -425,3 +425,82 @@ fn fit_rejects_bad_input_with_exit_2_naming_it() {
         );
     }
 }
+
+#[test]
+fn graded_layer_in_a_stack_reports_its_error_bound_and_a_constant_one_is_homogeneous() {
+    let query = "angle_deg,wavelength_nm\n0,550\n40,700\n";
+    let graded = stdout(&run(
+        &["--stack", "1.0 | linear(1.8, 1.8) @ 250 | 1.52"],
+        query,
+    ));
+    let plain = stdout(&run(&["--stack", "1.0 | 1.8 @ 250 | 1.52"], query));
+    let mut g = graded.lines();
+    assert_eq!(
+        g.next(),
+        Some("angle_deg,wavelength_nm,r_s,r_p,r,t,a,error_bound")
+    );
+    for (g, p) in g.zip(plain.lines().skip(1)) {
+        let g: Vec<f64> = g.split(',').map(|f| f.parse().unwrap()).collect();
+        let p: Vec<f64> = p.split(',').map(|f| f.parse().unwrap()).collect();
+        for k in 2..6 {
+            assert!((g[k] - p[k]).abs() < 1e-12, "{g:?} vs {p:?}");
+        }
+        assert!(g[7] <= 1e-9, "error bound {}", g[7]);
+    }
+    // An air-to-glass ramp: far below bare glass's 4.3 %, within its stated bound.
+    let ramp = stdout(&run(
+        &[
+            "--stack",
+            "1.0 | linear(1.0, 1.52) @ 500 | 1.52",
+            "--graded-tolerance",
+            "1e-7",
+        ],
+        "angle_deg,wavelength_nm\n0,550\n",
+    ));
+    let v: Vec<f64> = ramp
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .map(|f| f.parse().unwrap())
+        .collect();
+    assert!(v[4] < 0.005 && v[7] <= 1e-7, "{v:?}");
+}
+
+#[test]
+fn bad_graded_layers_are_rejected_naming_them() {
+    let flags = ["--angle-deg", "0", "--wavelength-nm", "550"];
+    for (stack, needle) in [
+        ("1.0 | linear(1.0 1.5) @ 100 | 1.5", "n_front, n_back"),
+        ("1.0 | exponential(1.0, 1.5+1i) @ 100 | 1.5", "real"),
+        (
+            "1.0 | linear(1.0, 1.5) @ 100 | linear(1.0, 1.5) @ 100 | 1.5",
+            "only one",
+        ),
+        (
+            "1.0 | graded(/nonexistent/p.csv) | 1.5",
+            "/nonexistent/p.csv",
+        ),
+        ("1.0 | linear(1.0, -1.5) @ 100 | 1.5", "-1.5"),
+    ] {
+        rejects(
+            &[&["--stack", stack][..], &flags[..]].concat(),
+            "",
+            &[needle],
+        );
+    }
+    rejects(
+        &[
+            &[
+                "--stack",
+                "1.0 | linear(1.0, 1.5) @ 100 | 1.5",
+                "--graded-tolerance",
+                "0",
+            ][..],
+            &flags[..],
+        ]
+        .concat(),
+        "",
+        &["--graded-tolerance 0"],
+    );
+}

@@ -72,6 +72,10 @@ pub struct Args {
     /// The inner layer (1-based) whose thickness a `thickness_nm` column or flag overrides.
     #[arg(long, value_name = "K", default_value_t = 1, requires = "stack")]
     vary_layer: usize,
+    /// A graded layer (`linear(a, b) @ d`, `exponential(a, b) @ d` or `graded(PATH)` in
+    /// --stack) is sliced until its estimated error in R and T is at most this.
+    #[arg(long, value_name = "TOL", default_value_t = 1e-9, requires = "stack")]
+    graded_tolerance: f64,
 }
 
 /// One validated query, with the input line it came from (0 for flags).
@@ -98,7 +102,13 @@ pub fn run(args: Args) -> CliResult {
 }
 
 fn run_stack(text: &str, args: &Args) -> Result<String, CliError> {
-    let parsed = stack::parse_stack(text)?;
+    let (parsed, graded) = stack::parse_stack_graded(text)?;
+    if !(args.graded_tolerance.is_finite() && args.graded_tolerance > 0.0) {
+        return Err(CliError::input(format!(
+            "--graded-tolerance {} is not finite and > 0",
+            args.graded_tolerance
+        )));
+    }
     let queries = match (args.angle_deg, args.wavelength_nm) {
         (None, None) if args.thickness_nm.is_none() => stack::queries_from_csv(&read_stdin()?)?,
         (Some(angle_deg), Some(wavelength_nm)) => {
@@ -120,7 +130,13 @@ fn run_stack(text: &str, args: &Args) -> Result<String, CliError> {
             ));
         }
     };
-    stack::render(&parsed, args.vary_layer, &queries)
+    stack::render(
+        &parsed,
+        graded.as_ref(),
+        args.graded_tolerance,
+        args.vary_layer,
+        &queries,
+    )
 }
 
 fn read_stdin() -> Result<String, CliError> {
