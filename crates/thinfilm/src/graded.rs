@@ -41,6 +41,14 @@ pub enum Profile {
         /// Index at the back face (real, > 0).
         back: f64,
     },
+    /// `1/n(z)` linear from `1/front` to `1/back` (real): the profile whose wave equation
+    /// at normal incidence is a Cauchy–Euler equation, solvable in closed form.
+    Reciprocal {
+        /// Index at the front face (real, > 0).
+        front: f64,
+        /// Index at the back face (real, > 0).
+        back: f64,
+    },
     /// Tabulated `(z_frac, n)` with `z_frac` = z/d from 0 to 1 strictly increasing,
     /// linear in between (see [`Profile::from_csv`]).
     Table(Vec<(f64, Complex64)>),
@@ -119,6 +127,10 @@ impl Profile {
             Profile::Exponential { front, back } => {
                 Complex64::new(front * (back / front).powf(z_frac), 0.0)
             }
+            Profile::Reciprocal { front, back } => Complex64::new(
+                1.0 / (1.0 / front + (1.0 / back - 1.0 / front) * z_frac),
+                0.0,
+            ),
             Profile::Table(rows) => {
                 let at = rows
                     .partition_point(|&(z, _)| z <= z_frac)
@@ -135,7 +147,7 @@ impl Profile {
                 fresnel::check_complex_index("profile front", *front)?;
                 fresnel::check_complex_index("profile back", *back)
             }
-            Profile::Exponential { front, back } => {
+            Profile::Exponential { front, back } | Profile::Reciprocal { front, back } => {
                 fresnel::check_real_index("profile front", *front)?;
                 fresnel::check_real_index("profile back", *back)
             }
