@@ -24,6 +24,8 @@ struct Cli {
 enum Command {
     /// Thin-film reflectance and transmittance, spectral, from CSV on stdin or flags.
     Reflectance(commands::reflectance::Args),
+    /// Fit a film's (or one stack layer's) thickness to a measured reflectance spectrum.
+    Fit(commands::fit::Args),
     /// CIE colour of a soap film, from CSV `thickness_nm,angle_deg` on stdin.
     Color(commands::color::Args),
     /// Draw the interference colour chart (colour against thickness) to a PNG.
@@ -50,6 +52,7 @@ fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Reflectance(args) => commands::reflectance::run(args),
+        Command::Fit(args) => commands::fit::run(args),
         Command::Color(args) => commands::color::run(args),
         Command::Chart(args) => commands::chart::run(args),
         Command::Bake(args) => commands::bake::run(args),

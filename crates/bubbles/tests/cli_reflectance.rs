@@ -282,3 +282,225 @@ fn bad_refractive_index_is_rejected() {
 fn partial_single_query_flags_are_rejected() {
     rejects(&["--thickness-nm", "5"], "", &["--angle-deg"]);
 }
+
+#[test]
+fn incoherent_slide_in_a_stack_is_the_closed_form_sum_of_intensities() {
+    // A bare 1 mm slide: R = R1 + T1² R1 / (1 − R1²) for each polarisation, R1 from the
+    // single interface; its thickness does not matter when it does not absorb.
+    let text = stdout(&run(
+        &["--stack", "1.0 | 1.52 @ 1e6 incoherent | 1.0"],
+        "angle_deg,wavelength_nm\n0,550\n45,600\n",
+    ));
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("angle_deg,wavelength_nm,r_s,r_p,r,t,a"));
+    for (line, angle) in lines.zip([0.0, 45.0]) {
+        let v: Vec<f64> = line.split(',').map(|f| f.parse().unwrap()).collect();
+        let cos = f64::to_radians(angle).cos();
+        let one = thinfilm::Interface::new(1.0, thinfilm::Complex64::new(1.52, 0.0))
+            .unwrap()
+            .response(cos);
+        for (r, r1) in [(v[2], one.r_s), (v[3], one.r_p)] {
+            let t1 = 1.0 - r1;
+            let closed = r1 + t1 * t1 * r1 / (1.0 - r1 * r1);
+            assert!((r - closed).abs() < 1e-14, "angle {angle}: {r} vs {closed}");
+        }
+        assert!(
+            v[6].abs() < 1e-14,
+            "a lossless slide absorbs nothing: a = {}",
+            v[6]
+        );
+    }
+}
+
+#[test]
+fn misspelt_incoherent_marker_is_rejected_naming_it() {
+    rejects(
+        &[
+            "--stack",
+            "1.0 | 1.52 @ 1e6 incoherant | 1.0",
+            "--angle-deg",
+            "0",
+            "--wavelength-nm",
+            "550",
+        ],
+        "",
+        &["medium 2", "1e6 incoherant"],
+    );
+}
+
+// `bubbles fit` (here beside the reflectance it inverts): a spectrum written by
+// `bubbles reflectance --stack` is fitted back.
+
+fn fit(args: &[&str], stdin: &str) -> Output {
+    common::bubbles_piped(&[&["fit"], args].concat(), stdin)
+}
+
+#[test]
+fn fit_recovers_the_thickness_that_reflectance_wrote() {
+    let mut query = String::from("angle_deg,wavelength_nm\n");
+    for k in 0..=100 {
+        query.push_str(&format!("10,{}\n", 420 + 4 * k));
+    }
+    let stack = "1.0 | 1.46 @ 812.5 | 3.88+0.02i";
+    let spectrum = stdout(&common::bubbles_piped(
+        &["reflectance", "--stack", stack],
+        &query,
+    ));
+    // Keep wavelength_nm and the unpolarised r (columns 2 and 5).
+    let mut csv = String::from("wavelength_nm,r\n");
+    for line in spectrum.lines().skip(1) {
+        let v: Vec<&str> = line.split(',').collect();
+        csv.push_str(&format!("{},{}\n", v[1], v[4]));
+    }
+    let out = stdout(&fit(
+        &[
+            "--spectrum",
+            "-",
+            "--stack",
+            stack,
+            "--angle-deg",
+            "10",
+            "--max-nm",
+            "3000",
+        ],
+        &csv,
+    ));
+    let mut lines = out.lines();
+    assert_eq!(
+        lines.next(),
+        Some(
+            "thickness_nm,low_nm,high_nm,sigma_nm,systematic_nm,offset,rms_residual,runner_up_nm,runner_up_rms"
+        )
+    );
+    let v: Vec<f64> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(|f| f.parse().unwrap())
+        .collect();
+    assert!((v[0] - 812.5).abs() < 1e-3, "{v:?}");
+    assert!(v[1] <= 812.5 + 1e-3 && 812.5 - 1e-3 <= v[2], "{v:?}");
+}
+
+#[test]
+fn fit_rejects_bad_input_with_exit_2_naming_it() {
+    let spectrum = "wavelength_nm,r\n400,0.1\n500,0.2\n600,0.3\n";
+    for (args, stdin, needle) in [
+        (
+            vec!["--spectrum", "-"],
+            "wavelength_nm,r\n400,0.1\n500,x\n",
+            "x",
+        ),
+        (vec!["--spectrum", "-", "--angle-deg", "95"], spectrum, "95"),
+        (
+            vec!["--spectrum", "-", "--min-nm", "9", "--max-nm", "1"],
+            spectrum,
+            "[9, 1]",
+        ),
+        (
+            vec![
+                "--spectrum",
+                "-",
+                "--stack",
+                "1 | 1.46 @ 0 | 3.9",
+                "--vary-layer",
+                "2",
+            ],
+            spectrum,
+            "--vary-layer 2",
+        ),
+        (
+            vec!["--spectrum", "/nonexistent/s.csv"],
+            "",
+            "/nonexistent/s.csv",
+        ),
+    ] {
+        let output = fit(&args, stdin);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(output.stdout.is_empty());
+        assert!(
+            stderr.contains(needle),
+            "{args:?}: {stderr:?} lacks {needle:?}"
+        );
+    }
+}
+
+#[test]
+fn graded_layer_in_a_stack_reports_its_error_bound_and_a_constant_one_is_homogeneous() {
+    let query = "angle_deg,wavelength_nm\n0,550\n40,700\n";
+    let graded = stdout(&run(
+        &["--stack", "1.0 | linear(1.8, 1.8) @ 250 | 1.52"],
+        query,
+    ));
+    let plain = stdout(&run(&["--stack", "1.0 | 1.8 @ 250 | 1.52"], query));
+    let mut g = graded.lines();
+    assert_eq!(
+        g.next(),
+        Some("angle_deg,wavelength_nm,r_s,r_p,r,t,a,error_bound")
+    );
+    for (g, p) in g.zip(plain.lines().skip(1)) {
+        let g: Vec<f64> = g.split(',').map(|f| f.parse().unwrap()).collect();
+        let p: Vec<f64> = p.split(',').map(|f| f.parse().unwrap()).collect();
+        for k in 2..6 {
+            assert!((g[k] - p[k]).abs() < 1e-12, "{g:?} vs {p:?}");
+        }
+        assert!(g[7] <= 1e-9, "error bound {}", g[7]);
+    }
+    // An air-to-glass ramp: far below bare glass's 4.3 %, within its stated bound.
+    let ramp = stdout(&run(
+        &[
+            "--stack",
+            "1.0 | linear(1.0, 1.52) @ 500 | 1.52",
+            "--graded-tolerance",
+            "1e-7",
+        ],
+        "angle_deg,wavelength_nm\n0,550\n",
+    ));
+    let v: Vec<f64> = ramp
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .map(|f| f.parse().unwrap())
+        .collect();
+    assert!(v[4] < 0.005 && v[7] <= 1e-7, "{v:?}");
+}
+
+#[test]
+fn bad_graded_layers_are_rejected_naming_them() {
+    let flags = ["--angle-deg", "0", "--wavelength-nm", "550"];
+    for (stack, needle) in [
+        ("1.0 | linear(1.0 1.5) @ 100 | 1.5", "n_front, n_back"),
+        ("1.0 | exponential(1.0, 1.5+1i) @ 100 | 1.5", "real"),
+        (
+            "1.0 | linear(1.0, 1.5) @ 100 | linear(1.0, 1.5) @ 100 | 1.5",
+            "only one",
+        ),
+        (
+            "1.0 | graded(/nonexistent/p.csv) | 1.5",
+            "/nonexistent/p.csv",
+        ),
+        ("1.0 | linear(1.0, -1.5) @ 100 | 1.5", "-1.5"),
+    ] {
+        rejects(
+            &[&["--stack", stack][..], &flags[..]].concat(),
+            "",
+            &[needle],
+        );
+    }
+    rejects(
+        &[
+            &[
+                "--stack",
+                "1.0 | linear(1.0, 1.5) @ 100 | 1.5",
+                "--graded-tolerance",
+                "0",
+            ][..],
+            &flags[..],
+        ]
+        .concat(),
+        "",
+        &["--graded-tolerance 0"],
+    );
+}

@@ -25,6 +25,7 @@
 use crate::fresnel::{self, OpticsError};
 
 mod cells;
+pub(crate) mod film_f64;
 mod kernel;
 mod term;
 

@@ -21,14 +21,17 @@
 //! Optics: [`fresnel`], [`airy`] (exact single film), [`tmm`] (N-layer stacks, exact for
 //! any thickness), [`dispersion`] (real models, each with its wavelength range), [`index`]
 //! (complex and tabulated n,k models), [`incidence`] (angle or sin θ, exact at grazing),
-//! and the f32 fast path [`batch`]. Colour, split pbrt-style:
+//! the exact film grid [`grid`] and the f32 fast path [`batch`]. Colour, split pbrt-style:
 //! [`spectrum`], [`cmf`], [`illuminant`], [`integrate`] (with [`cells`], exact at grazing
 //! incidence), [`colorspace`], [`lab`].
 
 pub mod airy;
 pub mod batch;
 pub mod dispersion;
+pub mod fit;
 pub mod fresnel;
+pub mod graded;
+pub mod grid;
 pub mod incidence;
 pub mod index;
 pub mod tmm;

@@ -16,6 +16,8 @@ use crate::incidence::Incidence;
 use crate::index::IndexModel;
 use num_complex::Complex64;
 
+mod incoherent;
+
 /// One homogeneous layer of a stack.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Layer {
@@ -23,6 +25,9 @@ pub struct Layer {
     pub index: IndexModel,
     /// Physical thickness in nm.
     pub thickness_nm: f64,
+    /// `false` for an incoherent layer (thick compared with the light's coherence length,
+    /// such as a substrate slide): intensities add across it instead of amplitudes.
+    pub coherent: bool,
 }
 
 impl Layer {
@@ -31,6 +36,16 @@ impl Layer {
         Layer {
             index: index.into(),
             thickness_nm,
+            coherent: true,
+        }
+    }
+
+    /// An incoherent layer (see [`Layer::coherent`]): its multiple reflections add in
+    /// intensity, as in Byrnes' `inc_tmm`; only its absorption depends on its thickness.
+    pub fn incoherent(index: impl Into<IndexModel>, thickness_nm: f64) -> Layer {
+        Layer {
+            coherent: false,
+            ..Layer::new(index, thickness_nm)
         }
     }
 
@@ -62,6 +77,8 @@ struct Media {
     n0: f64,
     layers: Vec<(Complex64, f64)>,
     n_sub: Complex64,
+    /// Positions in `layers` of the incoherent layers, front to back.
+    incoherent: Vec<usize>,
 }
 
 impl Stack {
@@ -125,6 +142,9 @@ impl Stack {
         incidence: Incidence,
     ) -> Result<Amplitudes, OpticsError> {
         let media = self.media(wavelength_nm)?;
+        if let Some(&k) = media.incoherent.first() {
+            return Err(OpticsError::Incoherent { layer: k + 1 });
+        }
         if incidence.cos() == 0.0 {
             let (r_s, r_p, t) = if media.all_equal() {
                 (0.0, 0.0, 1.0)
@@ -138,8 +158,7 @@ impl Stack {
                 t_p: t.into(),
             });
         }
-        let s = media.solve(Polarisation::S, wavelength_nm, incidence);
-        let h = media.solve(Polarisation::P, wavelength_nm, incidence);
+        let [s, h] = media.solve_both(wavelength_nm, incidence);
         // The p solve works with H_y: its r has the opposite sign and its t is scaled by
         // n_sub/n_0 relative to the electric-field convention of `fresnel`.
         Ok(Amplitudes {
@@ -171,8 +190,10 @@ impl Stack {
         if incidence.cos() == 0.0 {
             return Ok(Response::grazing(media.all_equal()));
         }
-        let s = media.solve(Polarisation::S, wavelength_nm, incidence);
-        let p = media.solve(Polarisation::P, wavelength_nm, incidence);
+        if !media.incoherent.is_empty() {
+            return Ok(media.incoherent_response(wavelength_nm, incidence));
+        }
+        let [s, p] = media.solve_both(wavelength_nm, incidence);
         Ok(Response {
             r_s: s.r.norm_sqr(),
             r_p: p.r.norm_sqr(),
@@ -208,10 +229,14 @@ impl Stack {
             .iter()
             .map(|layer| Ok((checked(&layer.index, "layer index")?, layer.thickness_nm)))
             .collect::<Result<_, OpticsError>>()?;
+        let incoherent = (self.layers.iter().enumerate())
+            .filter_map(|(k, layer)| (!layer.coherent).then_some(k))
+            .collect();
         Ok(Media {
             n0: self.n_incident,
             layers,
             n_sub: checked(&self.n_substrate, "n_substrate")?,
+            incoherent,
         })
     }
 }
@@ -229,68 +254,149 @@ impl Media {
         self.n_sub == n0 && self.layers.iter().all(|&(n, _)| n == n0)
     }
 
-    /// Requires `incidence.cos() > 0`.
+    /// `[s, p]`; requires `incidence.cos() > 0`.
+    fn solve_both(&self, wavelength_nm: f64, incidence: Incidence) -> [Solution; 2] {
+        let block = Block {
+            entry: Complex64::new(self.n0, 0.0),
+            layers: &self.layers,
+            reversed: false,
+            exit: self.n_sub,
+        };
+        block.solve_pols(
+            [Polarisation::S, Polarisation::P],
+            self.n0,
+            wavelength_nm,
+            incidence,
+        )
+    }
+}
+
+/// Coherent layers between two semi-infinite media: the whole stack, or (with incoherent
+/// layers) the run of coherent layers between two incoherent media.
+struct Block<'a> {
+    /// The medium light arrives from (complex when it is an absorbing incoherent layer).
+    entry: Complex64,
+    /// The coherent layers, front to back as stored.
+    layers: &'a [(Complex64, f64)],
+    /// Light meets `layers` back to front (the block seen from its exit side).
+    reversed: bool,
+    /// The medium light leaves into.
+    exit: Complex64,
+}
+
+impl Block<'_> {
+    /// Requires `incidence.cos() > 0`; `n0` is the real incident medium of the whole stack
+    /// (its `n0 sin θ` is the same in every medium, Snell).
     ///
     /// `[B, C] = M_1 ⋯ M_N [1, y_sub]` is carried as `e^{L} [B', C']` with `[B', C']` of
     /// modulus ≤ 1: each layer's matrix is applied divided by `e^{Im δ}` (its largest
     /// possible growth) and the product renormalised, the scales summed into `L`. Then
     /// `r` is scale-free, `t = 2 y0 e^{−L} / (y0 B' + C')` and `T` carries `e^{−2L}`.
-    fn solve(&self, pol: Polarisation, wavelength_nm: f64, incidence: Incidence) -> Solution {
+    /// From an absorbing entry medium `T = |t|² Re y_sub / Re y0`: Byrnes' power ratio
+    /// for incoherent media, the flux of the forward wave alone.
+    fn solve(
+        &self,
+        pol: Polarisation,
+        n0: f64,
+        wavelength_nm: f64,
+        incidence: Incidence,
+    ) -> Solution {
+        let [solution] = self.solve_pols([pol], n0, wavelength_nm, incidence);
+        solution
+    }
+
+    /// [`Block::solve`] for several polarisations at once: each layer's normal index,
+    /// phase and trigonometry, the costly part, are computed once for all of them.
+    fn solve_pols<const N: usize>(
+        &self,
+        pols: [Polarisation; N],
+        n0: f64,
+        wavelength_nm: f64,
+        incidence: Incidence,
+    ) -> [Solution; N] {
         let k_per_nm = std::f64::consts::TAU / wavelength_nm;
-        let admittance = |n: Complex64, q: Complex64| match pol {
+        let admittance = |pol: Polarisation, n: Complex64, q: Complex64| match pol {
             Polarisation::S => q,
             Polarisation::P => q / (n * n),
         };
-        let n0 = Complex64::new(self.n0, 0.0);
-        let y0 = admittance(n0, n0 * incidence.cos());
-        let y_sub = admittance(self.n_sub, incidence.normal_index(self.n0, self.n_sub));
-        let mut field = (Complex64::new(1.0, 0.0), y_sub);
-        let mut log_scale = 0.0;
-        for &(n, thickness_nm) in self.layers.iter().rev() {
-            let q = incidence.normal_index(self.n0, n);
-            let y = admittance(n, q);
+        let q_entry = incidence.normal_index(n0, self.entry);
+        let q_exit = incidence.normal_index(n0, self.exit);
+        let y0 = pols.map(|pol| admittance(pol, self.entry, q_entry));
+        let y_sub = pols.map(|pol| admittance(pol, self.exit, q_exit));
+        let mut field = y_sub.map(|y| (Complex64::new(1.0, 0.0), y));
+        let mut log_scale = [0.0; N];
+        // The matrices multiply from the exit side towards the entry side.
+        let count = self.layers.len();
+        for step in 0..count {
+            let at = if self.reversed {
+                step
+            } else {
+                count - 1 - step
+            };
+            let (n, thickness_nm) = self.layers[at];
+            let q = incidence.normal_index(n0, n);
             let delta = k_per_nm * thickness_nm * q;
             let (cos_d, sin_d, sinc_d) = scaled_trig(delta);
-            let q_over_y = match pol {
-                Polarisation::S => Complex64::new(1.0, 0.0),
-                Polarisation::P => n * n,
-            };
-            let sin_over_y = k_per_nm * thickness_nm * q_over_y * sinc_d;
-            let minus_i = Complex64::new(0.0, -1.0);
-            field = (
-                cos_d * field.0 + minus_i * sin_over_y * field.1,
-                minus_i * y * sin_d * field.0 + cos_d * field.1,
-            );
-            let size = field.0.norm().max(field.1.norm());
-            if size > 0.0 && size.is_finite() {
-                field = (field.0 / size, field.1 / size);
-                log_scale += delta.im + size.ln();
-            } else {
-                log_scale += delta.im;
+            for k in 0..N {
+                let pol = pols[k];
+                let y = admittance(pol, n, q);
+                let q_over_y = match pol {
+                    Polarisation::S => Complex64::new(1.0, 0.0),
+                    Polarisation::P => n * n,
+                };
+                let sin_over_y = k_per_nm * thickness_nm * q_over_y * sinc_d;
+                let minus_i = Complex64::new(0.0, -1.0);
+                let f = field[k];
+                let next = (
+                    cos_d * f.0 + minus_i * sin_over_y * f.1,
+                    minus_i * y * sin_d * f.0 + cos_d * f.1,
+                );
+                let size = next.0.norm().max(next.1.norm());
+                if size > 0.0 && size.is_finite() {
+                    field[k] = (next.0 / size, next.1 / size);
+                    log_scale[k] += delta.im + size.ln();
+                } else {
+                    field[k] = next;
+                    log_scale[k] += delta.im;
+                }
             }
         }
-        let (b, c) = field;
-        let den = y0 * b + c;
-        let shrink = (-log_scale).exp();
-        Solution {
-            r: divide(y0 * b - c, den),
-            t: divide(2.0 * y0, den) * shrink,
-            // Divided factor by factor: |den|² alone underflows a hair from grazing.
-            transmittance: 4.0 * (y0.re / den.norm()) * (y_sub.re / den.norm()) * shrink * shrink,
-        }
+        std::array::from_fn(|k| {
+            let (y0, y_sub) = (y0[k], y_sub[k]);
+            let (b, c) = field[k];
+            let den = y0 * b + c;
+            let shrink = (-log_scale[k]).exp();
+            let transmittance = if y0.im == 0.0 {
+                // Divided factor by factor: |den|² alone underflows a hair from grazing.
+                4.0 * (y0.re / den.norm()) * (y_sub.re / den.norm()) * shrink * shrink
+            } else if y0.re > 0.0 {
+                let ratio = y0.norm() / den.norm() * shrink;
+                4.0 * ratio * ratio * (y_sub.re / y0.re)
+            } else {
+                // An evanescent entry medium carries no power towards the block.
+                0.0
+            };
+            Solution {
+                r: divide(y0 * b - c, den),
+                t: divide(2.0 * y0, den) * shrink,
+                transmittance,
+            }
+        })
     }
 }
 
 /// `(cos δ, sin δ, sin δ / δ)`, each times `e^{−Im δ}` so that none overflows however large
 /// `Im δ ≥ 0` is: `e^{−Im δ} cos δ = (e^{i Re δ − 2 Im δ} + e^{−i Re δ}) / 2`.
 fn scaled_trig(delta: Complex64) -> (Complex64, Complex64, Complex64) {
-    let damp = (-delta.im).exp();
-    let forward = Complex64::from_polar((-2.0 * delta.im).exp(), delta.re);
-    let backward = Complex64::from_polar(1.0, -delta.re);
+    // One sine and cosine for both waves (libm's are exactly odd and even in their angle).
+    let (sin_re, cos_re) = delta.re.sin_cos();
+    let grow = (-2.0 * delta.im).exp();
+    let forward = Complex64::new(grow * cos_re, grow * sin_re);
+    let backward = Complex64::new(cos_re, -sin_re);
     let cos_d = 0.5 * (forward + backward);
     let sin_d = Complex64::new(0.0, -0.5) * (forward - backward);
     let sinc_d = if delta.norm_sqr() < 1e-8 {
-        sinc(delta) * damp
+        sinc(delta) * (-delta.im).exp()
     } else {
         sin_d / delta
     };

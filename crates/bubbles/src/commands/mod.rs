@@ -6,6 +6,7 @@ pub mod bench;
 pub mod chart;
 pub mod color;
 pub mod compare;
+pub mod fit;
 pub mod reflectance;
 pub mod render;
 pub mod simulate;

@@ -10,7 +10,7 @@
 //! Stack input columns: `angle_deg,wavelength_nm[,thickness_nm]`; output adds the
 //! absorbed fraction `a = 1 − r − t`.
 
-mod stack;
+pub(crate) mod stack;
 
 use std::fmt::Write as _;
 use std::io::{Read as _, Write as _};
@@ -62,14 +62,20 @@ pub struct Args {
     )]
     n_film: Option<f64>,
     /// A multilayer stack, e.g. "1.0 | 1.38 @ 100 | 2.1 @ 60 | 0.18+3.4i": media from the
-    /// incidence side, inner layers as `index @ thickness_nm`; an index is a number, a+bi,
-    /// `water` or a `wavelength_nm,n,k` CSV file. CSV on stdin then gives
+    /// incidence side, inner layers as `index @ thickness_nm`, or `index @ thickness_nm
+    /// incoherent` for a layer whose reflections add in intensity (a 1 mm slide:
+    /// `1.52 @ 1e6 incoherent`); an index is a number, a+bi, `water` or a
+    /// `wavelength_nm,n,k` CSV file. CSV on stdin then gives
     /// `angle_deg,wavelength_nm[,thickness_nm]`.
     #[arg(long, value_name = "STACK")]
     stack: Option<String>,
     /// The inner layer (1-based) whose thickness a `thickness_nm` column or flag overrides.
     #[arg(long, value_name = "K", default_value_t = 1, requires = "stack")]
     vary_layer: usize,
+    /// A graded layer (`linear(a, b) @ d`, `exponential(a, b) @ d` or `graded(PATH)` in
+    /// --stack) is sliced until its estimated error in R and T is at most this.
+    #[arg(long, value_name = "TOL", default_value_t = 1e-9, requires = "stack")]
+    graded_tolerance: f64,
 }
 
 /// One validated query, with the input line it came from (0 for flags).
@@ -96,7 +102,13 @@ pub fn run(args: Args) -> CliResult {
 }
 
 fn run_stack(text: &str, args: &Args) -> Result<String, CliError> {
-    let parsed = stack::parse_stack(text)?;
+    let (parsed, graded) = stack::parse_stack_graded(text)?;
+    if !(args.graded_tolerance.is_finite() && args.graded_tolerance > 0.0) {
+        return Err(CliError::input(format!(
+            "--graded-tolerance {} is not finite and > 0",
+            args.graded_tolerance
+        )));
+    }
     let queries = match (args.angle_deg, args.wavelength_nm) {
         (None, None) if args.thickness_nm.is_none() => stack::queries_from_csv(&read_stdin()?)?,
         (Some(angle_deg), Some(wavelength_nm)) => {
@@ -118,7 +130,13 @@ fn run_stack(text: &str, args: &Args) -> Result<String, CliError> {
             ));
         }
     };
-    stack::render(&parsed, args.vary_layer, &queries)
+    stack::render(
+        &parsed,
+        graded.as_ref(),
+        args.graded_tolerance,
+        args.vary_layer,
+        &queries,
+    )
 }
 
 fn read_stdin() -> Result<String, CliError> {

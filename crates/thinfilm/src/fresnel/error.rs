@@ -88,6 +88,21 @@ pub enum OpticsError {
         /// The rejected value.
         value: f64,
     },
+    /// A thickness fit's inputs that cannot be used (named in `reason`).
+    Fit {
+        /// What is wrong.
+        reason: String,
+    },
+    /// A graded-index layer's tolerance that is invalid or not reached (named in `reason`).
+    Graded {
+        /// What is wrong.
+        reason: String,
+    },
+    /// Amplitudes asked of a stack with an incoherent layer, which has only intensities.
+    Incoherent {
+        /// The first incoherent layer, 1-based.
+        layer: usize,
+    },
 }
 
 impl fmt::Display for OpticsError {
@@ -149,6 +164,13 @@ impl fmt::Display for OpticsError {
             OpticsError::NotFinite { what, index, value } => {
                 write!(f, "{what}[{index}] = {value} is not a valid value")
             }
+            OpticsError::Fit { reason } => write!(f, "thickness fit: {reason}"),
+            OpticsError::Graded { reason } => write!(f, "graded layer: {reason}"),
+            OpticsError::Incoherent { layer } => write!(
+                f,
+                "layer {layer} is incoherent: a stack with incoherent layers has intensities \
+                 (R, T), not amplitudes"
+            ),
         }
     }
 }

@@ -5,11 +5,19 @@
 //! `index @ thickness_nm`. An index is a real number (`1.38`), a complex one with `κ ≥ 0`
 //! (`0.18+3.4i`), `water` (IAPWS, 200–1100 nm), or the path of a `wavelength_nm,n,k` CSV
 //! table. The incidence medium must be a real number (its power flux must be defined).
+//! A layer followed by the word `incoherent` (`1.52 @ 1e6 incoherent`, a 1 mm slide) adds
+//! its multiple reflections in intensity, not amplitude (Byrnes' `inc_tmm`).
+//! One inner layer may be graded-index: `linear(n_front, n_back) @ thickness_nm` (n and
+//! κ linear in depth, e.g. `linear(1.0, 1.52) @ 500`), `exponential(n_front, n_back) @
+//! thickness_nm` (real), or `graded(PATH)` with a `z_nm,n,k` CSV profile whose last z is
+//! the thickness; each query then slices it until the estimated error is within
+//! `--graded-tolerance`, reported in an `error_bound` column (`thinfilm::graded`).
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use thinfilm::dispersion::RefractiveIndex;
+use thinfilm::graded::{GradedLayer, Profile};
 use thinfilm::{Complex64, Incidence, IndexModel, Layer, NkTable, Stack};
 
 use crate::csv_table::{CsvRow, CsvTable};
@@ -18,11 +26,85 @@ use crate::error::CliError;
 /// Header of the stack output without the optional leading `thickness_nm`.
 const HEADER: &str = "angle_deg,wavelength_nm,r_s,r_p,r,t,a";
 
-/// Parses `--stack` text into a validated stack.
+/// Parses `--stack` text into a validated stack without graded layers.
+///
+/// # Errors
+/// An input error quoting the medium (1-based) and the bad token or value, or naming a
+/// graded layer.
+pub fn parse_stack(text: &str) -> Result<Stack, CliError> {
+    match parse_stack_graded(text)? {
+        (stack, None) => Ok(stack),
+        (_, Some((k, _))) => Err(CliError::input(format!(
+            "--stack \"{text}\": medium {}: a graded layer is not supported here",
+            k + 2
+        ))),
+    }
+}
+
+/// A graded token's profile and thickness, or `None` if `medium` is no graded token.
+fn parse_graded(medium: &str) -> Option<Result<(Profile, f64), String>> {
+    let lower = medium.to_ascii_lowercase();
+    if let Some(path) = lower
+        .strip_prefix("graded(")
+        .and_then(|r| r.strip_suffix(')'))
+    {
+        let path = &medium[7..7 + path.len()];
+        let text = match std::fs::read_to_string(path.trim()) {
+            Ok(text) => text,
+            Err(e) => return Some(Err(format!("graded profile {}: {e}", path.trim()))),
+        };
+        return Some(Profile::from_csv(&text).map_err(|e| format!("{}: {e}", path.trim())));
+    }
+    let kind = ["linear(", "exponential("]
+        .into_iter()
+        .find(|k| lower.starts_with(k))?;
+    let parsed = (|| {
+        let (inner, thickness) = medium[kind.len()..]
+            .split_once(')')
+            .ok_or_else(|| format!("`{medium}` lacks its `)`"))?;
+        let (front, back) = inner
+            .split_once(',')
+            .ok_or_else(|| format!("`{inner}` is not `n_front, n_back`"))?;
+        let thickness = thickness
+            .trim()
+            .strip_prefix('@')
+            .ok_or_else(|| format!("`{medium}` is not `{kind}n_front, n_back) @ thickness_nm`"))?
+            .trim();
+        let thickness_nm = parse_real(thickness)
+            .filter(|d| *d >= 0.0)
+            .ok_or_else(|| format!("thickness `{thickness}` is not a number >= 0 nm"))?;
+        let index = |t: &str| {
+            let t = t.trim();
+            parse_real(t)
+                .map(Complex64::from)
+                .or_else(|| parse_complex(t))
+                .ok_or_else(|| format!("`{t}` is not an index"))
+        };
+        let (front, back) = (index(front)?, index(back)?);
+        let profile = if kind == "linear(" {
+            Profile::Linear { front, back }
+        } else {
+            if front.im != 0.0 || back.im != 0.0 {
+                return Err(format!("an exponential profile is real: `{inner}`"));
+            }
+            Profile::Exponential {
+                front: front.re,
+                back: back.re,
+            }
+        };
+        Ok((profile, thickness_nm))
+    })();
+    Some(parsed)
+}
+
+/// Parses `--stack` text into a validated stack and its graded layer, if any: its position
+/// among the inner layers (0-based) and the layer, whose place in the stack holds a
+/// homogeneous stand-in of its front index and thickness.
 ///
 /// # Errors
 /// An input error quoting the medium (1-based) and the bad token or value.
-pub fn parse_stack(text: &str) -> Result<Stack, CliError> {
+#[allow(clippy::type_complexity)]
+pub fn parse_stack_graded(text: &str) -> Result<(Stack, Option<(usize, GradedLayer)>), CliError> {
     let media: Vec<&str> = text.split('|').map(str::trim).collect();
     let bad = |k: usize, what: String| {
         CliError::input(format!("--stack \"{text}\": medium {}: {what}", k + 1))
@@ -44,23 +126,43 @@ pub fn parse_stack(text: &str) -> Result<Stack, CliError> {
         )
     })?;
     let mut layers = Vec::new();
+    let mut graded = None;
     for (k, medium) in media.iter().enumerate().take(last).skip(1) {
+        if let Some(parsed) = parse_graded(medium) {
+            let (profile, thickness_nm) = parsed.map_err(|e| bad(k, e))?;
+            let front = profile.index_at(0.0);
+            let layer =
+                GradedLayer::try_new(profile, thickness_nm).map_err(|e| bad(k, e.to_string()))?;
+            if graded.is_some() {
+                return Err(bad(k, "only one layer may be graded".into()));
+            }
+            graded = Some((k - 1, layer));
+            layers.push(Layer::new(front, thickness_nm));
+            continue;
+        }
         let Some((index, thickness)) = medium.split_once('@') else {
             return Err(bad(k, format!("`{medium}` is not `index @ thickness_nm`")));
         };
         let index = parse_index(index.trim()).map_err(|e| bad(k, e))?;
-        let thickness = thickness.trim();
+        let (thickness, coherent) = match thickness.trim().rsplit_once(char::is_whitespace) {
+            Some((d, word)) if word.eq_ignore_ascii_case("incoherent") => (d.trim(), false),
+            _ => (thickness.trim(), true),
+        };
         let thickness_nm = parse_real(thickness).filter(|d| *d >= 0.0).ok_or_else(|| {
             bad(
                 k,
                 format!("thickness `{thickness}` is not a number >= 0 nm"),
             )
         })?;
-        layers.push(Layer::new(index, thickness_nm));
+        layers.push(Layer {
+            coherent,
+            ..Layer::new(index, thickness_nm)
+        });
     }
     let substrate = parse_index(media[last]).map_err(|e| bad(last, e))?;
-    Stack::new(n_incident, layers, substrate)
-        .map_err(|e| CliError::input(format!("--stack \"{text}\": {e}")))
+    let stack = Stack::new(n_incident, layers, substrate)
+        .map_err(|e| CliError::input(format!("--stack \"{text}\": {e}")))?;
+    Ok((stack, graded))
 }
 
 fn parse_real(token: &str) -> Option<f64> {
@@ -147,9 +249,18 @@ fn thickness(row: &CsvRow<'_>) -> Result<f64, CliError> {
 /// query overrides a thickness. Built whole before anything is printed.
 pub fn render(
     stack: &Stack,
+    graded: Option<&(usize, GradedLayer)>,
+    tolerance: f64,
     vary_layer: usize,
     queries: &[StackQuery],
 ) -> Result<String, CliError> {
+    if let Some(&(k, _)) = graded {
+        if queries.iter().any(|q| q.thickness_nm.is_some()) && vary_layer == k + 1 {
+            return Err(CliError::input(format!(
+                "--vary-layer {vary_layer} names the graded layer, whose thickness is its profile's"
+            )));
+        }
+    }
     let with_thickness = queries.iter().any(|q| q.thickness_nm.is_some());
     if with_thickness && !(1..=stack.layers.len()).contains(&vary_layer) {
         return Err(CliError::input(format!(
@@ -162,6 +273,9 @@ pub fn render(
         out.push_str("thickness_nm,");
     }
     out.push_str(HEADER);
+    if graded.is_some() {
+        out.push_str(",error_bound");
+    }
     out.push('\n');
     let mut varied = stack.clone();
     for q in queries {
@@ -181,10 +295,26 @@ pub fn render(
             varied.layers[vary_layer - 1].thickness_nm = d;
             let _ = write!(out, "{d},");
         }
-        let resp = varied
-            .try_response_at(q.wavelength_nm, incidence)
-            .map_err(|e| at(e.to_string()))?;
-        let _ = writeln!(
+        let (resp, bound) = match graded {
+            None => (
+                varied
+                    .try_response_at(q.wavelength_nm, incidence)
+                    .map_err(|e| at(e.to_string()))?,
+                None,
+            ),
+            Some((k, layer)) => {
+                let with = |slices: Vec<Layer>| {
+                    let mut s = varied.clone();
+                    s.layers.splice(*k..=*k, slices);
+                    Ok(s)
+                };
+                let c = layer
+                    .converged_response(with, q.wavelength_nm, incidence, tolerance)
+                    .map_err(|e| at(e.to_string()))?;
+                (c.response, Some(c.error_bound))
+            }
+        };
+        let _ = write!(
             out,
             "{},{},{},{},{},{},{}",
             q.angle_deg,
@@ -195,6 +325,10 @@ pub fn render(
             resp.t(),
             resp.absorptance()
         );
+        if let Some(bound) = bound {
+            let _ = write!(out, ",{bound}");
+        }
+        out.push('\n');
     }
     Ok(out)
 }
@@ -213,11 +347,22 @@ mod tests {
     }
 
     #[test]
+    fn incoherent_word_marks_a_layer() {
+        let stack = parse_stack("1.0 | 1.33 @ 300 | 1.52 @ 1e6 INCOHERENT | 1.0").unwrap();
+        let flags: Vec<bool> = stack.layers.iter().map(|l| l.coherent).collect();
+        assert_eq!(flags, [true, false]);
+        assert_eq!(stack.layers[1].thickness_nm, 1e6);
+        let err = parse_stack("1.0 | 1.52 @ 1e6 incoherant | 1.0").unwrap_err();
+        assert!(err.to_string().contains("1e6 incoherant"), "{err}");
+    }
+
+    #[test]
     fn stack_syntax_gives_the_layers_in_order() {
         let stack = parse_stack("1.0 | 1.38 @ 100 | 2.1 @ 60 | 0.18+3.4i").unwrap();
         assert_eq!(stack.n_incident, 1.0);
         let d: Vec<f64> = stack.layers.iter().map(|l| l.thickness_nm).collect();
         assert_eq!(d, [100.0, 60.0]);
+        assert!(stack.layers.iter().all(|layer| layer.coherent));
         assert_eq!(
             stack.n_substrate.as_constant(),
             Some(Complex64::new(0.18, 3.4))

@@ -1,0 +1,177 @@
+//! `bubbles fit`: the thickness of a film, or of one layer of a stack, fitted to a measured
+//! reflectance spectrum (`thinfilm::fit`: global search over the fringe order, 95 %
+//! interval, residual).
+//!
+//! Input: `--spectrum F.csv` with columns `wavelength_nm,r` (unpolarised reflectance; `-`
+//! reads stdin). Output: one CSV row
+//! `thickness_nm,low_nm,high_nm,sigma_nm,systematic_nm,offset,rms_residual,runner_up_nm,runner_up_rms`.
+
+use std::io::{Read as _, Write as _};
+
+use thinfilm::fit::{Measurement, Search, fit_thickness};
+use thinfilm::{Incidence, Layer, Stack};
+
+use crate::csv_table::CsvTable;
+use crate::error::{CliError, CliResult};
+
+const HEADER: &str = "thickness_nm,low_nm,high_nm,sigma_nm,systematic_nm,offset,rms_residual,runner_up_nm,runner_up_rms";
+
+/// Arguments of `bubbles fit`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The measured spectrum: CSV `wavelength_nm,r` (`-` for stdin).
+    #[arg(long, value_name = "FILE")]
+    spectrum: String,
+    /// Film index of a free film `n_outside | n_film | n_outside` (without --stack).
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 1.33,
+        conflicts_with = "stack"
+    )]
+    n_film: f64,
+    /// Index on both sides of a free film (without --stack).
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 1.0,
+        conflicts_with = "stack"
+    )]
+    n_outside: f64,
+    /// A stack in `bubbles reflectance --stack` syntax; the thickness of layer
+    /// --vary-layer is fitted (its written thickness is ignored).
+    #[arg(long, value_name = "STACK")]
+    stack: Option<String>,
+    /// The inner layer (1-based) whose thickness is fitted.
+    #[arg(long, value_name = "K", default_value_t = 1, requires = "stack")]
+    vary_layer: usize,
+    /// Angle of incidence in degrees, in [0, 90).
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    angle_deg: f64,
+    /// Thinnest thickness searched, nm.
+    #[arg(
+        long,
+        value_name = "NM",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    min_nm: f64,
+    /// Thickest thickness searched, nm.
+    #[arg(
+        long,
+        value_name = "NM",
+        default_value_t = 5000.0,
+        allow_negative_numbers = true
+    )]
+    max_nm: f64,
+    /// Uncertainty of the spectrometer's wavelength calibration, nm (widens the interval).
+    #[arg(
+        long,
+        value_name = "NM",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    wavelength_uncertainty_nm: f64,
+}
+
+/// Runs `bubbles fit`.
+pub fn run(args: Args) -> CliResult {
+    let text = if args.spectrum == "-" {
+        let mut text = String::new();
+        std::io::stdin()
+            .read_to_string(&mut text)
+            .map_err(|e| CliError::input(format!("cannot read the spectrum from stdin: {e}")))?;
+        text
+    } else {
+        std::fs::read_to_string(&args.spectrum)
+            .map_err(|e| CliError::input(format!("--spectrum {}: {e}", args.spectrum)))?
+    };
+    let table = CsvTable::parse(&text, &["wavelength_nm", "r"], &[])?;
+    let (mut wavelength_nm, mut reflectance) = (Vec::new(), Vec::new());
+    for row in table.rows() {
+        wavelength_nm.push(row.number("wavelength_nm")?);
+        reflectance.push(row.number("r")?);
+    }
+    if !(0.0..90.0).contains(&args.angle_deg) {
+        return Err(CliError::input(format!(
+            "--angle-deg {} is not an angle in [0, 90) degrees",
+            args.angle_deg
+        )));
+    }
+    let incidence = Incidence::try_from_angle_deg(args.angle_deg)
+        .map_err(|e| CliError::input(format!("--angle-deg: {e}")))?;
+    let (base, layer) = match &args.stack {
+        Some(text) => {
+            let stack = super::reflectance::stack::parse_stack(text)?;
+            if !(1..=stack.layers.len()).contains(&args.vary_layer) {
+                return Err(CliError::input(format!(
+                    "--vary-layer {} names no layer: the stack has {} inner layer(s)",
+                    args.vary_layer,
+                    stack.layers.len()
+                )));
+            }
+            (stack, args.vary_layer - 1)
+        }
+        None => {
+            let film = Stack::new(
+                args.n_outside,
+                vec![Layer::new(args.n_film, 0.0)],
+                args.n_outside,
+            )
+            .map_err(|e| {
+                CliError::input(format!(
+                    "--n-film {} / --n-outside {}: {e}",
+                    args.n_film, args.n_outside
+                ))
+            })?;
+            (film, 0)
+        }
+    };
+    // The unknown layer's largest real index over the spectrum sets the scan step.
+    let n_max = wavelength_nm
+        .iter()
+        .filter_map(|&w| base.layers[layer].index.try_n_at(w).ok())
+        .fold(0.0f64, |m, n| m.max(n.re));
+    let model = |d: f64| {
+        let mut stack = base.clone();
+        stack.layers[layer].thickness_nm = d;
+        Ok(stack)
+    };
+    let fit = fit_thickness(
+        model,
+        &Measurement {
+            wavelength_nm: &wavelength_nm,
+            reflectance: &reflectance,
+            incidence,
+            wavelength_uncertainty_nm: args.wavelength_uncertainty_nm,
+        },
+        Search {
+            min_nm: args.min_nm,
+            max_nm: args.max_nm,
+            n_max: if n_max > 0.0 { n_max } else { 1.0 },
+        },
+    )
+    .map_err(|e| CliError::input(e.to_string()))?;
+    let out = format!(
+        "{HEADER}\n{},{},{},{},{},{},{},{},{}\n",
+        fit.thickness_nm,
+        fit.low_nm,
+        fit.high_nm,
+        fit.sigma_nm,
+        fit.systematic_nm,
+        fit.offset,
+        fit.rms_residual,
+        fit.runner_up_nm,
+        fit.runner_up_rms
+    );
+    let mut stdout = std::io::stdout().lock();
+    stdout
+        .write_all(out.as_bytes())
+        .and_then(|()| stdout.flush())
+        .map_err(|e| CliError::runtime(format!("cannot write to stdout: {e}")))
+}

@@ -1,0 +1,87 @@
+"""Type hints for thinfilm: exact thin-film and multilayer optics, computed in Rust."""
+
+from typing import Sequence, TypedDict
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+__all__ = ["rt", "graded_rt", "film_rt", "film_rt_grid", "fit_thickness", "film_xyz", "xyz_to_srgb"]
+
+def rt(
+    n: Sequence[complex] | ArrayLike,
+    d_nm: Sequence[float] | ArrayLike,
+    wavelength_nm: ArrayLike,
+    angle_deg: ArrayLike,
+    pol: str = "u",
+    coherent: Sequence[bool] | None = None,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Reflectance and transmittance ``(R, T)`` of a multilayer stack (incoherent layers
+    where ``coherent`` says False)."""
+
+def graded_rt(
+    n: Sequence[complex] | ArrayLike,
+    d_nm: Sequence[float] | ArrayLike,
+    layer: int,
+    profile: tuple[str, complex, complex] | ArrayLike,
+    wavelength_nm: ArrayLike,
+    angle_deg: ArrayLike,
+    pol: str = "u",
+    tolerance: float = 1e-9,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """``(R, T, error_bound)`` of a stack whose inner layer ``layer`` is graded-index."""
+
+def film_rt(
+    thickness_nm: ArrayLike,
+    angle_deg: ArrayLike,
+    wavelength_nm: ArrayLike,
+    n_film: float = 1.33,
+    n_outside: float = 1.0,
+    fast: bool = False,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``(R, T)`` of a free-standing film (unpolarised), broadcast."""
+
+def film_rt_grid(
+    thickness_nm: ArrayLike,
+    angle_deg: ArrayLike,
+    wavelength_nm: ArrayLike,
+    n_film: float = 1.33,
+    n_outside: float = 1.0,
+    pol: str = "u",
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``(R, T)`` on the grid of three 1-d axes, shape ``(thickness, angle, wavelength)``."""
+
+class FitResult(TypedDict):
+    """What :func:`fit_thickness` returns."""
+
+    thickness_nm: float
+    interval_nm: tuple[float, float]
+    sigma_nm: float
+    systematic_nm: float
+    offset: float
+    rms_residual: float
+    runner_up_nm: float
+    runner_up_rms: float
+
+def fit_thickness(
+    wavelength_nm: ArrayLike,
+    reflectance: ArrayLike,
+    n: Sequence[complex] | ArrayLike = (1.0, 1.33, 1.0),
+    d_nm: Sequence[float] | ArrayLike | None = None,
+    layer: int = 0,
+    angle_deg: float = 0.0,
+    thickness_range_nm: tuple[float, float] = (0.0, 5000.0),
+    wavelength_uncertainty_nm: float = 0.0,
+) -> FitResult:
+    """Fit the thickness of one layer to a measured unpolarised reflectance spectrum."""
+
+def film_xyz(
+    thickness_nm: ArrayLike,
+    angle_deg: ArrayLike,
+    n_film: float = 1.33,
+    illuminant: str = "d65",
+    observer: str = "1931",
+) -> NDArray[np.float64]:
+    """CIE XYZ of the light a soap film in air reflects, shape ``(..., 3)``."""
+
+def xyz_to_srgb(xyz: ArrayLike) -> NDArray[np.float64]:
+    """Encoded sRGB in [0, 1] of XYZ of shape ``(..., 3)``."""
