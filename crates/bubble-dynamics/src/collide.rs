@@ -1,8 +1,9 @@
 //! Contacts: bubble–collider and bubble–bubble, resolved per substep by a position
-//! projection (no interpenetration), an impulse on each bubble's centre of mass that
-//! gives the restitution (the normal velocity of the centre of mass after contact is −e
-//! times that before), then a per-vertex impulse that stops what is left of each touching
-//! vertex's approach. Broad phase: bounding spheres with sort-and-sweep on x.
+//! projection (no interpenetration) and per-vertex impulses that stop each touching
+//! vertex's approach, with the restitution applied to centres of mass: a static
+//! collider's through a contact episode (the bubble squashes and springs back, and leaves
+//! at −e times its arrival speed), a pair's by an impulse on both centres of mass along
+//! the line of centres. Broad phase: bounding spheres with sort-and-sweep on x.
 
 use glam::DVec3;
 
@@ -41,66 +42,142 @@ struct Contact {
     friction: f64,
 }
 
-/// Pushes every vertex of `bubble` out of every collider it touches, bounces its centre
-/// of mass with the collider's restitution and stops the rest of each touching vertex's
-/// approach.
-pub(crate) fn resolve_static(bubble: &mut Bubble, colliders: &[Collider]) {
+/// One bubble's impact on one static collider, from the first touch to the separation.
+///
+/// The film and gas squash and spring back under the per-vertex contacts as they would;
+/// the episode only sets how fast the centre of mass leaves: while it moves away and
+/// still touches, any normal speed above e times the arrival speed is taken out (the
+/// spring gives back more than e asks); at the separation any shortfall is added (the
+/// wobble kept what e = 1 asks back). A restitution phase lasts at most as long as the
+/// compression did (a spring's two halves), so a bubble that came to rest on the ground
+/// is not held there afterwards.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Episode {
+    /// Unit contact normal at the first touch.
+    normal: DVec3,
+    /// Normal speed of the centre of mass towards the collider at the first touch, m/s
+    /// (0 when no episode is open).
+    arrival_m_per_s: f64,
+    /// Time the centre of mass has spent approaching, s.
+    compression_s: f64,
+    /// Time since it stopped approaching, s.
+    restitution_s: f64,
+}
+
+/// Pushes every vertex of `bubble` out of every collider it touches and stops each
+/// touching vertex's approach (friction included), then sets the centre of mass's
+/// leaving speed to the collider's restitution through the bubble's contact episode with
+/// it. `substep_s` is the substep just taken.
+pub(crate) fn resolve_static(bubble: &mut Bubble, colliders: &[Collider], substep_s: f64) {
+    if bubble.episodes.len() != colliders.len() {
+        bubble.episodes = vec![Episode::default(); colliders.len()];
+    }
     let bounds = Bounds::of(&bubble.positions_m);
     let mut touching = Vec::new();
-    for collider in colliders {
+    for (k, collider) in colliders.iter().enumerate() {
         // Signed distances are 1-Lipschitz: a far centre means no vertex can touch.
-        if collider.signed_distance_m(bounds.center_m).0 > bounds.radius_m {
-            continue;
-        }
+        let far = collider.signed_distance_m(bounds.center_m).0 > bounds.radius_m;
         let (restitution, friction) = collider.contact();
         touching.clear();
         let mut normal_sum = DVec3::ZERO;
-        for (i, x) in bubble.positions_m.iter().enumerate() {
-            let (distance, normal) = collider.signed_distance_m(*x);
-            if distance < 0.0 {
-                normal_sum += normal * -distance;
-                touching.push((i, normal, -distance));
+        if !far {
+            for (i, x) in bubble.positions_m.iter().enumerate() {
+                let (distance, normal) = collider.signed_distance_m(*x);
+                if distance < 0.0 {
+                    normal_sum += normal * -distance;
+                    touching.push((i, normal, -distance));
+                }
             }
         }
-        let Some(normal) = normal_sum.try_normalize() else {
-            continue;
-        };
-        // Each vertex inside is projected onto the surface (a whole-bubble shift would
-        // also undo the slight compression this leaves, 1.6 to 2.6 % of the arrival speed
-        // coming back at e = 0, but it pushes a bubble in a crowd into its neighbours).
         for &(i, normal, depth_m) in &touching {
             bubble.positions_m[i] += normal * depth_m;
-        }
-        bounce_center_of_mass(bubble, normal, (restitution, friction));
-        for &(i, normal, depth_m) in &touching {
             let contact = Contact {
                 normal,
                 depth_m,
-                restitution,
+                restitution: 0.0,
                 friction,
             };
             let v = &mut bubble.velocities_m_per_s[i];
             *v += contact_impulse(&contact, *v, 1.0);
         }
+        let touch_normal = normal_sum.try_normalize();
+        let mut episode = bubble.episodes[k];
+        if episode.arrival_m_per_s == 0.0 {
+            let Some(normal) = touch_normal else {
+                continue;
+            };
+            // Opened by an impact only: a resting or grazing touch is left to the
+            // vertices, so nothing is held to the ground.
+            let arrival = -bubble.velocity_m_per_s().dot(normal);
+            if arrival <= RESTING_SPEED_M_PER_S {
+                continue;
+            }
+            episode = Episode {
+                normal,
+                arrival_m_per_s: arrival,
+                compression_s: 0.0,
+                restitution_s: 0.0,
+            };
+        }
+        let v_n = bubble.velocity_m_per_s().dot(episode.normal);
+        if v_n < 0.0 && episode.restitution_s == 0.0 {
+            episode.compression_s += substep_s;
+        } else {
+            episode.restitution_s += substep_s;
+        }
+        let target = restitution * episode.arrival_m_per_s;
+        let held = touch_normal.is_some() && v_n > target;
+        if held {
+            shift_normal_velocity(bubble, episode.normal, target - v_n);
+        }
+        // Over once the bubble is clear and leaving, or once the spring has had its time
+        // and no longer pushes past e (the energy it held has gone into the contacts).
+        let separated = touch_normal.is_none() && v_n >= 0.0;
+        let spring_over = episode.restitution_s > episode.compression_s && !held;
+        if separated || spring_over {
+            if v_n < target {
+                // What the spring did not give back: first from the wobble's kinetic
+                // energy, the rest added (the wobble keeps its potential energy).
+                boost_from_wobble(bubble, episode.normal, v_n, target);
+                let v_n = bubble.velocity_m_per_s().dot(episode.normal);
+                shift_normal_velocity(bubble, episode.normal, target - v_n);
+            }
+            episode = Episode::default();
+        }
+        bubble.episodes[k] = episode;
     }
 }
 
-/// The whole-bubble part of a contact with an immovable body along the unit `normal`:
-/// every vertex gets the same velocity change, so the shape is untouched and the centre
-/// of mass leaves with −e times its approach speed (Coulomb friction on its tangential
-/// velocity).
-fn bounce_center_of_mass(bubble: &mut Bubble, normal: DVec3, (restitution, friction): (f64, f64)) {
-    let contact = Contact {
-        normal,
-        depth_m: 0.0,
-        restitution,
-        friction,
+/// Raises the centre of mass's normal speed from `v_n` towards `target` with kinetic
+/// energy taken from the motion relative to it (the wobble the impact left), so the
+/// bounce creates no kinetic energy: relative velocities shrink by the common factor
+/// that pays for the raise, or vanish if they cannot pay for all of it.
+fn boost_from_wobble(bubble: &mut Bubble, normal: DVec3, v_n: f64, target: f64) {
+    let mass_kg = bubble.inertial_mass_kg();
+    let v_cm = bubble.velocity_m_per_s();
+    let relative_j: f64 = bubble
+        .velocities_m_per_s
+        .iter()
+        .zip(&bubble.inertial_mass_kg)
+        .map(|(v, m)| 0.5 * m * (*v - v_cm).length_squared())
+        .sum();
+    let needed_j = 0.5 * mass_kg * (target * target - v_n * v_n);
+    let (scale, new_v_n) = if relative_j >= needed_j {
+        ((1.0 - needed_j / relative_j).sqrt(), target)
+    } else {
+        (0.0, (v_n * v_n + 2.0 * relative_j / mass_kg).sqrt())
     };
-    // With a unit inverse mass the impulse is the velocity change itself.
-    let dv = contact_impulse(&contact, bubble.velocity_m_per_s(), 1.0);
-    if dv != DVec3::ZERO {
-        bubble.velocities_m_per_s.iter_mut().for_each(|v| *v += dv);
+    let dv = normal * (new_v_n - v_n);
+    for v in &mut bubble.velocities_m_per_s {
+        *v = v_cm + (*v - v_cm) * scale + dv;
     }
+}
+
+/// Adds `dv_m_per_s` along the unit `normal` to every vertex: the centre of mass's
+/// normal velocity changes by that much, the shape not at all.
+fn shift_normal_velocity(bubble: &mut Bubble, normal: DVec3, dv_m_per_s: f64) {
+    let dv = normal * dv_m_per_s;
+    bubble.velocities_m_per_s.iter_mut().for_each(|v| *v += dv);
 }
 
 /// Contact impulse (N·s) for relative velocity `v_rel` and effective inverse mass

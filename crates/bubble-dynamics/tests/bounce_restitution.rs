@@ -17,6 +17,8 @@ struct Bounce {
     left_ground: bool,
     /// |film mass after − before| / before.
     film_mass_drift: f64,
+    /// Kinetic energy of the particles at the end over that at the start.
+    kinetic_ratio: f64,
 }
 
 /// Throws a bubble straight down at the ground at `speed_m_per_s` with no gravity and no
@@ -43,6 +45,7 @@ fn bounce_on_ground(restitution: f64, speed_m_per_s: f64, damping_per_s: f64) ->
     let mut w: World = world(params, vec![bubble]);
     let v_in = w.bubbles()[0].velocity_m_per_s().y;
     let film_mass_before = w.bubbles()[0].film_mass_kg();
+    let kinetic_before = w.bubbles()[0].kinetic_energy_j();
     let lowest_of = |w: &World| {
         w.bubbles()[0]
             .positions_m()
@@ -61,18 +64,27 @@ fn bounce_on_ground(restitution: f64, speed_m_per_s: f64, damping_per_s: f64) ->
         lowest_per_r: lowest / r,
         left_ground: lowest_of(&w) > 1e-3 * r,
         film_mass_drift: (b.film_mass_kg() - film_mass_before).abs() / film_mass_before,
+        kinetic_ratio: b.kinetic_energy_j() / kinetic_before,
     }
 }
 
-/// Even with a perfectly elastic ground and no damping, a bounce gives back no more
-/// than the bubble brought.
+/// Even with a perfectly elastic ground and no damping, the centre of mass leaves no
+/// faster than it came; the kinetic energy of the particles gains at most the top-up the
+/// contact adds when the spring gives back less than e asks (measured 1.1 to 1.4 %: the
+/// wobble keeps its potential energy).
 #[test]
 fn elastic_bounce_without_damping_returns_no_more_than_it_receives() {
     for speed in [0.2, 1.0] {
-        let e = bounce_on_ground(1.0, speed, 0.0).achieved;
+        let b = bounce_on_ground(1.0, speed, 0.0);
         assert!(
-            (0.5..=1.0 + 1e-9).contains(&e),
-            "achieved restitution {e:.6} at {speed} m/s"
+            (0.5..=1.0 + 1e-9).contains(&b.achieved),
+            "achieved restitution {:.6} at {speed} m/s",
+            b.achieved
+        );
+        assert!(
+            b.kinetic_ratio <= 1.02,
+            "kinetic energy grew by {:.2} % at {speed} m/s",
+            100.0 * (b.kinetic_ratio - 1.0)
         );
     }
 }
@@ -89,8 +101,8 @@ fn achieved_restitution_follows_the_configured_coefficient() {
             for e in [0.0, 0.5, 1.0] {
                 let b = bounce_on_ground(e, speed, damping_per_s);
                 println!(
-                    "e = {e}, {speed} m/s, damping {damping_per_s}/s: achieved {:.4}, lowest {:.2e} R",
-                    b.achieved, b.lowest_per_r
+                    "e = {e}, {speed} m/s, damping {damping_per_s}/s: achieved {:.4}, lowest {:.2e} R, kinetic energy after/before {:.4}",
+                    b.achieved, b.lowest_per_r, b.kinetic_ratio
                 );
                 assert!(
                     (b.achieved - e).abs() <= 0.05,
