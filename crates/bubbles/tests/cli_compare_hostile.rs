@@ -245,3 +245,20 @@ fn a_heat_map_that_names_an_input_is_refused_however_it_is_spelled() {
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(sub.join("heat.png").is_file());
 }
+
+#[test]
+fn an_image_that_is_not_a_png_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    // An HDR EXR was clamped to 8 bits and compared as if it were sRGB.
+    image::Rgb32FImage::from_pixel(4, 3, image::Rgb([0.5, 2.0, 0.1]))
+        .save(dir.path().join("hdr.exr"))
+        .unwrap();
+    write_uniform_png(
+        &dir.path().join("a.png"),
+        (4, 3),
+        png::ColorType::Rgb,
+        &[10, 10, 10],
+    );
+    let out = bubbles(&["compare", "a.png", "hdr.exr"], dir.path());
+    assert_refused(&out, &["hdr.exr", "compare reads PNG images"]);
+}
