@@ -135,7 +135,9 @@ pub(crate) fn resolve_static(bubble: &mut Bubble, colliders: &[Collider], subste
         let separated = touch_normal.is_none() && v_n >= 0.0;
         let spring_over = episode.restitution_s > episode.compression_s && !held;
         if separated || spring_over {
-            if v_n < target {
+            // A bubble pressed back in (wind, gravity, a neighbour) when the spring's time
+            // is over gets nothing: its contact has become a resting one.
+            if (0.0..target).contains(&v_n) {
                 // What the spring did not give back: first from the wobble's kinetic
                 // energy, the rest added (the wobble keeps its potential energy).
                 boost_from_wobble(bubble, episode.normal, v_n, target);

@@ -172,3 +172,46 @@ fn bubble_pairs_bounce_with_the_configured_restitution() {
         }
     }
 }
+
+/// A bubble that landed on the default ground (e = 0.3) is not held there once its
+/// impact is over: an updraft (air drag, no gravity) lifts it off again. (At e = 0
+/// exactly it is: docs/dynamics.md.)
+#[test]
+fn a_bubble_that_landed_can_leave_the_ground_again() {
+    let r = 0.03;
+    let params = WorldParams {
+        colliders: vec![Collider::Plane {
+            point_m: DVec3::ZERO,
+            normal: DVec3::Y,
+            restitution: bubble_dynamics::DEFAULT_RESTITUTION,
+            friction: 0.0,
+        }],
+        air_density_kg_per_m3: 1.2,
+        wind: bubble_dynamics::Wind::uniform(DVec3::new(0.0, 0.3, 0.0)),
+        ..isolated()
+    };
+    let bubble = BubbleParams {
+        center_m: DVec3::new(0.0, 1.2 * r, 0.0),
+        velocity_m_per_s: DVec3::new(0.0, -1.0, 0.0),
+        ..plain_bubble(r, 2)
+    };
+    let mut w = world(params, vec![bubble]);
+    let mut landed = false;
+    for _ in 0..480 {
+        w.step().expect("stable");
+        let lowest = w.bubbles()[0]
+            .positions_m()
+            .iter()
+            .map(|x| x.y)
+            .fold(f64::INFINITY, f64::min);
+        landed |= lowest < 1e-6 * r;
+    }
+    let b = &w.bubbles()[0];
+    assert!(landed, "the bubble never reached the ground");
+    assert!(
+        b.center_m().y > 2.0 * r && b.velocity_m_per_s().y > 0.0,
+        "held down: centre at {:.4} m, rising at {:.4} m/s",
+        b.center_m().y,
+        b.velocity_m_per_s().y
+    );
+}
