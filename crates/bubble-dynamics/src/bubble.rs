@@ -81,6 +81,8 @@ pub struct Bubble {
     pub(crate) film: Film,
     pub(crate) slosh: Option<Slosh>,
     pub(crate) scratch: Scratch,
+    /// The open contact episode with each static collider, by collider index.
+    pub(crate) episodes: Vec<crate::collide::Episode>,
 }
 
 impl Bubble {
@@ -146,6 +148,7 @@ impl Bubble {
                 .then(|| Slosh::new(params, topology.triangles(), unit_positions)),
             topology: Arc::clone(&topology),
             scratch: Scratch::default(),
+            episodes: Vec::new(),
         };
         bubble.refresh_inertial_mass();
         bubble.volume_m3 = enclosed_volume_m3(&bubble.positions_m, bubble.topology.triangles());

@@ -11,7 +11,8 @@ pub const DEFAULT_RESTITUTION: f64 = 0.3;
 pub const DEFAULT_FRICTION: f64 = 0.4;
 
 /// A static obstacle. Bubbles stay outside it; contacts bounce with `restitution` (the
-/// ratio of normal speeds after and before) and slide with Coulomb `friction`.
+/// ratio of the bubble's centre-of-mass normal speeds after and before) and slide with
+/// Coulomb `friction`.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Collider {
     /// Half-space: the solid lies on the side opposite to `normal`.

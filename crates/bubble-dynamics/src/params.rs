@@ -68,7 +68,8 @@ pub struct WorldParams {
     pub max_substeps: u32,
     /// Vertex speed judged to be an energy blow-up, m/s (default: speed of sound in air).
     pub max_speed_m_per_s: f64,
-    /// Restitution of bubble–bubble contacts, in [0, 1].
+    /// Restitution of bubble–bubble contacts, in [0, 1]: the ratio of the centres of
+    /// mass's relative normal speeds after and before.
     pub bubble_restitution: f64,
     /// Coulomb friction coefficient of bubble–bubble contacts.
     pub bubble_friction: f64,

@@ -248,7 +248,7 @@ impl World {
                 self.params.bubble_friction,
             );
             for b in &mut self.bubbles {
-                collide::resolve_static(b, &self.params.colliders);
+                collide::resolve_static(b, &self.params.colliders, h);
             }
             self.check_divergence(step, k, t_s)?;
         }

@@ -93,6 +93,36 @@ pub fn lut_bytes(width: usize, height: usize, tables: usize) -> u64 {
     width as u64 * height as u64 * 12 * tables as u64
 }
 
+/// Bytes per texel of one baked table held in memory (RGB f32).
+pub const BAKE_TABLE_BYTES_PER_TEXEL: u64 = 12;
+
+/// Bytes per texel a writer holds on top of the tables while it encodes one table: EXR
+/// streams from the table itself (blocks of lines); a 16-bit PNG holds its codes, their
+/// big-endian copy and the compressed stream (at most about the codes' size); the 8-bit
+/// preview its bytes and their compressed stream. Measured at 4096 × 2048 as peak
+/// resident memory above the tables' own: 0.03, 15.2 and 3.6 (docs/lut.md).
+pub fn bake_writer_bytes_per_texel(format: lut::Format) -> u64 {
+    match format {
+        lut::Format::Exr => 1,
+        lut::Format::Png16 => 18,
+        lut::Format::Png8 => 6,
+    }
+}
+
+/// Bytes `bake` plans for `width × height` tables with `lights` light tables written in
+/// `formats`: every table it holds until the files are written (reflectivity,
+/// transmittance, one per light), plus the largest writer, which runs one table at a time.
+pub fn bake_bytes(width: usize, height: usize, lights: usize, formats: &[lut::Format]) -> u64 {
+    let texels = width as u64 * height as u64;
+    let tables = (2 + lights as u64) * texels * BAKE_TABLE_BYTES_PER_TEXEL;
+    let writer = formats
+        .iter()
+        .map(|&f| bake_writer_bytes_per_texel(f))
+        .max()
+        .unwrap_or(0);
+    tables + texels * writer
+}
+
 /// Bytes of the frame buffers for `width × height` at `samples` per pixel (HDR colour
 /// and depth per sample, plus the resolved image).
 pub fn frame_bytes(width: usize, height: usize, samples: u32) -> u64 {
@@ -108,6 +138,20 @@ pub fn icosphere_vertices(subdivisions: u32) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bake_plans_every_table_and_the_largest_writer() {
+        use lut::Format::{Exr, Png8, Png16};
+        let texels = 16384 * 4096;
+        // Issue 28's bake: seven lights, three formats; 7.9 GiB, refused.
+        let bytes = bake_bytes(16384, 4096, 7, &[Exr, Png16, Png8]);
+        assert_eq!(bytes, texels * (9 * 12 + 18));
+        assert!(bytes > MEMORY_BUDGET_BYTES);
+        // One writer runs at a time: the largest counts, not the sum.
+        assert_eq!(bake_bytes(100, 10, 0, &[Png8, Exr]), 1000 * (2 * 12 + 6));
+        // The largest table with one light, written as EXR only, fits.
+        assert!(bake_bytes(16384, 4096, 1, &[Exr]) <= MEMORY_BUDGET_BYTES);
+    }
 
     #[test]
     fn help_states_the_constants() {

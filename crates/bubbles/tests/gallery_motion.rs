@@ -229,9 +229,12 @@ fn dropped_bubble_flattens_on_the_plane_rebounds_and_never_crosses_it() {
         .iter()
         .map(|f| f[0].center_m()[1])
         .fold(f64::MIN, f64::max);
+    // It leaves at the ground's restitution, 0.3 of its arrival speed, and a soap bubble
+    // is nearly as light as the air it displaces: the centre rose 0.92 R (1.2 R when the
+    // contact gave back 0.85 whatever the restitution).
     let radius = frames[0][0].extent_m(0) / 2.0;
     assert!(
-        y_after - y_contact > radius,
+        y_after - y_contact > 0.5 * radius,
         "no rebound: the centre rose {:.4} m after contact",
         y_after - y_contact
     );

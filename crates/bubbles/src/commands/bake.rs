@@ -11,6 +11,8 @@ use thinfilm::dispersion::RefractiveIndex;
 use thinfilm::illuminant::Illuminant;
 
 use crate::error::{CliError, CliResult};
+use crate::limits;
+use crate::scene::values::{Bounds, FilmIndex, FilmThickness, plain};
 
 /// Bakes with more spectral samples than this show a progress bar (about a second).
 const PROGRESS_THRESHOLD_SAMPLES: u64 = 500_000_000;
@@ -24,9 +26,9 @@ pub struct Args {
     /// Table size: thickness columns x cos θ rows, each 2..=16384.
     #[arg(long, value_name = "WxH", default_value_t = Resolution::DEFAULT)]
     resolution: Resolution,
-    /// Thickness of the last column, in nm (the first is 0).
-    #[arg(long, value_name = "N", default_value_t = lut::config::DEFAULT_THICKNESS_MAX_NM, allow_negative_numbers = true)]
-    thickness_max_nm: f32,
+    /// Thickness of the last column, in nm (the first is 0), 1..=100000.
+    #[arg(long, value_name = "N", default_value_t = f64::from(lut::config::DEFAULT_THICKNESS_MAX_NM), allow_negative_numbers = true)]
+    thickness_max_nm: f64,
     /// Lights to bake a light-source table for: a built-in name (d65, d50, a, e, f2, f11,
     /// sodium) or a CSV spectrum file (header `wavelength_nm,value`). Repeatable.
     #[arg(long = "illuminant", value_name = "NAME|PATH.csv", num_args = 1.., default_value = "sodium")]
@@ -37,7 +39,7 @@ pub struct Args {
     /// Output formats, comma-separated: exr, png16, png8 (sRGB preview).
     #[arg(long, value_name = "LIST", default_value = "exr,png16")]
     format: String,
-    /// Constant film refractive index (default: soap film with dispersion).
+    /// Constant film refractive index, 1..=4 (default: soap film with dispersion).
     #[arg(
         long,
         value_name = "N",
@@ -59,7 +61,9 @@ pub struct Args {
 /// Runs `bubbles bake`.
 pub fn run(args: Args) -> CliResult {
     let formats = Format::parse_list(&args.format).map_err(|e| CliError::input(e.to_string()))?;
+    check_numbers(&args)?;
     let config = config_from(&args)?;
+    check_memory(&config, &formats)?;
     let set = bake_with_bar(&config);
     let written = set.save(&args.out, &formats).map_err(|e| match e {
         lut::SaveError::Encode { .. } => CliError::runtime(e.to_string()),
@@ -70,6 +74,71 @@ pub fn run(args: Args) -> CliResult {
         let _ = writeln!(report, "{}", path.display());
     }
     print!("{report}");
+    Ok(())
+}
+
+/// Refuses, by flag and value, every number outside the range in which the bake stays
+/// finite and physical, before anything narrows it to f32 or prints it in full.
+fn check_numbers(args: &Args) -> Result<(), CliError> {
+    let thickness = FilmThickness::MIN..=f64::from(lut::config::MAX_THICKNESS_NM);
+    check_range(
+        "--thickness-max-nm",
+        args.thickness_max_nm,
+        &thickness,
+        "nm",
+    )?;
+    if let Some(n) = args.n_film {
+        check_range("--n-film", n, &(FilmIndex::MIN..=FilmIndex::MAX), "")?;
+    }
+    check_range("--step-nm", args.step_nm, &lut::config::STEP_RANGE_NM, "nm")
+}
+
+/// `value` of `flag` must lie in `range` (NaN never does); the message names both.
+fn check_range(
+    flag: &str,
+    value: f64,
+    range: &std::ops::RangeInclusive<f64>,
+    unit: &str,
+) -> Result<(), CliError> {
+    if range.contains(&value) {
+        return Ok(());
+    }
+    let unit = if unit.is_empty() {
+        String::new()
+    } else {
+        format!(" {unit}")
+    };
+    Err(CliError::input(format!(
+        "{flag} {} is out of range: it must be in {}..={}{unit}",
+        plain(value),
+        plain(*range.start()),
+        plain(*range.end())
+    )))
+}
+
+/// Refuses a bake whose tables and largest writer would pass the planned-memory limit.
+fn check_memory(config: &BakeConfig, formats: &[Format]) -> Result<(), CliError> {
+    let bytes = limits::bake_bytes(
+        config.width(),
+        config.height(),
+        config.lights().len(),
+        formats,
+    );
+    if bytes > limits::MEMORY_BUDGET_BYTES {
+        return Err(CliError::input(format!(
+            "bake of {} tables of {}x{} texels in {} plans {:.2} GiB, above the {} GiB memory limit (see --help): lower --resolution or bake fewer --illuminant or --format",
+            2 + config.lights().len(),
+            config.width(),
+            config.height(),
+            formats
+                .iter()
+                .map(ToString::to_string)
+                .collect::<Vec<_>>()
+                .join(","),
+            bytes as f64 / f64::from(1u32 << 30),
+            limits::MEMORY_BUDGET_BYTES >> 30
+        )));
+    }
     Ok(())
 }
 
@@ -94,7 +163,8 @@ fn config_from(args: &Args) -> Result<BakeConfig, CliError> {
         .collect::<Result<Vec<_>, _>>()?;
     BakeConfig::builder()
         .resolution(width, height)
-        .thickness_max_nm(args.thickness_max_nm)
+        // check_numbers bounded it to 1..=1e5 nm, where f32 holds it to 6e-8 relative.
+        .thickness_max_nm(args.thickness_max_nm as f32)
         .film_index(film_index)
         .observer(observer)
         .step_nm(args.step_nm)

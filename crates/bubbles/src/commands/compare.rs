@@ -1,7 +1,14 @@
 //! `bubbles compare A.png B.png`: CIEDE2000 between two renders (mean, 95th and 99th
 //! percentiles, maximum), optionally a heat map with a colour bar.
+//!
+//! Inputs are single-frame, opaque PNG images within the input limits (`--help`): each
+//! header is checked before anything is decoded, and an animated PNG, a pixel that is
+//! not fully opaque or a heat map that would overwrite an input is refused with exit
+//! code 2 (ΔE2000 is defined between colours, not between colours over an unknown
+//! background).
 
 use crate::error::{CliError, CliResult};
+use crate::input;
 use std::path::{Path, PathBuf};
 use thinfilm::colorspace::{XYZ_FROM_SRGB, apply, srgb_decode};
 use thinfilm::{Lab, ciede2000, lab_from_xyz};
@@ -9,11 +16,11 @@ use thinfilm::{Lab, ciede2000, lab_from_xyz};
 /// Arguments of `bubbles compare`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// First image (8-bit sRGB PNG), e.g. the reference.
+    /// First image (opaque, single-frame sRGB PNG, 8 or 16 bits), e.g. the reference.
     pub a: PathBuf,
     /// Second image, the same size.
     pub b: PathBuf,
-    /// Also write a heat map of ΔE2000 with a colour bar (PNG).
+    /// Also write a heat map of ΔE2000 with a colour bar (PNG; not one of the inputs).
     #[arg(long)]
     pub heatmap: Option<PathBuf>,
     /// ΔE2000 at the top of the heat map's scale (larger values are clipped to it).
@@ -45,19 +52,24 @@ pub fn run(args: Args) -> CliResult {
             args.heatmap_max
         )));
     }
-    let a = load(&args.a)?;
-    let b = load(&args.b)?;
-    if a.dimensions() != b.dimensions() {
+    if let Some(out) = &args.heatmap {
+        refuse_overwriting_an_input(out, [&args.a, &args.b])?;
+    }
+    let size_a = check_header(&args.a)?;
+    let size_b = check_header(&args.b)?;
+    if size_a != size_b {
         return Err(CliError::input(format!(
             "{} is {}x{} but {} is {}x{}: compare needs images of the same size",
             args.a.display(),
-            a.width(),
-            a.height(),
+            size_a.0,
+            size_a.1,
             args.b.display(),
-            b.width(),
-            b.height()
+            size_b.0,
+            size_b.1
         )));
     }
+    let a = load(&args.a)?;
+    let b = load(&args.b)?;
     let de = delta_e_map(a.as_raw(), b.as_raw());
     let stats = stats(&de);
     if let Some(out) = &args.heatmap {
@@ -87,10 +99,115 @@ pub fn run(args: Args) -> CliResult {
     Ok(())
 }
 
+/// Refuses a heat map path that names one of the `inputs`, however spelled (`./a.png`,
+/// `dir/../a.png`, a symbolic or hard link): the heat map would replace it.
+fn refuse_overwriting_an_input(out: &Path, inputs: [&Path; 2]) -> Result<(), CliError> {
+    // A path that does not exist yet cannot be an input that does.
+    let Ok(out_meta) = std::fs::metadata(out) else {
+        return Ok(());
+    };
+    let out_real = std::fs::canonicalize(out).ok();
+    for input in inputs {
+        let same_path = out_real.is_some() && std::fs::canonicalize(input).ok() == out_real;
+        let same_file = std::fs::metadata(input).is_ok_and(|m| same_inode(&m, &out_meta));
+        if same_path || same_file {
+            return Err(CliError::input(format!(
+                "--heatmap {} is the input {}: the heat map would overwrite it; write it elsewhere",
+                out.display(),
+                input.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Whether two metadata describe the same file (device and inode; never on non-Unix).
+fn same_inode(a: &std::fs::Metadata, b: &std::fs::Metadata) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        a.dev() == b.dev() && a.ino() == b.ino()
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (a, b);
+        false
+    }
+}
+
+/// Checks an input from its header alone, before anything decodes it: within the pixel
+/// limit (the message `render` gives), a PNG, and one frame. Returns its size.
+fn check_header(path: &Path) -> Result<(u32, u32), CliError> {
+    input::check_image_file(path, "image")?;
+    let cannot = |e: &dyn std::fmt::Display| {
+        CliError::input(format!("cannot read image {}: {e}", path.display()))
+    };
+    let file = std::fs::File::open(path).map_err(|e| cannot(&e))?;
+    let reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .map_err(|e| {
+            CliError::input(format!(
+                "image {} is not a PNG compare can read ({e}): compare reads PNG images",
+                path.display()
+            ))
+        })?;
+    let info = reader.info();
+    if let Some(animation) = info.animation_control
+        && animation.num_frames > 1
+    {
+        return Err(CliError::input(format!(
+            "image {} is an animated PNG of {} frames: compare reads one frame; compare the frames as separate PNGs",
+            path.display(),
+            animation.num_frames
+        )));
+    }
+    Ok((info.width, info.height))
+}
+
+/// Decodes a checked input (its pixels are within the limit, so the decoder's own
+/// allocation cap is lifted) and refuses one with a pixel that is not fully opaque.
 fn load(path: &Path) -> Result<image::RgbImage, CliError> {
-    let img = image::open(path)
-        .map_err(|e| CliError::input(format!("cannot read image {}: {e}", path.display())))?;
+    let cannot = |e: &dyn std::fmt::Display| {
+        CliError::input(format!("cannot read image {}: {e}", path.display()))
+    };
+    let mut reader = image::ImageReader::open(path)
+        .and_then(|r| r.with_guessed_format())
+        .map_err(|e| cannot(&e))?;
+    reader.no_limits();
+    let img = reader.decode().map_err(|e| cannot(&e))?;
+    if let Some((index, alpha, max)) = first_translucent(&img) {
+        let (x, y) = (
+            index as u64 % u64::from(img.width()),
+            index as u64 / u64::from(img.width()),
+        );
+        return Err(CliError::input(format!(
+            "image {} has a pixel that is not opaque at ({x}, {y}), alpha {alpha} of {max}: compare reads opaque images only (ΔE2000 needs the colour under the alpha); flatten it onto its background first",
+            path.display()
+        )));
+    }
     Ok(img.to_rgb8())
+}
+
+/// The first pixel whose alpha is below full, as (pixel index, alpha, full alpha).
+fn first_translucent(img: &image::DynamicImage) -> Option<(usize, f64, f64)> {
+    use image::DynamicImage as D;
+    fn find<T: Copy + PartialEq + Into<f64>>(
+        raw: &[T],
+        channels: usize,
+        full: T,
+    ) -> Option<(usize, f64, f64)> {
+        raw.chunks_exact(channels)
+            .position(|px| px[channels - 1] != full)
+            .map(|i| (i, raw[i * channels + channels - 1].into(), full.into()))
+    }
+    match img {
+        D::ImageLumaA8(b) => find(b.as_raw(), 2, u8::MAX),
+        D::ImageRgba8(b) => find(b.as_raw(), 4, u8::MAX),
+        D::ImageLumaA16(b) => find(b.as_raw(), 2, u16::MAX),
+        D::ImageRgba16(b) => find(b.as_raw(), 4, u16::MAX),
+        D::ImageRgba32F(b) => find(b.as_raw(), 4, 1.0f32),
+        _ => None,
+    }
 }
 
 /// CIELAB of an 8-bit sRGB pixel, relative to the sRGB white.
