@@ -11,10 +11,10 @@ use std::path::Path;
 
 use glam::{Vec3, Vec4};
 
+use crate::RenderError;
 use crate::index_f32::index_f32;
 use crate::lod::{anisotropic_taps, cube_lod};
 use crate::texture::{check_texels, read_linear_rgb};
-use crate::{Environment, RenderError};
 
 /// Largest accepted face size, in texels.
 pub const MAX_FACE_SIZE: usize = 8192;
@@ -110,8 +110,12 @@ impl CubeMap {
         })
     }
 
-    /// Renders an environment into a cube map of `face_size²` faces (borders included).
-    pub fn from_environment(env: &Environment, face_size: usize) -> Result<Self, RenderError> {
+    /// A cube map of `face_size²` faces (borders included) holding `radiance` along each
+    /// texel's direction, with its mip chain.
+    pub fn from_radiance(
+        face_size: usize,
+        radiance: impl Fn(Vec3) -> [f32; 3],
+    ) -> Result<Self, RenderError> {
         check_face_size(face_size)?;
         let mut cube = Self::black(face_size);
         let top = &mut cube.levels[0];
@@ -121,7 +125,7 @@ impl CubeMap {
                 for x in 0..m {
                     let dir = top.texel_direction(f, x, y);
                     let off = top.face_offset(f) + y * m + x;
-                    top.texels[off] = env.radiance(dir);
+                    top.texels[off] = radiance(dir);
                 }
             }
         }
@@ -448,6 +452,7 @@ fn check_face_size(face_size: usize) -> Result<(), RenderError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Environment;
     use crate::Sky;
 
     #[test]

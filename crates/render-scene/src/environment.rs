@@ -177,6 +177,13 @@ pub fn lerp3(a: [f32; 3], b: [f32; 3], t: f32) -> [f32; 3] {
     ]
 }
 
+impl CubeMap {
+    /// Renders an environment into a cube map of `face_size²` faces (borders included).
+    pub fn from_environment(env: &Environment, face_size: usize) -> Result<Self, RenderError> {
+        Self::from_radiance(face_size, |dir| env.radiance(dir))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

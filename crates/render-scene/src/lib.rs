@@ -33,6 +33,7 @@ pub mod index_f32;
 pub mod irradiance;
 pub mod lod;
 pub mod lut_sampler;
+mod material;
 pub mod mesh;
 mod obj;
 pub mod reflection;
@@ -54,8 +55,9 @@ pub use frame::{Frame, FrameTimings, linear_to_srgb, tone_map};
 pub use glam::{Mat3, Vec3};
 pub use irradiance::Irradiance;
 pub use lut::Lut;
+pub use material::{Material, Pattern};
 pub use mesh::TriMesh;
-pub use scene::{BubbleMesh, FilmTables, Ground, Light, Material, Object, Pattern, RenderScene};
+pub use scene::{BubbleMesh, FilmTables, Ground, Light, Object, RenderScene};
 pub use settings::{
     MAX_IMAGE_SIDE, PartialShading, ReflectionFilter, ReflectionMode, RenderSettings,
     SAMPLE_COUNTS, ToneMap,

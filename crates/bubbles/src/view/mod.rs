@@ -2,6 +2,8 @@
 
 mod controls;
 mod font;
+mod keys;
+mod pixels;
 mod scale;
 mod window;
 

@@ -1,8 +1,10 @@
 //! The window: winit events in, [`ViewState`] updated, the solver stepped at its fixed
 //! step against the wall clock, the CPU renderer drawn through softbuffer.
 
-use super::controls::{self, Command, Input, Key, Orbit, ReflectionKey, ViewState};
+use super::controls::{self, Command, Input, Orbit, ReflectionKey, ViewState};
 use super::font;
+use super::keys::map_key;
+use super::pixels::{tone_map_into, upscale};
 use super::scale::ResolutionScale;
 use super::{Args, CONTROLS};
 use crate::error::{CliError, CliResult};
@@ -18,7 +20,6 @@ use winit::application::ApplicationHandler;
 use winit::dpi::{PhysicalPosition, PhysicalSize};
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
-use winit::keyboard::{Key as WKey, NamedKey};
 use winit::window::{Window, WindowId};
 
 /// Solver steps allowed per displayed frame; beyond it the simulation runs in slow
@@ -547,64 +548,6 @@ impl App {
                     pan,
                 },
             );
-        }
-    }
-}
-
-fn map_key(key: &WKey) -> Option<Key> {
-    Some(match key {
-        WKey::Named(NamedKey::Escape) => Key::Escape,
-        WKey::Named(NamedKey::ArrowLeft) => Key::Left,
-        WKey::Named(NamedKey::ArrowRight) => Key::Right,
-        WKey::Named(NamedKey::ArrowUp) => Key::Up,
-        WKey::Named(NamedKey::ArrowDown) => Key::Down,
-        WKey::Named(NamedKey::Space) => Key::Space,
-        WKey::Character(c) => match c.as_str() {
-            "w" | "W" => Key::W,
-            "+" | "=" => Key::Plus,
-            "-" | "_" => Key::Minus,
-            " " => Key::Space,
-            "1" => Key::Digit(1),
-            "2" => Key::Digit(2),
-            "3" => Key::Digit(3),
-            "m" | "M" => Key::M,
-            "p" | "P" => Key::P,
-            "." => Key::Period,
-            "r" | "R" => Key::R,
-            "f" | "F" => Key::F,
-            "s" | "S" => Key::S,
-            "h" | "H" => Key::H,
-            _ => return None,
-        },
-        _ => return None,
-    })
-}
-
-/// Tone-maps linear radiance into 0RGB words, reusing `out`'s allocation.
-///
-/// In parallel: one `powf` per channel made this the costliest step of a 1280×720 frame
-/// (more than the render) when it ran on one thread. Each pixel is independent, so the
-/// result does not depend on the thread count.
-fn tone_map_into(out: &mut Vec<u32>, rgb: &[[f32; 3]], exposure_ev: f32, tonemap: raster::ToneMap) {
-    use rayon::prelude::*;
-    let scale = exposure_ev.exp2();
-    out.resize(rgb.len(), 0);
-    out.par_iter_mut()
-        .zip(rgb.par_iter())
-        .for_each(|(word, px)| {
-            let [r, g, b] = raster::tone_map(px.map(|c| c * scale), tonemap)
-                .map(|c| (raster::linear_to_srgb(c) * 255.0 + 0.5) as u32);
-            *word = (r << 16) | (g << 8) | b;
-        });
-}
-
-/// Nearest-neighbour upscale of an `iw`×`ih` image into a `w`×`h` one.
-fn upscale(src: &[u32], iw: usize, ih: usize, dst: &mut [u32], w: usize, h: usize) {
-    for (y, row) in dst.chunks_exact_mut(w).take(h).enumerate() {
-        let sy = (y * ih / h).min(ih - 1);
-        let src_row = &src[sy * iw..(sy + 1) * iw];
-        for (x, px) in row.iter_mut().enumerate() {
-            *px = src_row[(x * iw / w).min(iw - 1)];
         }
     }
 }
