@@ -1,27 +1,10 @@
 //! `bubbles bake` end to end: what it writes, and that bad input exits 2 with a clear
 //! message, nothing on stdout and no file in the output directory.
 
+mod common;
+
+use common::{bake, files_in};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn bake(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bubbles"))
-        .arg("bake")
-        .args(args)
-        .output()
-        .expect("bubbles runs")
-}
-
-fn files_in(dir: &Path) -> Vec<String> {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return Vec::new();
-    };
-    let mut names: Vec<_> = entries
-        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
-}
 
 /// Runs a bake that must be refused as bad input, returning its stderr.
 fn refused(dir: &Path, extra: &[&str]) -> String {

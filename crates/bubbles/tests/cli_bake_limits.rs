@@ -3,25 +3,37 @@
 //! value, in a few digits, with exit code 2 and no file written; a bake whose tables and
 //! writers would pass the planned-memory limit is refused before any work.
 
+mod common;
+
+use common::{bake, files_in};
 use std::path::Path;
-use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
-fn bake(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bubbles"))
-        .arg("bake")
-        .args(args)
-        .output()
-        .expect("bubbles runs")
-}
-
-fn files_in(dir: &Path) -> Vec<String> {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return Vec::new();
-    };
-    entries
-        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
-        .collect()
+/// Bakes EXR tables of `resolution` into `out_dir` with the flags `extra`, and checks that
+/// the bake succeeds and every texel it wrote is finite.
+fn assert_bakes_finite_tables(out_dir: &Path, resolution: &str, extra: &[&str]) {
+    let mut args = vec![
+        "--out",
+        out_dir.to_str().expect("utf-8"),
+        "--resolution",
+        resolution,
+        "--format",
+        "exr",
+    ];
+    args.extend_from_slice(extra);
+    let output = bake(&args);
+    assert!(
+        output.status.success(),
+        "{extra:?}: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let set = lut::LutSet::load(out_dir).expect("loads back");
+    for (name, table) in set.named_tables() {
+        assert!(
+            table.texels().iter().flatten().all(|v| v.is_finite()),
+            "{extra:?}: {name} has a non-finite texel"
+        );
+    }
 }
 
 /// Runs a small bake with `extra` that must be refused; returns its stderr.
@@ -106,29 +118,7 @@ fn the_ends_of_every_range_are_accepted_and_bake_finite_tables() {
         &["--thickness-max-nm", "1", "--n-film", "1"][..],
         &["--thickness-max-nm", "100000", "--n-film", "4"][..],
     ] {
-        let out_dir = dir.path().join("ends");
-        let mut args = vec![
-            "--out",
-            out_dir.to_str().expect("utf-8"),
-            "--resolution",
-            "64x8",
-            "--format",
-            "exr",
-        ];
-        args.extend_from_slice(extra);
-        let output = bake(&args);
-        assert!(
-            output.status.success(),
-            "{extra:?}: {}",
-            String::from_utf8_lossy(&output.stderr)
-        );
-        let set = lut::LutSet::load(&out_dir).expect("loads back");
-        for (name, table) in set.named_tables() {
-            assert!(
-                table.texels().iter().flatten().all(|v| v.is_finite()),
-                "{extra:?}: {name} has a non-finite texel"
-            );
-        }
+        assert_bakes_finite_tables(&dir.path().join("ends"), "64x8", extra);
     }
 }
 
@@ -187,29 +177,7 @@ fn spectra_at_the_edges_of_their_range_bake_finite_tables_or_are_refused() {
         ["--reference", tiny.as_str()],
         ["--illuminant", wide.as_str()],
     ] {
-        let out_dir = dir.path().join("spectra");
-        let mut args = vec![
-            "--out",
-            out_dir.to_str().expect("utf-8"),
-            "--resolution",
-            "32x4",
-            "--format",
-            "exr",
-        ];
-        args.extend_from_slice(&extra);
-        let output = bake(&args);
-        assert!(
-            output.status.success(),
-            "{extra:?}: {}",
-            String::from_utf8_lossy(&output.stderr)
-        );
-        let set = lut::LutSet::load(&out_dir).expect("loads back");
-        for (name, table) in set.named_tables() {
-            assert!(
-                table.texels().iter().flatten().all(|v| v.is_finite()),
-                "{extra:?}: {name} has a non-finite texel"
-            );
-        }
+        assert_bakes_finite_tables(&dir.path().join("spectra"), "32x4", &extra);
     }
     let huge = csv("huge.csv", "380,1e300\n780,1e300\n");
     let stderr = refused(dir.path(), &["--illuminant", huge.as_str()]);

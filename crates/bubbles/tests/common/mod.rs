@@ -42,3 +42,24 @@ pub fn json_field(json: &str, key: &str) -> f64 {
     let end = rest.find([',', '}']).unwrap();
     rest[..end].trim().parse().unwrap()
 }
+
+/// Runs `bubbles bake ARGS` in the working directory and waits for it.
+pub fn bake(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bubbles"))
+        .arg("bake")
+        .args(args)
+        .output()
+        .expect("bubbles runs")
+}
+
+/// The names of the files in `dir`, sorted; none when it does not exist.
+pub fn files_in(dir: &Path) -> Vec<String> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut names: Vec<_> = entries
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
