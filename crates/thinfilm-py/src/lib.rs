@@ -387,17 +387,7 @@ fn fit_thickness<'py>(
             )
         })
         .map_err(value_error)?;
-    Ok([
-        fit.thickness_nm,
-        fit.low_nm,
-        fit.high_nm,
-        fit.sigma_nm,
-        fit.systematic_nm,
-        fit.offset,
-        fit.rms_residual,
-        fit.runner_up_nm,
-        fit.runner_up_rms,
-    ])
+    Ok(fit.values())
 }
 
 /// `(R, T, error bound)` of the stack `n`, `d_nm` whose inner layer `layer` is graded:

@@ -75,6 +75,36 @@ pub struct Fit {
     pub runner_up_rms: f64,
 }
 
+impl Fit {
+    /// The names of [`Fit::values`], in order (the field names).
+    pub const FIELDS: [&'static str; 9] = [
+        "thickness_nm",
+        "low_nm",
+        "high_nm",
+        "sigma_nm",
+        "systematic_nm",
+        "offset",
+        "rms_residual",
+        "runner_up_nm",
+        "runner_up_rms",
+    ];
+
+    /// Every number of the fit, in the order of [`Fit::FIELDS`].
+    pub fn values(&self) -> [f64; 9] {
+        [
+            self.thickness_nm,
+            self.low_nm,
+            self.high_nm,
+            self.sigma_nm,
+            self.systematic_nm,
+            self.offset,
+            self.rms_residual,
+            self.runner_up_nm,
+            self.runner_up_rms,
+        ]
+    }
+}
+
 /// Fits the thickness `d` of `model(d)` to `measured`.
 ///
 /// # Errors

@@ -8,13 +8,11 @@
 
 use std::io::{Read as _, Write as _};
 
-use thinfilm::fit::{Measurement, Search, fit_thickness};
+use thinfilm::fit::{Fit, Measurement, Search, fit_thickness};
 use thinfilm::{Incidence, Layer, Stack};
 
 use crate::csv_table::CsvTable;
 use crate::error::{CliError, CliResult};
-
-const HEADER: &str = "thickness_nm,low_nm,high_nm,sigma_nm,systematic_nm,offset,rms_residual,runner_up_nm,runner_up_rms";
 
 /// Arguments of `bubbles fit`.
 #[derive(Debug, clap::Args)]
@@ -157,18 +155,8 @@ pub fn run(args: Args) -> CliResult {
         },
     )
     .map_err(|e| CliError::input(e.to_string()))?;
-    let out = format!(
-        "{HEADER}\n{},{},{},{},{},{},{},{},{}\n",
-        fit.thickness_nm,
-        fit.low_nm,
-        fit.high_nm,
-        fit.sigma_nm,
-        fit.systematic_nm,
-        fit.offset,
-        fit.rms_residual,
-        fit.runner_up_nm,
-        fit.runner_up_rms
-    );
+    let values: Vec<String> = fit.values().iter().map(f64::to_string).collect();
+    let out = format!("{}\n{}\n", Fit::FIELDS.join(","), values.join(","));
     let mut stdout = std::io::stdout().lock();
     stdout
         .write_all(out.as_bytes())
