@@ -8,9 +8,15 @@
 use raster::Renderer;
 use reference_tracer::{FilmSpec, ReferenceSettings, render_reference};
 use render_scene::{
-    BubbleMesh, Camera, Environment, FilmTables, Frame, Lut, RenderScene, RenderSettings, Vec3,
+    Camera, Environment, FilmTables, Frame, Lut, RenderScene, RenderSettings, Vec3,
 };
 use thinfilm::{Illuminant, Observer, RefractiveIndex};
+
+// The scene fixtures the renderer's own tests draw (icosphere bubbles, synthetic tables).
+#[path = "../crates/raster/tests/common/mod.rs"]
+mod common;
+
+use common::{bubble, lossless_tables};
 
 /// A renderer backend.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -96,50 +102,12 @@ fn on_every_backend(mut law: impl FnMut(Backend) -> bool) {
     );
 }
 
-/// A round bubble: an octahedron refined three times onto the sphere of radius `r`, of
-/// uniform thickness.
-fn bubble(center: Vec3, r: f32, thickness_nm: f32) -> BubbleMesh {
-    let mut positions = vec![Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
-    let mut triangles: Vec<[u32; 3]> = vec![
-        [0, 2, 4],
-        [2, 1, 4],
-        [1, 3, 4],
-        [3, 0, 4],
-        [2, 0, 5],
-        [1, 2, 5],
-        [3, 1, 5],
-        [0, 3, 5],
-    ];
-    for _ in 0..3 {
-        let mut next = Vec::new();
-        for t in &triangles {
-            let mid = |a: u32, b: u32, p: &mut Vec<Vec3>| {
-                p.push((p[a as usize] + p[b as usize]).normalize());
-                (p.len() - 1) as u32
-            };
-            let (ab, bc, ca) = (
-                mid(t[0], t[1], &mut positions),
-                mid(t[1], t[2], &mut positions),
-                mid(t[2], t[0], &mut positions),
-            );
-            next.extend([[t[0], ab, ca], [ab, t[1], bc], [ca, bc, t[2]], [ab, bc, ca]]);
-        }
-        triangles = next;
-    }
-    BubbleMesh {
-        normals: positions.clone(),
-        thickness_nm: vec![thickness_nm; positions.len()],
-        positions: positions.iter().map(|&n| center + n * r).collect(),
-        triangles,
-    }
-}
-
-/// Lossless tables: `R = 0.3` everywhere, `T = 0.7`, so `R + T = 1`.
-fn lossless_tables() -> FilmTables {
+/// Tables of constant `R` and `T`.
+fn constant_tables(r: f32, t: f32) -> FilmTables {
     let constant = |v: f32| Lut::try_from_fn(8, 8, 1500.0, move |_, _| [v; 3]).unwrap();
     FilmTables {
-        reflectivity: constant(0.3),
-        transmittance: Some(constant(0.7)),
+        reflectivity: constant(r),
+        transmittance: Some(constant(t)),
         lights: Vec::new(),
     }
 }
@@ -152,7 +120,7 @@ fn camera() -> Camera {
 fn an_empty_scene_shows_its_environment_on_every_backend() {
     let scene = RenderScene::new(camera(), Environment::Uniform([0.25, 0.5, 0.75]));
     on_every_backend(|backend| {
-        let Some(frame) = render(backend, &scene, &lossless_tables(), (24, 16)) else {
+        let Some(frame) = render(backend, &scene, &constant_tables(0.3, 0.7), (24, 16)) else {
             return false;
         };
         assert_eq!((frame.width(), frame.height()), (24, 16), "{backend:?}");
@@ -170,12 +138,15 @@ fn an_empty_scene_shows_its_environment_on_every_backend() {
 
 #[test]
 fn in_a_white_furnace_a_lossless_film_is_invisible_on_every_backend() {
-    // R + T = 1 (the tables here, the exact lossless Airy film in the reference): a film
+    // R + T = 1 (the synthetic tables, which vary R over thickness and angle; the exact
+    // lossless Airy film in the reference): a film
     // in a uniform white environment passes on exactly the light it does not reflect.
     let mut scene = RenderScene::new(camera(), Environment::Uniform([1.0; 3]));
     scene.bubbles = vec![
-        bubble(Vec3::new(-0.15, 0.0, 0.0), 0.25, 350.0),
-        bubble(Vec3::new(0.2, 0.05, -0.3), 0.2, 800.0),
+        bubble(Vec3::new(-0.15, 0.0, 0.0), 0.25, 3, |_| 350.0),
+        bubble(Vec3::new(0.2, 0.05, -0.3), 0.2, 3, |n| {
+            300.0 + 500.0 * n.y.abs()
+        }),
     ];
     on_every_backend(|backend| {
         let Some(frame) = render(backend, &scene, &lossless_tables(), (32, 24)) else {
@@ -202,10 +173,8 @@ fn a_lossy_film_blends_as_seed_000_says_on_the_raster_backends() {
     // reflection would be off by at least 0.1. (The reference traces the physical film,
     // not these tables, so it is not asked.)
     let mut scene = RenderScene::new(camera(), Environment::Uniform([1.0; 3]));
-    scene.bubbles = vec![bubble(Vec3::ZERO, 0.3, 500.0)];
-    let mut tables = lossless_tables();
-    // A lossy film: T = 0.5, R = 0.3.
-    tables.transmittance = Some(Lut::try_from_fn(8, 8, 1500.0, |_, _| [0.5; 3]).unwrap());
+    scene.bubbles = vec![bubble(Vec3::ZERO, 0.3, 3, |_| 500.0)];
+    let tables = constant_tables(0.3, 0.5);
     let cpu = render(Backend::Cpu, &scene, &tables, (32, 24)).unwrap();
     let centre = cpu.rgb()[12 * 32 + 16];
     for c in centre {
