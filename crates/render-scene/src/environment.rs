@@ -155,7 +155,7 @@ impl Environment {
 }
 
 /// Rejects a colour that is not finite and non-negative.
-pub fn check_rgb(what: &str, rgb: [f32; 3]) -> Result<(), RenderError> {
+pub(crate) fn check_rgb(what: &str, rgb: [f32; 3]) -> Result<(), RenderError> {
     if rgb.iter().all(|c| c.is_finite() && *c >= 0.0) {
         Ok(())
     } else {
@@ -168,7 +168,7 @@ pub fn check_rgb(what: &str, rgb: [f32; 3]) -> Result<(), RenderError> {
 
 /// `a·(1 − t) + b·t`, exact at both ends.
 #[inline]
-pub fn lerp3(a: [f32; 3], b: [f32; 3], t: f32) -> [f32; 3] {
+pub(crate) fn lerp3(a: [f32; 3], b: [f32; 3], t: f32) -> [f32; 3] {
     let s = 1.0 - t;
     [
         a[0] * s + b[0] * t,

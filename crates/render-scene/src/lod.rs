@@ -48,7 +48,7 @@ pub fn cube_lod(footprint_rad: f32, face_size: usize, s: f32, t: f32) -> f32 {
 /// `x = m·2^e` with `m` in `[√½, √2)`, and `log2 m = 2·atanh(s)/ln 2` with
 /// `s = (m − 1)/(m + 1)`, `|s| ≤ 0.172`, whose odd series converges to 1e-9 by `s⁹`.
 #[inline(always)]
-pub fn log2_at_least_one(x: f32) -> f32 {
+pub(crate) fn log2_at_least_one(x: f32) -> f32 {
     const SQRT_HALF_BITS: u32 = 0x3f35_04f3;
     // 2/ln 2 and its multiples 1/3, 1/5, 1/7, 1/9.
     const C: [f32; 5] = [2.885_39, 0.961_796_7, 0.577_078, 0.412_198_6, 0.320_598_9];

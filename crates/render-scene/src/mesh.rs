@@ -109,7 +109,11 @@ impl TriMesh {
 }
 
 /// Rejects non-finite positions or normals, naming the vertex.
-pub fn check_vertices(what: &str, positions: &[Vec3], normals: &[Vec3]) -> Result<(), RenderError> {
+pub(crate) fn check_vertices(
+    what: &str,
+    positions: &[Vec3],
+    normals: &[Vec3],
+) -> Result<(), RenderError> {
     for (k, (p, n)) in positions.iter().zip(normals).enumerate() {
         if !(p.is_finite() && n.is_finite()) {
             return Err(RenderError::scene(
@@ -122,7 +126,7 @@ pub fn check_vertices(what: &str, positions: &[Vec3], normals: &[Vec3]) -> Resul
 }
 
 /// Rejects out-of-range indices, naming the triangle.
-pub fn check_triangles(
+pub(crate) fn check_triangles(
     what: &str,
     triangles: &[[u32; 3]],
     vertices: usize,

@@ -9,7 +9,7 @@ use crate::{Irradiance, Light, Material, Pattern};
 /// `x.floor()` without a libm call (baseline x86-64 has no rounding instruction);
 /// exact for |x| < 2²³, where every f32 beyond is already an integer.
 #[inline]
-pub fn fast_floor(x: f32) -> f32 {
+pub(crate) fn fast_floor(x: f32) -> f32 {
     if x.abs() < 8_388_608.0 {
         let t = x as i32 as f32;
         if t > x { t - 1.0 } else { t }

@@ -144,7 +144,7 @@ fn split_clamp(t: f32, n: usize) -> (usize, usize, f32) {
 }
 
 /// The sRGB decoding curve (IEC 61966-2-1) for one channel in `[0, 1]`.
-pub fn srgb_to_linear(c: f32) -> f32 {
+pub(crate) fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 {
         c / 12.92
     } else {
@@ -153,7 +153,7 @@ pub fn srgb_to_linear(c: f32) -> f32 {
 }
 
 /// Reads an image file as linear RGB: float formats as stored, integer formats through the sRGB curve.
-pub fn read_linear_rgb(path: &Path) -> Result<(usize, usize, Vec<[f32; 3]>), RenderError> {
+pub(crate) fn read_linear_rgb(path: &Path) -> Result<(usize, usize, Vec<[f32; 3]>), RenderError> {
     let err = |message: String| RenderError::ImageRead {
         path: path.to_path_buf(),
         message,
@@ -189,7 +189,11 @@ pub fn read_linear_rgb(path: &Path) -> Result<(usize, usize, Vec<[f32; 3]>), Ren
 
 /// Checks that every texel of a row-major image `width` wide is finite and non-negative,
 /// naming `what` and the first bad texel's position otherwise.
-pub fn check_texels(what: &str, texels: &[[f32; 3]], width: usize) -> Result<(), RenderError> {
+pub(crate) fn check_texels(
+    what: &str,
+    texels: &[[f32; 3]],
+    width: usize,
+) -> Result<(), RenderError> {
     match texels
         .iter()
         .position(|t| t.iter().any(|c| !(c.is_finite() && *c >= 0.0)))
@@ -205,7 +209,14 @@ pub fn check_texels(what: &str, texels: &[[f32; 3]], width: usize) -> Result<(),
 /// Bilinear blend of the texels `a b` (top row) and `c d` (bottom row), in the one
 /// operation order every sampler uses, so their results stay bit-identical.
 #[inline(always)]
-pub fn bilerp(a: [f32; 3], b: [f32; 3], c: [f32; 3], d: [f32; 3], tx: f32, ty: f32) -> [f32; 3] {
+pub(crate) fn bilerp(
+    a: [f32; 3],
+    b: [f32; 3],
+    c: [f32; 3],
+    d: [f32; 3],
+    tx: f32,
+    ty: f32,
+) -> [f32; 3] {
     let mut out = [0.0; 3];
     for k in 0..3 {
         let top = a[k] + (b[k] - a[k]) * tx;
