@@ -6,6 +6,8 @@ use std::sync::Arc;
 use glam::DVec3;
 
 use crate::film::Slosh;
+use crate::film_flow::on_bubble::GridFilm;
+use crate::film_flow::{FilmFlow, FlowParams};
 use crate::geometry::{self, barycentric_vertex_areas_m2, enclosed_volume_m3, surface_area_m2};
 use crate::params::{BubbleParams, GAS_CONSTANT_J_PER_MOL_K, MassDistribution, WorldParams};
 use crate::rng::SphereField;
@@ -83,6 +85,18 @@ pub struct Bubble {
     pub(crate) scratch: Scratch,
     /// The open contact episode with each static collider, by collider index.
     pub(crate) episodes: Vec<crate::collide::Episode>,
+    /// The film flow on its cube-sphere, when `film_grid > 0`.
+    pub(crate) grid_film: Option<Box<GridFilm>>,
+}
+
+/// A bubble's film thickness over its material sphere, as the cube map renderers read.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FilmField {
+    /// Cells along a face edge, n.
+    pub face_size: usize,
+    /// Thickness of cell `face·n² + y·n + x` in nm, stretched by the mesh's deformation
+    /// (faces in OpenGL cube-map order, see `film_flow::grid`).
+    pub thickness_nm: Vec<f64>,
 }
 
 impl Bubble {
@@ -149,6 +163,9 @@ impl Bubble {
             topology: Arc::clone(&topology),
             scratch: Scratch::default(),
             episodes: Vec::new(),
+            grid_film: (params.film_grid > 0).then(|| {
+                Box::new(grid_film(params, world, unit_positions, &rest, triangles))
+            }),
         };
         bubble.refresh_inertial_mass();
         bubble.volume_m3 = enclosed_volume_m3(&bubble.positions_m, bubble.topology.triangles());
@@ -189,6 +206,25 @@ impl Bubble {
                 f64::INFINITY
             };
         }
+    }
+
+    /// The film flow, when the bubble has one (`film_grid > 0`).
+    pub fn film_flow(&self) -> Option<&FilmFlow> {
+        self.grid_film.as_ref().map(|g| &g.flow)
+    }
+
+    /// The film's thickness field for renderers, when the bubble has a film flow.
+    pub fn film_field(&self) -> Option<FilmField> {
+        self.grid_film.as_ref().map(|g| FilmField {
+            face_size: g.flow.grid().face_size(),
+            thickness_nm: g.thickness_nm(&self.positions_m, self.topology.triangles()),
+        })
+    }
+
+    /// Where each mesh vertex sits on the film grid (its unit rest direction), when the
+    /// bubble has a film flow.
+    pub fn material_dirs(&self) -> Option<&[DVec3]> {
+        self.grid_film.as_ref().map(|g| &g.material_dirs[..])
     }
 
     /// Stable identifier: the bubble's index in the list given to `World::try_new`.
@@ -371,6 +407,43 @@ pub(crate) fn face_areas_m2(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<
 
 /// Film mass per vertex, kg: ρ·h·A in total, shared by `distribution`, modulated by a
 /// smooth seeded pattern of relative amplitude `thickness_variation`.
+/// The film flow of a new bubble: the initial thickness pattern of the per-vertex film
+/// (same seed, same smooth field), evaluated at every cell and scaled to the mean.
+fn grid_film(
+    params: &BubbleParams,
+    world: &WorldParams,
+    unit_positions: &[DVec3],
+    rest: &[DVec3],
+    triangles: &[[u32; 3]],
+) -> GridFilm {
+    let pattern = SphereField::new(params.seed, 6, 0.0);
+    let flow = FlowParams {
+        radius_m: params.radius_m,
+        density_kg_per_m3: params.film_density_kg_per_m3,
+        elasticity_n_per_m: params.gibbs_elasticity_n_per_m,
+        viscosity_pa_s: params.film_viscosity_pa_s,
+        drainage_viscosity_pa_s: params.drainage_viscosity_pa_s,
+        evaporation_nm_per_s: params.evaporation_nm_per_s,
+        air_viscosity_pa_s: world.air_viscosity_pa_s,
+        air_density_kg_per_m3: world.air_density_kg_per_m3,
+    };
+    let h0 = params.mean_thickness_nm * 1e-9;
+    let variation = params.thickness_variation;
+    let mut film = GridFilm::new(
+        params.film_grid as usize,
+        flow,
+        unit_positions,
+        rest,
+        triangles,
+        |d| h0 * (1.0 + variation * pattern.value(d, 0.0)),
+    );
+    // The pattern's mean over the sphere is not exactly zero: rescale to the mean.
+    let area = 4.0 * PI * params.radius_m * params.radius_m;
+    let scale = h0 * area / film.flow.liquid_volume_m3();
+    film.flow.h_m.iter_mut().for_each(|h| *h *= scale);
+    film
+}
+
 fn initial_film_mass_kg(
     params: &BubbleParams,
     unit_positions: &[DVec3],

@@ -28,6 +28,7 @@ mod collider;
 mod dynamics;
 mod error;
 mod film;
+pub mod film_flow;
 pub mod geometry;
 pub mod icosphere;
 mod params;
@@ -37,12 +38,12 @@ mod validate;
 mod wind;
 mod world;
 
-pub use bubble::{Bubble, rest_pressure_excess_pa};
+pub use bubble::{Bubble, FilmField, rest_pressure_excess_pa};
 pub use collider::{Collider, DEFAULT_FRICTION, DEFAULT_RESTITUTION};
 pub use error::{Divergence, ParamError, SimError};
 pub use params::{
     AIR_MOLAR_MASS_KG_PER_MOL, BubbleParams, GAS_CONSTANT_J_PER_MOL_K, Integrator,
-    MassDistribution, STANDARD_GRAVITY_M_PER_S2, STANDARD_PRESSURE_PA, WorldParams,
+    MAX_FILM_GRID, MassDistribution, STANDARD_GRAVITY_M_PER_S2, STANDARD_PRESSURE_PA, WorldParams,
 };
 pub use topology::{Edge, Topology};
 pub use wind::{Gusts, Wind, WindFn};

@@ -131,6 +131,9 @@ impl WorldParams {
     }
 }
 
+/// Largest film-flow grid: 6·512² cells, 1.6 M.
+pub const MAX_FILM_GRID: usize = 512;
+
 /// Parameters of one bubble.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BubbleParams {
@@ -177,6 +180,11 @@ pub struct BubbleParams {
     pub mass_distribution: MassDistribution,
     /// Seed of the initial thickness pattern and of the sloshing.
     pub seed: u64,
+    /// Cells along a face of the film-flow cube-sphere (0: no flow; the per-vertex
+    /// drainage and sloshing move the film instead). Must halve down to at most 8.
+    pub film_grid: u32,
+    /// Viscosity of the film liquid for the flow's viscous sheet stress, Pa·s.
+    pub film_viscosity_pa_s: f64,
 }
 
 impl Default for BubbleParams {
@@ -203,6 +211,8 @@ impl Default for BubbleParams {
             initial_scale: DVec3::ONE,
             mass_distribution: MassDistribution::AreaWeighted,
             seed: 0,
+            film_grid: 0,
+            film_viscosity_pa_s: 1.0e-3,
         }
     }
 }
@@ -250,6 +260,15 @@ impl BubbleParams {
         positive("gas_molar_mass_kg_per_mol", self.gas_molar_mass_kg_per_mol)?;
         positive("gas_temperature_k", self.gas_temperature_k)?;
         nonzero_vec("initial_scale", self.initial_scale)?;
+        let grid = self.film_grid as usize;
+        if grid > MAX_FILM_GRID || (grid > 0 && !crate::film_flow::Hierarchy::supports(grid)) {
+            return Err(ParamError::new(
+                "film_grid",
+                self.film_grid,
+                format!("must be 0 (off) or at most {MAX_FILM_GRID}, halving down to 8 or less (e.g. 32, 64, 128, 256)"),
+            ));
+        }
+        non_negative("film_viscosity_pa_s", self.film_viscosity_pa_s)?;
         if self.initial_scale.min_element() <= 0.0 {
             return Err(ParamError::new(
                 "initial_scale",

@@ -9,6 +9,7 @@ use rayon::prelude::*;
 use crate::bubble::Bubble;
 use crate::collide;
 use crate::collider::Collider;
+use crate::film_flow::Forcing;
 use crate::error::{Divergence, ParamError, SimError};
 use crate::geometry::enclosed_volume_m3;
 use crate::icosphere::equilibrium_icosphere;
@@ -255,10 +256,24 @@ impl World {
         self.steps = step;
         self.last_substeps = substeps;
         let gravity = self.params.gravity_m_per_s2;
-        let mut v_start = v_start;
-        for_each_bubble(&mut self.bubbles, &mut v_start, parallel, |b, v0| {
+        let mut slots: Vec<(DVec3, DVec3)> = v_start
+            .into_iter()
+            .zip(&self.bubbles)
+            .map(|(v0, b)| (v0, self.wind.velocity(b.center_m(), t0) - b.velocity_m_per_s()))
+            .collect();
+        let parallel = parallel || self.bubbles.iter().any(|b| b.grid_film.is_some());
+        for_each_bubble(&mut self.bubbles, &mut slots, parallel, |b, (v0, air)| {
             let acceleration = (b.velocity_m_per_s() - *v0) / dt;
-            b.transport_film(gravity - acceleration, dt, t0);
+            match b.grid_film.as_mut() {
+                Some(film) => film.step(
+                    dt,
+                    &Forcing {
+                        g_eff_m_per_s2: gravity - acceleration,
+                        air_m_per_s: *air,
+                    },
+                ),
+                None => b.transport_film(gravity - acceleration, dt, t0),
+            }
         });
         Ok(self.remove_burst(step))
     }

@@ -1,0 +1,437 @@
+//! The film's state on the cube-sphere and one time step of its flow.
+//!
+//! Per cell: thickness `h` and surfactant concentration `Γ` (relative to the rest
+//! value). Per edge: the surfaces' velocity `u` normal to the edge (the liquid moves with
+//! the surfaces as a plug, plus the Poiseuille drainage flux relative to them).
+//!
+//! Momentum, per unit film mass: gravity `g_t`, the Marangoni stress `∇T/(ρh)` with the
+//! film tension `T = T₀ − E_f ln Γ` (insoluble surfactant, constant Gibbs elasticity
+//! `E_f = dT/d ln A`), the thin viscous sheet's stress `ν(−∇×∇×u + 2Ku + 4∇∇·u)`, and the
+//! air's shear. The Marangoni term is the stiff one (waves at `√(E_f/(ρh))`, 10 m/s on a
+//! 500 nm film): it is taken backward-Euler, which leaves one linear system per step (see
+//! `solve`), and is then stable for any step. Viscosity is explicit, sub-stepped under
+//! its bound; transport is upwind under a Courant bound of 1/2 an edge.
+
+use glam::DVec3;
+
+use super::grid::CubeSphere;
+use super::solve::{Hierarchy, SolveReport, Work};
+
+/// Thickness floor of the Marangoni coefficient `E_f/(ρh)`, m: a hole or a Newton black
+/// film keeps a finite (if huge) stiffness.
+const H_FLOOR_M: f64 = 1e-9;
+/// Largest fraction of a cell's content that may leave it in one transport sub-step.
+const MAX_OUTFLOW_FRACTION: f64 = 0.5;
+/// Relative residual of the Marangoni solve.
+const SOLVE_TOLERANCE: f64 = 1e-10;
+/// Iteration cap of the Marangoni solve (it takes 3–8).
+const SOLVE_MAX_ITERATIONS: u32 = 40;
+
+/// The physical constants of one bubble's film.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlowParams {
+    /// Radius of the material sphere the grid lies on, m.
+    pub radius_m: f64,
+    /// Density of the film liquid, kg/m³.
+    pub density_kg_per_m3: f64,
+    /// Gibbs elasticity of the film, `E_f = dT/d ln A` (twice one surface's), N/m.
+    pub elasticity_n_per_m: f64,
+    /// Viscosity of the film liquid, Pa·s: the sheet's 2D shear viscosity is `μh`.
+    pub viscosity_pa_s: f64,
+    /// Effective viscosity of the Poiseuille drainage flux `ρ g_t h³/(3μ)`, Pa·s
+    /// (infinite: no drainage).
+    pub drainage_viscosity_pa_s: f64,
+    /// Evaporative thinning, nm/s.
+    pub evaporation_nm_per_s: f64,
+    /// Viscosity of the outside air, Pa·s.
+    pub air_viscosity_pa_s: f64,
+    /// Density of the outside air, kg/m³.
+    pub air_density_kg_per_m3: f64,
+}
+
+/// What drives the film during one step, in the film's material frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Forcing {
+    /// Gravity minus the bubble's acceleration, m/s².
+    pub g_eff_m_per_s2: DVec3,
+    /// The air's velocity far from the bubble relative to the bubble, m/s.
+    pub air_m_per_s: DVec3,
+}
+
+/// The film's flow state on a cube-sphere.
+#[derive(Clone, Debug)]
+pub struct FilmFlow {
+    grid: std::sync::Arc<CubeSphere>,
+    hierarchy: std::sync::Arc<Hierarchy>,
+    params: FlowParams,
+    pub(crate) h_m: Vec<f64>,
+    pub(crate) gamma: Vec<f64>,
+    pub(crate) u_m_per_s: Vec<f64>,
+    scratch: Scratch,
+}
+
+#[derive(Clone, Debug, Default)]
+struct Scratch {
+    work: Work,
+    edge: Vec<f64>,
+    edge2: Vec<f64>,
+    cell: Vec<f64>,
+    cell2: Vec<f64>,
+    vertex: Vec<f64>,
+    weight: Vec<f64>,
+    u_start: Vec<f64>,
+}
+
+impl FilmFlow {
+    /// A film at rest with thickness `h_m(centre direction)` and uniform surfactant.
+    ///
+    /// # Panics
+    /// If `grid` and `hierarchy` differ in size.
+    pub fn new(
+        grid: std::sync::Arc<CubeSphere>,
+        hierarchy: std::sync::Arc<Hierarchy>,
+        params: FlowParams,
+        h_m: impl Fn(DVec3) -> f64,
+    ) -> Self {
+        let h: Vec<f64> = grid.centres().iter().map(|&c| h_m(c)).collect();
+        let cells = grid.cells();
+        let edges = grid.edges().len();
+        Self {
+            params,
+            h_m: h,
+            gamma: vec![1.0; cells],
+            u_m_per_s: vec![0.0; edges],
+            hierarchy,
+            grid,
+            scratch: Scratch::default(),
+        }
+    }
+
+    /// The grid.
+    pub fn grid(&self) -> &CubeSphere {
+        &self.grid
+    }
+
+    /// The constants.
+    pub fn params(&self) -> &FlowParams {
+        &self.params
+    }
+
+    /// Thickness of each cell, m.
+    pub fn thickness_m(&self) -> &[f64] {
+        &self.h_m
+    }
+
+    /// Surfactant concentration of each cell, relative to the rest value.
+    pub fn surfactant(&self) -> &[f64] {
+        &self.gamma
+    }
+
+    /// Surface velocity normal to each edge (along the edge's normal), m/s.
+    pub fn edge_velocity_m_per_s(&self) -> &[f64] {
+        &self.u_m_per_s
+    }
+
+    /// Sets the edge velocities from a tangential velocity field `u(direction)`, m/s.
+    pub fn set_velocity(&mut self, u: impl Fn(DVec3) -> DVec3) {
+        for (v, e) in self.u_m_per_s.iter_mut().zip(self.grid.edges()) {
+            let mid = (self.grid.centres()[e.a as usize] + self.grid.centres()[e.b as usize])
+                .normalize();
+            *v = u(mid).dot(e.normal);
+        }
+    }
+
+    /// Sets the surfactant concentration from `gamma(direction)`.
+    pub fn set_surfactant(&mut self, gamma: impl Fn(DVec3) -> f64) {
+        for (g, &c) in self.gamma.iter_mut().zip(self.grid.centres()) {
+            *g = gamma(c);
+        }
+    }
+
+    /// Liquid volume ∫h dA over the material sphere, m³.
+    pub fn liquid_volume_m3(&self) -> f64 {
+        let r2 = self.params.radius_m * self.params.radius_m;
+        self.h_m.iter().zip(self.grid.areas_sr()).map(|(h, a)| h * a).sum::<f64>() * r2
+    }
+
+    /// Surfactant amount ∫Γ dA, relative concentration × m².
+    pub fn surfactant_amount_m2(&self) -> f64 {
+        let r2 = self.params.radius_m * self.params.radius_m;
+        self.gamma.iter().zip(self.grid.areas_sr()).map(|(g, a)| g * a).sum::<f64>() * r2
+    }
+
+    /// Kinetic energy per unit film density, ½∫h|u|² dA with each edge's normal
+    /// velocity on its dual area (`l·d`), m⁵/s².
+    pub fn kinetic_measure(&self) -> f64 {
+        let r2 = self.params.radius_m * self.params.radius_m;
+        let g = &self.grid;
+        g.edges()
+            .iter()
+            .zip(&self.u_m_per_s)
+            .map(|(e, u)| {
+                let h = 0.5 * (self.h_m[e.a as usize] + self.h_m[e.b as usize]);
+                h * u * u * e.length * e.dual_length
+            })
+            .sum::<f64>()
+            * r2
+    }
+
+    /// Advances the film by `dt_s` under `forcing`; returns the Marangoni solve's report.
+    pub fn step(&mut self, dt_s: f64, forcing: &Forcing) -> SolveReport {
+        let mut s = std::mem::take(&mut self.scratch);
+        s.u_start.clear();
+        s.u_start.extend_from_slice(&self.u_m_per_s);
+        self.momentum_explicit(&mut s, dt_s, forcing);
+        let report = self.marangoni_implicit(&mut s, dt_s);
+        self.transport_thickness(&mut s, dt_s, forcing.g_eff_m_per_s2);
+        let evaporated = self.params.evaporation_nm_per_s * 1e-9 * dt_s;
+        if evaporated > 0.0 {
+            self.h_m.iter_mut().for_each(|h| *h = (*h - evaporated).max(0.0));
+        }
+        self.scratch = s;
+        report
+    }
+
+    /// `u ← u + dt (g_t + viscous)`, then the air's shear, implicit per edge.
+    fn momentum_explicit(&mut self, s: &mut Scratch, dt_s: f64, forcing: &Forcing) {
+        // Gravity as the discrete gradient of the potential g·x between cell centres, so
+        // a discrete Marangoni gradient can balance it exactly (the edge projection g·n
+        // carries an O(Δx) curl that no tension gradient can hold).
+        let centres = self.grid.centres();
+        let g = forcing.g_eff_m_per_s2;
+        for (u, e) in self.u_m_per_s.iter_mut().zip(self.grid.edges()) {
+            let rise = g.dot(centres[e.b as usize] - centres[e.a as usize]);
+            *u += dt_s * rise / e.dual_length;
+        }
+        let nu = self.params.viscosity_pa_s / self.params.density_kg_per_m3;
+        if nu > 0.0 {
+            let substeps = (dt_s * self.viscous_rate_bound(nu) / 1.5).ceil().max(1.0);
+            for _ in 0..substeps as u32 {
+                self.viscous_substep(s, nu, dt_s / substeps);
+            }
+        }
+        self.air_shear(dt_s, forcing.air_m_per_s);
+    }
+
+    /// An upper bound of the viscous operator's eigenvalues (Gershgorin), 1/s.
+    fn viscous_rate_bound(&self, nu: f64) -> f64 {
+        let r = self.params.radius_m;
+        let g = &self.grid;
+        let (cells, verts) = (g.areas_sr(), g.vertex_areas_sr());
+        g.edges()
+            .iter()
+            .map(|e| {
+                let curl = 2.0 * e.dual_length
+                    / e.length
+                    / verts[e.v0 as usize].min(verts[e.v1 as usize]);
+                let div = 4.0 * 2.0 * e.length / e.dual_length
+                    / cells[e.a as usize].min(cells[e.b as usize]);
+                4.0 * (curl + div) + 2.0
+            })
+            .fold(0.0, f64::max)
+            * nu
+            / (r * r)
+    }
+
+    /// One explicit step of the sheet's viscous stress over `dt_s`.
+    fn viscous_substep(&mut self, s: &mut Scratch, nu: f64, dt_s: f64) {
+        let r = self.params.radius_m;
+        let g = &self.grid;
+        let vorticity = &mut s.vertex;
+        vorticity.clear();
+        vorticity.resize(g.vertex_areas_sr().len(), 0.0);
+        let divergence = &mut s.cell;
+        divergence.clear();
+        divergence.resize(g.cells(), 0.0);
+        for (e, &u) in g.edges().iter().zip(&self.u_m_per_s) {
+            vorticity[e.v1 as usize] += u * e.dual_length;
+            vorticity[e.v0 as usize] -= u * e.dual_length;
+            divergence[e.a as usize] += u * e.length;
+            divergence[e.b as usize] -= u * e.length;
+        }
+        for (z, a) in vorticity.iter_mut().zip(g.vertex_areas_sr()) {
+            *z /= a * r;
+        }
+        for (d, a) in divergence.iter_mut().zip(g.areas_sr()) {
+            *d /= a * r;
+        }
+        let k = 1.0 / (r * r);
+        for (u, e) in self.u_m_per_s.iter_mut().zip(g.edges()) {
+            let curl_curl = (vorticity[e.v1 as usize] - vorticity[e.v0 as usize]) / (e.length * r);
+            let grad_div =
+                (divergence[e.b as usize] - divergence[e.a as usize]) / (e.dual_length * r);
+            *u += dt_s * nu * (-curl_curl + 2.0 * k * *u + 4.0 * grad_div);
+        }
+    }
+
+    /// The outside air drags the film towards the potential flow's surface velocity
+    /// `1.5 (U − (U·n)n)`, through a boundary layer of thickness `√(ν_air R/|U|)`
+    /// (at most R); implicit per edge, so stable however thin the film.
+    fn air_shear(&mut self, dt_s: f64, air_m_per_s: DVec3) {
+        let p = &self.params;
+        let speed = air_m_per_s.length();
+        if p.air_viscosity_pa_s <= 0.0 || speed <= 0.0 {
+            return;
+        }
+        let nu_air = p.air_viscosity_pa_s / p.air_density_kg_per_m3.max(f64::MIN_POSITIVE);
+        let delta_m = (nu_air * p.radius_m / speed).sqrt().min(p.radius_m);
+        for (u, e) in self.u_m_per_s.iter_mut().zip(self.grid.edges()) {
+            let h = (0.5 * (self.h_m[e.a as usize] + self.h_m[e.b as usize])).max(H_FLOOR_M);
+            let rate = p.air_viscosity_pa_s / (delta_m * p.density_kg_per_m3 * h);
+            let target = 1.5 * air_m_per_s.dot(e.normal);
+            *u = (*u + dt_s * rate * target) / (1.0 + dt_s * rate);
+        }
+    }
+
+    /// Backward-Euler Marangoni step: solves for the surfactant the step ends with, sets
+    /// the velocities from its gradient, and moves the surfactant with fluxes that sum to
+    /// zero (so it is conserved to rounding whatever the solver's residual).
+    fn marangoni_implicit(&mut self, s: &mut Scratch, dt_s: f64) -> SolveReport {
+        let p = self.params;
+        let r = p.radius_m;
+        let g = std::sync::Arc::clone(&self.grid);
+        // Surfactant flux across each edge (per R): upwind with the velocity the step
+        // started with (transport), central with the step's change of velocity (the
+        // forces' part, which the implicit solve treats centrally: an upwind flux there
+        // would diffuse Γ at |g dt| and no gradient could hold a film at rest).
+        let advective = &mut s.edge;
+        advective.clear();
+        advective.extend(
+            g.edges()
+                .iter()
+                .zip(&self.u_m_per_s)
+                .zip(&s.u_start)
+                .map(|((e, &u), &u0)| {
+                    let (ga, gb) = (self.gamma[e.a as usize], self.gamma[e.b as usize]);
+                    let up = if u0 >= 0.0 { ga } else { gb };
+                    (up * u0 + 0.5 * (ga + gb) * (u - u0)) * e.length
+                }),
+        );
+        // Rows divided by R²: α = A (sr), w = dt² E l/(ρ h d R²), b = A Γ − dt Σ F/R.
+        let stiffness = |e: &super::grid::GridEdge| {
+            let h = (0.5 * (self.h_m[e.a as usize] + self.h_m[e.b as usize])).max(H_FLOOR_M);
+            dt_s * p.elasticity_n_per_m / (p.density_kg_per_m3 * h)
+        };
+        s.weight.clear();
+        s.weight.extend(
+            g.edges()
+                .iter()
+                .map(|e| dt_s * stiffness(e) * e.length / (e.dual_length * r * r)),
+        );
+        let rhs = &mut s.cell;
+        rhs.clear();
+        rhs.extend(g.areas_sr().iter().zip(&self.gamma).map(|(a, gm)| a * gm));
+        for (e, f) in g.edges().iter().zip(advective.iter()) {
+            rhs[e.a as usize] -= dt_s * f / r;
+            rhs[e.b as usize] += dt_s * f / r;
+        }
+        let solution = &mut s.cell2;
+        solution.clear();
+        solution.extend_from_slice(&self.gamma);
+        let report = self.hierarchy.solve(
+            &mut s.work,
+            g.areas_sr(),
+            &s.weight,
+            rhs,
+            solution,
+            SOLVE_TOLERANCE,
+            SOLVE_MAX_ITERATIONS,
+        );
+        // Velocity correction and the conservative surfactant update.
+        let flux = &mut s.edge2;
+        flux.clear();
+        for ((e, u), f_adv) in g.edges().iter().zip(self.u_m_per_s.iter_mut()).zip(advective.iter()) {
+            let (a, b) = (e.a as usize, e.b as usize);
+            let gamma_c = 0.5 * (self.gamma[a] + self.gamma[b]);
+            let du = -stiffness(e) * (solution[b] - solution[a])
+                / (gamma_c.max(f64::MIN_POSITIVE) * e.dual_length * r);
+            *u += du;
+            flux.push(f_adv + gamma_c * du * e.length);
+        }
+        for (e, f) in g.edges().iter().zip(flux.iter()) {
+            let (a, b) = (e.a as usize, e.b as usize);
+            let moved = dt_s * f / r;
+            self.gamma[a] -= moved / g.areas_sr()[a];
+            self.gamma[b] += moved / g.areas_sr()[b];
+        }
+        report
+    }
+
+    /// Moves liquid with the surfaces (upwind) and by the drainage flux relative to them,
+    /// in sub-steps that keep each cell's outflow below half its content.
+    fn transport_thickness(&mut self, s: &mut Scratch, dt_s: f64, g_eff: DVec3) {
+        let p = self.params;
+        let r = p.radius_m;
+        let g = std::sync::Arc::clone(&self.grid);
+        let drain = if p.drainage_viscosity_pa_s.is_finite() && p.drainage_viscosity_pa_s > 0.0 {
+            p.density_kg_per_m3 / (3.0 * p.drainage_viscosity_pa_s)
+        } else {
+            0.0
+        };
+        // Speed of every edge: the surfaces' plus the drainage's (ρ g_t h²/(3μ)).
+        s.edge.clear();
+        s.edge.extend(g.edges().iter().zip(&self.u_m_per_s).map(|(e, &u)| {
+            edge_speed(e, u, drain * g_eff.dot(e.normal), &self.h_m)
+        }));
+        let courant = g
+            .edges()
+            .iter()
+            .zip(s.edge.iter())
+            .map(|(e, v)| {
+                let a = g.areas_sr()[e.a as usize].min(g.areas_sr()[e.b as usize]);
+                v.abs() * dt_s * e.length / (a * r)
+            })
+            .fold(0.0, f64::max);
+        let substeps = (courant * 4.0 / MAX_OUTFLOW_FRACTION).ceil().clamp(1.0, 64.0) as u32;
+        let h_dt = dt_s / f64::from(substeps);
+        for k in 0..substeps {
+            if k > 0 {
+                for ((v, e), &u) in s.edge.iter_mut().zip(g.edges()).zip(&self.u_m_per_s) {
+                    *v = edge_speed(e, u, drain * g_eff.dot(e.normal), &self.h_m);
+                }
+            }
+            self.upwind_substep(s, h_dt);
+        }
+    }
+
+    /// One upwind transport of `h` with the edge speeds in `s.edge`, outflow-limited.
+    fn upwind_substep(&mut self, s: &mut Scratch, dt_s: f64) {
+        let r = self.params.radius_m;
+        let g = &self.grid;
+        let (speed, volume, outflow) = (&s.edge, &mut s.edge2, &mut s.cell);
+        volume.clear();
+        outflow.clear();
+        outflow.resize(g.cells(), 0.0);
+        // Volume across each edge over the step, per R² (m × sr).
+        for (e, &v) in g.edges().iter().zip(speed.iter()) {
+            let up = if v >= 0.0 { e.a } else { e.b } as usize;
+            let moved = self.h_m[up] * v * e.length * dt_s / r;
+            outflow[up] += moved.abs();
+            volume.push(moved);
+        }
+        let scale = &mut s.cell2;
+        scale.clear();
+        scale.extend(g.areas_sr().iter().zip(&self.h_m).zip(outflow.iter()).map(
+            |((a, h), out)| {
+                let budget = MAX_OUTFLOW_FRACTION * a * h;
+                if *out > budget { budget / out } else { 1.0 }
+            },
+        ));
+        for (e, moved) in g.edges().iter().zip(volume.iter()) {
+            let (a, b) = (e.a as usize, e.b as usize);
+            let up = if *moved >= 0.0 { a } else { b };
+            let m = moved * scale[up];
+            self.h_m[a] -= m / g.areas_sr()[a];
+            self.h_m[b] += m / g.areas_sr()[b];
+        }
+    }
+}
+
+/// Transport speed across edge `e`: the surfaces' `u` plus the drainage `c·h_up²`, with
+/// the upwind cell chosen by the sign of the speed at the mean thickness.
+fn edge_speed(e: &super::grid::GridEdge, u: f64, c: f64, h_m: &[f64]) -> f64 {
+    let (ha, hb) = (h_m[e.a as usize], h_m[e.b as usize]);
+    let mean = 0.5 * (ha + hb);
+    let h = if u + c * mean * mean >= 0.0 { ha } else { hb };
+    u + c * h * h
+}

@@ -1,0 +1,253 @@
+//! The film's surface grid: a gnomonic cube-sphere on the unit sphere, laid out as an
+//! OpenGL cube map (faces +X, −X, +Y, −Y, +Z, −Z; texel `face·n² + y·n + x`), so the
+//! renderer can read the field as a cube-map texture without resampling.
+//!
+//! Finite volumes on a C-grid: scalars (thickness, surfactant) live on cells, the film's
+//! tangential velocity as its component normal to each cell edge. Every grid line of a
+//! gnomonic cube-sphere is a great circle, so edges are exact arcs; cell areas are exact
+//! spherical areas.
+
+use std::collections::HashMap;
+
+use glam::{DVec3, IVec3};
+
+/// Major axis, `s` axis and `t` axis of each face (OpenGL cube-map order).
+pub const FACE_BASES: [(IVec3, IVec3, IVec3); 6] = [
+    (IVec3::X, IVec3::NEG_Z, IVec3::NEG_Y),
+    (IVec3::NEG_X, IVec3::Z, IVec3::NEG_Y),
+    (IVec3::Y, IVec3::X, IVec3::Z),
+    (IVec3::NEG_Y, IVec3::X, IVec3::NEG_Z),
+    (IVec3::Z, IVec3::X, IVec3::NEG_Y),
+    (IVec3::NEG_Z, IVec3::NEG_X, IVec3::NEG_Y),
+];
+
+/// One cell edge: the arc between two grid vertices, shared by cells `a` and `b`.
+#[derive(Clone, Copy, Debug)]
+pub struct GridEdge {
+    /// The cell the normal points away from.
+    pub a: u32,
+    /// The cell the normal points into.
+    pub b: u32,
+    /// The vertex at the tail of the edge tangent `midpoint × normal`.
+    pub v0: u32,
+    /// The vertex at its head.
+    pub v1: u32,
+    /// Unit tangent normal to the edge at its midpoint, from `a` towards `b`.
+    pub normal: DVec3,
+    /// Arc length of the edge on the unit sphere, rad.
+    pub length: f64,
+    /// Arc length between the centres of `a` and `b`, rad.
+    pub dual_length: f64,
+}
+
+/// A gnomonic cube-sphere of `6·n²` cells on the unit sphere.
+///
+/// # Guarantees
+/// - `n >= 1`; cell `face·n² + y·n + x` covers `s ∈ [2x/n − 1, 2(x+1)/n − 1]` and likewise
+///   `t` for `y` on face `face`;
+/// - the cell areas sum to 4π (to rounding) and every edge joins two distinct cells.
+#[derive(Clone, Debug)]
+pub struct CubeSphere {
+    n: usize,
+    centres: Vec<DVec3>,
+    areas_sr: Vec<f64>,
+    edges: Vec<GridEdge>,
+    vertex_areas_sr: Vec<f64>,
+}
+
+impl CubeSphere {
+    /// Builds the grid with `n × n` cells a face.
+    ///
+    /// # Panics
+    /// If `n == 0` or `n > 4096`.
+    pub fn new(n: usize) -> Self {
+        assert!((1..=4096).contains(&n), "cube-sphere face size {n} not in 1..=4096");
+        let mut vertex_ids: HashMap<IVec3, u32> = HashMap::new();
+        let mut vertex_dirs: Vec<DVec3> = Vec::new();
+        let mut corner = |p: IVec3| -> u32 {
+            *vertex_ids.entry(p).or_insert_with(|| {
+                vertex_dirs.push(p.as_dvec3().normalize());
+                (vertex_dirs.len() - 1) as u32
+            })
+        };
+        let cells = 6 * n * n;
+        let mut centres = Vec::with_capacity(cells);
+        let mut areas_sr = Vec::with_capacity(cells);
+        let mut cell_corners = Vec::with_capacity(cells);
+        for (face, &(major, su, tv)) in FACE_BASES.iter().enumerate() {
+            // Grid points as exact integers on the cube of half-side n, so the points a face
+            // shares with its neighbour are the same key.
+            let point = |i: usize, j: usize| {
+                major * n as i32 + su * (2 * i as i32 - n as i32) + tv * (2 * j as i32 - n as i32)
+            };
+            for y in 0..n {
+                for x in 0..n {
+                    let ids = [
+                        corner(point(x, y)),
+                        corner(point(x + 1, y)),
+                        corner(point(x + 1, y + 1)),
+                        corner(point(x, y + 1)),
+                    ];
+                    cell_corners.push(ids);
+                    centres.push(texel_direction(n, face, x, y));
+                    areas_sr.push(gnomonic_area(n, x, y));
+                }
+            }
+        }
+        let mut vertex_areas_sr = vec![0.0; vertex_dirs.len()];
+        for (ids, area) in cell_corners.iter().zip(&areas_sr) {
+            for &v in ids {
+                vertex_areas_sr[v as usize] += area / 4.0;
+            }
+        }
+        let edges = build_edges(&cell_corners, &centres, &vertex_dirs);
+        Self {
+            n,
+            centres,
+            areas_sr,
+            edges,
+            vertex_areas_sr,
+        }
+    }
+
+    /// Cells along a face edge.
+    pub fn face_size(&self) -> usize {
+        self.n
+    }
+
+    /// Number of cells, `6·n²`.
+    pub fn cells(&self) -> usize {
+        self.centres.len()
+    }
+
+    /// Unit direction of each cell's centre.
+    pub fn centres(&self) -> &[DVec3] {
+        &self.centres
+    }
+
+    /// Area of each cell on the unit sphere, sr.
+    pub fn areas_sr(&self) -> &[f64] {
+        &self.areas_sr
+    }
+
+    /// The cell edges.
+    pub fn edges(&self) -> &[GridEdge] {
+        &self.edges
+    }
+
+    /// Dual area of each grid vertex (a quarter of each cell around it), sr.
+    pub fn vertex_areas_sr(&self) -> &[f64] {
+        &self.vertex_areas_sr
+    }
+}
+
+/// Cell of the `n/2` grid holding cell `cell` of the `n` grid (same face, halved x, y).
+///
+/// # Panics
+/// If `n` is odd.
+pub fn parent_cell(n: usize, cell: usize) -> usize {
+    assert!(n % 2 == 0, "a grid of odd face size {n} has no parent");
+    let (face, rest) = (cell / (n * n), cell % (n * n));
+    let (y, x) = (rest / n, rest % n);
+    let m = n / 2;
+    face * m * m + (y / 2) * m + x / 2
+}
+
+/// Unit centre direction of cell `(x, y)` of face `face` on a grid of `n` cells a face.
+pub fn texel_direction(n: usize, face: usize, x: usize, y: usize) -> DVec3 {
+    let (major, su, tv) = FACE_BASES[face];
+    let s = (x as f64 + 0.5) / n as f64 * 2.0 - 1.0;
+    let t = (y as f64 + 0.5) / n as f64 * 2.0 - 1.0;
+    (major.as_dvec3() + su.as_dvec3() * s + tv.as_dvec3() * t).normalize()
+}
+
+/// Exact solid angle of the gnomonic cell `(x, y)`: the area element (1 + s² + t²)^(−3/2)
+/// integrates to atan(st/√(1 + s² + t²)).
+fn gnomonic_area(n: usize, x: usize, y: usize) -> f64 {
+    let f = |s: f64, t: f64| (s * t / (1.0 + s * s + t * t).sqrt()).atan();
+    let c = |i: usize| i as f64 / n as f64 * 2.0 - 1.0;
+    let (s0, s1, t0, t1) = (c(x), c(x + 1), c(y), c(y + 1));
+    f(s1, t1) - f(s0, t1) - f(s1, t0) + f(s0, t0)
+}
+
+fn arc(a: DVec3, b: DVec3) -> f64 {
+    a.cross(b).length().atan2(a.dot(b))
+}
+
+/// The edges of the cells, in the order cells first name them.
+fn build_edges(corners: &[[u32; 4]], centres: &[DVec3], vertices: &[DVec3]) -> Vec<GridEdge> {
+    let mut first_cell: HashMap<(u32, u32), u32> = HashMap::new();
+    let mut edges = Vec::with_capacity(corners.len() * 2);
+    for (cell, ids) in corners.iter().enumerate() {
+        for k in 0..4 {
+            let (p, q) = (ids[k], ids[(k + 1) % 4]);
+            let key = (p.min(q), p.max(q));
+            match first_cell.remove(&key) {
+                None => {
+                    first_cell.insert(key, cell as u32);
+                }
+                Some(a) => edges.push(edge(a, cell as u32, key, centres, vertices)),
+            }
+        }
+    }
+    assert!(first_cell.is_empty(), "cube-sphere edges left unpaired");
+    edges
+}
+
+fn edge(a: u32, b: u32, (p, q): (u32, u32), centres: &[DVec3], vertices: &[DVec3]) -> GridEdge {
+    let (ca, cb) = (centres[a as usize], centres[b as usize]);
+    let (vp, vq) = (vertices[p as usize], vertices[q as usize]);
+    let mut normal = vp.cross(vq).normalize();
+    if normal.dot(cb - ca) < 0.0 {
+        normal = -normal;
+    }
+    let tangent = (vp + vq).normalize().cross(normal);
+    let (v0, v1) = if (vq - vp).dot(tangent) > 0.0 { (p, q) } else { (q, p) };
+    GridEdge {
+        a,
+        b,
+        v0,
+        v1,
+        normal,
+        length: arc(vp, vq),
+        dual_length: arc(ca, cb),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn areas_sum_to_the_sphere_and_edges_pair_every_cell_side() {
+        for n in [1, 2, 3, 8, 17] {
+            let g = CubeSphere::new(n);
+            let total: f64 = g.areas_sr().iter().sum();
+            assert!((total - 4.0 * std::f64::consts::PI).abs() < 1e-12, "n {n}: {total}");
+            assert_eq!(g.edges().len(), 12 * n * n, "n {n}");
+            assert_eq!(g.vertex_areas_sr().len(), 6 * n * n + 2, "n {n}");
+            let mut sides = vec![0; g.cells()];
+            for e in g.edges() {
+                assert_ne!(e.a, e.b);
+                sides[e.a as usize] += 1;
+                sides[e.b as usize] += 1;
+                assert!(e.normal.dot(g.centres()[e.a as usize]).abs() < 1.0);
+            }
+            assert!(sides.iter().all(|&s| s == 4), "n {n}");
+        }
+    }
+
+    #[test]
+    fn parent_cells_cover_their_children() {
+        let (fine, coarse) = (CubeSphere::new(8), CubeSphere::new(4));
+        let mut area = vec![0.0; coarse.cells()];
+        for c in 0..fine.cells() {
+            area[parent_cell(8, c)] += fine.areas_sr()[c];
+            let d = fine.centres()[c].dot(coarse.centres()[parent_cell(8, c)]);
+            assert!(d > (0.3f64).cos(), "cell {c} far from its parent");
+        }
+        for (a, b) in area.iter().zip(coarse.areas_sr()) {
+            assert!((a - b).abs() < 1e-14, "{a} vs {b}");
+        }
+    }
+}

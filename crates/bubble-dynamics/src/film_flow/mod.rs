@@ -1,0 +1,14 @@
+//! The living film: thickness, surfactant and velocity on a cube-sphere grid much finer
+//! than the particle mesh, moved by gravity, Marangoni stress, the sheet's viscosity,
+//! drainage, the air's shear and evaporation (docs/dynamics.md, "Film flow").
+
+mod cell_map;
+mod flow;
+pub mod grid;
+pub(crate) mod on_bubble;
+pub mod solve;
+
+pub use flow::{FilmFlow, Forcing, FlowParams};
+pub use grid::CubeSphere;
+pub use solve::{Hierarchy, SolveReport};
+pub use cell_map::CellMap;
