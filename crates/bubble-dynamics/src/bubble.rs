@@ -7,7 +7,7 @@ use glam::DVec3;
 
 use crate::film::Slosh;
 use crate::film_flow::on_bubble::GridFilm;
-use crate::film_flow::{FilmFlow, FlowParams};
+use crate::film_flow::{BurstParams, FilmFlow, FlowParams};
 use crate::geometry::{self, barycentric_vertex_areas_m2, enclosed_volume_m3, surface_area_m2};
 use crate::params::{BubbleParams, GAS_CONSTANT_J_PER_MOL_K, MassDistribution, WorldParams};
 use crate::rng::SphereField;
@@ -97,6 +97,8 @@ pub struct FilmField {
     /// Thickness of cell `face·n² + y·n + x` in nm, stretched by the mesh's deformation
     /// (faces in OpenGL cube-map order, see `film_flow::grid`).
     pub thickness_nm: Vec<f64>,
+    /// Film coverage of each cell: 1 where film is, 0 in a burst hole, between on a rim.
+    pub coverage: Vec<f64>,
 }
 
 impl Bubble {
@@ -218,6 +220,7 @@ impl Bubble {
         self.grid_film.as_ref().map(|g| FilmField {
             face_size: g.flow.grid().face_size(),
             thickness_nm: g.thickness_nm(&self.positions_m, self.topology.triangles()),
+            coverage: g.flow.coverage().to_vec(),
         })
     }
 
@@ -426,6 +429,14 @@ fn grid_film(
         evaporation_nm_per_s: params.evaporation_nm_per_s,
         air_viscosity_pa_s: world.air_viscosity_pa_s,
         air_density_kg_per_m3: world.air_density_kg_per_m3,
+        burst: BurstParams {
+            sigma_n_per_m: params.sigma_n_per_m,
+            black_threshold_nm: params.black_threshold_nm,
+            black_film_nm: params.black_film_nm,
+            rupture_thickness_nm: params.rupture_thickness_nm,
+            nucleation_per_m2_s: params.nucleation_per_m2_s,
+        },
+        seed: params.seed,
     };
     let h0 = params.mean_thickness_nm * 1e-9;
     let variation = params.thickness_variation;

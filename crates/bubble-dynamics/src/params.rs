@@ -64,6 +64,9 @@ pub struct WorldParams {
     pub dt_s: f64,
     /// Time integrator.
     pub integrator: Integrator,
+    /// Step of the film flow, s: the flow gathers world steps until this much time has
+    /// passed (its stiff terms are implicit, so a display frame is one step).
+    pub film_dt_s: f64,
     /// Largest number of substeps one step may take before it is an error.
     pub max_substeps: u32,
     /// Vertex speed judged to be an energy blow-up, m/s (default: speed of sound in air).
@@ -93,6 +96,7 @@ impl Default for WorldParams {
             dt_s: 1.0 / 240.0,
             integrator: Integrator::SymplecticEuler,
             max_substeps: 2000,
+            film_dt_s: 1.0 / 60.0,
             max_speed_m_per_s: 343.0,
             bubble_restitution: 0.5,
             bubble_friction: 0.1,
@@ -112,6 +116,7 @@ impl WorldParams {
         non_negative("linear_drag_factor", self.linear_drag_factor)?;
         non_negative("added_mass_coefficient", self.added_mass_coefficient)?;
         positive("dt_s", self.dt_s)?;
+        positive("film_dt_s", self.film_dt_s)?;
         if self.max_substeps == 0 {
             return Err(ParamError::new(
                 "max_substeps",
@@ -185,6 +190,12 @@ pub struct BubbleParams {
     pub film_grid: u32,
     /// Viscosity of the film liquid for the flow's viscous sheet stress, Pa·s.
     pub film_viscosity_pa_s: f64,
+    /// Film-flow thickness under which the film turns black, nm (0: no black film).
+    pub black_threshold_nm: f64,
+    /// Thickness of the film-flow's common black film, nm.
+    pub black_film_nm: f64,
+    /// Rate of spontaneous holes per area of black film, 1/(m²·s) (film flow only).
+    pub nucleation_per_m2_s: f64,
 }
 
 impl Default for BubbleParams {
@@ -213,6 +224,9 @@ impl Default for BubbleParams {
             seed: 0,
             film_grid: 0,
             film_viscosity_pa_s: 1.0e-3,
+            black_threshold_nm: 30.0,
+            black_film_nm: 12.0,
+            nucleation_per_m2_s: 0.0,
         }
     }
 }
@@ -269,6 +283,16 @@ impl BubbleParams {
             ));
         }
         non_negative("film_viscosity_pa_s", self.film_viscosity_pa_s)?;
+        non_negative("black_threshold_nm", self.black_threshold_nm)?;
+        non_negative("black_film_nm", self.black_film_nm)?;
+        if self.black_threshold_nm > 0.0 && self.black_film_nm >= self.black_threshold_nm {
+            return Err(ParamError::new(
+                "black_film_nm",
+                self.black_film_nm,
+                format!("must be below black_threshold_nm = {}", self.black_threshold_nm),
+            ));
+        }
+        non_negative("nucleation_per_m2_s", self.nucleation_per_m2_s)?;
         if self.initial_scale.min_element() <= 0.0 {
             return Err(ParamError::new(
                 "initial_scale",

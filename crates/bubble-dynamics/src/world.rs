@@ -256,6 +256,7 @@ impl World {
         self.steps = step;
         self.last_substeps = substeps;
         let gravity = self.params.gravity_m_per_s2;
+        let film_dt = self.params.film_dt_s;
         let mut slots: Vec<(DVec3, DVec3)> = v_start
             .into_iter()
             .zip(&self.bubbles)
@@ -267,6 +268,7 @@ impl World {
             match b.grid_film.as_mut() {
                 Some(film) => film.step(
                     dt,
+                    film_dt,
                     &Forcing {
                         g_eff_m_per_s2: gravity - acceleration,
                         air_m_per_s: *air,
@@ -325,7 +327,11 @@ impl World {
         let mut events = Vec::new();
         self.bubbles.retain(|b| {
             let min_thickness_nm = b.min_thickness_nm();
-            let intact = min_thickness_nm >= b.film.rupture_thickness_nm;
+            // With a film flow, the bubble is gone once the rims have swept its film.
+            let intact = match b.film_flow() {
+                Some(flow) => !flow.fully_burst(),
+                None => min_thickness_nm >= b.film.rupture_thickness_nm,
+            };
             if !intact {
                 events.push(Event::Burst {
                     bubble_id: b.id,

@@ -2,6 +2,7 @@
 //! than the particle mesh, moved by gravity, Marangoni stress, the sheet's viscosity,
 //! drainage, the air's shear and evaporation (docs/dynamics.md, "Film flow").
 
+mod burst;
 mod cell_map;
 mod flow;
 pub mod grid;
@@ -12,3 +13,4 @@ pub use flow::{FilmFlow, Forcing, FlowParams};
 pub use grid::CubeSphere;
 pub use solve::{Hierarchy, SolveReport};
 pub use cell_map::CellMap;
+pub use burst::{BLACK_RELAX_S, BurstParams, Hole};

@@ -18,6 +18,9 @@ pub(crate) struct GridFilm {
     /// Rest directions of the mesh vertices: where each vertex sits on the film grid.
     pub(crate) material_dirs: Vec<DVec3>,
     rest_vertex_area_m2: Vec<f64>,
+    /// World time gathered since the last flow step, s, and the forcing's integral.
+    pending_s: f64,
+    pending_forcing: Forcing,
 }
 
 impl GridFilm {
@@ -38,12 +41,28 @@ impl GridFilm {
             map,
             material_dirs: unit_positions.iter().map(|u| u.normalize()).collect(),
             rest_vertex_area_m2: barycentric_vertex_areas_m2(rest_positions_m, triangles),
+            pending_s: 0.0,
+            pending_forcing: Forcing::default(),
         }
     }
 
-    /// One step of the flow.
-    pub(crate) fn step(&mut self, dt_s: f64, forcing: &Forcing) {
-        self.flow.step(dt_s, forcing);
+    /// Gathers a world step of `dt_s`; once `film_dt_s` has passed, steps the flow over
+    /// the gathered time with the forcing's mean over it.
+    pub(crate) fn step(&mut self, dt_s: f64, film_dt_s: f64, forcing: &Forcing) {
+        self.pending_s += dt_s;
+        self.pending_forcing.g_eff_m_per_s2 += forcing.g_eff_m_per_s2 * dt_s;
+        self.pending_forcing.air_m_per_s += forcing.air_m_per_s * dt_s;
+        // A relative margin: 4 steps of 1/240 s sum to 1/60 s only to rounding.
+        if self.pending_s >= film_dt_s * (1.0 - 1e-9) {
+            let t = self.pending_s;
+            let mean = Forcing {
+                g_eff_m_per_s2: self.pending_forcing.g_eff_m_per_s2 / t,
+                air_m_per_s: self.pending_forcing.air_m_per_s / t,
+            };
+            self.flow.step(t, &mean);
+            self.pending_s = 0.0;
+            self.pending_forcing = Forcing::default();
+        }
     }
 
     /// The film's thickness at every cell in nm, stretched by the mesh's deformation

@@ -26,6 +26,9 @@ struct Level {
 
 /// Largest number of cells solved directly on the coarsest level.
 const DENSE_CELLS: usize = 6 * 8 * 8;
+/// Face size the hierarchy coarsens down to when it can (a dense Cholesky of 6·4² cells
+/// costs 0.3 M flops a step; of 6·8², 19 M).
+const COARSEST_FACE: usize = 4;
 
 /// The multigrid hierarchy of a cube-sphere, built once per grid size.
 #[derive(Clone, Debug)]
@@ -39,6 +42,9 @@ pub struct Work {
     alpha: Vec<Vec<f64>>,
     weight: Vec<Vec<f64>>,
     coarse_factor: Vec<f64>,
+    /// Per level: each cell's diagonal, and the edge weights in adjacency order.
+    diag: Vec<Vec<f64>>,
+    csr_weight: Vec<Vec<f64>>,
     residual: Vec<Vec<f64>>,
     correction: Vec<Vec<f64>>,
     r: Vec<f64>,
@@ -52,18 +58,17 @@ pub struct Work {
 pub struct SolveReport {
     /// Conjugate-gradient iterations taken.
     pub iterations: u32,
-    /// Final residual norm relative to the right-hand side's.
+    /// Final residual norm relative to the starting guess's.
     pub relative_residual: f64,
 }
 
 impl Hierarchy {
-    /// Halves the grid while its face size stays even and its cells above
-    /// [`DENSE_CELLS`].
+    /// Halves the grid while its face size stays even and above [`COARSEST_FACE`].
     pub fn new(grid: &CubeSphere) -> Self {
         let fine_edges: Vec<(u32, u32)> = grid.edges().iter().map(|e| (e.a, e.b)).collect();
         let mut levels = vec![Level::new(grid.cells(), fine_edges)];
         let mut n = grid.face_size();
-        while n % 2 == 0 && 6 * n * n > DENSE_CELLS {
+        while n % 2 == 0 && n > COARSEST_FACE {
             let fine = levels.last().expect("one level");
             let parent: Vec<u32> = (0..fine.cells)
                 .map(|c| parent_cell(n, c) as u32)
@@ -81,7 +86,7 @@ impl Hierarchy {
     /// Whether a face size coarsens down to a directly solvable level.
     pub fn supports(face_size: usize) -> bool {
         let mut n = face_size;
-        while n % 2 == 0 && 6 * n * n > DENSE_CELLS {
+        while n % 2 == 0 && n > COARSEST_FACE {
             n /= 2;
         }
         n >= 1 && 6 * n * n <= DENSE_CELLS
@@ -118,11 +123,16 @@ impl Hierarchy {
         for i in 0..nc {
             r[i] = b[i] - q[i];
         }
-        let b_norm = dot(b, b).sqrt().max(f64::MIN_POSITIVE);
+        // Relative to the warm start's residual: the step's change, not the whole field.
+        let start_norm = dot(&r, &r).sqrt();
+        let b_norm = if start_norm > 0.0 { start_norm } else { 1.0 };
         let mut report = SolveReport {
             iterations: 0,
-            relative_residual: dot(&r, &r).sqrt() / b_norm,
+            relative_residual: start_norm / b_norm,
         };
+        if start_norm == 0.0 {
+            report.relative_residual = 0.0;
+        }
         if report.relative_residual > tolerance {
             self.v_cycle(work, 0, &r, &mut z);
             p.copy_from_slice(&z);
@@ -187,6 +197,22 @@ impl Hierarchy {
                 }
             }
         }
+        work.diag.resize(count, Vec::new());
+        work.csr_weight.resize(count, Vec::new());
+        for (k, level) in self.levels.iter().enumerate() {
+            let (diag, csr) = (&mut work.diag[k], &mut work.csr_weight[k]);
+            diag.clear();
+            csr.clear();
+            for i in 0..level.cells {
+                let mut d = work.alpha[k][i];
+                for &(_, e) in &level.adjacency[level.start[i] as usize..level.start[i + 1] as usize] {
+                    let w = work.weight[k][e as usize];
+                    d += w;
+                    csr.push(w);
+                }
+                diag.push(d);
+            }
+        }
         work.coarse_factor.clear();
         let last = self.levels.len() - 1;
         work.coarse_factor = dense_cholesky(
@@ -204,13 +230,11 @@ impl Hierarchy {
             dense_solve(&work.coarse_factor, level.cells, r, z);
             return;
         }
-        let (alpha, weight) = (&work.alpha[k], &work.weight[k]);
-        gauss_seidel(level, alpha, weight, r, z, false);
-        gauss_seidel(level, alpha, weight, r, z, false);
+        gauss_seidel(level, &work.diag[k], &work.csr_weight[k], r, z, false);
         // Residual, restricted by summing children (the equations are area-integrated).
         let mut az = std::mem::take(&mut work.residual[k]);
         az.resize(level.cells, 0.0);
-        apply(level, alpha, weight, z, &mut az);
+        apply(level, &work.alpha[k], &work.weight[k], z, &mut az);
         let coarse = &self.levels[k + 1];
         let mut rc = std::mem::take(&mut work.residual[k + 1]);
         rc.clear();
@@ -227,9 +251,7 @@ impl Hierarchy {
         work.residual[k] = az;
         work.residual[k + 1] = rc;
         work.correction[k + 1] = zc;
-        let (alpha, weight) = (&work.alpha[k], &work.weight[k]);
-        gauss_seidel(level, alpha, weight, r, z, true);
-        gauss_seidel(level, alpha, weight, r, z, true);
+        gauss_seidel(level, &work.diag[k], &work.csr_weight[k], r, z, true);
     }
 }
 
@@ -294,16 +316,16 @@ fn apply(level: &Level, alpha: &[f64], weight: &[f64], x: &[f64], out: &mut [f64
     }
 }
 
-/// One Gauss–Seidel sweep of `M z = r`, forwards or backwards.
-fn gauss_seidel(level: &Level, alpha: &[f64], weight: &[f64], r: &[f64], z: &mut [f64], back: bool) {
+/// One Gauss–Seidel sweep of `M z = r`, forwards or backwards, with the diagonal and
+/// the neighbour weights in adjacency order at hand.
+fn gauss_seidel(level: &Level, diag: &[f64], csr_weight: &[f64], r: &[f64], z: &mut [f64], back: bool) {
     let relax = |i: usize, z: &mut [f64]| {
-        let (mut diag, mut sum) = (alpha[i], r[i]);
-        for &(j, e) in &level.adjacency[level.start[i] as usize..level.start[i + 1] as usize] {
-            let w = weight[e as usize];
-            diag += w;
+        let (from, to) = (level.start[i] as usize, level.start[i + 1] as usize);
+        let mut sum = r[i];
+        for (&(j, _), w) in level.adjacency[from..to].iter().zip(&csr_weight[from..to]) {
             sum += w * z[j as usize];
         }
-        z[i] = sum / diag;
+        z[i] = sum / diag[i];
     };
     if back {
         (0..level.cells).rev().for_each(|i| relax(i, z));
@@ -370,7 +392,9 @@ mod tests {
     use super::*;
 
     /// A stiff system (weights 10⁴× the mass term, as a frame's Marangoni step gives)
-    /// converges to 1e-10 in a few iterations, and the answer satisfies the system.
+    /// converges to 1e-12 from zero in at most 20 iterations at n = 16 and 64 alike (the
+    /// multigrid preconditioner keeps the count from growing with the grid), and the
+    /// answer satisfies the system.
     #[test]
     fn stiff_system_converges_in_few_iterations() {
         for n in [16, 64] {
@@ -390,8 +414,8 @@ mod tests {
                 .collect();
             let mut x = vec![0.0; grid.cells()];
             let mut work = Work::default();
-            let report = h.solve(&mut work, &alpha, &weight, &b, &mut x, 1e-10, 50);
-            assert!(report.iterations <= 12, "n {n}: {report:?}");
+            let report = h.solve(&mut work, &alpha, &weight, &b, &mut x, 1e-12, 50);
+            assert!(report.iterations <= 20, "n {n}: {report:?}");
             let level = &h.levels[0];
             let mut ax = vec![0.0; grid.cells()];
             apply(level, &alpha, &weight, &x, &mut ax);

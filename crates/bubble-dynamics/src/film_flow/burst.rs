@@ -1,0 +1,256 @@
+//! Black film and bursting.
+//!
+//! Black film, a threshold model of the disjoining pressure: a film thinner than
+//! `black_threshold_nm` (about 30 nm, where the van der Waals attraction between the two
+//! surfaces wins over the film's electrostatic repulsion) thins to the common black film
+//! `black_film_nm` within [`BLACK_RELAX_S`], pushing its liquid into the thicker film
+//! around it (conservatively, so a black spot grows a thick rim as real ones do).
+//!
+//! Rupture: a hole nucleates where the film is thinner than `rupture_thickness_nm`, or at
+//! random on black film at `nucleation_per_m2_s` (a seeded Poisson process). Its rim
+//! retracts at the Taylor–Culick speed `√(2σ/(ρh))` of the film it meets (the mean
+//! thickness along the rim); the film behind the rim is gone (its liquid leaves as the
+//! rim's droplets). A hole is a spherical cap about its site; cells the rim only partly
+//! covers keep a fractional coverage, so renderers draw a sharp, anti-aliased rim.
+
+use glam::DVec3;
+
+use super::FilmFlow;
+use crate::rng::SplitMix64;
+
+/// Time for a film that fell under the black threshold to reach the black film, s.
+pub const BLACK_RELAX_S: f64 = 0.05;
+
+/// A hole in the film: a spherical cap about `site`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hole {
+    /// Unit direction of the nucleation site on the material sphere.
+    pub site: DVec3,
+    /// Geodesic radius of the hole on the material sphere, m.
+    pub radius_m: f64,
+}
+
+/// Black-film and rupture constants.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BurstParams {
+    /// Surface tension of one film surface, N/m (the rim's pull is 2σ).
+    pub sigma_n_per_m: f64,
+    /// Thickness under which the film turns black, nm (0: no black film).
+    pub black_threshold_nm: f64,
+    /// Thickness of the common black film, nm.
+    pub black_film_nm: f64,
+    /// Thickness under which the film ruptures at once, nm.
+    pub rupture_thickness_nm: f64,
+    /// Rate of spontaneous holes per black-film area, 1/(m²·s).
+    pub nucleation_per_m2_s: f64,
+}
+
+/// The holes of a film and what bursting has removed.
+#[derive(Clone, Debug)]
+pub struct BurstState {
+    params: BurstParams,
+    holes: Vec<Hole>,
+    rng: SplitMix64,
+    /// Per cell: 1 where film is, 0 where a hole is, between on the rim.
+    coverage: Vec<f64>,
+    burst_volume_m3: f64,
+}
+
+impl BurstState {
+    /// No holes yet, all film present.
+    pub fn new(params: BurstParams, cells: usize, seed: u64) -> Self {
+        Self {
+            params,
+            holes: Vec::new(),
+            rng: SplitMix64::new(seed ^ 0xB1AC_F11E),
+            coverage: vec![1.0; cells],
+            burst_volume_m3: 0.0,
+        }
+    }
+
+    /// The holes.
+    pub fn holes(&self) -> &[Hole] {
+        &self.holes
+    }
+
+    /// Film coverage of each cell, in [0, 1].
+    pub fn coverage(&self) -> &[f64] {
+        &self.coverage
+    }
+
+    /// Liquid the rims have swept off the film (as droplets), m³.
+    pub fn burst_volume_m3(&self) -> f64 {
+        self.burst_volume_m3
+    }
+
+    /// Whether the rims have swept the whole film.
+    pub fn fully_burst(&self) -> bool {
+        !self.holes.is_empty() && self.coverage.iter().all(|&c| c == 0.0)
+    }
+
+    /// Opens a hole at `site` (a unit direction), e.g. to burst a bubble on purpose.
+    pub fn nucleate(&mut self, site: DVec3) {
+        self.holes.push(Hole {
+            site: site.normalize(),
+            radius_m: 0.0,
+        });
+    }
+
+    /// One step of `dt_s`: black film, nucleation, rim retraction, coverage.
+    pub(crate) fn step(&mut self, flow: &mut FilmFlow, dt_s: f64) {
+        self.blacken(flow, dt_s);
+        self.nucleate_where_due(flow, dt_s);
+        self.retract(flow, dt_s);
+        self.sweep(flow);
+    }
+
+    /// Thins black cells towards the black film, their liquid shared among the
+    /// neighbours above the threshold in proportion to edge length.
+    fn blacken(&self, flow: &mut FilmFlow, dt_s: f64) {
+        let p = &self.params;
+        if p.black_threshold_nm <= 0.0 {
+            return;
+        }
+        let (threshold, black) = (p.black_threshold_nm * 1e-9, p.black_film_nm * 1e-9);
+        let fraction = 1.0 - (-dt_s / BLACK_RELAX_S).exp();
+        let grid = std::sync::Arc::clone(&flow.grid);
+        let areas = grid.areas_sr();
+        // Judged once, before anything moves: which cells are thick film, and how much of
+        // each cell's boundary borders them.
+        let thick: Vec<bool> = flow
+            .h_m
+            .iter()
+            .zip(&self.coverage)
+            .map(|(&h, &c)| h >= threshold && c > 0.0)
+            .collect();
+        let mut thick_sides = vec![0.0; grid.cells()];
+        for e in grid.edges() {
+            let (a, b) = (e.a as usize, e.b as usize);
+            if thick[b] {
+                thick_sides[a] += e.length;
+            }
+            if thick[a] {
+                thick_sides[b] += e.length;
+            }
+        }
+        let excess: Vec<f64> = flow
+            .h_m
+            .iter()
+            .zip(&thick_sides)
+            .map(|(&h, &sides)| {
+                if h < threshold && h > black && sides > 0.0 {
+                    (h - black) * fraction
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        for e in grid.edges() {
+            let (a, b) = (e.a as usize, e.b as usize);
+            for (from, to) in [(a, b), (b, a)] {
+                if excess[from] > 0.0 && thick[to] {
+                    let volume = excess[from] * areas[from] * e.length / thick_sides[from];
+                    flow.h_m[from] -= volume / areas[from];
+                    flow.h_m[to] += volume / areas[to];
+                }
+            }
+        }
+    }
+
+    /// Opens holes where the film is under the rupture thickness, and at random on black
+    /// film.
+    fn nucleate_where_due(&mut self, flow: &FilmFlow, dt_s: f64) {
+        let p = self.params;
+        let r2 = flow.params.radius_m * flow.params.radius_m;
+        let grid = &flow.grid;
+        let inside = |holes: &[Hole], d: DVec3| {
+            holes
+                .iter()
+                .any(|h| arc(h.site, d) * flow.params.radius_m <= h.radius_m)
+        };
+        let thinnest = flow
+            .h_m
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| self.coverage[i] > 0.0)
+            .min_by(|a, b| a.1.total_cmp(b.1));
+        if let Some((i, &h)) = thinnest
+            && h < p.rupture_thickness_nm * 1e-9
+            && !inside(&self.holes, grid.centres()[i])
+        {
+            self.nucleate(grid.centres()[i]);
+        }
+        if p.nucleation_per_m2_s <= 0.0 || p.black_threshold_nm <= 0.0 {
+            return;
+        }
+        let black = p.black_threshold_nm * 1e-9;
+        for (i, (&h, &a)) in flow.h_m.iter().zip(grid.areas_sr()).enumerate() {
+            if h < black && self.coverage[i] > 0.0 {
+                let chance = p.nucleation_per_m2_s * a * r2 * dt_s;
+                if self.rng.next_f64() < chance && !inside(&self.holes, grid.centres()[i]) {
+                    self.nucleate(grid.centres()[i]);
+                }
+            }
+        }
+    }
+
+    /// Moves every rim outwards at the Taylor–Culick speed of the film along it.
+    fn retract(&mut self, flow: &FilmFlow, dt_s: f64) {
+        let p = self.params;
+        let r = flow.params.radius_m;
+        let rho = flow.params.density_kg_per_m3;
+        let grid = &flow.grid;
+        let width = (4.0 * std::f64::consts::PI / grid.cells() as f64).sqrt() * r;
+        for hole in &mut self.holes {
+            // Mean thickness of the film within a cell width outside the rim.
+            let (mut sum, mut area) = (0.0, 0.0);
+            for ((c, &h), &a) in grid.centres().iter().zip(&flow.h_m).zip(grid.areas_sr()) {
+                let d = arc(hole.site, *c) * r - hole.radius_m;
+                if (0.0..=1.5 * width).contains(&d) && h > 0.0 {
+                    sum += h * a;
+                    area += a;
+                }
+            }
+            if area > 0.0 {
+                let h_rim = sum / area;
+                hole.radius_m += (2.0 * p.sigma_n_per_m / (rho * h_rim)).sqrt() * dt_s;
+            } else {
+                // Nothing left ahead of the rim: it has closed over the far pole.
+                hole.radius_m = std::f64::consts::PI * r;
+            }
+        }
+    }
+
+    /// Sets the coverage from the holes and removes the film behind the rims.
+    fn sweep(&mut self, flow: &mut FilmFlow) {
+        if self.holes.is_empty() {
+            return;
+        }
+        let r = flow.params.radius_m;
+        let r2 = r * r;
+        let grid = std::sync::Arc::clone(&flow.grid);
+        for (i, (c, &a)) in grid.centres().iter().zip(grid.areas_sr()).enumerate() {
+            let width = a.sqrt() * r;
+            let open = self
+                .holes
+                .iter()
+                .map(|h| ((arc(h.site, *c) * r - h.radius_m) / width + 0.5).clamp(0.0, 1.0))
+                .fold(1.0, f64::min);
+            self.coverage[i] = open;
+            if open == 0.0 && flow.h_m[i] != 0.0 {
+                self.burst_volume_m3 += flow.h_m[i] * a * r2;
+                flow.h_m[i] = 0.0;
+            }
+        }
+        // No flow into or out of the holes.
+        for (u, e) in flow.u_m_per_s.iter_mut().zip(grid.edges()) {
+            if self.coverage[e.a as usize] == 0.0 || self.coverage[e.b as usize] == 0.0 {
+                *u = 0.0;
+            }
+        }
+    }
+}
+
+fn arc(a: DVec3, b: DVec3) -> f64 {
+    a.cross(b).length().atan2(a.dot(b))
+}
