@@ -419,7 +419,11 @@ fn grid_film(
     rest: &[DVec3],
     triangles: &[[u32; 3]],
 ) -> GridFilm {
-    let pattern = SphereField::new(params.seed, 6, 0.0);
+    // The per-vertex film's few broad lobes, plus the fine streaks a freshly blown film
+    // carries (too fine for the 642-vertex mesh, which is why only the grid has them).
+    let broad = SphereField::new(params.seed, 6, 0.0);
+    let fine = SphereField::with_wavenumbers(params.seed ^ 0x5_7EA4, 24, 0.0, (10.0, 30.0));
+    let pattern = |d: DVec3| 0.6 * broad.value(d, 0.0) + 0.4 * fine.value(d, 0.0);
     let flow = FlowParams {
         radius_m: params.radius_m,
         density_kg_per_m3: params.film_density_kg_per_m3,
@@ -446,12 +450,21 @@ fn grid_film(
         unit_positions,
         rest,
         triangles,
-        |d| h0 * (1.0 + variation * pattern.value(d, 0.0)),
+        |d| h0 * (1.0 + variation * pattern(d)),
     );
     // The pattern's mean over the sphere is not exactly zero: rescale to the mean.
     let area = 4.0 * PI * params.radius_m * params.radius_m;
     let scale = h0 * area / film.flow.liquid_volume_m3();
     film.flow.h_m.iter_mut().for_each(|h| *h *= scale);
+    // Start where a film of the mean thickness rests on its surfactant gradient
+    // (ln Γ = ρ h̄ g·x/E_f): only the thickness pattern's excess weight then moves it, not
+    // a whole-film sag in the first instants.
+    if params.gibbs_elasticity_n_per_m > 0.0 {
+        let k = params.film_density_kg_per_m3 * h0 * params.radius_m
+            / params.gibbs_elasticity_n_per_m;
+        let g = world.gravity_m_per_s2;
+        film.flow.set_surfactant(|d| (k * g.dot(d)).exp());
+    }
     film
 }
 

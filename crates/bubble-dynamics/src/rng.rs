@@ -63,11 +63,22 @@ impl SphereField {
     /// `count` waves with wavenumbers in [1.5, 4] (a few lobes over the sphere) and
     /// angular frequencies in [0.5, 1.5]·`omega_per_s`; amplitudes sum to 1.
     pub(crate) fn new(seed: u64, count: usize, omega_per_s: f64) -> Self {
+        Self::with_wavenumbers(seed, count, omega_per_s, (1.5, 4.0))
+    }
+
+    /// As [`SphereField::new`] with wavenumbers in `wavenumbers` (rad per unit length
+    /// along the wave's direction: 30 puts about ten stripes across the sphere).
+    pub(crate) fn with_wavenumbers(
+        seed: u64,
+        count: usize,
+        omega_per_s: f64,
+        wavenumbers: (f64, f64),
+    ) -> Self {
         let mut rng = SplitMix64::new(seed);
         let mut waves: Vec<Wave> = (0..count)
             .map(|_| Wave {
                 direction: rng.unit_vector(),
-                wavenumber: rng.range(1.5, 4.0),
+                wavenumber: rng.range(wavenumbers.0, wavenumbers.1),
                 phase: rng.range(0.0, std::f64::consts::TAU),
                 omega_per_s: omega_per_s * rng.range(0.5, 1.5),
                 amplitude: rng.range(0.5, 1.0),

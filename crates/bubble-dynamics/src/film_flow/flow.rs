@@ -113,6 +113,7 @@ struct Scratch {
     vertex: Vec<f64>,
     weight: Vec<f64>,
     u_start: Vec<f64>,
+    gradient: Vec<DVec3>,
 }
 
 impl FilmFlow {
@@ -340,26 +341,36 @@ impl FilmFlow {
         }
     }
 
-    /// The outside air drags the film towards the potential flow's surface velocity
-    /// `1.5 (U − (U·n)n)`, through a boundary layer of thickness `√(ν_air R/|U|)`
-    /// (at most R); implicit per edge, so stable however thin the film.
+    /// The air on both sides drags the film towards the air's surface velocity: outside,
+    /// the potential flow's `1.5 (U − (U·n)n)`; inside, the gas moving with the bubble.
+    /// Each side's shear is `μ_air Δu/δ` through a laminar boundary layer
+    /// `δ = √(ν_air ℓ/|Δu|)` over the eddy scale `ℓ = R/4`, at most R. Implicit per edge
+    /// (with δ from the step's starting slip), so stable however thin the film.
     fn air_shear(&mut self, dt_s: f64, air_m_per_s: DVec3) {
         let p = &self.params;
-        let speed = air_m_per_s.length();
-        if p.air_viscosity_pa_s <= 0.0 || speed <= 0.0 {
+        if p.air_viscosity_pa_s <= 0.0 {
             return;
         }
         let nu_air = p.air_viscosity_pa_s / p.air_density_kg_per_m3.max(f64::MIN_POSITIVE);
-        let delta_m = (nu_air * p.radius_m / speed).sqrt().min(p.radius_m);
+        let (r, eddy) = (p.radius_m, 0.25 * p.radius_m);
+        let layer = |slip: f64| {
+            if slip > 0.0 {
+                (nu_air * eddy / slip).sqrt().min(r)
+            } else {
+                r
+            }
+        };
         let centres = self.grid.centres();
         for (u, e) in self.u_m_per_s.iter_mut().zip(self.grid.edges()) {
             let h = (0.5 * (self.h_m[e.a as usize] + self.h_m[e.b as usize])).max(H_FLOOR_M);
-            let rate = p.air_viscosity_pa_s / (delta_m * p.density_kg_per_m3 * h);
+            let per_layer = p.air_viscosity_pa_s / (p.density_kg_per_m3 * h);
             // The potential flow's surface velocity is the gradient of 1.5 U·x: taken as
             // the discrete gradient between cell centres, curl-free like the real one.
             let rise = air_m_per_s.dot(centres[e.b as usize] - centres[e.a as usize]);
-            let target = 1.5 * rise / e.dual_length;
-            *u = (*u + dt_s * rate * target) / (1.0 + dt_s * rate);
+            let outside = 1.5 * rise / e.dual_length;
+            let k_out = per_layer / layer((*u - outside).abs());
+            let k_in = per_layer / layer(u.abs());
+            *u = (*u + dt_s * k_out * outside) / (1.0 + dt_s * (k_out + k_in));
         }
     }
 
@@ -476,24 +487,44 @@ impl FilmFlow {
         }
     }
 
-    /// One upwind transport of `h` with the edge speeds in `s.edge`, outflow-limited.
+    /// One transport of `h` with the edge speeds in `s.edge`: second-order upwind (the
+    /// upwind cell's Green–Gauss gradient carried to the edge midpoint, clamped between
+    /// the two cells' values so no new extremum appears), outflow-limited.
     fn upwind_substep(&mut self, s: &mut Scratch, dt_s: f64) {
         let r = self.params.radius_m;
         let g = &self.grid;
+        let areas = g.areas_sr();
+        // Cell gradients of h on the unit sphere, per radian.
+        s.gradient.clear();
+        s.gradient.resize(g.cells(), DVec3::ZERO);
+        for e in g.edges() {
+            let (a, b) = (e.a as usize, e.b as usize);
+            let flux = e.normal * (0.5 * (self.h_m[a] + self.h_m[b]) * e.length);
+            s.gradient[a] += flux;
+            s.gradient[b] -= flux;
+        }
+        for ((grad, a), c) in s.gradient.iter_mut().zip(areas).zip(g.centres()) {
+            *grad /= *a;
+            *grad -= *c * grad.dot(*c);
+        }
         let (speed, volume, outflow) = (&s.edge, &mut s.edge2, &mut s.cell);
         volume.clear();
         outflow.clear();
         outflow.resize(g.cells(), 0.0);
         // Volume across each edge over the step, per R² (m × sr).
         for (e, &v) in g.edges().iter().zip(speed.iter()) {
-            let up = if v >= 0.0 { e.a } else { e.b } as usize;
-            let moved = self.h_m[up] * v * e.length * dt_s / r;
+            let (up, down) = if v >= 0.0 { (e.a, e.b) } else { (e.b, e.a) };
+            let (up, down) = (up as usize, down as usize);
+            let (h_up, h_down) = (self.h_m[up], self.h_m[down]);
+            let reach = s.gradient[up].dot(e.midpoint - g.centres()[up]);
+            let h_face = (h_up + reach).clamp(h_up.min(h_down), h_up.max(h_down));
+            let moved = h_face * v * e.length * dt_s / r;
             outflow[up] += moved.abs();
             volume.push(moved);
         }
         let scale = &mut s.cell2;
         scale.clear();
-        scale.extend(g.areas_sr().iter().zip(&self.h_m).zip(outflow.iter()).map(
+        scale.extend(areas.iter().zip(&self.h_m).zip(outflow.iter()).map(
             |((a, h), out)| {
                 let budget = MAX_OUTFLOW_FRACTION * a * h;
                 if *out > budget { budget / out } else { 1.0 }
@@ -503,8 +534,8 @@ impl FilmFlow {
             let (a, b) = (e.a as usize, e.b as usize);
             let up = if *moved >= 0.0 { a } else { b };
             let m = moved * scale[up];
-            self.h_m[a] -= m / g.areas_sr()[a];
-            self.h_m[b] += m / g.areas_sr()[b];
+            self.h_m[a] -= m / areas[a];
+            self.h_m[b] += m / areas[b];
         }
     }
 }

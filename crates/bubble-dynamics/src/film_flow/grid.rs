@@ -34,6 +34,8 @@ pub struct GridEdge {
     pub v1: u32,
     /// Unit tangent normal to the edge at its midpoint, from `a` towards `b`.
     pub normal: DVec3,
+    /// Unit direction of the edge's midpoint.
+    pub midpoint: DVec3,
     /// Arc length of the edge on the unit sphere, rad.
     pub length: f64,
     /// Arc length between the centres of `a` and `b`, rad.
@@ -209,6 +211,7 @@ fn edge(a: u32, b: u32, (p, q): (u32, u32), centres: &[DVec3], vertices: &[DVec3
         v0,
         v1,
         normal,
+        midpoint: (vp + vq).normalize(),
         length: arc(vp, vq),
         dual_length: arc(ca, cb),
     }

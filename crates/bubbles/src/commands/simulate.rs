@@ -27,7 +27,13 @@ const ABOUT_OUTPUT: &str = "Simulates the scene's bubbles (seed 000 §3: film te
     each vertex line is `v x y z r g b` with r = g = b = thickness / 4000 nm (clamped to 1), the \
     vertex-colour extension that Blender, MeshLab and most OBJ readers import as a colour \
     attribute, and the exact thicknesses follow as `#thickness_nm` comment lines, in vertex \
-    order. Files are written to a temporary name in DIR, then renamed.";
+    order. Files are written to a temporary name in DIR, then renamed.\n\n\
+    --export-film DIR writes, at the same frames, DIR/film_<id>_00000.exr, … for every bubble \
+    with a film flow (`film_grid` > 0): the film's cube-sphere grid as a 32-bit float EXR of \
+    6n × n pixels, the faces side by side in OpenGL cube-map order (+X, −X, +Y, −Y, +Z, −Z; \
+    each face's rows top to bottom, its texel (x, y) at s = (x + ½)·2/n − 1, t likewise), \
+    R = thickness in nm (stretched by the mesh's deformation, as renderers draw it), \
+    G = coverage (1 film, 0 burst hole), B = 0.";
 
 /// Arguments of `bubbles simulate`.
 #[derive(Debug, clap::Args)]
@@ -47,7 +53,10 @@ pub struct Args {
     /// Write one OBJ file per output frame into this directory (created if missing).
     #[arg(long)]
     pub export_obj: Option<PathBuf>,
-    /// Output frames per second for --export-obj.
+    /// Write each bubble's film-flow field as an EXR per output frame into this directory.
+    #[arg(long)]
+    pub export_film: Option<PathBuf>,
+    /// Output frames per second for --export-obj and --export-film.
     #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
     pub fps: f64,
 }
@@ -70,13 +79,18 @@ pub fn run(args: Args) -> CliResult {
         None => e,
     })?;
     check_work(&scene, &world, &args)?;
-    if let Some(dir) = &args.export_obj {
-        std::fs::create_dir_all(dir).map_err(|e| {
-            CliError::input(format!(
-                "--export-obj {}: cannot create directory: {e}",
-                dir.display()
-            ))
-        })?;
+    for (flag, dir) in [("--export-obj", &args.export_obj), ("--export-film", &args.export_film)] {
+        if let Some(dir) = dir {
+            std::fs::create_dir_all(dir).map_err(|e| {
+                CliError::input(format!("{flag} {}: cannot create directory: {e}", dir.display()))
+            })?;
+        }
+    }
+    if args.export_film.is_some() && world.bubbles().iter().all(|b| b.film_flow().is_none()) {
+        return Err(CliError::input(format!(
+            "--export-film: no bubble of {} has a film flow (give a [[bubbles]] entry film_grid = 64)",
+            scene.origin
+        )));
     }
     let started = Instant::now();
     let (events, frames) = simulate(&mut world, &args).map_err(|failure| match failure {
@@ -129,7 +143,7 @@ fn radius_error(r: f64, message: &str) -> CliError {
 fn check_work(scene: &Scene, world: &World, args: &Args) -> CliResult {
     let what = format!("--seconds {}", plain(args.seconds));
     scene.check_steps(&what, world.time_s(), args.seconds, world.dt_s())?;
-    if args.export_obj.is_some() {
+    if args.export_obj.is_some() || args.export_film.is_some() {
         let frames = (args.seconds * args.fps + 1e-9).floor() + 1.0;
         if frames > limits::MAX_OBJ_FRAMES as f64 {
             return Err(CliError::input(format!(
@@ -158,16 +172,21 @@ fn simulate_with(
     args: &Args,
     bar: &mut Progress,
 ) -> Result<(Vec<Event>, usize), SimFailure> {
-    let Some(dir) = &args.export_obj else {
+    if args.export_obj.is_none() && args.export_film.is_none() {
         return Ok((advance_world(world, args.seconds, bar)?, 0));
-    };
+    }
     // The last frame lands exactly on --seconds; rounding protects k/fps = seconds.
     let last = (args.seconds * args.fps + 1e-9).floor() as usize;
     let mut events = Vec::new();
     for k in 0..=last {
         events.extend(advance_world(world, k as f64 / args.fps, bar)?);
-        write_atomic(&dir.join(format!("frame_{k:05}.obj")), &obj_text(world, k))
-            .map_err(SimFailure::Write)?;
+        if let Some(dir) = &args.export_obj {
+            write_atomic(&dir.join(format!("frame_{k:05}.obj")), &obj_text(world, k))
+                .map_err(SimFailure::Write)?;
+        }
+        if let Some(dir) = &args.export_film {
+            write_films(world, dir, k).map_err(SimFailure::Write)?;
+        }
     }
     events.extend(advance_world(world, args.seconds, bar)?);
     Ok((events, last + 1))
@@ -226,6 +245,29 @@ fn write_bubble(out: &mut String, bubble: &Bubble, base: usize) {
         let [a, b, c] = t.map(|i| i as usize + base);
         let _ = writeln!(out, "f {a}//{a} {b}//{b} {c}//{c}");
     }
+}
+
+/// Writes every film-flow bubble's field as `dir/film_<id>_<frame>.exr` (see `--help`).
+fn write_films(world: &World, dir: &Path, frame: usize) -> CliResult {
+    for b in world.bubbles() {
+        let Some(field) = b.film_field() else {
+            continue;
+        };
+        let n = field.face_size;
+        let mut rgb = vec![[0.0f32; 3]; 6 * n * n];
+        for (cell, (h, c)) in field.thickness_nm.iter().zip(&field.coverage).enumerate() {
+            let (face, rest) = (cell / (n * n), cell % (n * n));
+            let (y, x) = (rest / n, rest % n);
+            rgb[y * 6 * n + face * n + x] = [*h as f32, *c as f32, 0.0];
+        }
+        let image = raster::Frame::try_from_rgb(6 * n, n, rgb)
+            .ok_or_else(|| CliError::runtime(format!("film grid of face size {n} has no image")))?;
+        let path = dir.join(format!("film_{}_{frame:05}.exr", b.id()));
+        image
+            .write_exr(&path)
+            .map_err(|e| CliError::runtime(format!("cannot write {}: {e}", path.display())))?;
+    }
+    Ok(())
 }
 
 /// Writes `text` to a temporary file next to `path`, then renames it over `path`.

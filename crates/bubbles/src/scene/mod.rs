@@ -19,7 +19,7 @@ pub use to_dynamics::sim_error;
 pub use to_raster::bubble_meshes;
 
 /// Built-in scenes, by name, with their TOML source.
-pub const BUILTINS: [(&str, &str); 8] = [
+pub const BUILTINS: [(&str, &str); 9] = [
     ("paper", include_str!("../../scenes/paper.toml")),
     (
         "white-furnace",
@@ -37,6 +37,7 @@ pub const BUILTINS: [(&str, &str); 8] = [
     ("demo", include_str!("../../scenes/demo.toml")),
     ("demo-white", include_str!("../../scenes/demo-white.toml")),
     ("pond", include_str!("../../scenes/pond.toml")),
+    ("swirl", include_str!("../../scenes/swirl.toml")),
 ];
 
 /// Name of the scene used when none is given.

@@ -6,7 +6,8 @@
 use super::values::{
     Absorption, Acceleration, AngularSpeed, Bounds, BubbleRadius, Coordinate, Count, CubeMapSize,
     Damping, DecayPerMetre, DecayPerSecond, Direction, Direction2, Elasticity, Evaporation,
-    Exposure, FieldOfView, FilmIndex, FilmThickness, GustSpeed, InitialScale, Intensity,
+    Exposure, FieldOfView, FilmGrid, FilmIndex, FilmThickness, FilmViscosity, GustSpeed,
+    InitialScale, Intensity, NucleationRate,
     LightRadius, Luminance, LutAngleSamples, LutThicknessSamples, MeshScale, MolarMass, Num, Num3,
     ObjectRadius, PatternScale, Radiance, Reflectance, RuptureThickness, Samples, Seconds,
     Shininess, SloshSpeed, Speed, Subdivisions, SurfaceTension, TimeStep, Variation, Viscosity,
@@ -436,6 +437,21 @@ pub struct BubbleSpec {
     /// anything but 1 starts it out of equilibrium).
     #[serde(default)]
     pub initial_scale: Option<Num3<InitialScale>>,
+    /// Cells along a face of the film-flow cube-sphere (0: no flow, the per-vertex film).
+    #[serde(default)]
+    pub film_grid: Option<Count<FilmGrid>>,
+    /// Viscosity of the film liquid in the flow's viscous stress, Pa·s.
+    #[serde(default)]
+    pub film_viscosity_pa_s: Option<Num<FilmViscosity>>,
+    /// Thickness under which the flowing film turns black, nm (0: never).
+    #[serde(default)]
+    pub black_threshold_nm: Option<Num<RuptureThickness>>,
+    /// Thickness of the common black film, nm.
+    #[serde(default)]
+    pub black_film_nm: Option<Num<RuptureThickness>>,
+    /// Rate of spontaneous holes per area of black film, 1/(m²·s).
+    #[serde(default)]
+    pub nucleation_per_m2_s: Option<Num<NucleationRate>>,
 }
 
 fn mean_thickness() -> Num<FilmThickness> {
@@ -499,6 +515,9 @@ pub struct DynamicsSpec {
     /// Fixed time step, s.
     #[serde(default)]
     pub dt_s: Option<Num<TimeStep>>,
+    /// Step of the film flow, s (default 1/60).
+    #[serde(default)]
+    pub film_dt_s: Option<Num<TimeStep>>,
     /// Gravity, m/s².
     #[serde(default)]
     pub gravity_m_per_s2: Option<Num3<Acceleration>>,

@@ -73,6 +73,7 @@ impl Scene {
                 .gravity_m_per_s2
                 .map_or(defaults.gravity_m_per_s2, |g| dvec(g.get())),
             dt_s: d.dt_s.map_or(defaults.dt_s, |v| v.get()),
+            film_dt_s: d.film_dt_s.map_or(defaults.film_dt_s, |v| v.get()),
             integrator,
             wind: self.wind(),
             colliders: self.colliders(),
@@ -165,6 +166,20 @@ pub(crate) fn bubble_params(spec: &BubbleSpec) -> BubbleParams {
         initial_scale: spec
             .initial_scale
             .map_or(defaults.initial_scale, |v| dvec(v.get())),
+        film_grid: spec.film_grid.map_or(defaults.film_grid, |v| v.get()),
+        film_viscosity_pa_s: or(
+            spec.film_viscosity_pa_s.map(|v| v.get()),
+            defaults.film_viscosity_pa_s,
+        ),
+        black_threshold_nm: or(
+            spec.black_threshold_nm.map(|v| v.get()),
+            defaults.black_threshold_nm,
+        ),
+        black_film_nm: or(spec.black_film_nm.map(|v| v.get()), defaults.black_film_nm),
+        nucleation_per_m2_s: or(
+            spec.nucleation_per_m2_s.map(|v| v.get()),
+            defaults.nucleation_per_m2_s,
+        ),
         ..defaults
     }
 }

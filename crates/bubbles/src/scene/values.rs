@@ -298,6 +298,12 @@ bounds! {
     Variation: 0.0, 0.99, "";
     /// Film flow speed.
     SloshSpeed: 0.0, 10.0, "m/s";
+    /// Film-flow grid cells along a cube face (0: off; the solver checks it halves to 8).
+    FilmGrid: 0.0, bubble_dynamics::MAX_FILM_GRID as f64, "cells";
+    /// Viscosity of the film liquid.
+    FilmViscosity: 0.0, 10.0, "Pa·s";
+    /// Rate of spontaneous holes in black film.
+    NucleationRate: 0.0, 1e9, "1/(m²·s)";
     /// Evaporative thinning rate.
     Evaporation: 0.0, 1e4, "nm/s";
     /// Molar mass of the gas inside.
