@@ -11,6 +11,10 @@ fn world_with_flow(grid: u32) -> World {
         initial_scale: DVec3::new(1.15, 0.9, 1.0),
         velocity_m_per_s: DVec3::new(0.2, 0.0, 0.1),
         seed: 7,
+        // Slow drainage and no rupture: this bubble must keep its film for the test.
+        drainage_viscosity_pa_s: 1e-6,
+        rupture_thickness_nm: 0.0,
+        black_threshold_nm: 0.0,
         ..BubbleParams::default()
     };
     let params = WorldParams {

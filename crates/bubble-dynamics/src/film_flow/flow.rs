@@ -256,6 +256,9 @@ impl FilmFlow {
         s.u_start.extend_from_slice(&self.u_m_per_s);
         self.momentum_explicit(&mut s, dt_s, forcing);
         let report = self.marangoni_implicit(&mut s, dt_s);
+        // After the Marangoni step, so a film the surfactant holds at rest stays there
+        // (damping the explicit velocity first would bias the balance by k·dt).
+        self.air_shear(dt_s, forcing.air_m_per_s);
         self.transport_thickness(&mut s, dt_s, forcing.g_eff_m_per_s2);
         let evaporated = self.params.evaporation_nm_per_s * 1e-9 * dt_s;
         if evaporated > 0.0 {
@@ -269,7 +272,7 @@ impl FilmFlow {
         report
     }
 
-    /// `u ← u + dt (g_t + viscous)`, then the air's shear, implicit per edge.
+    /// `u ← u + dt (g_t + viscous)`.
     fn momentum_explicit(&mut self, s: &mut Scratch, dt_s: f64, forcing: &Forcing) {
         // Gravity as the discrete gradient of the potential g·x between cell centres, so
         // a discrete Marangoni gradient can balance it exactly (the edge projection g·n
@@ -287,7 +290,6 @@ impl FilmFlow {
                 self.viscous_substep(s, nu, dt_s / substeps);
             }
         }
-        self.air_shear(dt_s, forcing.air_m_per_s);
     }
 
     /// An upper bound of the viscous operator's eigenvalues (Gershgorin), 1/s.
@@ -398,6 +400,23 @@ impl FilmFlow {
                     (up * u0 + 0.5 * (ga + gb) * (u - u0)) * e.length
                 }),
         );
+        // The transport part may not take more than half a cell's surfactant in one step
+        // (a fast film on a coarse step would otherwise drive Γ negative): scale each
+        // donor's upwind outflow down to that.
+        let outflow = &mut s.cell;
+        outflow.clear();
+        outflow.resize(g.cells(), 0.0);
+        for (e, &u0) in g.edges().iter().zip(&s.u_start) {
+            let up = if u0 >= 0.0 { e.a } else { e.b } as usize;
+            outflow[up] += dt_s * (self.gamma[up] * u0 * e.length).abs() / r;
+        }
+        for ((f, e), &u0) in advective.iter_mut().zip(g.edges()).zip(&s.u_start) {
+            let up = if u0 >= 0.0 { e.a } else { e.b } as usize;
+            let budget = MAX_OUTFLOW_FRACTION * g.areas_sr()[up] * self.gamma[up];
+            if outflow[up] > budget {
+                *f -= (1.0 - budget / outflow[up]) * self.gamma[up] * u0 * e.length;
+            }
+        }
         // Rows divided by R²: α = A (sr), w = dt² E l/(ρ h d R²), b = A Γ − dt Σ F/R.
         let stiffness = |e: &super::grid::GridEdge| {
             let h = (0.5 * (self.h_m[e.a as usize] + self.h_m[e.b as usize])).max(H_FLOOR_M);
@@ -439,11 +458,21 @@ impl FilmFlow {
             *u += du;
             flux.push(f_adv + gamma_c * du * e.length);
         }
-        for (e, f) in g.edges().iter().zip(flux.iter()) {
-            let (a, b) = (e.a as usize, e.b as usize);
-            let moved = dt_s * f / r;
-            self.gamma[a] -= moved / g.areas_sr()[a];
-            self.gamma[b] += moved / g.areas_sr()[b];
+        let before = &mut s.cell2;
+        before.clear();
+        before.extend_from_slice(&self.gamma);
+        apply_fluxes(&g, flux, dt_s / r, &mut self.gamma);
+        if self.gamma.iter().any(|&x| x < 0.0) {
+            // A violent step (a film torn near zero thickness, where the waves run at
+            // hundreds of m/s) overshot: redo it with every flux upwind and each donor
+            // limited, which keeps Γ positive and still conserves it.
+            self.gamma.copy_from_slice(before);
+            for ((f, e), &u) in flux.iter_mut().zip(g.edges()).zip(&self.u_m_per_s) {
+                let up = if u >= 0.0 { e.a } else { e.b } as usize;
+                *f = self.gamma[up] * u * e.length;
+            }
+            limit_outflow(&g, flux, dt_s / r, &self.gamma);
+            apply_fluxes(&g, flux, dt_s / r, &mut self.gamma);
         }
         report
     }
@@ -536,6 +565,33 @@ impl FilmFlow {
             let m = moved * scale[up];
             self.h_m[a] -= m / areas[a];
             self.h_m[b] += m / areas[b];
+        }
+    }
+}
+
+/// Moves `scale·flux_e` (per unit sphere area) from cell `a` to `b` of every edge.
+fn apply_fluxes(g: &CubeSphere, flux: &[f64], scale: f64, values: &mut [f64]) {
+    for (e, f) in g.edges().iter().zip(flux) {
+        let (a, b) = (e.a as usize, e.b as usize);
+        let moved = scale * f;
+        values[a] -= moved / g.areas_sr()[a];
+        values[b] += moved / g.areas_sr()[b];
+    }
+}
+
+/// Scales each donor's outgoing fluxes so no cell gives more than
+/// [`MAX_OUTFLOW_FRACTION`] of its content in one step.
+fn limit_outflow(g: &CubeSphere, flux: &mut [f64], scale: f64, values: &[f64]) {
+    let mut outflow = vec![0.0; g.cells()];
+    for (e, f) in g.edges().iter().zip(flux.iter()) {
+        let donor = if *f >= 0.0 { e.a } else { e.b } as usize;
+        outflow[donor] += (scale * f).abs();
+    }
+    for (e, f) in g.edges().iter().zip(flux.iter_mut()) {
+        let donor = if *f >= 0.0 { e.a } else { e.b } as usize;
+        let budget = MAX_OUTFLOW_FRACTION * g.areas_sr()[donor] * values[donor];
+        if outflow[donor] > budget {
+            *f *= budget / outflow[donor];
         }
     }
 }
