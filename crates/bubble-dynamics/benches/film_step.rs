@@ -1,6 +1,7 @@
 //! Criterion bench: one film-flow step (1/60 s: gravity, viscosity, air shear, the
 //! implicit Marangoni solve, transport) of a 5 cm bubble's film at n = 64, 128 and 256
-//! cells a face, on one core.
+//! cells a face, on one core: the `swirl` scene's film (drainage μ 1e-6 Pa·s,
+//! evaporation 40 nm/s), 600 nm ± 5 %, in gravity and a 0.3 m/s breeze.
 
 use std::sync::Arc;
 
@@ -11,11 +12,15 @@ use criterion::{Criterion, criterion_group, criterion_main};
 fn film(n: usize) -> FilmFlow {
     let grid = Arc::new(CubeSphere::new(n));
     let hierarchy = Arc::new(Hierarchy::new(&grid));
-    let params = FlowParams {
-        drainage_viscosity_pa_s: 5e-8,
+    let mut params = FlowParams {
+        drainage_viscosity_pa_s: 1e-6,
+        evaporation_nm_per_s: 40.0,
         ..FlowParams::water_film(0.05)
     };
-    FilmFlow::new(grid, hierarchy, params, |d| 500e-9 * (1.0 + 0.2 * (4.0 * d.x + d.y).sin()))
+    // A film that keeps flowing through the measurement: no rupture.
+    params.burst.rupture_thickness_nm = 0.0;
+    params.burst.black_threshold_nm = 0.0;
+    FilmFlow::new(grid, hierarchy, params, |d| 600e-9 * (1.0 + 0.05 * (4.0 * d.x + d.y).sin()))
 }
 
 fn bench_film_step(c: &mut Criterion) {

@@ -44,6 +44,7 @@ fn a_hole_opens_at_the_taylor_culick_speed() {
         }
         let measured = (samples[1].1 - samples[0].1) / (samples[1].0 - samples[0].0);
         let rel = (measured - speed) / speed;
+        eprintln!("h {:.0} nm: rim {measured:.4} m/s, Taylor–Culick {speed:.4} m/s", h_m * 1e9);
         assert!(
             rel.abs() < 0.05,
             "h {h_m:e} m: rim at {measured:.3} m/s, Taylor–Culick {speed:.3} m/s ({rel:+.3})"

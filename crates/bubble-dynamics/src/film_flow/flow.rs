@@ -114,6 +114,7 @@ struct Scratch {
     weight: Vec<f64>,
     u_start: Vec<f64>,
     gradient: Vec<DVec3>,
+    drag: Vec<f64>,
 }
 
 impl FilmFlow {
@@ -255,10 +256,8 @@ impl FilmFlow {
         s.u_start.clear();
         s.u_start.extend_from_slice(&self.u_m_per_s);
         self.momentum_explicit(&mut s, dt_s, forcing);
+        self.air_shear(&mut s, dt_s, forcing.air_m_per_s);
         let report = self.marangoni_implicit(&mut s, dt_s);
-        // After the Marangoni step, so a film the surfactant holds at rest stays there
-        // (damping the explicit velocity first would bias the balance by k·dt).
-        self.air_shear(dt_s, forcing.air_m_per_s);
         self.transport_thickness(&mut s, dt_s, forcing.g_eff_m_per_s2);
         let evaporated = self.params.evaporation_nm_per_s * 1e-9 * dt_s;
         if evaporated > 0.0 {
@@ -347,9 +346,14 @@ impl FilmFlow {
     /// the potential flow's `1.5 (U − (U·n)n)`; inside, the gas moving with the bubble.
     /// Each side's shear is `μ_air Δu/δ` through a laminar boundary layer
     /// `δ = √(ν_air ℓ/|Δu|)` over the eddy scale `ℓ = R/4`, at most R. Implicit per edge
-    /// (with δ from the step's starting slip), so stable however thin the film.
-    fn air_shear(&mut self, dt_s: f64, air_m_per_s: DVec3) {
+    /// (with δ from the step's starting slip), so stable however thin the film. Records
+    /// each edge's implicit factor `1/(1 + dt k)`, by which the Marangoni step's own
+    /// velocity change is damped too: drag and Marangoni stress are then one backward-Euler
+    /// step, and a film they hold together stays at rest.
+    fn air_shear(&mut self, s: &mut Scratch, dt_s: f64, air_m_per_s: DVec3) {
         let p = &self.params;
+        s.drag.clear();
+        s.drag.resize(self.u_m_per_s.len(), 1.0);
         if p.air_viscosity_pa_s <= 0.0 {
             return;
         }
@@ -363,7 +367,7 @@ impl FilmFlow {
             }
         };
         let centres = self.grid.centres();
-        for (u, e) in self.u_m_per_s.iter_mut().zip(self.grid.edges()) {
+        for ((u, e), factor) in self.u_m_per_s.iter_mut().zip(self.grid.edges()).zip(&mut s.drag) {
             let h = (0.5 * (self.h_m[e.a as usize] + self.h_m[e.b as usize])).max(H_FLOOR_M);
             let per_layer = p.air_viscosity_pa_s / (p.density_kg_per_m3 * h);
             // The potential flow's surface velocity is the gradient of 1.5 U·x: taken as
@@ -372,7 +376,8 @@ impl FilmFlow {
             let outside = 1.5 * rise / e.dual_length;
             let k_out = per_layer / layer((*u - outside).abs());
             let k_in = per_layer / layer(u.abs());
-            *u = (*u + dt_s * k_out * outside) / (1.0 + dt_s * (k_out + k_in));
+            *factor = 1.0 / (1.0 + dt_s * (k_out + k_in));
+            *u = (*u + dt_s * k_out * outside) * *factor;
         }
     }
 
@@ -417,16 +422,19 @@ impl FilmFlow {
                 *f -= (1.0 - budget / outflow[up]) * self.gamma[up] * u0 * e.length;
             }
         }
-        // Rows divided by R²: α = A (sr), w = dt² E l/(ρ h d R²), b = A Γ − dt Σ F/R.
-        let stiffness = |e: &super::grid::GridEdge| {
+        // Rows divided by R²: α = A (sr), w = dt² E l/(ρ h d R²)/(1 + dt k),
+        // b = A Γ − dt Σ F/R.
+        let drag = std::mem::take(&mut s.drag);
+        let stiffness = |k: usize, e: &super::grid::GridEdge| {
             let h = (0.5 * (self.h_m[e.a as usize] + self.h_m[e.b as usize])).max(H_FLOOR_M);
-            dt_s * p.elasticity_n_per_m / (p.density_kg_per_m3 * h)
+            dt_s * p.elasticity_n_per_m / (p.density_kg_per_m3 * h) * drag[k]
         };
         s.weight.clear();
         s.weight.extend(
             g.edges()
                 .iter()
-                .map(|e| dt_s * stiffness(e) * e.length / (e.dual_length * r * r)),
+                .enumerate()
+                .map(|(k, e)| dt_s * stiffness(k, e) * e.length / (e.dual_length * r * r)),
         );
         let rhs = &mut s.cell;
         rhs.clear();
@@ -450,10 +458,16 @@ impl FilmFlow {
         // Velocity correction and the conservative surfactant update.
         let flux = &mut s.edge2;
         flux.clear();
-        for ((e, u), f_adv) in g.edges().iter().zip(self.u_m_per_s.iter_mut()).zip(advective.iter()) {
+        for (k, ((e, u), f_adv)) in g
+            .edges()
+            .iter()
+            .zip(self.u_m_per_s.iter_mut())
+            .zip(advective.iter())
+            .enumerate()
+        {
             let (a, b) = (e.a as usize, e.b as usize);
             let gamma_c = 0.5 * (self.gamma[a] + self.gamma[b]);
-            let du = -stiffness(e) * (solution[b] - solution[a])
+            let du = -stiffness(k, e) * (solution[b] - solution[a])
                 / (gamma_c.max(f64::MIN_POSITIVE) * e.dual_length * r);
             *u += du;
             flux.push(f_adv + gamma_c * du * e.length);
@@ -474,6 +488,7 @@ impl FilmFlow {
             limit_outflow(&g, flux, dt_s / r, &self.gamma);
             apply_fluxes(&g, flux, dt_s / r, &mut self.gamma);
         }
+        s.drag = drag;
         report
     }
 
