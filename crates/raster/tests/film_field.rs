@@ -8,7 +8,7 @@ use common::{
     bubble, draining, film_field, paper_scene, settings, synthetic_reflectivity, with_film,
 };
 use raster::{
-    Camera, Environment, FilmTables, Frame, ReflectionMode, RenderScene, RenderSettings, Renderer,
+    Camera, Environment, FilmTables, Frame, Material, Object, ReflectionMode, RenderScene, RenderSettings, Renderer,
     Sky, Vec3,
 };
 
@@ -58,6 +58,16 @@ fn the_field_thickness_replaces_the_vertex_thickness() {
     assert!(d300 > 0.05, "300 nm and 650 nm films look alike ({d300})");
 }
 
+/// A black box behind the origin: what shows through a film is dark, so its reflection
+/// (of the sky) shows.
+fn black_wall() -> Object {
+    Object::Box {
+        center: Vec3::new(0.0, 0.0, -2.0),
+        half_extents_m: Vec3::new(10.0, 10.0, 0.5),
+        material: Material::matte([0.0; 3]),
+    }
+}
+
 /// Texels of the stripe on face +Z (face 4): columns 128 and 129 of 256.
 const STRIPE: [usize; 2] = [128, 129];
 const N: usize = 256;
@@ -77,9 +87,10 @@ fn a_stripe_two_texels_wide_reaches_the_screen_unblurred() {
     // the level-5 mesh's vertices are 17 mm apart.
     let (w, h) = (256, 128);
     let camera = Camera::look_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y, 6.0);
-    let sky = Environment::Sky(Sky::default());
+    let sky = Environment::Uniform([1.0; 3]);
     let scene_with = |f: &dyn Fn(Vec3) -> f32| {
         let mut scene = RenderScene::new(camera, sky.clone());
+        scene.objects = vec![black_wall()];
         let field = film_field(N, |d| (f(d), 1.0));
         scene.bubbles = vec![with_film(bubble(Vec3::ZERO, 0.5, 5, |_| 0.0), field)];
         scene
@@ -119,7 +130,7 @@ fn a_stripe_two_texels_wide_reaches_the_screen_unblurred() {
             // triangles): only stripe texels are read.
             if x > STRIPE[0] as f32 + 0.1 && x < STRIPE[1] as f32 - 0.1 {
                 core += 1;
-                assert!(diff(full, base) > 0.02, "pixel ({px}, {py}): the films look alike");
+                assert!(diff(full, base) > 0.02, "pixel ({px}, {py}): the films look alike: {full:?} {base:?}");
                 let d = diff(got, full);
                 assert!(d < 1e-4, "stripe pixel ({px}, {py}) at column {x} is off by {d}");
             } else if x < STRIPE[0] as f32 - 1.1 || x > STRIPE[1] as f32 + 1.1 {
@@ -151,6 +162,7 @@ fn coverage_zero_is_no_film_and_coverage_half_is_the_analytic_blend() {
     // gives B·(1 − (1 − T)/2) + add/2 = (B + F)/2.
     let camera = Camera::look_at(Vec3::new(0.2, 0.3, 2.0), Vec3::ZERO, Vec3::Y, 40.0);
     let mut flat = RenderScene::new(camera, Environment::Sky(Sky::default()));
+    flat.objects = vec![black_wall()];
     let quad = raster::BubbleMesh {
         positions: vec![
             Vec3::new(-0.5, -0.4, 0.0),
@@ -185,7 +197,7 @@ fn coverage_zero_is_no_film_and_coverage_half_is_the_analytic_blend() {
         }
     }
     assert!(worst < 1e-5, "coverage 1/2 is off the blend by {worst} (relative)");
-    assert!(max_diff(&full, &background) > 0.05, "the film is invisible");
+    assert!(max_diff(&full, &background) > 0.05, "the film is invisible: {}", max_diff(&full, &background));
 }
 
 #[test]
