@@ -162,7 +162,13 @@ fn coverage_zero_is_no_film_and_coverage_half_is_the_analytic_blend() {
     // gives B·(1 − (1 − T)/2) + add/2 = (B + F)/2.
     let camera = Camera::look_at(Vec3::new(0.2, 0.3, 2.0), Vec3::ZERO, Vec3::Y, 40.0);
     let mut flat = RenderScene::new(camera, Environment::Sky(Sky::default()));
-    flat.objects = vec![black_wall()];
+    // A lit checker wall behind: what shows through the film is neither black nor the sky.
+    flat.ambient_rgb = [1.0; 3];
+    flat.objects = vec![Object::Box {
+        center: Vec3::new(0.0, 0.0, -2.0),
+        half_extents_m: Vec3::new(10.0, 10.0, 0.5),
+        material: Material::checker([0.9; 3], [0.2; 3], 0.1),
+    }];
     let quad = raster::BubbleMesh {
         positions: vec![
             Vec3::new(-0.5, -0.4, 0.0),
