@@ -12,8 +12,8 @@ use render_scene::lut_sampler::LutSampler;
 use render_scene::reflection::Reflection;
 use render_scene::tessellate::{Geometry, tessellate};
 use render_scene::{
-    BubbleMesh, CubeMap, Environment, FilmField, FilmTables, Frame, FrameTimings, Material, PartialShading,
-    ReflectionFilter, ReflectionMode, RenderError, RenderScene, RenderSettings,
+    BubbleMesh, CubeMap, Environment, FilmField, FilmTables, Frame, FrameTimings, Material,
+    PartialShading, ReflectionFilter, ReflectionMode, RenderError, RenderScene, RenderSettings,
 };
 
 use crate::passes::bubble::{BubbleCtx, setup_bubble_tris};

@@ -8,8 +8,8 @@ use common::{
     bubble, draining, film_field, paper_scene, settings, synthetic_reflectivity, with_film,
 };
 use raster::{
-    Camera, Environment, FilmTables, Frame, Material, Object, ReflectionMode, RenderScene, RenderSettings, Renderer,
-    Sky, Vec3,
+    Camera, Environment, FilmTables, Frame, Material, Object, ReflectionMode, RenderScene,
+    RenderSettings, Renderer, Sky, Vec3,
 };
 
 fn render(scene: &RenderScene, tables: &FilmTables, settings: &RenderSettings) -> Frame {
@@ -95,7 +95,10 @@ fn a_stripe_two_texels_wide_reaches_the_screen_unblurred() {
         scene.bubbles = vec![with_film(bubble(Vec3::ZERO, 0.5, 5, |_| 0.0), field)];
         scene
     };
-    let in_stripe = |d: Vec3| face_z_column(d).is_some_and(|x| (x.round() as usize) == STRIPE[0] || x.round() as usize == STRIPE[1]);
+    let in_stripe = |d: Vec3| {
+        face_z_column(d)
+            .is_some_and(|x| (x.round() as usize) == STRIPE[0] || x.round() as usize == STRIPE[1])
+    };
     let st = settings(w, h, 1, ReflectionMode::StaticEnvironment);
     let tables = tables();
     let stripe = render(
@@ -105,7 +108,13 @@ fn a_stripe_two_texels_wide_reaches_the_screen_unblurred() {
     );
     let all_base = render(&scene_with(&|_| BASE_NM), &tables, &st);
     let face_stripe = render(
-        &scene_with(&|d| if face_z_column(d).is_some() { STRIPE_NM } else { BASE_NM }),
+        &scene_with(&|d| {
+            if face_z_column(d).is_some() {
+                STRIPE_NM
+            } else {
+                BASE_NM
+            }
+        }),
         &tables,
         &st,
     );
@@ -122,22 +131,34 @@ fn a_stripe_two_texels_wide_reaches_the_screen_unblurred() {
                 continue;
             }
             let hit = o + d * (-b - disc.sqrt());
-            let Some(x) = face_z_column(hit) else { continue };
+            let Some(x) = face_z_column(hit) else {
+                continue;
+            };
             let k = py * w + px;
             let (got, base, full) = (stripe.rgb()[k], all_base.rgb()[k], face_stripe.rgb()[k]);
-            let diff = |a: [f32; 3], b: [f32; 3]| (0..3).map(|c| (a[c] - b[c]).abs()).fold(0.0, f32::max);
+            let diff =
+                |a: [f32; 3], b: [f32; 3]| (0..3).map(|c| (a[c] - b[c]).abs()).fold(0.0, f32::max);
             // Within the stripe's two texel centres (margin for the mesh's flat
             // triangles): only stripe texels are read.
             if x > STRIPE[0] as f32 + 0.1 && x < STRIPE[1] as f32 - 0.1 {
                 core += 1;
-                assert!(diff(full, base) > 0.02, "pixel ({px}, {py}): the films look alike: {full:?} {base:?}");
+                assert!(
+                    diff(full, base) > 0.02,
+                    "pixel ({px}, {py}): the films look alike: {full:?} {base:?}"
+                );
                 let d = diff(got, full);
-                assert!(d < 1e-4, "stripe pixel ({px}, {py}) at column {x} is off by {d}");
+                assert!(
+                    d < 1e-4,
+                    "stripe pixel ({px}, {py}) at column {x} is off by {d}"
+                );
             } else if x < STRIPE[0] as f32 - 1.1 || x > STRIPE[1] as f32 + 1.1 {
                 // Beyond the bilinear reach of the stripe: the base film exactly.
                 outside += 1;
                 let d = diff(got, base);
-                assert!(d < 1e-4, "pixel ({px}, {py}) at column {x} shows the stripe by {d}");
+                assert!(
+                    d < 1e-4,
+                    "pixel ({px}, {py}) at column {x} shows the stripe by {d}"
+                );
             }
         }
     }
@@ -154,7 +175,10 @@ fn coverage_zero_is_no_film_and_coverage_half_is_the_analytic_blend() {
     hole.bubbles[0] = with_film(hole.bubbles[0].clone(), film_field(8, |_| (500.0, 0.0)));
     let mut without = paper_scene();
     without.bubbles.remove(0);
-    assert_eq!(bits(&render(&hole, &tables, &st)), bits(&render(&without, &tables, &st)));
+    assert_eq!(
+        bits(&render(&hole, &tables, &st)),
+        bits(&render(&without, &tables, &st))
+    );
     let with_bubble = render(&paper_scene(), &tables, &st);
     assert!(max_diff(&with_bubble, &render(&without, &tables, &st)) > 0.05);
 
@@ -202,8 +226,15 @@ fn coverage_zero_is_no_film_and_coverage_half_is_the_analytic_blend() {
             worst = worst.max((half.rgb()[k][c] - want).abs() / want.max(1e-3));
         }
     }
-    assert!(worst < 1e-5, "coverage 1/2 is off the blend by {worst} (relative)");
-    assert!(max_diff(&full, &background) > 0.05, "the film is invisible: {}", max_diff(&full, &background));
+    assert!(
+        worst < 1e-5,
+        "coverage 1/2 is off the blend by {worst} (relative)"
+    );
+    assert!(
+        max_diff(&full, &background) > 0.05,
+        "the film is invisible: {}",
+        max_diff(&full, &background)
+    );
 }
 
 #[test]
@@ -245,13 +276,19 @@ fn a_film_with_mismatched_material_directions_is_refused_naming_the_bubble() {
     }
     scene.bubbles[1] = b.clone();
     let st = settings(16, 16, 1, ReflectionMode::StaticEnvironment);
-    let err = Renderer::new().render(&scene, &tables(), &st).unwrap_err().to_string();
+    let err = Renderer::new()
+        .render(&scene, &tables(), &st)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("bubble 1, film"), "{err}");
     if let Some(f) = &mut b.film {
         f.material_dirs.push(Vec3::ZERO);
     }
     scene.bubbles[1] = b;
-    let err = Renderer::new().render(&scene, &tables(), &st).unwrap_err().to_string();
+    let err = Renderer::new()
+        .render(&scene, &tables(), &st)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("bubble 1, film, vertex"), "{err}");
     assert!(err.contains("non-zero"), "{err}");
 }

@@ -253,7 +253,10 @@ fn reference_coverage_zero_is_no_film_and_coverage_half_the_blend() {
         for c in 0..3 {
             let want = 0.5 * (background.rgb()[k][c] + full.rgb()[k][c]);
             let got = half.rgb()[k][c];
-            assert!((got - want).abs() < 1e-5 * want.max(1.0), "pixel {k}: {got} vs {want}");
+            assert!(
+                (got - want).abs() < 1e-5 * want.max(1.0),
+                "pixel {k}: {got} vs {want}"
+            );
         }
     }
     assert!(max_diff(&full, &background) > 0.02, "the film is invisible");

@@ -152,7 +152,12 @@ impl FilmField {
     /// # Panics
     /// Panics if `face >= 6`.
     pub fn texel_direction(face_size: usize, face: usize, x: usize, y: usize) -> Vec3 {
-        unit_or_raw(raw_direction(face_size, face, x as f32 + 0.5, y as f32 + 0.5))
+        unit_or_raw(raw_direction(
+            face_size,
+            face,
+            x as f32 + 0.5,
+            y as f32 + 0.5,
+        ))
     }
 
     /// Bilinear sample at a material direction (any non-zero length; zero reads the
@@ -178,7 +183,12 @@ impl FilmField {
         let base = face * m * m + y0 * m + x0;
         let quad = &self.bordered[base..base + m + 2];
         let [a, b, c, d] = [quad[0], quad[1], quad[m], quad[m + 1]];
-        let w = Vec4::new((1.0 - tx) * (1.0 - ty), tx * (1.0 - ty), (1.0 - tx) * ty, tx * ty);
+        let w = Vec4::new(
+            (1.0 - tx) * (1.0 - ty),
+            tx * (1.0 - ty),
+            (1.0 - tx) * ty,
+            tx * ty,
+        );
         let cov = Vec4::new(a[1], b[1], c[1], d[1]);
         let wc = w * cov;
         let sum = wc.x + wc.y + wc.z + wc.w;
@@ -219,8 +229,7 @@ impl FilmField {
                         // Border texel (centre at bordered index − 1 + 0.5 texels).
                         let dir = raw_direction(n, f, x as f32 - 0.5, y as f32 - 0.5);
                         let (g, s, t) = face_coordinates(dir);
-                        let to_index =
-                            |c: f32| (((c + 1.0) * 0.5 * n as f32) as usize).min(n - 1);
+                        let to_index = |c: f32| (((c + 1.0) * 0.5 * n as f32) as usize).min(n - 1);
                         at(g, to_index(s), to_index(t))
                     } else {
                         continue;
@@ -446,7 +455,11 @@ mod tests {
         assert!(worst < 1e-2, "coverage jumps by {worst}");
         // Every sample with any coverage reads 800 nm, holes' thickness never blended in.
         for i in 0..2000 {
-            let d = Vec3::new(hash01(3 * i) - 0.5, hash01(3 * i + 1) - 0.5, hash01(3 * i + 2) - 0.5);
+            let d = Vec3::new(
+                hash01(3 * i) - 0.5,
+                hash01(3 * i + 1) - 0.5,
+                hash01(3 * i + 2) - 0.5,
+            );
             let s = field.sample(d);
             if s.coverage > 0.0 {
                 assert!((s.thickness_nm - 800.0).abs() < 1e-3, "{d}: {s:?}");
@@ -462,9 +475,7 @@ mod tests {
         let ok = || (vec![100.0f32; 6 * n * n], vec![1.0f32; 6 * n * n]);
         let err = |r: Result<FilmField, RenderError>| r.unwrap_err().to_string();
         assert!(err(FilmField::try_new(0, vec![], vec![])).contains("face_size"));
-        assert!(
-            err(FilmField::try_new(MAX_FACE_SIZE + 1, vec![], vec![])).contains("face_size")
-        );
+        assert!(err(FilmField::try_new(MAX_FACE_SIZE + 1, vec![], vec![])).contains("face_size"));
         let (h, c) = ok();
         assert!(err(FilmField::try_new(n, h[1..].to_vec(), c)).contains("53 thicknesses"));
         let (h, c) = ok();
@@ -486,6 +497,9 @@ mod tests {
         }
         let (h, c) = ok();
         let f = FilmField::try_new(n, h.clone(), c.clone()).unwrap();
-        assert_eq!((f.face_size(), f.thickness_nm(), f.coverage()), (n, &h[..], &c[..]));
+        assert_eq!(
+            (f.face_size(), f.thickness_nm(), f.coverage()),
+            (n, &h[..], &c[..])
+        );
     }
 }

@@ -5,8 +5,8 @@ use std::collections::HashMap;
 
 use render_scene::Vec3;
 use render_scene::{
-    BubbleFilm, BubbleMesh, Camera, FilmField, Environment, FilmTables, Frame, Ground, Irradiance, Light, Lut, Material,
-    Object, ReflectionMode, RenderScene, RenderSettings, Sky,
+    BubbleFilm, BubbleMesh, Camera, Environment, FilmField, FilmTables, Frame, Ground, Irradiance,
+    Light, Lut, Material, Object, ReflectionMode, RenderScene, RenderSettings, Sky,
 };
 
 /// Default settings at the given size, sample count and reflection mode.
