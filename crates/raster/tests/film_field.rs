@@ -77,7 +77,7 @@ const STRIPE_NM: f32 = 700.0;
 /// Column coordinate (texel units, texel i centred at i) of `dir` on face +Z, if there.
 fn face_z_column(dir: Vec3) -> Option<f32> {
     let (face, s, _) = render_scene::cubemap::face_coordinates(dir);
-    (face == 4).then(|| (s + 1.0) * 0.5 * N as f32 - 0.5)
+    (face == 4).then_some((s + 1.0) * 0.5 * N as f32 - 0.5)
 }
 
 #[test]
