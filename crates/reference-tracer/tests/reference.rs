@@ -233,9 +233,14 @@ fn reference_coverage_zero_is_no_film_and_coverage_half_the_blend() {
     assert!(d < 1e-4, "a film of coverage 0 shows by {d}");
     assert!(max_diff(&with, &without) > 0.02, "the bubble is invisible");
 
-    // One flat film over a black box under a white sky: coverage c gives (1 − c)·B + c·F.
+    // One flat film over a lit grey box under a white sky: coverage c gives
+    // (1 − c)·B + c·F (the box is not black, so the film's transmittance shows).
     let settings = small(6, 6);
     let mut bare = flat_film_scene(400.0, 20.0);
+    bare.ambient_rgb = [1.0; 3];
+    if let Object::Box { material, .. } = &mut bare.objects[0] {
+        *material = Material::matte([0.6; 3]);
+    }
     let film = bare.bubbles.remove(0);
     let background = render(&bare, &settings);
     let at = |coverage: f32| {
