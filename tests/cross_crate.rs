@@ -43,6 +43,7 @@ fn sphere_bubble(center: Vec3, radius_m: f32, thickness_nm: f32) -> BubbleMesh {
         positions: mesh.positions,
         normals: mesh.normals,
         triangles: mesh.triangles,
+        film: None,
     }
 }
 
@@ -119,6 +120,7 @@ fn simulated_bubble_in_white_furnace_is_invisible() {
         normals: b.vertex_normals().iter().map(|n| n.as_vec3()).collect(),
         thickness_nm: b.thickness_nm().iter().map(|&t| t as f32).collect(),
         triangles: b.triangles().to_vec(),
+        film: None,
     });
     let mut renderer = Renderer::new();
     let frame = renderer

@@ -4,7 +4,12 @@
 
 use glam::Vec3;
 use render_scene::camera::View;
-use render_scene::tessellate::{ATTRS, Geometry};
+use render_scene::tessellate::Geometry;
+
+/// Attributes per rasterised vertex: the scene's [`render_scene::tessellate::ATTRS`]
+/// (normal x, y, z and texture u, v; bubbles: normal and thickness) and a sixth, so a
+/// bubble with a film field carries its material direction in the last three.
+pub(crate) const ATTRS: usize = render_scene::tessellate::ATTRS + 1;
 
 /// Sub-pixel precision of snapped vertices: 1/256 pixel.
 pub(crate) const SUBPIXEL: i64 = 256;
@@ -480,11 +485,8 @@ pub(crate) fn clip_vertex(view: &View, p: Vec3, attrs: [f32; ATTRS]) -> ClipVert
 pub(crate) fn setup_geometry(geometry: &Geometry, view: &View, out: &mut Vec<SetupTri>) {
     for (t, &tag) in geometry.triangles.iter().zip(&geometry.tags) {
         let tri = t.map(|i| {
-            clip_vertex(
-                view,
-                geometry.positions[i as usize],
-                geometry.attrs[i as usize],
-            )
+            let [a, b, c, d, e] = geometry.attrs[i as usize];
+            clip_vertex(view, geometry.positions[i as usize], [a, b, c, d, e, 0.0])
         });
         setup_triangle(view, tri, tag, 0.0, |s| out.push(s));
     }

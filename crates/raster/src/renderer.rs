@@ -12,8 +12,8 @@ use render_scene::lut_sampler::LutSampler;
 use render_scene::reflection::Reflection;
 use render_scene::tessellate::{Geometry, tessellate};
 use render_scene::{
-    BubbleMesh, CubeMap, Environment, FilmTables, Frame, FrameTimings, Material, PartialShading,
-    ReflectionFilter, ReflectionMode, RenderError, RenderScene, RenderSettings,
+    BubbleMesh, CubeMap, Environment, FilmField, FilmTables, Frame, FrameTimings, Material,
+    PartialShading, ReflectionFilter, ReflectionMode, RenderError, RenderScene, RenderSettings,
 };
 
 use crate::passes::bubble::{BubbleCtx, setup_bubble_tris};
@@ -162,6 +162,11 @@ impl Renderer {
                 )
             })
             .collect();
+        let films: Vec<Option<&FilmField>> = scene
+            .bubbles
+            .iter()
+            .map(|b| b.film.as_ref().map(|f| &*f.field))
+            .collect();
         let bubbles = BubbleCtx {
             view,
             pattern,
@@ -170,6 +175,7 @@ impl Renderer {
             lights: &scene.lights,
             light_tables: &light_tables,
             reflections: &reflections,
+            films: &films,
             filter: self.filter,
             partial: self.partial,
             tris: &self.bubble_tris,

@@ -401,6 +401,7 @@ fn folded_film_scene() -> RenderScene {
         normals: Vec::new(),
         thickness_nm: Vec::new(),
         triangles: Vec::new(),
+        film: None,
     };
     for (y, thickness_nm) in [(0.5, 300.0), (1.0, 550.0)] {
         let first = film.positions.len() as u32;

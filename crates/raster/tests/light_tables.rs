@@ -25,6 +25,7 @@ fn light_table_highlight_is_not_coloured_twice() {
         positions: mesh.positions,
         normals: mesh.normals,
         triangles: mesh.triangles,
+        film: None,
     });
     scene.lights.push(Light {
         position: Vec3::new(0.0, 0.0, 2.0),

@@ -132,9 +132,33 @@ impl Tracer<'_> {
             n = -n;
         }
         let cos_theta = f64::from(-dir.dot(n)).clamp(0.0, 1.0);
-        let thickness_nm =
-            f64::from(blend(idx.map(|i| mesh.thickness_nm[i as usize]), u, v)).max(0.0);
-        let f = self.film_factors(thickness_nm, cos_theta);
+        // A film field gives thickness and coverage at the hit's material direction, read
+        // through the same `FilmField::sample` as the real-time backends.
+        let (thickness_nm, coverage) = match &mesh.film {
+            None => (blend(idx.map(|i| mesh.thickness_nm[i as usize]), u, v), 1.0),
+            Some(film) => {
+                let dir_m = blend(idx.map(|i| film.material_dirs[i as usize]), u, v);
+                let s = film.field.sample(dir_m);
+                (s.thickness_nm, s.coverage)
+            }
+        };
+        if coverage <= 0.0 {
+            // A hole: the ray goes on as if this film were not there.
+            self.trace(p, dir, beam, films_left, Some(tri), out);
+            return;
+        }
+        let thickness_nm = f64::from(thickness_nm).max(0.0);
+        let mut f = self.film_factors(thickness_nm, cos_theta);
+        if coverage < 1.0 {
+            // Coverage c blends the film in: R' = c·R, T' = 1 − c·(1 − T).
+            let c = f64::from(coverage);
+            for k in 0..MAX_WAVELENGTHS {
+                f.r_s[k] *= c;
+                f.r_p[k] *= c;
+                f.t_s[k] = 1.0 - c * (1.0 - f.t_s[k]);
+                f.t_p[k] = 1.0 - c * (1.0 - f.t_p[k]);
+            }
+        }
         let ch = self.channels();
         let mut beam = beam.clone();
         let s_axis = dir.cross(n).normalize_or_zero();

@@ -83,6 +83,7 @@ fn flat_film_scene(thickness_nm: f32, angle_deg: f32) -> RenderScene {
         normals: vec![Vec3::Z; 4],
         thickness_nm: vec![thickness_nm; 4],
         triangles: vec![[0, 1, 2], [0, 2, 3]],
+        film: None,
     }];
     scene.objects = vec![Object::Box {
         center: Vec3::new(0.0, 0.0, -1.0),
@@ -184,4 +185,84 @@ fn unpolarised_chord_product_overestimates_the_polarised_one_at_60_degrees() {
         "unpolarised product {unpolarised} vs polarised {polarised}: {:.1} % brighter",
         100.0 * excess
     );
+}
+
+fn max_diff(a: &Frame, b: &Frame) -> f32 {
+    a.rgb()
+        .iter()
+        .zip(b.rgb())
+        .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs()))
+        .fold(0.0, f32::max)
+}
+
+#[test]
+fn reference_reads_the_film_field_thickness_over_the_vertex_thickness() {
+    let settings = small(8, 8);
+    let mut by_field = flat_film_scene(300.0, 20.0);
+    let quad = &mut by_field.bubbles[0];
+    quad.film = Some(render_scene::BubbleFilm {
+        field: std::sync::Arc::new(common::film_field(4, |_| (650.0, 1.0))),
+        material_dirs: quad.positions.iter().map(|p| *p + Vec3::Z).collect(),
+    });
+    let field = render(&by_field, &settings);
+    let vertex = render(&flat_film_scene(650.0, 20.0), &settings);
+    let d = max_diff(&field, &vertex);
+    assert!(d < 1e-4, "field 650 nm vs vertex 650 nm differ by {d}");
+    let d300 = max_diff(&field, &render(&flat_film_scene(300.0, 20.0), &settings));
+    assert!(d300 > 0.02, "300 nm and 650 nm films look alike ({d300})");
+}
+
+#[test]
+fn reference_coverage_zero_is_no_film_and_coverage_half_the_blend() {
+    let settings = small(12, 12);
+    let mut scene = common::paper_scene();
+    scene.ground = None;
+    let mut hole = scene.clone();
+    hole.bubbles[0] = common::with_film(
+        hole.bubbles[0].clone(),
+        common::film_field(4, |_| (500.0, 0.0)),
+    );
+    let mut without = scene.clone();
+    without.bubbles.remove(0);
+    let (hole, without, with) = (
+        render(&hole, &settings),
+        render(&without, &settings),
+        render(&scene, &settings),
+    );
+    let d = max_diff(&hole, &without);
+    assert!(d < 1e-4, "a film of coverage 0 shows by {d}");
+    assert!(max_diff(&with, &without) > 0.02, "the bubble is invisible");
+
+    // One flat film over a lit grey box under a white sky: coverage c gives
+    // (1 − c)·B + c·F (the box is not black, so the film's transmittance shows).
+    let settings = small(6, 6);
+    let mut bare = flat_film_scene(400.0, 20.0);
+    bare.ambient_rgb = [1.0; 3];
+    if let Object::Box { material, .. } = &mut bare.objects[0] {
+        *material = Material::matte([0.6; 3]);
+    }
+    let film = bare.bubbles.remove(0);
+    let background = render(&bare, &settings);
+    let at = |coverage: f32| {
+        let mut s = bare.clone();
+        let mut f = film.clone();
+        f.film = Some(render_scene::BubbleFilm {
+            field: std::sync::Arc::new(common::film_field(4, move |_| (400.0, coverage))),
+            material_dirs: f.positions.iter().map(|p| *p + Vec3::Z).collect(),
+        });
+        s.bubbles = vec![f];
+        render(&s, &settings)
+    };
+    let (full, half) = (at(1.0), at(0.5));
+    for k in 0..full.rgb().len() {
+        for c in 0..3 {
+            let want = 0.5 * (background.rgb()[k][c] + full.rgb()[k][c]);
+            let got = half.rgb()[k][c];
+            assert!(
+                (got - want).abs() < 1e-5 * want.max(1.0),
+                "pixel {k}: {got} vs {want}"
+            );
+        }
+    }
+    assert!(max_diff(&full, &background) > 0.02, "the film is invisible");
 }

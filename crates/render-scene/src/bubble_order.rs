@@ -99,6 +99,7 @@ mod tests {
             positions,
             normals,
             triangles: Vec::new(),
+            film: None,
         }
     }
 

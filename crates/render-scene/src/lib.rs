@@ -7,7 +7,8 @@
 //! (`reference-tracer`). This crate is what they share:
 //! - the scene: [`Camera`] and its per-pixel [`camera::View`], [`Environment`] and
 //!   [`Irradiance`], [`Ground`], [`Object`]s and their one tessellation ([`tessellate`]),
-//!   [`Light`]s, [`BubbleMesh`]es with their drawing order ([`bubble_order`]), the
+//!   [`Light`]s, [`BubbleMesh`]es with their drawing order ([`bubble_order`]) and film
+//!   fields ([`FilmField`]), the
 //!   [`WaterSurface`], [`Texture`]s, [`SphereMap`]s and [`CubeMap`]s;
 //! - the per-pixel formulas: opaque [`shading`], the LUT lookup ([`lut_sampler`]), cube-map
 //!   sampling and its footprint filter ([`cubemap`], [`lod`]), a bubble's [`reflection`]
@@ -26,6 +27,7 @@ pub mod camera;
 pub mod cubemap;
 pub mod environment;
 mod error;
+pub mod film_field;
 pub mod frame;
 pub mod ground_view;
 pub mod highlight;
@@ -51,6 +53,7 @@ pub use camera::{Camera, DEFAULT_NEAR_M};
 pub use cubemap::{CubeMap, MAX_FACE_SIZE};
 pub use environment::{Environment, Sky};
 pub use error::RenderError;
+pub use film_field::{BubbleFilm, FilmField, FilmSample, MAX_FILM_THICKNESS_NM};
 pub use frame::{Frame, FrameTimings, linear_to_srgb, tone_map};
 pub use glam::{Mat3, Vec3};
 pub use irradiance::Irradiance;

@@ -6,7 +6,9 @@ use lut::Lut;
 
 use crate::environment::check_rgb;
 use crate::mesh::{check_triangles, check_vertices};
-use crate::{Camera, Environment, Irradiance, Material, RenderError, TriMesh, WaterSurface};
+use crate::{
+    BubbleFilm, Camera, Environment, Irradiance, Material, RenderError, TriMesh, WaterSurface,
+};
 
 /// The infinite horizontal plane `y = height_m`, seen from both sides.
 #[derive(Debug, Clone, PartialEq)]
@@ -104,6 +106,11 @@ pub struct BubbleMesh {
     pub thickness_nm: Vec<f32>,
     /// Vertex indices of each triangle (any winding).
     pub triangles: Vec<[u32; 3]>,
+    /// The film's thickness and coverage as a field over the bubble's material sphere,
+    /// read per pixel at the interpolated material direction. When present, the field's
+    /// thickness replaces `thickness_nm` in shading, and its coverage `c` blends the film
+    /// in: transmittance `1 − c·(1 − T)`, added radiance `c·add` (`c = 0`: no film there).
+    pub film: Option<BubbleFilm>,
 }
 
 impl BubbleMesh {
@@ -143,7 +150,32 @@ impl BubbleMesh {
                 ),
             ));
         }
-        check_triangles(&what, &self.triangles, n)
+        check_triangles(&what, &self.triangles, n)?;
+        if let Some(film) = &self.film {
+            if film.material_dirs.len() != n {
+                return Err(RenderError::scene(
+                    format!("{what}, film"),
+                    format!(
+                        "{n} positions but {} material directions",
+                        film.material_dirs.len()
+                    ),
+                ));
+            }
+            if let Some(v) = film
+                .material_dirs
+                .iter()
+                .position(|d| !(d.is_finite() && d.length_squared() > 0.0))
+            {
+                return Err(RenderError::scene(
+                    format!("{what}, film, vertex {v}"),
+                    format!(
+                        "material direction {} must be finite and non-zero",
+                        film.material_dirs[v]
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 }
 

@@ -152,6 +152,7 @@ pub fn bubble_meshes(world: &World) -> Vec<BubbleMesh> {
             normals: b.vertex_normals().iter().map(|n| n.as_vec3()).collect(),
             thickness_nm: b.thickness_nm().iter().map(|&d| d as f32).collect(),
             triangles: b.triangles().to_vec(),
+            film: None,
         })
         .collect()
 }

@@ -189,6 +189,13 @@ pub(super) fn check_supported(
             return Err(unsupported("a textured material"));
         }
     }
+    if let Some(k) = scene.bubbles.iter().position(|b| b.film.is_some()) {
+        // Never drawn with the vertex thickness instead: that would be a different film.
+        return Err(unsupported(format!(
+            "film fields: bubble {k} carries one (per-pixel film thickness and coverage; \
+             the wgpu backend does not draw film fields yet)"
+        )));
+    }
     Ok(())
 }
 
@@ -418,4 +425,39 @@ fn stack_tables(
         row0 += t.height();
     }
     Ok(((width as u32, height as u32, texels.0), info.0, first_light))
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use render_scene::{BubbleFilm, BubbleMesh, Camera, FilmField, Vec3};
+
+    use super::*;
+
+    #[test]
+    fn a_bubble_with_a_film_field_is_refused_naming_it() {
+        let camera = Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 40.0);
+        let mut scene = RenderScene::new(camera, Environment::Uniform([1.0; 3]));
+        let settings = RenderSettings::default();
+        let plain = BubbleMesh {
+            positions: vec![Vec3::X, Vec3::Y, Vec3::Z],
+            normals: vec![Vec3::X, Vec3::Y, Vec3::Z],
+            thickness_nm: vec![500.0; 3],
+            triangles: vec![[0, 1, 2]],
+            film: None,
+        };
+        scene.bubbles = vec![plain.clone(), plain.clone()];
+        assert!(check_supported(&scene, &settings).is_ok());
+        let field = FilmField::try_new(1, vec![500.0; 6], vec![1.0; 6]).unwrap();
+        scene.bubbles[1].film = Some(BubbleFilm {
+            field: Arc::new(field),
+            material_dirs: plain.normals.clone(),
+        });
+        let err = check_supported(&scene, &settings).unwrap_err();
+        assert!(matches!(err, GpuError::Unsupported(_)), "{err:?}");
+        let text = err.to_string();
+        assert!(text.contains("bubble 1"), "{text}");
+        assert!(text.contains("does not draw film fields"), "{text}");
+    }
 }

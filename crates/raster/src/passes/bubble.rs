@@ -8,11 +8,10 @@ use render_scene::highlight::LightSight;
 use render_scene::lod::reflection_derivatives;
 use render_scene::lut_sampler::LutSampler;
 use render_scene::reflection::Reflection;
-use render_scene::tessellate::ATTRS;
-use render_scene::{Light, PartialShading, ReflectionFilter, RenderScene};
+use render_scene::{FilmField, Light, PartialShading, ReflectionFilter, RenderScene};
 
 use crate::raster::{
-    NO_SURFACE, Plane, SamplePattern, SetupTri, clip_vertex, for_each_covered_in_row,
+    ATTRS, NO_SURFACE, Plane, SamplePattern, SetupTri, clip_vertex, for_each_covered_in_row,
     setup_triangle,
 };
 use crate::strip::{Bins, STRIP_ROWS};
@@ -29,6 +28,8 @@ pub(crate) struct BubbleCtx<'a> {
     pub light_tables: &'a [LutSampler<'a>],
     /// Per bubble (by original index).
     pub reflections: &'a [Reflection<'a>],
+    /// Per bubble (by original index): its film field, if it has one.
+    pub films: &'a [Option<&'a FilmField>],
     /// How cube maps are read.
     pub filter: ReflectionFilter,
     /// How pixels a triangle covers in part are shaded.
@@ -205,13 +206,26 @@ impl BubbleCtx<'_> {
     /// whether they may be shared with the rest of the pixel: no light's highlight reaches
     /// within [`SHARE_MARGIN_PX`] of it.
     ///
+    /// A bubble with a film field reads its thickness and coverage `c` from the field at
+    /// the interpolated material direction (attributes 3..6) and blends the film in by
+    /// `c`: `T' = 1 − c·(1 − T)`, `add' = c·add`. A hole (`c = 0`) is exactly no film.
+    ///
     /// The vector arithmetic runs in `Vec3A` lanes: the same IEEE operations in the same
     /// order as `Vec3`'s (glam sums dot products x, y, then z in both), so results are
     /// bit-identical, in fewer instructions.
     #[inline]
     fn shade(&self, tri: &SetupTri, px: f32, py: f32) -> ([f32; 3], [f32; 3], bool) {
         let (inv_w, a) = tri.interpolate(px, py);
-        let thickness_nm = a[3].max(0.0);
+        let (thickness_nm, coverage) = match self.films[tri.tag as usize] {
+            None => (a[3].max(0.0), 1.0),
+            Some(field) => {
+                let film = field.sample(Vec3::new(a[3], a[4], a[5]));
+                if film.coverage <= 0.0 {
+                    return ([1.0; 3], [0.0; 3], true);
+                }
+                (film.thickness_nm, film.coverage)
+            }
+        };
         let (ax, ay) = self.view.ray_coefficients(px, py);
         let d = Vec3A::from(self.view.forward)
             + Vec3A::from(self.view.right) * ax
@@ -260,6 +274,13 @@ impl BubbleCtx<'_> {
                 }
             }
         }
+        if coverage < 1.0 {
+            return (
+                t_rgb.map(|t| 1.0 - coverage * (1.0 - t)),
+                add.map(|a| coverage * a),
+                shareable,
+            );
+        }
         (t_rgb, add, shareable)
     }
 
@@ -307,11 +328,13 @@ pub(crate) fn setup_bubble_tris(scene: &RenderScene, view: &View, out: &mut Vec<
                     let tri = t.map(|i| {
                         let i = i as usize;
                         let n = bubble.normals[i];
-                        clip_vertex(
-                            view,
-                            bubble.positions[i],
-                            [n.x, n.y, n.z, bubble.thickness_nm[i], 0.0],
-                        )
+                        // With a film field the material direction replaces the thickness.
+                        let rest = match &bubble.film {
+                            Some(film) => film.material_dirs[i].to_array(),
+                            None => [bubble.thickness_nm[i], 0.0, 0.0],
+                        };
+                        let [a, b, c] = rest;
+                        clip_vertex(view, bubble.positions[i], [n.x, n.y, n.z, a, b, c])
                     });
                     let extra = reflection_rate(view, bubble, *t);
                     // One surface per bubble and facing: the back layer, then the front.

@@ -35,7 +35,7 @@ pub(crate) fn setup_water(water: &WaterSurface, view: &View, out: &mut Vec<Setup
                 x,
                 y,
                 w,
-                attrs: [n.x, n.y, n.z, 0.0, 0.0],
+                attrs: [n.x, n.y, n.z, 0.0, 0.0, 0.0],
             }
         });
         setup_triangle(view, tri, WATER, 0.0, |s| out.push(s));

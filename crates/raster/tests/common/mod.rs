@@ -5,8 +5,8 @@ use std::collections::HashMap;
 
 use render_scene::Vec3;
 use render_scene::{
-    BubbleMesh, Camera, Environment, FilmTables, Frame, Ground, Irradiance, Light, Lut, Material,
-    Object, ReflectionMode, RenderScene, RenderSettings, Sky,
+    BubbleFilm, BubbleMesh, Camera, Environment, FilmField, FilmTables, Frame, Ground, Irradiance,
+    Light, Lut, Material, Object, ReflectionMode, RenderScene, RenderSettings, Sky,
 };
 
 /// Default settings at the given size, sample count and reflection mode.
@@ -100,7 +100,34 @@ pub fn bubble(
         normals: unit.clone(),
         thickness_nm: unit.iter().map(|n| thickness(*n)).collect(),
         triangles,
+        film: None,
     }
+}
+
+/// `bubble` (a [`bubble`] mesh) with film field `field`, each vertex at its unit normal's
+/// material direction.
+pub fn with_film(mut bubble: BubbleMesh, field: FilmField) -> BubbleMesh {
+    bubble.film = Some(BubbleFilm {
+        field: std::sync::Arc::new(field),
+        material_dirs: bubble.normals.clone(),
+    });
+    bubble
+}
+
+/// A film field of `face_size` texels a face with `(thickness nm, coverage)` at each
+/// texel centre's direction.
+pub fn film_field(face_size: usize, f: impl Fn(Vec3) -> (f32, f32)) -> FilmField {
+    let (mut h, mut c) = (Vec::new(), Vec::new());
+    for face in 0..6 {
+        for y in 0..face_size {
+            for x in 0..face_size {
+                let (a, b) = f(FilmField::texel_direction(face_size, face, x, y));
+                h.push(a);
+                c.push(b);
+            }
+        }
+    }
+    FilmField::try_new(face_size, h, c).unwrap()
 }
 
 /// Draining film: thin on top, thick at the bottom (nm).
