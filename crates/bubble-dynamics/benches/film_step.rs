@@ -6,7 +6,7 @@
 use std::sync::Arc;
 
 use bubble_dynamics::DVec3;
-use bubble_dynamics::film_flow::{CubeSphere, FilmFlow, Forcing, FlowParams, Hierarchy};
+use bubble_dynamics::film_flow::{CubeSphere, FilmFlow, FlowParams, Forcing, Hierarchy};
 use criterion::{Criterion, criterion_group, criterion_main};
 
 fn film(n: usize) -> FilmFlow {
@@ -20,7 +20,9 @@ fn film(n: usize) -> FilmFlow {
     // A film that keeps flowing through the measurement: no rupture.
     params.burst.rupture_thickness_nm = 0.0;
     params.burst.black_threshold_nm = 0.0;
-    FilmFlow::new(grid, hierarchy, params, |d| 600e-9 * (1.0 + 0.05 * (4.0 * d.x + d.y).sin()))
+    FilmFlow::new(grid, hierarchy, params, |d| {
+        600e-9 * (1.0 + 0.05 * (4.0 * d.x + d.y).sin())
+    })
 }
 
 fn bench_film_step(c: &mut Criterion) {

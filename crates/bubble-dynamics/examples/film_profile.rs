@@ -4,8 +4,7 @@
 use std::sync::Arc;
 
 use bubble_dynamics::DVec3;
-use bubble_dynamics::film_flow::{CubeSphere, FilmFlow, Forcing, FlowParams, Hierarchy};
-
+use bubble_dynamics::film_flow::{CubeSphere, FilmFlow, FlowParams, Forcing, Hierarchy};
 
 fn film(n: usize) -> FilmFlow {
     let grid = Arc::new(CubeSphere::new(n));
@@ -18,19 +17,32 @@ fn film(n: usize) -> FilmFlow {
     // A film that keeps flowing through the measurement: no rupture.
     params.burst.rupture_thickness_nm = 0.0;
     params.burst.black_threshold_nm = 0.0;
-    FilmFlow::new(grid, hierarchy, params, |d| 600e-9 * (1.0 + 0.05 * (4.0 * d.x + d.y).sin()))
+    FilmFlow::new(grid, hierarchy, params, |d| {
+        600e-9 * (1.0 + 0.05 * (4.0 * d.x + d.y).sin())
+    })
 }
 
 fn main() {
     let arg = |k: usize, d: f64| std::env::args().nth(k).map_or(d, |s| s.parse().unwrap());
-    let forcing = Forcing { g_eff_m_per_s2: DVec3::new(0.0, -arg(3, 9.81), 0.0), air_m_per_s: DVec3::new(arg(2, 0.3), 0.0, 0.0) };
+    let forcing = Forcing {
+        g_eff_m_per_s2: DVec3::new(0.0, -arg(3, 9.81), 0.0),
+        air_m_per_s: DVec3::new(arg(2, 0.3), 0.0, 0.0),
+    };
     let n = arg(1, 64.0) as usize;
     let mut f = film(n);
     for k in 0..40 {
         let t = std::time::Instant::now();
         let r = f.step(1.0 / 60.0, &forcing);
         let hmin = f.thickness_m().iter().cloned().fold(1.0, f64::min);
-        let umax = f.edge_velocity_m_per_s().iter().map(|u| u.abs()).fold(0.0, f64::max);
-        eprintln!("{k} {} it {:.2} ms hmin {hmin:.3e} umax {umax:.3}", r.iterations, t.elapsed().as_secs_f64() * 1e3);
+        let umax = f
+            .edge_velocity_m_per_s()
+            .iter()
+            .map(|u| u.abs())
+            .fold(0.0, f64::max);
+        eprintln!(
+            "{k} {} it {:.2} ms hmin {hmin:.3e} umax {umax:.3}",
+            r.iterations,
+            t.elapsed().as_secs_f64() * 1e3
+        );
     }
 }

@@ -165,9 +165,8 @@ impl Bubble {
             topology: Arc::clone(&topology),
             scratch: Scratch::default(),
             episodes: Vec::new(),
-            grid_film: (params.film_grid > 0).then(|| {
-                Box::new(grid_film(params, world, unit_positions, &rest, triangles))
-            }),
+            grid_film: (params.film_grid > 0)
+                .then(|| Box::new(grid_film(params, world, unit_positions, &rest, triangles))),
         };
         bubble.refresh_inertial_mass();
         bubble.volume_m3 = enclosed_volume_m3(&bubble.positions_m, bubble.topology.triangles());
@@ -460,8 +459,8 @@ fn grid_film(
     // (ln Γ = ρ h̄ g·x/E_f): only the thickness pattern's excess weight then moves it, not
     // a whole-film sag in the first instants.
     if params.gibbs_elasticity_n_per_m > 0.0 {
-        let k = params.film_density_kg_per_m3 * h0 * params.radius_m
-            / params.gibbs_elasticity_n_per_m;
+        let k =
+            params.film_density_kg_per_m3 * h0 * params.radius_m / params.gibbs_elasticity_n_per_m;
         let g = world.gravity_m_per_s2;
         film.flow.set_surfactant(|d| (k * g.dot(d)).exp());
     }

@@ -279,7 +279,9 @@ impl BubbleParams {
             return Err(ParamError::new(
                 "film_grid",
                 self.film_grid,
-                format!("must be 0 (off) or at most {MAX_FILM_GRID}, halving down to 8 or less (e.g. 32, 64, 128, 256)"),
+                format!(
+                    "must be 0 (off) or at most {MAX_FILM_GRID}, halving down to 8 or less (e.g. 32, 64, 128, 256)"
+                ),
             ));
         }
         non_negative("film_viscosity_pa_s", self.film_viscosity_pa_s)?;
@@ -289,7 +291,10 @@ impl BubbleParams {
             return Err(ParamError::new(
                 "black_film_nm",
                 self.black_film_nm,
-                format!("must be below black_threshold_nm = {}", self.black_threshold_nm),
+                format!(
+                    "must be below black_threshold_nm = {}",
+                    self.black_threshold_nm
+                ),
             ));
         }
         non_negative("nucleation_per_m2_s", self.nucleation_per_m2_s)?;

@@ -9,8 +9,8 @@ use rayon::prelude::*;
 use crate::bubble::Bubble;
 use crate::collide;
 use crate::collider::Collider;
-use crate::film_flow::Forcing;
 use crate::error::{Divergence, ParamError, SimError};
+use crate::film_flow::Forcing;
 use crate::geometry::enclosed_volume_m3;
 use crate::icosphere::equilibrium_icosphere;
 use crate::params::{BubbleParams, WorldParams};
@@ -260,7 +260,12 @@ impl World {
         let mut slots: Vec<(DVec3, DVec3)> = v_start
             .into_iter()
             .zip(&self.bubbles)
-            .map(|(v0, b)| (v0, self.wind.velocity(b.center_m(), t0) - b.velocity_m_per_s()))
+            .map(|(v0, b)| {
+                (
+                    v0,
+                    self.wind.velocity(b.center_m(), t0) - b.velocity_m_per_s(),
+                )
+            })
             .collect();
         let parallel = parallel || self.bubbles.iter().any(|b| b.grid_film.is_some());
         for_each_bubble(&mut self.bubbles, &mut slots, parallel, |b, (v0, air)| {

@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use bubble_dynamics::film_flow::{CubeSphere, FilmFlow, Forcing, FlowParams, Hierarchy};
+use bubble_dynamics::film_flow::{CubeSphere, FilmFlow, FlowParams, Forcing, Hierarchy};
 use bubble_dynamics::{BubbleParams, DVec3, Event, World, WorldParams};
 
 fn flow(n: usize, p: FlowParams, h_m: impl Fn(DVec3) -> f64) -> FilmFlow {
@@ -44,12 +44,18 @@ fn a_hole_opens_at_the_taylor_culick_speed() {
         }
         let measured = (samples[1].1 - samples[0].1) / (samples[1].0 - samples[0].0);
         let rel = (measured - speed) / speed;
-        eprintln!("h {:.0} nm: rim {measured:.4} m/s, Taylor–Culick {speed:.4} m/s", h_m * 1e9);
+        eprintln!(
+            "h {:.0} nm: rim {measured:.4} m/s, Taylor–Culick {speed:.4} m/s",
+            h_m * 1e9
+        );
         assert!(
             rel.abs() < 0.05,
             "h {h_m:e} m: rim at {measured:.3} m/s, Taylor–Culick {speed:.3} m/s ({rel:+.3})"
         );
-        assert!(f.coverage().iter().any(|&c| c == 1.0), "the hole took everything");
+        assert!(
+            f.coverage().iter().any(|&c| c == 1.0),
+            "the hole took everything"
+        );
         // What the rim swept is accounted for, to rounding.
         let dv = (f.liquid_volume_m3() + f.burst_volume_m3() - v0) / v0;
         assert!(dv.abs() < 1e-12, "film + swept liquid drifted {dv:e}");
@@ -93,7 +99,10 @@ fn thin_film_turns_black_and_pushes_its_liquid_into_the_rim() {
         .filter(|&(_, &before)| before >= 30e-9)
         .map(|(now, before)| now - before)
         .fold(0.0, f64::max);
-    assert!(gain > 5e-9, "no thickened rim around the black spot (gain {gain:e} m)");
+    assert!(
+        gain > 5e-9,
+        "no thickened rim around the black spot (gain {gain:e} m)"
+    );
 }
 
 #[test]

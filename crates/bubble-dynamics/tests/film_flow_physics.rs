@@ -5,7 +5,7 @@
 use std::sync::Arc;
 
 use bubble_dynamics::DVec3;
-use bubble_dynamics::film_flow::{CubeSphere, FilmFlow, Forcing, FlowParams, Hierarchy};
+use bubble_dynamics::film_flow::{CubeSphere, FilmFlow, FlowParams, Forcing, Hierarchy};
 
 const G: f64 = 9.80665;
 
@@ -50,7 +50,10 @@ fn projection(a: &[f64], b: &[f64], w: &[f64]) -> f64 {
 
 fn assert_rel(what: &str, got: f64, want: f64, tol: f64) {
     let rel = (got - want).abs() / want.abs();
-    assert!(rel <= tol, "{what}: got {got:.6e}, want {want:.6e}, relative difference {rel:.3e} > {tol:e}");
+    assert!(
+        rel <= tol,
+        "{what}: got {got:.6e}, want {want:.6e}, relative difference {rel:.3e} > {tol:e}"
+    );
 }
 
 #[test]
@@ -73,12 +76,30 @@ fn liquid_and_surfactant_are_conserved_under_every_force() {
         f.step(dt, &forcing);
     }
     let (v1, s1) = (f.liquid_volume_m3(), f.surfactant_amount_m2());
-    assert!(((v1 - v0) / v0).abs() < 1e-12, "volume drifted {:.3e}", (v1 - v0) / v0);
-    assert!(((s1 - s0) / s0).abs() < 1e-12, "surfactant drifted {:.3e}", (s1 - s0) / s0);
-    assert!(f.thickness_m().iter().all(|h| *h > 0.0), "thickness went non-positive");
-    assert!(f.surfactant().iter().all(|g| *g > 0.0), "surfactant went non-positive");
+    assert!(
+        ((v1 - v0) / v0).abs() < 1e-12,
+        "volume drifted {:.3e}",
+        (v1 - v0) / v0
+    );
+    assert!(
+        ((s1 - s0) / s0).abs() < 1e-12,
+        "surfactant drifted {:.3e}",
+        (s1 - s0) / s0
+    );
+    assert!(
+        f.thickness_m().iter().all(|h| *h > 0.0),
+        "thickness went non-positive"
+    );
+    assert!(
+        f.surfactant().iter().all(|g| *g > 0.0),
+        "surfactant went non-positive"
+    );
     // The flow did something: the film is no longer the initial one.
-    let moved = f.edge_velocity_m_per_s().iter().map(|u| u.abs()).fold(0.0, f64::max);
+    let moved = f
+        .edge_velocity_m_per_s()
+        .iter()
+        .map(|u| u.abs())
+        .fold(0.0, f64::max);
     assert!(moved > 1e-4, "nothing moved ({moved})");
 }
 
@@ -87,7 +108,12 @@ fn measured_frequency(n: usize, l: usize, h_m: f64, periods: f64) -> f64 {
     let mut p = params(0.05);
     p.viscosity_pa_s = 0.0;
     let mut f = flow(n, p, |_| h_m);
-    let pattern: Vec<f64> = f.grid().centres().iter().map(|c| legendre(l, c.z).0).collect();
+    let pattern: Vec<f64> = f
+        .grid()
+        .centres()
+        .iter()
+        .map(|c| legendre(l, c.z).0)
+        .collect();
     f.set_surfactant(|d| 1.0 + 1e-4 * legendre(l, d.z).0);
     let c = (p.elasticity_n_per_m / (p.density_kg_per_m3 * h_m)).sqrt();
     let omega = c * ((l * (l + 1)) as f64).sqrt() / p.radius_m;
@@ -137,7 +163,10 @@ fn marangoni_wave_error_falls_with_the_grid_then_levels_below_three_percent() {
     };
     let errors = [8, 16, 32].map(error);
     eprintln!("wave-speed error at n = 8, 16, 32: {errors:?}");
-    assert!(errors[1] < errors[0] / 1.2, "error did not fall from n 8 to 16: {errors:?}");
+    assert!(
+        errors[1] < errors[0] / 1.2,
+        "error did not fall from n 8 to 16: {errors:?}"
+    );
     assert!(errors[2] < 0.03, "error at n 32 above 3 %: {errors:?}");
 }
 
@@ -184,7 +213,10 @@ fn surface_vortices_decay_at_the_boussinesq_scriven_rate() {
     let rigid = decay_rate(32, 1);
     eprintln!("l = 1: decay {rigid:.3e}/s");
     let l2 = nu * 4.0 / (r * r);
-    assert!(rigid.abs() < 0.01 * l2, "solid-body rotation decays at {rigid:.3e}/s");
+    assert!(
+        rigid.abs() < 0.01 * l2,
+        "solid-body rotation decays at {rigid:.3e}/s"
+    );
 }
 
 #[test]
@@ -195,8 +227,14 @@ fn vortex_decay_error_falls_with_the_grid() {
         (decay_rate(8, 4) - expected).abs() / expected,
         (decay_rate(16, 4) - expected).abs() / expected,
     );
-    eprintln!("decay-rate error l 4: n 8 {coarse:.3e}, n 16 {fine:.3e}, ratio {:.2}", coarse / fine);
-    assert!(fine < coarse / 1.8, "error did not fall: {coarse:e} → {fine:e}");
+    eprintln!(
+        "decay-rate error l 4: n 8 {coarse:.3e}, n 16 {fine:.3e}, ratio {:.2}",
+        coarse / fine
+    );
+    assert!(
+        fine < coarse / 1.8,
+        "error did not fall: {coarse:e} → {fine:e}"
+    );
 }
 
 /// The surfactant gradient that holds a uniform film of thickness `h` against gravity
@@ -222,11 +260,25 @@ fn a_surfactant_gradient_holds_the_film_against_gravity() {
         f.step(dt, &forcing);
     }
     // Unbalanced, the film would fall at g·t: 9.8 m/s after a second.
-    let fastest = f.edge_velocity_m_per_s().iter().map(|u| u.abs()).fold(0.0, f64::max);
+    let fastest = f
+        .edge_velocity_m_per_s()
+        .iter()
+        .map(|u| u.abs())
+        .fold(0.0, f64::max);
     eprintln!("balanced film after 1 s: fastest edge {fastest:.3e} m/s");
-    assert!(fastest < 1e-4, "the balanced film moves at {fastest:.3e} m/s");
-    let spread = f.thickness_m().iter().map(|h| (h - h0).abs()).fold(0.0, f64::max);
-    assert!(spread < 1e-3 * h0, "the balanced film's thickness moved {spread:.3e} m");
+    assert!(
+        fastest < 1e-4,
+        "the balanced film moves at {fastest:.3e} m/s"
+    );
+    let spread = f
+        .thickness_m()
+        .iter()
+        .map(|h| (h - h0).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        spread < 1e-3 * h0,
+        "the balanced film's thickness moved {spread:.3e} m"
+    );
 }
 
 #[test]
@@ -240,8 +292,15 @@ fn behind_immobile_surfaces_the_film_drains_by_the_poiseuille_law() {
     let mut f = flow(32, p, |_| h0);
     f.set_surfactant(balancing_surfactant(&p, h0, g));
     let dt = 1e-4;
-    f.step(dt, &Forcing { g_eff_m_per_s2: g, air_m_per_s: DVec3::ZERO });
-    let rate = 2.0 * p.density_kg_per_m3 * G * h0.powi(3) / (3.0 * p.drainage_viscosity_pa_s * p.radius_m);
+    f.step(
+        dt,
+        &Forcing {
+            g_eff_m_per_s2: g,
+            air_m_per_s: DVec3::ZERO,
+        },
+    );
+    let rate =
+        2.0 * p.density_kg_per_m3 * G * h0.powi(3) / (3.0 * p.drainage_viscosity_pa_s * p.radius_m);
     let areas = f.grid().areas_sr().to_vec();
     let pattern: Vec<f64> = f.grid().centres().iter().map(|c| -rate * c.z).collect();
     let observed: Vec<f64> = f.thickness_m().iter().map(|h| (h - h0) / dt).collect();

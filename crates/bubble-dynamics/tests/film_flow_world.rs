@@ -1,7 +1,7 @@
 //! The film flow inside the world: conservation on a moving, deforming bubble, a
 //! thickness field that follows the mesh's stretch, and determinism at any thread count.
 
-use bubble_dynamics::{BubbleParams, DVec3, World, WorldParams, Wind};
+use bubble_dynamics::{BubbleParams, DVec3, Wind, World, WorldParams};
 
 fn world_with_flow(grid: u32) -> World {
     let bubble = BubbleParams {
@@ -32,13 +32,20 @@ fn film_volume_and_surfactant_are_conserved_on_a_moving_deforming_bubble() {
     let start = w.bubbles()[0].center_m();
     w.advance(1.0).expect("stable");
     let b = &w.bubbles()[0];
-    assert!((b.center_m() - start).length() > 0.05, "the bubble did not move");
+    assert!(
+        (b.center_m() - start).length() > 0.05,
+        "the bubble did not move"
+    );
     let flow = b.film_flow().expect("flow on");
     let dv = (flow.liquid_volume_m3() - v0) / v0;
     let ds = (flow.surfactant_amount_m2() - s0) / s0;
     assert!(dv.abs() < 1e-12, "liquid volume drifted {dv:.3e} in 1 s");
     assert!(ds.abs() < 1e-12, "surfactant drifted {ds:.3e} in 1 s");
-    let moving = flow.edge_velocity_m_per_s().iter().map(|u| u.abs()).fold(0.0, f64::max);
+    let moving = flow
+        .edge_velocity_m_per_s()
+        .iter()
+        .map(|u| u.abs())
+        .fold(0.0, f64::max);
     assert!(moving > 1e-5, "the film never moved ({moving} m/s)");
 }
 
@@ -51,7 +58,12 @@ fn the_field_thickness_follows_the_mesh_stretch() {
     let field = b.film_field().expect("flow on");
     let flow = b.film_flow().expect("flow on");
     let areas = flow.grid().areas_sr();
-    let mean_now: f64 = field.thickness_nm.iter().zip(areas).map(|(h, a)| h * a).sum::<f64>()
+    let mean_now: f64 = field
+        .thickness_nm
+        .iter()
+        .zip(areas)
+        .map(|(h, a)| h * a)
+        .sum::<f64>()
         / areas.iter().sum::<f64>();
     let rest_area = 4.0 * std::f64::consts::PI * 0.03f64.powi(2);
     let expected = 500.0 * rest_area / b.area_m2();
@@ -65,7 +77,10 @@ fn the_field_thickness_follows_the_mesh_stretch() {
 #[test]
 fn film_flow_is_identical_at_any_thread_count() {
     let run = |threads| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         pool.install(|| {
             let mut w = world_with_flow(16);
             w.advance(0.25).expect("stable");

@@ -76,7 +76,12 @@ fn search(d: DVec3, unit_positions: &[DVec3], triangles: &[[u32; 3]]) -> (u32, [
     triangles
         .iter()
         .enumerate()
-        .map(|(t, tri)| (t as u32, ray_barycentric(d, tri.map(|i| unit_positions[i as usize]))))
+        .map(|(t, tri)| {
+            (
+                t as u32,
+                ray_barycentric(d, tri.map(|i| unit_positions[i as usize])),
+            )
+        })
         .max_by(|a, b| {
             let min = |w: &[f64; 3]| w[0].min(w[1]).min(w[2]);
             min(&a.1).total_cmp(&min(&b.1))
@@ -124,7 +129,10 @@ mod tests {
 
     #[test]
     fn every_cell_lands_inside_a_triangle_and_linear_fields_interpolate_exactly() {
-        let icosphere::Icosphere { positions, triangles } = icosphere::icosphere(3);
+        let icosphere::Icosphere {
+            positions,
+            triangles,
+        } = icosphere::icosphere(3);
         let grid = CubeSphere::new(16);
         let map = CellMap::new(grid.centres(), &positions, &triangles);
         for &(_, w) in &map.cells {

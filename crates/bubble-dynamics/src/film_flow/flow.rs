@@ -171,8 +171,8 @@ impl FilmFlow {
     /// Sets the edge velocities from a tangential velocity field `u(direction)`, m/s.
     pub fn set_velocity(&mut self, u: impl Fn(DVec3) -> DVec3) {
         for (v, e) in self.u_m_per_s.iter_mut().zip(self.grid.edges()) {
-            let mid = (self.grid.centres()[e.a as usize] + self.grid.centres()[e.b as usize])
-                .normalize();
+            let mid =
+                (self.grid.centres()[e.a as usize] + self.grid.centres()[e.b as usize]).normalize();
             *v = u(mid).dot(e.normal);
         }
     }
@@ -212,19 +212,31 @@ impl FilmFlow {
     }
 
     fn burst_state(&self) -> &BurstState {
-        self.burst.as_ref().expect("a film always has its burst state")
+        self.burst
+            .as_ref()
+            .expect("a film always has its burst state")
     }
 
     /// Liquid volume ∫h dA over the material sphere, m³.
     pub fn liquid_volume_m3(&self) -> f64 {
         let r2 = self.params.radius_m * self.params.radius_m;
-        self.h_m.iter().zip(self.grid.areas_sr()).map(|(h, a)| h * a).sum::<f64>() * r2
+        self.h_m
+            .iter()
+            .zip(self.grid.areas_sr())
+            .map(|(h, a)| h * a)
+            .sum::<f64>()
+            * r2
     }
 
     /// Surfactant amount ∫Γ dA, relative concentration × m².
     pub fn surfactant_amount_m2(&self) -> f64 {
         let r2 = self.params.radius_m * self.params.radius_m;
-        self.gamma.iter().zip(self.grid.areas_sr()).map(|(g, a)| g * a).sum::<f64>() * r2
+        self.gamma
+            .iter()
+            .zip(self.grid.areas_sr())
+            .map(|(g, a)| g * a)
+            .sum::<f64>()
+            * r2
     }
 
     /// Kinetic energy per unit film density, ½∫h|u|² dA with each edge's normal
@@ -261,7 +273,9 @@ impl FilmFlow {
         self.transport_thickness(&mut s, dt_s, forcing.g_eff_m_per_s2);
         let evaporated = self.params.evaporation_nm_per_s * 1e-9 * dt_s;
         if evaporated > 0.0 {
-            self.h_m.iter_mut().for_each(|h| *h = (*h - evaporated).max(0.0));
+            self.h_m
+                .iter_mut()
+                .for_each(|h| *h = (*h - evaporated).max(0.0));
         }
         if let Some(mut burst) = self.burst.take() {
             burst.step(self, dt_s);
@@ -299,10 +313,10 @@ impl FilmFlow {
         g.edges()
             .iter()
             .map(|e| {
-                let curl = 2.0 * e.dual_length
-                    / e.length
-                    / verts[e.v0 as usize].min(verts[e.v1 as usize]);
-                let div = 4.0 * 2.0 * e.length / e.dual_length
+                let curl =
+                    2.0 * e.dual_length / e.length / verts[e.v0 as usize].min(verts[e.v1 as usize]);
+                let div = 4.0 * 2.0 * e.length
+                    / e.dual_length
                     / cells[e.a as usize].min(cells[e.b as usize]);
                 4.0 * (curl + div) + 2.0
             })
@@ -367,7 +381,12 @@ impl FilmFlow {
             }
         };
         let centres = self.grid.centres();
-        for ((u, e), factor) in self.u_m_per_s.iter_mut().zip(self.grid.edges()).zip(&mut s.drag) {
+        for ((u, e), factor) in self
+            .u_m_per_s
+            .iter_mut()
+            .zip(self.grid.edges())
+            .zip(&mut s.drag)
+        {
             let h = (0.5 * (self.h_m[e.a as usize] + self.h_m[e.b as usize])).max(H_FLOOR_M);
             let per_layer = p.air_viscosity_pa_s / (p.density_kg_per_m3 * h);
             // The potential flow's surface velocity is the gradient of 1.5 U·x: taken as
@@ -394,17 +413,13 @@ impl FilmFlow {
         // would diffuse Γ at |g dt| and no gradient could hold a film at rest).
         let advective = &mut s.edge;
         advective.clear();
-        advective.extend(
-            g.edges()
-                .iter()
-                .zip(&self.u_m_per_s)
-                .zip(&s.u_start)
-                .map(|((e, &u), &u0)| {
-                    let (ga, gb) = (self.gamma[e.a as usize], self.gamma[e.b as usize]);
-                    let up = if u0 >= 0.0 { ga } else { gb };
-                    (up * u0 + 0.5 * (ga + gb) * (u - u0)) * e.length
-                }),
-        );
+        advective.extend(g.edges().iter().zip(&self.u_m_per_s).zip(&s.u_start).map(
+            |((e, &u), &u0)| {
+                let (ga, gb) = (self.gamma[e.a as usize], self.gamma[e.b as usize]);
+                let up = if u0 >= 0.0 { ga } else { gb };
+                (up * u0 + 0.5 * (ga + gb) * (u - u0)) * e.length
+            },
+        ));
         // The transport part may not take more than half a cell's surfactant in one step
         // (a fast film on a coarse step would otherwise drive Γ negative): scale each
         // donor's upwind outflow down to that.
@@ -505,9 +520,12 @@ impl FilmFlow {
         };
         // Speed of every edge: the surfaces' plus the drainage's (ρ g_t h²/(3μ)).
         s.edge.clear();
-        s.edge.extend(g.edges().iter().zip(&self.u_m_per_s).map(|(e, &u)| {
-            edge_speed(e, u, drain * g_eff.dot(e.normal), &self.h_m)
-        }));
+        s.edge.extend(
+            g.edges()
+                .iter()
+                .zip(&self.u_m_per_s)
+                .map(|(e, &u)| edge_speed(e, u, drain * g_eff.dot(e.normal), &self.h_m)),
+        );
         let courant = g
             .edges()
             .iter()
@@ -568,12 +586,16 @@ impl FilmFlow {
         }
         let scale = &mut s.cell2;
         scale.clear();
-        scale.extend(areas.iter().zip(&self.h_m).zip(outflow.iter()).map(
-            |((a, h), out)| {
-                let budget = MAX_OUTFLOW_FRACTION * a * h;
-                if *out > budget { budget / out } else { 1.0 }
-            },
-        ));
+        scale.extend(
+            areas
+                .iter()
+                .zip(&self.h_m)
+                .zip(outflow.iter())
+                .map(|((a, h), out)| {
+                    let budget = MAX_OUTFLOW_FRACTION * a * h;
+                    if *out > budget { budget / out } else { 1.0 }
+                }),
+        );
         for (e, moved) in g.edges().iter().zip(volume.iter()) {
             let (a, b) = (e.a as usize, e.b as usize);
             let up = if *moved >= 0.0 { a } else { b };

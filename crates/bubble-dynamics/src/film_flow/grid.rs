@@ -63,7 +63,10 @@ impl CubeSphere {
     /// # Panics
     /// If `n == 0` or `n > 4096`.
     pub fn new(n: usize) -> Self {
-        assert!((1..=4096).contains(&n), "cube-sphere face size {n} not in 1..=4096");
+        assert!(
+            (1..=4096).contains(&n),
+            "cube-sphere face size {n} not in 1..=4096"
+        );
         let mut vertex_ids: HashMap<IVec3, u32> = HashMap::new();
         let mut vertex_dirs: Vec<DVec3> = Vec::new();
         let mut corner = |p: IVec3| -> u32 {
@@ -204,7 +207,11 @@ fn edge(a: u32, b: u32, (p, q): (u32, u32), centres: &[DVec3], vertices: &[DVec3
         normal = -normal;
     }
     let tangent = (vp + vq).normalize().cross(normal);
-    let (v0, v1) = if (vq - vp).dot(tangent) > 0.0 { (p, q) } else { (q, p) };
+    let (v0, v1) = if (vq - vp).dot(tangent) > 0.0 {
+        (p, q)
+    } else {
+        (q, p)
+    };
     GridEdge {
         a,
         b,
@@ -226,7 +233,10 @@ mod tests {
         for n in [1, 2, 3, 8, 17] {
             let g = CubeSphere::new(n);
             let total: f64 = g.areas_sr().iter().sum();
-            assert!((total - 4.0 * std::f64::consts::PI).abs() < 1e-12, "n {n}: {total}");
+            assert!(
+                (total - 4.0 * std::f64::consts::PI).abs() < 1e-12,
+                "n {n}: {total}"
+            );
             assert_eq!(g.edges().len(), 12 * n * n, "n {n}");
             assert_eq!(g.vertex_areas_sr().len(), 6 * n * n + 2, "n {n}");
             let mut sides = vec![0; g.cells()];

@@ -9,8 +9,8 @@ pub mod grid;
 pub(crate) mod on_bubble;
 pub mod solve;
 
-pub use flow::{FilmFlow, Forcing, FlowParams};
+pub use burst::{BLACK_RELAX_S, BurstParams, Hole};
+pub use cell_map::CellMap;
+pub use flow::{FilmFlow, FlowParams, Forcing};
 pub use grid::CubeSphere;
 pub use solve::{Hierarchy, SolveReport};
-pub use cell_map::CellMap;
-pub use burst::{BLACK_RELAX_S, BurstParams, Hole};

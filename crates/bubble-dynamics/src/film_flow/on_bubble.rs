@@ -7,7 +7,7 @@ use std::sync::Arc;
 use glam::DVec3;
 
 use super::cell_map::CellMap;
-use super::{CubeSphere, FilmFlow, Forcing, FlowParams, Hierarchy};
+use super::{CubeSphere, FilmFlow, FlowParams, Forcing, Hierarchy};
 use crate::geometry::barycentric_vertex_areas_m2;
 
 /// The flow of one bubble's film on its material sphere.

@@ -70,9 +70,7 @@ impl Hierarchy {
         let mut n = grid.face_size();
         while n % 2 == 0 && n > COARSEST_FACE {
             let fine = levels.last().expect("one level");
-            let parent: Vec<u32> = (0..fine.cells)
-                .map(|c| parent_cell(n, c) as u32)
-                .collect();
+            let parent: Vec<u32> = (0..fine.cells).map(|c| parent_cell(n, c) as u32).collect();
             let (coarse, coarse_edge_of_fine) = coarsen(fine, &parent, 6 * (n / 2) * (n / 2));
             levels.last_mut().expect("one level").coarse_edge_of_fine = coarse_edge_of_fine;
             let mut coarse = coarse;
@@ -205,7 +203,9 @@ impl Hierarchy {
             csr.clear();
             for i in 0..level.cells {
                 let mut d = work.alpha[k][i];
-                for &(_, e) in &level.adjacency[level.start[i] as usize..level.start[i + 1] as usize] {
+                for &(_, e) in
+                    &level.adjacency[level.start[i] as usize..level.start[i + 1] as usize]
+                {
                     let w = work.weight[k][e as usize];
                     d += w;
                     csr.push(w);
@@ -215,11 +215,8 @@ impl Hierarchy {
         }
         work.coarse_factor.clear();
         let last = self.levels.len() - 1;
-        work.coarse_factor = dense_cholesky(
-            &self.levels[last],
-            &work.alpha[last],
-            &work.weight[last],
-        );
+        work.coarse_factor =
+            dense_cholesky(&self.levels[last], &work.alpha[last], &work.weight[last]);
     }
 
     /// One symmetric V-cycle on level `k` for residual `r`, result in `z`.
@@ -318,7 +315,14 @@ fn apply(level: &Level, alpha: &[f64], weight: &[f64], x: &[f64], out: &mut [f64
 
 /// One Gauss–Seidel sweep of `M z = r`, forwards or backwards, with the diagonal and
 /// the neighbour weights in adjacency order at hand.
-fn gauss_seidel(level: &Level, diag: &[f64], csr_weight: &[f64], r: &[f64], z: &mut [f64], back: bool) {
+fn gauss_seidel(
+    level: &Level,
+    diag: &[f64],
+    csr_weight: &[f64],
+    r: &[f64],
+    z: &mut [f64],
+    back: bool,
+) {
     let relax = |i: usize, z: &mut [f64]| {
         let (from, to) = (level.start[i] as usize, level.start[i + 1] as usize);
         let mut sum = r[i];
@@ -419,7 +423,12 @@ mod tests {
             let level = &h.levels[0];
             let mut ax = vec![0.0; grid.cells()];
             apply(level, &alpha, &weight, &x, &mut ax);
-            let err = ax.iter().zip(&b).map(|(p, q)| (p - q).powi(2)).sum::<f64>().sqrt();
+            let err = ax
+                .iter()
+                .zip(&b)
+                .map(|(p, q)| (p - q).powi(2))
+                .sum::<f64>()
+                .sqrt();
             assert!(err <= 1e-9 * dot(&b, &b).sqrt(), "n {n}: residual {err}");
         }
     }

@@ -79,10 +79,16 @@ pub fn run(args: Args) -> CliResult {
         None => e,
     })?;
     check_work(&scene, &world, &args)?;
-    for (flag, dir) in [("--export-obj", &args.export_obj), ("--export-film", &args.export_film)] {
+    for (flag, dir) in [
+        ("--export-obj", &args.export_obj),
+        ("--export-film", &args.export_film),
+    ] {
         if let Some(dir) = dir {
             std::fs::create_dir_all(dir).map_err(|e| {
-                CliError::input(format!("{flag} {}: cannot create directory: {e}", dir.display()))
+                CliError::input(format!(
+                    "{flag} {}: cannot create directory: {e}",
+                    dir.display()
+                ))
             })?;
         }
     }

@@ -7,11 +7,11 @@ use super::values::{
     Absorption, Acceleration, AngularSpeed, Bounds, BubbleRadius, Coordinate, Count, CubeMapSize,
     Damping, DecayPerMetre, DecayPerSecond, Direction, Direction2, Elasticity, Evaporation,
     Exposure, FieldOfView, FilmGrid, FilmIndex, FilmThickness, FilmViscosity, GustSpeed,
-    InitialScale, Intensity, NucleationRate,
-    LightRadius, Luminance, LutAngleSamples, LutThicknessSamples, MeshScale, MolarMass, Num, Num3,
-    ObjectRadius, PatternScale, Radiance, Reflectance, RuptureThickness, Samples, Seconds,
-    Shininess, SloshSpeed, Speed, Subdivisions, SurfaceTension, TimeStep, Variation, Viscosity,
-    WaterDepth, WaterIndex, WaterSlices, WaveAmplitude, Wavelength,
+    InitialScale, Intensity, LightRadius, Luminance, LutAngleSamples, LutThicknessSamples,
+    MeshScale, MolarMass, NucleationRate, Num, Num3, ObjectRadius, PatternScale, Radiance,
+    Reflectance, RuptureThickness, Samples, Seconds, Shininess, SloshSpeed, Speed, Subdivisions,
+    SurfaceTension, TimeStep, Variation, Viscosity, WaterDepth, WaterIndex, WaterSlices,
+    WaveAmplitude, Wavelength,
 };
 use serde::Deserialize;
 

@@ -5,8 +5,8 @@ use super::schema::{EnvironmentSpec, MaterialSpec, ObjectSpec};
 use crate::error::CliError;
 use bubble_dynamics::World;
 use raster::{
-    BubbleMesh, Camera, Environment, Ground, Irradiance, Material, Object, Pattern, RenderScene,
-    Sky, Texture, TriMesh, Vec3,
+    BubbleFilm, BubbleMesh, Camera, Environment, FilmField, Ground, Irradiance, Material, Object,
+    Pattern, RenderScene, Sky, Texture, TriMesh, Vec3,
 };
 
 impl Scene {
@@ -142,7 +142,8 @@ impl Scene {
     }
 }
 
-/// The solver's bubbles as renderable meshes (f32, outward normals, thickness in nm).
+/// The solver's bubbles as renderable meshes (f32, outward normals, thickness in nm),
+/// each with its film-flow field when it has one.
 pub fn bubble_meshes(world: &World) -> Vec<BubbleMesh> {
     world
         .bubbles()
@@ -152,9 +153,34 @@ pub fn bubble_meshes(world: &World) -> Vec<BubbleMesh> {
             normals: b.vertex_normals().iter().map(|n| n.as_vec3()).collect(),
             thickness_nm: b.thickness_nm().iter().map(|&d| d as f32).collect(),
             triangles: b.triangles().to_vec(),
-            film: None,
+            film: bubble_film(b),
         })
         .collect()
+}
+
+/// The renderers' view of a bubble's film flow: its grid as a cube-map field (thickness
+/// clamped to the field's range, as the film tables clamp it) and each vertex's material
+/// direction.
+fn bubble_film(b: &bubble_dynamics::Bubble) -> Option<BubbleFilm> {
+    let field = b.film_field()?;
+    let dirs = b.material_dirs()?;
+    let max = raster::MAX_FILM_THICKNESS_NM;
+    let thickness = field
+        .thickness_nm
+        .iter()
+        .map(|&h| (h as f32).clamp(0.0, max))
+        .collect();
+    let coverage = field
+        .coverage
+        .iter()
+        .map(|&c| (c as f32).clamp(0.0, 1.0))
+        .collect();
+    let field = FilmField::try_new(field.face_size, thickness, coverage)
+        .expect("a film grid is a valid cube-map field (sizes from the solver, values clamped)");
+    Some(BubbleFilm {
+        field: std::sync::Arc::new(field),
+        material_dirs: dirs.iter().map(|d| d.as_vec3()).collect(),
+    })
 }
 
 fn scale_texture(tex: Texture, k: f64) -> Texture {
