@@ -192,8 +192,7 @@ pub(super) fn check_supported(
     if let Some(k) = scene.bubbles.iter().position(|b| b.film.is_some()) {
         // Never drawn with the vertex thickness instead: that would be a different film.
         return Err(unsupported(format!(
-            "film fields: bubble {k} carries one (per-pixel film thickness and coverage; \
-             the wgpu backend does not draw film fields yet)"
+            "film fields (bubble {k} carries one: per-pixel film thickness and coverage)"
         )));
     }
     Ok(())
@@ -458,6 +457,9 @@ mod tests {
         assert!(matches!(err, GpuError::Unsupported(_)), "{err:?}");
         let text = err.to_string();
         assert!(text.contains("bubble 1"), "{text}");
-        assert!(text.contains("does not draw film fields"), "{text}");
+        assert!(
+            text.contains("does not support film fields (bubble 1"),
+            "{text}"
+        );
     }
 }
