@@ -16,7 +16,7 @@ use glam::DVec3;
 
 use super::burst::{BurstParams, BurstState, Hole};
 use super::grid::CubeSphere;
-use super::solve::{Hierarchy, SolveReport, Work};
+use super::solve::{Hierarchy, SolveLimits, SolveReport, Work};
 
 /// Thickness floor of the Marangoni coefficient `E_f/(ρh)`, m: a hole or a Newton black
 /// film keeps a finite (if huge) stiffness.
@@ -467,8 +467,10 @@ impl FilmFlow {
             &s.weight,
             rhs,
             solution,
-            SOLVE_TOLERANCE,
-            SOLVE_MAX_ITERATIONS,
+            SolveLimits {
+                tolerance: SOLVE_TOLERANCE,
+                max_iterations: SOLVE_MAX_ITERATIONS,
+            },
         );
         // Velocity correction and the conservative surfactant update.
         let flux = &mut s.edge2;

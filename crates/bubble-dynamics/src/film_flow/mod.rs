@@ -13,4 +13,4 @@ pub use burst::{BLACK_RELAX_S, BurstParams, Hole};
 pub use cell_map::CellMap;
 pub use flow::{FilmFlow, FlowParams, Forcing};
 pub use grid::CubeSphere;
-pub use solve::{Hierarchy, SolveReport};
+pub use solve::{Hierarchy, SolveLimits, SolveReport};

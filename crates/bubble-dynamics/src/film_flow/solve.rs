@@ -53,6 +53,15 @@ pub struct Work {
     q: Vec<f64>,
 }
 
+/// When a solve stops.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolveLimits {
+    /// Residual relative to the starting guess's at which it stops.
+    pub tolerance: f64,
+    /// Most conjugate-gradient iterations.
+    pub max_iterations: u32,
+}
+
 /// How a solve ended.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolveReport {
@@ -90,8 +99,8 @@ impl Hierarchy {
         n >= 1 && 6 * n * n <= DENSE_CELLS
     }
 
-    /// Solves `(diag(alpha) + Σ_e weight_e (x_a − x_b)²-Laplacian) x = b` into `x`, starting
-    /// from `x`'s values, to `tolerance` relative residual or `max_iterations`.
+    /// Solves `(diag(alpha) + L_weight) x = b` into `x`, starting from `x`'s values, until
+    /// `limits` say stop.
     ///
     /// # Panics
     /// If a slice's length does not match the finest level.
@@ -102,9 +111,12 @@ impl Hierarchy {
         weight: &[f64],
         b: &[f64],
         x: &mut [f64],
-        tolerance: f64,
-        max_iterations: u32,
+        limits: SolveLimits,
     ) -> SolveReport {
+        let SolveLimits {
+            tolerance,
+            max_iterations,
+        } = limits;
         self.prepare(work, alpha, weight);
         let fine = &self.levels[0];
         let nc = fine.cells;
@@ -418,7 +430,11 @@ mod tests {
                 .collect();
             let mut x = vec![0.0; grid.cells()];
             let mut work = Work::default();
-            let report = h.solve(&mut work, &alpha, &weight, &b, &mut x, 1e-12, 50);
+            let limits = SolveLimits {
+                tolerance: 1e-12,
+                max_iterations: 50,
+            };
+            let report = h.solve(&mut work, &alpha, &weight, &b, &mut x, limits);
             assert!(report.iterations <= 20, "n {n}: {report:?}");
             let level = &h.levels[0];
             let mut ax = vec![0.0; grid.cells()];
