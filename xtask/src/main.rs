@@ -212,17 +212,19 @@ fn figures() -> bool {
     fig2 && chart && paper && furnace && sodium && gallery
 }
 
-/// The gallery scenes of docs/gallery.md (seed 000 Figs. 5–7, the demo and seed 002's
-/// pond): a still and a short animated PNG of each, a GIF preview of the wind scene, and
-/// the pond at two times for docs/water.md.
+/// The gallery scenes of docs/gallery.md (seed 000 Figs. 5–7, the demo, seed 002's pond
+/// and the living film's swirl): a still and a short animated PNG of each, a GIF preview
+/// of the wind scene, the swirl at three ages, and the pond at two times for
+/// docs/water.md.
 fn gallery() -> bool {
-    const GALLERY: [(&str, &str, &str, &str); 5] = [
+    const GALLERY: [(&str, &str, &str, &str); 6] = [
         // scene, still time (s), animation length (s), fps
         ("wind", "0.2", "1.2", "15"),
         ("plane-collision", "0.15", "1.2", "15"),
         ("bubble-collision", "0.12", "1", "20"),
         ("demo", "0.5", "2", "10"),
         ("pond", "1", "2", "10"),
+        ("swirl", "2.5", "5.5", "10"),
     ];
     let dir = "docs/figures/gallery";
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
@@ -256,6 +258,11 @@ fn gallery() -> bool {
             "--height",
             "150",
         ]);
+    }
+    // The swirl scene's film at three ages, full size (docs/gallery.md).
+    for time_s in ["0.5", "2.5", "5.3"] {
+        let still = format!("{dir}/swirl_t{time_s}.png");
+        ok &= bubbles(&["render", "swirl", "--out", &still, "--time-s", time_s]);
     }
     for time_s in ["0.5", "2"] {
         let still = format!("{dir}/pond_t{time_s}s.png");
