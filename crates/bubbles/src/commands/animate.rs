@@ -42,7 +42,7 @@ pub const MANIFEST: &str = "animation.txt";
 )]
 pub struct Args {
     /// A scene file (.toml) or a built-in scene: `wind`, `plane-collision`,
-    /// `bubble-collision`, `demo`, `demo-white`, `pond`, `paper`, `white-furnace`.
+    /// `bubble-collision`, `demo`, `demo-white`, `pond`, `swirl`, `paper`, `white-furnace`.
     pub scene: String,
     /// Length of the animation, simulated seconds (> 0, at most 3600).
     #[arg(long, allow_negative_numbers = true)]

@@ -1,0 +1,99 @@
+//! `bubbles simulate --export-film`: the film-flow field as one EXR per frame and bubble,
+//! read back; and the refusal when no bubble has a flow.
+
+mod common;
+
+use common::{bubbles, stderr};
+
+const SCENE: &str = r#"
+[camera]
+eye_m = [0.0, 0.0, 0.3]
+target_m = [0.0, 0.0, 0.0]
+
+[[bubbles]]
+center_m = [0.0, 0.0, 0.0]
+radius_m = 0.03
+mean_thickness_nm = 400.0
+film_grid = 16
+thickness_variation = 0.1
+drainage_viscosity_pa_s = 1e-6
+"#;
+
+#[test]
+fn export_film_writes_the_cube_map_field_of_each_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("film.toml"), SCENE).unwrap();
+    let out = bubbles(
+        &[
+            "simulate",
+            "film.toml",
+            "--seconds",
+            "0.5",
+            "--fps",
+            "4",
+            "--export-film",
+            "film",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let mut names: Vec<String> = std::fs::read_dir(dir.path().join("film"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    let expected: Vec<String> = (0..=2).map(|k| format!("film_0_{k:05}.exr")).collect();
+    assert_eq!(
+        names, expected,
+        "one EXR per output frame, no temporary files left"
+    );
+    for name in &names {
+        let image = image::open(dir.path().join("film").join(name))
+            .unwrap()
+            .to_rgb32f();
+        assert_eq!(image.dimensions(), (6 * 16, 16), "{name}: 6n × n");
+        let (mut sum, mut count) = (0.0f64, 0usize);
+        for p in image.pixels() {
+            assert!(p[0].is_finite() && p[0] > 0.0, "{name}: thickness {}", p[0]);
+            assert_eq!(p[1], 1.0, "{name}: no hole, full coverage");
+            sum += f64::from(p[0]);
+            count += 1;
+        }
+        // Cells of a gnomonic grid differ in area, so the plain mean of the cells is
+        // only near the area-weighted 400 nm (the film holds its volume exactly).
+        let mean = sum / count as f64;
+        assert!(
+            (mean - 400.0).abs() < 40.0,
+            "{name}: mean cell thickness {mean} nm"
+        );
+    }
+}
+
+#[test]
+fn export_film_without_a_film_flow_exits_2_naming_film_grid() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = bubbles(
+        &[
+            "simulate",
+            "paper",
+            "--seconds",
+            "0.1",
+            "--export-film",
+            "film",
+        ],
+        dir.path(),
+    );
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("film_grid"), "{}", stderr(&out));
+}
+
+#[test]
+fn a_film_grid_that_does_not_halve_to_eight_exits_2_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = SCENE.replace("film_grid = 16", "film_grid = 63");
+    std::fs::write(dir.path().join("film.toml"), scene).unwrap();
+    let out = bubbles(&["simulate", "film.toml", "--seconds", "0.1"], dir.path());
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("film_grid"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("63"), "{}", stderr(&out));
+}
