@@ -224,7 +224,7 @@ fn gallery() -> bool {
         ("bubble-collision", "0.12", "1", "20"),
         ("demo", "0.5", "2", "10"),
         ("pond", "1", "2", "10"),
-        ("swirl", "2.5", "5.5", "10"),
+        ("swirl", "5", "12.5", "8"),
     ];
     let dir = "docs/figures/gallery";
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
@@ -260,7 +260,7 @@ fn gallery() -> bool {
         ]);
     }
     // The swirl scene's film at three ages, full size (docs/gallery.md).
-    for time_s in ["0.5", "2.5", "5.3"] {
+    for time_s in ["0.5", "5", "11.5"] {
         let still = format!("{dir}/swirl_t{time_s}.png");
         ok &= bubbles(&["render", "swirl", "--out", &still, "--time-s", time_s]);
     }

@@ -259,21 +259,39 @@ impl Bubble {
         &self.thickness_nm
     }
 
-    /// Smallest vertex thickness, nm.
+    /// Smallest film thickness, nm: of the vertices, or with a film flow of the cells
+    /// that still hold film.
     pub fn min_thickness_nm(&self) -> f64 {
-        self.thickness_nm
-            .iter()
-            .copied()
-            .fold(f64::INFINITY, f64::min)
+        match self.film_field() {
+            Some(field) => field
+                .thickness_nm
+                .iter()
+                .zip(&field.coverage)
+                .filter(|&(_, &c)| c > 0.0)
+                .map(|(&h, _)| h)
+                .fold(f64::INFINITY, f64::min),
+            None => self
+                .thickness_nm
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min),
+        }
     }
 
-    /// Largest vertex thickness, nm.
+    /// Largest film thickness, nm: of the vertices, or with a film flow of the cells.
     pub fn max_thickness_nm(&self) -> f64 {
-        self.thickness_nm.iter().copied().fold(0.0, f64::max)
+        match self.film_field() {
+            Some(field) => field.thickness_nm.iter().copied().fold(0.0, f64::max),
+            None => self.thickness_nm.iter().copied().fold(0.0, f64::max),
+        }
     }
 
-    /// Area-weighted mean thickness (film volume / area), nm.
+    /// Area-weighted mean thickness (film volume / area), nm; with a film flow, of the
+    /// flow's liquid.
     pub fn mean_thickness_nm(&self) -> f64 {
+        if let Some(flow) = self.film_flow() {
+            return 1e9 * flow.liquid_volume_m3() / self.area_m2();
+        }
         1e9 * self.film_mass_kg() / (self.film.density_kg_per_m3 * self.area_m2())
     }
 

@@ -331,11 +331,13 @@ impl World {
         let time_s = self.time_s();
         let mut events = Vec::new();
         self.bubbles.retain(|b| {
-            let min_thickness_nm = b.min_thickness_nm();
             // With a film flow, the bubble is gone once the rims have swept its film.
-            let intact = match b.film_flow() {
-                Some(flow) => !flow.fully_burst(),
-                None => min_thickness_nm >= b.film.rupture_thickness_nm,
+            let (intact, min_thickness_nm) = match b.film_flow() {
+                Some(flow) => (!flow.fully_burst(), flow_min_thickness_nm(flow)),
+                None => {
+                    let min = b.min_thickness_nm();
+                    (min >= b.film.rupture_thickness_nm, min)
+                }
             };
             if !intact {
                 events.push(Event::Burst {
@@ -351,6 +353,12 @@ impl World {
         });
         events
     }
+}
+
+/// The film thickness where a flow's first hole opened on its own (0 when holes were
+/// only opened by hand), nm: the thinnest film, which is where holes nucleate.
+fn flow_min_thickness_nm(flow: &crate::film_flow::FilmFlow) -> f64 {
+    1e9 * flow.first_hole_thickness_m().unwrap_or(0.0)
 }
 
 impl Bubble {

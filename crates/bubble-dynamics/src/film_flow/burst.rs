@@ -54,6 +54,8 @@ pub struct BurstState {
     /// Per cell: 1 where film is, 0 where a hole is, between on the rim.
     coverage: Vec<f64>,
     burst_volume_m3: f64,
+    /// Thickness of the film where the first hole opened on its own, m.
+    first_hole_thickness_m: Option<f64>,
 }
 
 impl BurstState {
@@ -65,6 +67,7 @@ impl BurstState {
             rng: SplitMix64::new(seed ^ 0xB1AC_F11E),
             coverage: vec![1.0; cells],
             burst_volume_m3: 0.0,
+            first_hole_thickness_m: None,
         }
     }
 
@@ -81,6 +84,12 @@ impl BurstState {
     /// Liquid the rims have swept off the film (as droplets), m³.
     pub fn burst_volume_m3(&self) -> f64 {
         self.burst_volume_m3
+    }
+
+    /// Thickness of the film where the first hole opened on its own (under the rupture
+    /// thickness, or by nucleation in black film), m.
+    pub fn first_hole_thickness_m(&self) -> Option<f64> {
+        self.first_hole_thickness_m
     }
 
     /// Whether the rims have swept the whole film.
@@ -178,6 +187,7 @@ impl BurstState {
             && h < p.rupture_thickness_nm * 1e-9
             && !inside(&self.holes, grid.centres()[i])
         {
+            self.first_hole_thickness_m.get_or_insert(h);
             self.nucleate(grid.centres()[i]);
         }
         if p.nucleation_per_m2_s <= 0.0 || p.black_threshold_nm <= 0.0 {
@@ -188,6 +198,7 @@ impl BurstState {
             if h < black && self.coverage[i] > 0.0 {
                 let chance = p.nucleation_per_m2_s * a * r2 * dt_s;
                 if self.rng.next_f64() < chance && !inside(&self.holes, grid.centres()[i]) {
+                    self.first_hole_thickness_m.get_or_insert(h);
                     self.nucleate(grid.centres()[i]);
                 }
             }

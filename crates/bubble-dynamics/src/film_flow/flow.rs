@@ -199,6 +199,11 @@ impl FilmFlow {
         self.burst_state().burst_volume_m3()
     }
 
+    /// Thickness of the film where the first hole opened on its own, m.
+    pub fn first_hole_thickness_m(&self) -> Option<f64> {
+        self.burst_state().first_hole_thickness_m()
+    }
+
     /// Whether the rims have swept the whole film away.
     pub fn fully_burst(&self) -> bool {
         self.burst_state().fully_burst()
