@@ -185,3 +185,26 @@ fn renderer_transmittance_equals_the_films_own_integrated_transmittance() {
         "1 − R (renderer) differs from the integrated T spectrum by up to {worst:e}"
     );
 }
+
+/// The film-flow solver's cells and the renderers' film cube map are one layout: every
+/// solver cell's centre, sampled through `FilmField`, reads back that cell's value (a
+/// field that numbers its cells), and the two crates' texel directions agree.
+#[test]
+fn the_film_flow_grid_is_the_renderers_film_cube_map() {
+    use bubble_dynamics::film_flow::{CubeSphere, grid::texel_direction};
+    for n in [1, 4, 16] {
+        let grid = CubeSphere::new(n);
+        let cells = grid.cells();
+        let thickness: Vec<f32> = (0..cells).map(|k| k as f32).collect();
+        let field = raster::FilmField::try_new(n, thickness, vec![1.0; cells]).unwrap();
+        for (k, centre) in grid.centres().iter().enumerate() {
+            let (face, rest) = (k / (n * n), k % (n * n));
+            let (y, x) = (rest / n, rest % n);
+            let theirs = raster::FilmField::texel_direction(n, face, x, y);
+            let ours = texel_direction(n, face, x, y).as_vec3();
+            assert!((theirs - ours).length() < 1e-6, "n {n} cell {k}: {ours} vs {theirs}");
+            let read = field.sample(centre.as_vec3()).thickness_nm;
+            assert!((read - k as f32).abs() < 1e-3, "n {n} cell {k} reads {read}");
+        }
+    }
+}

@@ -3,27 +3,14 @@
 //! cells a face, on one core: the `swirl` scene's film (drainage μ 1e-6 Pa·s,
 //! evaporation 40 nm/s), 600 nm ± 5 %, in gravity and a 0.3 m/s breeze.
 
-use std::sync::Arc;
+#[path = "common/swirl_film.rs"]
+mod swirl_film;
 
 use bubble_dynamics::DVec3;
-use bubble_dynamics::film_flow::{CubeSphere, FilmFlow, FlowParams, Forcing, Hierarchy};
+use bubble_dynamics::film_flow::Forcing;
 use criterion::{Criterion, criterion_group, criterion_main};
 
-fn film(n: usize) -> FilmFlow {
-    let grid = Arc::new(CubeSphere::new(n));
-    let hierarchy = Arc::new(Hierarchy::new(&grid));
-    let mut params = FlowParams {
-        drainage_viscosity_pa_s: 1e-6,
-        evaporation_nm_per_s: 40.0,
-        ..FlowParams::water_film(0.05)
-    };
-    // A film that keeps flowing through the measurement: no rupture.
-    params.burst.rupture_thickness_nm = 0.0;
-    params.burst.black_threshold_nm = 0.0;
-    FilmFlow::new(grid, hierarchy, params, |d| {
-        600e-9 * (1.0 + 0.05 * (4.0 * d.x + d.y).sin())
-    })
-}
+use swirl_film::swirl_film;
 
 fn bench_film_step(c: &mut Criterion) {
     let forcing = Forcing {
@@ -32,7 +19,7 @@ fn bench_film_step(c: &mut Criterion) {
     };
     let mut group = c.benchmark_group("film_step");
     for n in [64, 128, 256] {
-        let mut f = film(n);
+        let mut f = swirl_film(n);
         // Past the start-up transient: the film sags onto its Marangoni balance.
         for _ in 0..30 {
             f.step(1.0 / 60.0, &forcing);
