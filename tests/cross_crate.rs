@@ -202,9 +202,15 @@ fn the_film_flow_grid_is_the_renderers_film_cube_map() {
             let (y, x) = (rest / n, rest % n);
             let theirs = raster::FilmField::texel_direction(n, face, x, y);
             let ours = texel_direction(n, face, x, y).as_vec3();
-            assert!((theirs - ours).length() < 1e-6, "n {n} cell {k}: {ours} vs {theirs}");
+            assert!(
+                (theirs - ours).length() < 1e-6,
+                "n {n} cell {k}: {ours} vs {theirs}"
+            );
             let read = field.sample(centre.as_vec3()).thickness_nm;
-            assert!((read - k as f32).abs() < 1e-3, "n {n} cell {k} reads {read}");
+            assert!(
+                (read - k as f32).abs() < 1e-3,
+                "n {n} cell {k} reads {read}"
+            );
         }
     }
 }

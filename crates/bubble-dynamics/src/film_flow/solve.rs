@@ -240,6 +240,7 @@ impl Hierarchy {
             return;
         }
         gauss_seidel(level, &work.diag[k], &work.csr_weight[k], r, z, false);
+        gauss_seidel(level, &work.diag[k], &work.csr_weight[k], r, z, false);
         // Residual, restricted by summing children (the equations are area-integrated).
         let mut az = std::mem::take(&mut work.residual[k]);
         az.resize(level.cells, 0.0);
@@ -260,6 +261,7 @@ impl Hierarchy {
         work.residual[k] = az;
         work.residual[k + 1] = rc;
         work.correction[k + 1] = zc;
+        gauss_seidel(level, &work.diag[k], &work.csr_weight[k], r, z, true);
         gauss_seidel(level, &work.diag[k], &work.csr_weight[k], r, z, true);
     }
 }
