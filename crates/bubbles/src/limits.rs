@@ -40,6 +40,11 @@ pub const MAX_BUBBLES: usize = 1000;
 /// Bubble vertices in one scene, summed over its bubbles.
 pub const MAX_BUBBLE_VERTICES: usize = 1_000_000;
 
+/// Film-flow cells in one scene, summed over its bubbles (`6·film_grid²` each): one
+/// 512-cell grid or four of 256 (each cell holds about 400 bytes with its edges, the
+/// multigrid levels and the scratch: 0.6 GB at the limit).
+pub const MAX_FILM_CELLS: usize = 6 * 512 * 512;
+
 /// Opaque objects (spheres, boxes, meshes) in one scene.
 pub const MAX_OBJECTS: usize = 1000;
 
@@ -73,6 +78,7 @@ pub const HELP: &str = "Limits (a larger request is refused with exit code 2):
   bubble subdivisions                         0..=6
   --width, --height, bench --size             1..=16384 pixels
   bubbles per scene                           1000 (1000000 vertices in all)
+  film-flow cells per scene (6 film_grid²)    1572864
   objects per scene                           1000 (4000000 triangles in all)
   lights per scene                            64
   water slices per side                       1..=512
@@ -165,6 +171,7 @@ mod tests {
             MAX_IMAGE_SIDE as u64,
             MAX_BUBBLES as u64,
             MAX_BUBBLE_VERTICES as u64,
+            MAX_FILM_CELLS as u64,
             MAX_OBJECTS as u64,
             MAX_LIGHTS as u64,
             MAX_OPAQUE_TRIANGLES,

@@ -97,3 +97,25 @@ fn a_film_grid_that_does_not_halve_to_eight_exits_2_naming_it() {
     assert!(stderr(&out).contains("film_grid"), "{}", stderr(&out));
     assert!(stderr(&out).contains("63"), "{}", stderr(&out));
 }
+
+#[test]
+fn film_grids_above_the_cell_limit_exit_2_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let one = SCENE
+        .split("[[bubbles]]")
+        .nth(1)
+        .unwrap()
+        .replace("film_grid = 16", "film_grid = 512");
+    let scene = format!(
+        "{}[[bubbles]]{one}[[bubbles]]{one}",
+        SCENE.split("[[bubbles]]").next().unwrap()
+    );
+    std::fs::write(dir.path().join("film.toml"), scene).unwrap();
+    let out = bubbles(&["simulate", "film.toml", "--seconds", "0.1"], dir.path());
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("3145728 cells"), "{}", stderr(&out));
+    assert!(
+        started.elapsed().as_secs() < 5,
+        "refused only after building the grids"
+    );
+}

@@ -30,6 +30,18 @@ impl Scene {
                 limits::MAX_BUBBLE_VERTICES
             )));
         }
+        let film_cells: usize = f
+            .bubbles
+            .iter()
+            .filter_map(|b| b.film_grid)
+            .map(|n| 6 * (n.get() as usize).pow(2))
+            .sum();
+        if film_cells > limits::MAX_FILM_CELLS {
+            return Err(self.error(format!(
+                "the bubbles' film grids have {film_cells} cells in all, above the limit of {} (lower film_grid; see --help)",
+                limits::MAX_FILM_CELLS
+            )));
+        }
         self.check_environment_files()?;
         let mut triangles = 0;
         for object in &f.objects {
