@@ -175,6 +175,7 @@ impl GpuRenderer {
         let materials = buffer("materials", &data.materials, wgpu::BufferUsages::STORAGE);
         let lights = buffer("lights", &data.lights, wgpu::BufferUsages::STORAGE);
         let lut_info = buffer("lut info", &data.lut_info, wgpu::BufferUsages::STORAGE);
+        let film_info = buffer("film info", &data.film_info, wgpu::BufferUsages::STORAGE);
         let vertex = wgpu::BufferUsages::VERTEX;
         let objects = (data.all_vertices > 0).then(|| buffer("objects", &data.objects, vertex));
         let bubbles = (!data.bubbles.is_empty()).then(|| buffer("bubbles", &data.bubbles, vertex));
@@ -215,6 +216,17 @@ impl GpuRenderer {
                 4 * mip_floats
             )));
         }
+        let film_bytes = data.film_texels.len() as u64;
+        if film_bytes > max_bytes {
+            return Err(GpuError::Unsupported(format!(
+                "film fields taking {film_bytes} bytes (this device binds at most {max_bytes})"
+            )));
+        }
+        let film_texels = buffer(
+            "film texels",
+            &data.film_texels,
+            wgpu::BufferUsages::STORAGE,
+        );
         let mips = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("cube mips"),
             size: 4 * mip_floats,
@@ -243,6 +255,8 @@ impl GpuRenderer {
                     )),
                 ),
                 bind(3, mips.as_entire_binding()),
+                bind(4, film_info.as_entire_binding()),
+                bind(5, film_texels.as_entire_binding()),
             ],
         });
         let mut encoder = device.create_command_encoder(&Default::default());

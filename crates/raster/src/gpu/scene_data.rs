@@ -38,8 +38,15 @@ pub(super) const NO_TABLE: u32 = u32::MAX;
 pub(super) const VIEW_BYTES: u64 = 9 * 16;
 /// Bytes of one object vertex: position, normal, tag.
 pub(super) const OBJECT_VERTEX_BYTES: u64 = 28;
-/// Bytes of one bubble vertex: position, normal, thickness, pixel angle, bubble index.
-pub(super) const BUBBLE_VERTEX_BYTES: u64 = 36;
+/// Bytes of one bubble vertex: position, normal, thickness, pixel angle, bubble index,
+/// material direction (zero without a film field).
+pub(super) const BUBBLE_VERTEX_BYTES: u64 = 48;
+/// Bytes of one WGSL `FilmInfo` (per bubble: its field's place in `film_texels`).
+pub(super) const FILM_INFO_BYTES: u64 = 16;
+/// `FilmInfo.has_film` of a bubble drawn with its vertex thickness.
+pub(super) const NO_FILM_FIELD: u32 = 0;
+/// `FilmInfo.has_film` of a bubble whose film field is read per pixel.
+pub(super) const FILM_FIELD: u32 = 1;
 
 /// Little-endian bytes for a GPU buffer.
 #[derive(Debug, Default)]
@@ -154,6 +161,12 @@ pub(super) struct SceneData {
     pub luts: LutTexture,
     /// `array<LutInfo>`.
     pub lut_info: Vec<u8>,
+    /// `array<FilmInfo>`, one per bubble (by scene index; one unused entry when none).
+    pub film_info: Vec<u8>,
+    /// `array<vec2<f32>>`: every distinct film field's bordered faces
+    /// (`FilmField::bordered`, `[thickness_nm, coverage]`), one after another (one unused
+    /// texel when no bubble has a field).
+    pub film_texels: Vec<u8>,
 }
 
 /// Why the wgpu backend cannot draw `what` (it draws the scenes the built-in scenes use).
@@ -189,12 +202,6 @@ pub(super) fn check_supported(
             return Err(unsupported("a textured material"));
         }
     }
-    if let Some(k) = scene.bubbles.iter().position(|b| b.film.is_some()) {
-        // Never drawn with the vertex thickness instead: that would be a different film.
-        return Err(unsupported(format!(
-            "film fields (bubble {k} carries one: per-pixel film thickness and coverage)"
-        )));
-    }
     Ok(())
 }
 
@@ -224,6 +231,7 @@ impl SceneData {
         let all_vertices = (object_bytes.0.len() as u64 / OBJECT_VERTEX_BYTES) as u32;
         let (bubbles, bubble_draws) = bubble_vertices(scene, view);
         let (luts, lut_info, first_light) = stack_tables(tables, max_texture_side)?;
+        let (film_info, film_texels) = film_fields(scene);
         // A light without a table of its own uses the reflectivity (table 0).
         let light_tables: Vec<u32> = scene
             .lights
@@ -252,6 +260,8 @@ impl SceneData {
             bubble_draws,
             luts,
             lut_info,
+            film_info,
+            film_texels,
         })
     }
 }
@@ -370,6 +380,10 @@ fn bubble_vertices(scene: &RenderScene, view: &View) -> (Vec<u8>, Vec<std::ops::
                     let (p, n) = (bubble.positions[i], bubble.normals[i]);
                     b.f32(p.x).f32(p.y).f32(p.z).f32(n.x).f32(n.y).f32(n.z);
                     b.f32(bubble.thickness_nm[i]).f32(rate).u32(k as u32);
+                    // The CPU's attributes 3..6 (`setup_bubble_tris`): where the vertex
+                    // sits on the film field, interpolated and looked up per pixel.
+                    let m = bubble.film.as_ref().map_or(Vec3::ZERO, |f| f.material_dirs[i]);
+                    b.f32(m.x).f32(m.y).f32(m.z);
                 }
             }
             let end = (b.0.len() as u64 / BUBBLE_VERTEX_BYTES) as u32;
@@ -380,6 +394,44 @@ fn bubble_vertices(scene: &RenderScene, view: &View) -> (Vec<u8>, Vec<std::ops::
         }
     }
     (b.0, draws)
+}
+
+/// The film fields as `scene.wgsl` reads them: one `FilmInfo` per bubble (first texel of
+/// its field in the texel array, face size, `FILM_FIELD` or `NO_FILM_FIELD`, 0), and
+/// every distinct field's bordered faces (a field two bubbles share is stored once).
+fn film_fields(scene: &RenderScene) -> (Vec<u8>, Vec<u8>) {
+    let mut info = Bytes::default();
+    let mut texels = Bytes::default();
+    let mut stored: Vec<(*const render_scene::FilmField, u32)> = Vec::new();
+    for bubble in &scene.bubbles {
+        let Some(film) = &bubble.film else {
+            info.u32(0).u32(0).u32(NO_FILM_FIELD).u32(0);
+            continue;
+        };
+        let key = std::sync::Arc::as_ptr(&film.field);
+        let offset = match stored.iter().find(|(p, _)| *p == key) {
+            Some(&(_, offset)) => offset,
+            None => {
+                let offset = (texels.0.len() / 8) as u32;
+                for &[h, c] in film.field.bordered() {
+                    texels.f32(h).f32(c);
+                }
+                stored.push((key, offset));
+                offset
+            }
+        };
+        info.u32(offset)
+            .u32(film.field.face_size() as u32)
+            .u32(FILM_FIELD)
+            .u32(0);
+    }
+    if info.0.is_empty() {
+        info.u32(0).u32(0).u32(NO_FILM_FIELD).u32(0);
+    }
+    if texels.0.is_empty() {
+        texels.f32(0.0).f32(0.0);
+    }
+    (info.0, texels.0)
 }
 
 /// The stacked LUT texture `(width, height, texels)`.
@@ -434,9 +486,20 @@ mod tests {
 
     use super::*;
 
+    fn words(bytes: &[u8]) -> Vec<u32> {
+        bytes
+            .chunks_exact(4)
+            .map(|w| u32::from_le_bytes(w.try_into().unwrap()))
+            .collect()
+    }
+
+    fn floats(bytes: &[u8]) -> Vec<f32> {
+        words(bytes).into_iter().map(f32::from_bits).collect()
+    }
+
     #[test]
-    fn a_bubble_with_a_film_field_is_refused_naming_it() {
-        let camera = Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 40.0);
+    fn film_fields_are_packed_once_each_with_every_vertex_material_direction() {
+        let camera = Camera::look_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y, 40.0);
         let mut scene = RenderScene::new(camera, Environment::Uniform([1.0; 3]));
         let settings = RenderSettings::default();
         let plain = BubbleMesh {
@@ -446,20 +509,82 @@ mod tests {
             triangles: vec![[0, 1, 2]],
             film: None,
         };
-        scene.bubbles = vec![plain.clone(), plain.clone()];
-        assert!(check_supported(&scene, &settings).is_ok());
-        let field = FilmField::try_new(1, vec![500.0; 6], vec![1.0; 6]).unwrap();
-        scene.bubbles[1].film = Some(BubbleFilm {
-            field: Arc::new(field),
-            material_dirs: plain.normals.clone(),
-        });
-        let err = check_supported(&scene, &settings).unwrap_err();
-        assert!(matches!(err, GpuError::Unsupported(_)), "{err:?}");
-        let text = err.to_string();
-        assert!(text.contains("bubble 1"), "{text}");
-        assert!(
-            text.contains("does not support film fields (bubble 1"),
-            "{text}"
+        let (h, c): (Vec<f32>, Vec<f32>) = (0..24).map(|i| (10.0 * i as f32, 0.5)).unzip();
+        let shared = Arc::new(FilmField::try_new(2, h, c).unwrap());
+        let other = Arc::new(FilmField::try_new(1, vec![700.0; 6], vec![1.0; 6]).unwrap());
+        let dirs = vec![Vec3::new(1.0, 2.0, 3.0), Vec3::NEG_Y, Vec3::new(0.0, 0.0, -5.0)];
+        let film = |field: &Arc<FilmField>| {
+            Some(BubbleFilm {
+                field: field.clone(),
+                material_dirs: dirs.clone(),
+            })
+        };
+        scene.bubbles = vec![plain.clone(); 4];
+        scene.bubbles[1].film = film(&shared);
+        scene.bubbles[2].film = film(&other);
+        scene.bubbles[3].film = film(&shared);
+        // The wgpu backend draws film fields: nothing refuses them.
+        check_supported(&scene, &settings).unwrap();
+        let tables = FilmTables::from_reflectivity(
+            render_scene::Lut::try_from_fn(4, 4, 1000.0, |_, _| [0.1; 3]).unwrap(),
         );
+        let view = scene.camera.view(16, 16);
+        let data = SceneData::new(
+            &scene,
+            &tables,
+            &settings,
+            &view,
+            8192,
+            ReflectionFilter::Footprint,
+        )
+        .unwrap();
+        // Bubble 0 none; 1 and 3 share the first field (offset 0, 6·4² texels); 2 after it.
+        let first = 6 * 4 * 4;
+        assert_eq!(
+            words(&data.film_info),
+            [
+                [0, 0, NO_FILM_FIELD, 0],
+                [0, 2, FILM_FIELD, 0],
+                [first, 1, FILM_FIELD, 0],
+                [0, 2, FILM_FIELD, 0]
+            ]
+            .concat()
+        );
+        assert_eq!(data.film_info.len() as u64, 4 * FILM_INFO_BYTES);
+        let texels = floats(&data.film_texels);
+        let want: Vec<f32> = shared
+            .bordered()
+            .iter()
+            .chain(other.bordered())
+            .flatten()
+            .copied()
+            .collect();
+        assert_eq!(texels, want);
+        // Every vertex carries its material direction (zero without a field) after its
+        // bubble index.
+        let vertices = floats(&data.bubbles);
+        let stride = (BUBBLE_VERTEX_BYTES / 4) as usize;
+        assert_eq!(vertices.len() % stride, 0);
+        let mut seen = [0usize; 4];
+        for v in vertices.chunks_exact(stride) {
+            let k = v[8].to_bits() as usize;
+            seen[k] += 1;
+            let m = Vec3::new(v[9], v[10], v[11]);
+            if k == 0 {
+                assert_eq!(m, Vec3::ZERO);
+            } else {
+                assert!(dirs.contains(&m), "bubble {k}: {m}");
+            }
+        }
+        assert_eq!(seen, [3; 4]);
+    }
+
+    #[test]
+    fn a_scene_without_film_fields_packs_one_unused_entry_each() {
+        let camera = Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 40.0);
+        let scene = RenderScene::new(camera, Environment::Uniform([1.0; 3]));
+        let (info, texels) = film_fields(&scene);
+        assert_eq!(words(&info), [0, 0, NO_FILM_FIELD, 0]);
+        assert_eq!(floats(&texels), [0.0, 0.0]);
     }
 }
