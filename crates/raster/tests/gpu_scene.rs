@@ -10,8 +10,7 @@
 mod common;
 
 use common::{
-    bubble, film_field, lossless_tables, paper_scene, settings, synthetic_reflectivity,
-    with_film,
+    bubble, film_field, lossless_tables, paper_scene, settings, synthetic_reflectivity, with_film,
 };
 use raster::gpu::{GpuError, GpuOptions, GpuRenderer};
 use raster::{
@@ -335,7 +334,11 @@ fn film_scene() -> RenderScene {
     let holes = film_field(16, |d| {
         let c = (0.8 * d.x + 0.6 * d.y + 0.2).clamp(0.0, 1.0);
         // A hole's thickness is meaningless: the sample must never blend it in.
-        if c > 0.0 { (350.0 + 400.0 * d.z.abs(), c) } else { (1.0e3, 0.0) }
+        if c > 0.0 {
+            (350.0 + 400.0 * d.z.abs(), c)
+        } else {
+            (1.0e3, 0.0)
+        }
     });
     scene.bubbles[1] = with_film(scene.bubbles[1].clone(), holes);
     scene
@@ -375,7 +378,10 @@ fn gpu_film_field_thickness_replaces_the_vertex_thickness_as_on_the_cpu() {
              {p99:.3}; on {film_pixels} film pixels {film_error:.3} (vertex thickness: \
              {film_effect:.3})"
         );
-        assert!(film_pixels >= 1000, "only {film_pixels} pixels show the field");
+        assert!(
+            film_pixels >= 1000,
+            "only {film_pixels} pixels show the field"
+        );
         assert!(mean <= 0.5 && p99 <= 2.0, "mean {mean}, p99 {p99}");
         assert!(
             film_error <= 0.1 * film_effect,
@@ -407,7 +413,14 @@ fn gpu_film_with_coverage_zero_is_no_bubble_at_all() {
     whole.bubbles[0] = with_film(whole.bubbles[0].clone(), film_field(8, |_| (500.0, 1.0)));
     let shown = gpu.render_srgb8(&whole, &tables, &s).unwrap();
     let (mean, _) = delta_e(&shown, &want);
-    assert!(mean > 0.5, "the whole film is invisible (mean ΔE {mean})");
+    let shows = per_pixel_delta_e(&shown, &want)
+        .iter()
+        .filter(|&&e| e > 1.0)
+        .count();
+    assert!(
+        shows >= 500,
+        "the whole film shows on {shows} pixels only (mean ΔE {mean})"
+    );
 }
 
 #[test]
@@ -418,9 +431,13 @@ fn gpu_film_with_coverage_half_matches_the_cpu_blend() {
     // over face +Z so the thickness varies over it.
     let camera = raster::Camera::look_at(Vec3::new(0.2, 0.3, 2.0), Vec3::ZERO, Vec3::Y, 40.0);
     let mut flat = RenderScene::new(camera, Environment::Sky(Sky::default()));
-    flat.ambient_rgb = [1.0; 3];
+    // A dim wall: a whole film (B·T + R·sky) and half of one differ by (R·sky − B·R)/2,
+    // which a wall as bright as the sky would cancel.
+    flat.ambient_rgb = [0.2; 3];
+    // Its front face off the checker's cell boundaries (z = −1.53; on one it flips with
+    // rounding, differently on the two backends).
     flat.objects = vec![Object::Box {
-        center: Vec3::new(0.0, 0.0, -2.0),
+        center: Vec3::new(0.0, 0.0, -2.03),
         half_extents_m: Vec3::new(10.0, 10.0, 0.5),
         material: Material::checker([0.9; 3], [0.2; 3], 0.1),
     }];
@@ -433,9 +450,7 @@ fn gpu_film_with_coverage_half_matches_the_cpu_blend() {
         ];
         raster::BubbleMesh {
             film: Some(raster::BubbleFilm {
-                field: std::sync::Arc::new(film_field(16, |d| {
-                    (400.0 + 300.0 * d.x, coverage)
-                })),
+                field: std::sync::Arc::new(film_field(16, |d| (400.0 + 300.0 * d.x, coverage))),
                 material_dirs: positions.iter().map(|p| *p + Vec3::Z).collect(),
             }),
             positions,

@@ -11,7 +11,7 @@ use render_scene::{
 };
 
 use super::scene_data::{
-    BUBBLE_VERTEX_BYTES, FILM_INFO_BYTES, OBJECT_VERTEX_BYTES, SceneData, VIEW_BYTES, view_bytes,
+    BUBBLE_VERTEX_BYTES, OBJECT_VERTEX_BYTES, SceneData, VIEW_BYTES, view_bytes,
 };
 use super::shader_source::{scene_wgsl, tonemap_wgsl};
 
@@ -113,8 +113,6 @@ fn uniform_and_storage_structs_have_the_sizes_scene_data_writes() {
         ("Material", materials, data.materials.len()),
         ("Light", lights, data.lights.len()),
         ("LutInfo", tables, data.lut_info.len()),
-        ("FilmInfo", 1, data.film_info.len()),
-        ("FilmInfo", 1, FILM_INFO_BYTES as usize),
     ];
     for (name, count, rust_bytes) in checks {
         let wgsl = struct_size(&module, name) as usize * count;

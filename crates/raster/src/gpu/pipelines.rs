@@ -91,9 +91,8 @@ impl Layouts {
                 entry(1, storage()),
                 entry(2, texture(wgpu::TextureViewDimension::D2Array)),
                 entry(3, storage()),
-                // The film fields: per bubble its `FilmInfo`, and their bordered texels.
-                entry(4, storage()),
-                entry(5, storage()),
+                // The film fields' bordered texels (Rg32Float, read with textureLoad).
+                entry(4, texture(wgpu::TextureViewDimension::D2)),
             ],
         );
         let compute = |binding, ty| wgpu::BindGroupLayoutEntry {
@@ -222,7 +221,7 @@ impl Pipelines {
         })];
         let bubble_attrs = wgpu::vertex_attr_array![
             0 => Float32x3, 1 => Float32x3, 2 => Float32, 3 => Float32, 4 => Uint32,
-            5 => Float32x3
+            5 => Float32x3, 6 => Uint32x2
         ];
         let bubbles = [Some(wgpu::VertexBufferLayout {
             array_stride: BUBBLE_VERTEX_BYTES,

@@ -175,7 +175,6 @@ impl GpuRenderer {
         let materials = buffer("materials", &data.materials, wgpu::BufferUsages::STORAGE);
         let lights = buffer("lights", &data.lights, wgpu::BufferUsages::STORAGE);
         let lut_info = buffer("lut info", &data.lut_info, wgpu::BufferUsages::STORAGE);
-        let film_info = buffer("film info", &data.film_info, wgpu::BufferUsages::STORAGE);
         let vertex = wgpu::BufferUsages::VERTEX;
         let objects = (data.all_vertices > 0).then(|| buffer("objects", &data.objects, vertex));
         let bubbles = (!data.bubbles.is_empty()).then(|| buffer("bubbles", &data.bubbles, vertex));
@@ -216,24 +215,15 @@ impl GpuRenderer {
                 4 * mip_floats
             )));
         }
-        let film_bytes = data.film_texels.len() as u64;
-        if film_bytes > max_bytes {
-            return Err(GpuError::Unsupported(format!(
-                "film fields taking {film_bytes} bytes (this device binds at most {max_bytes})"
-            )));
-        }
-        let film_texels = buffer(
-            "film texels",
-            &data.film_texels,
-            wgpu::BufferUsages::STORAGE,
-        );
         let mips = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("cube mips"),
             size: 4 * mip_floats,
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        let lut_texture = self.lut_texture(&data.luts);
+        let lut_texture = self.data_texture("luts", wgpu::TextureFormat::Rgba32Float, &data.luts);
+        let film_texture =
+            self.data_texture("film fields", wgpu::TextureFormat::Rg32Float, &data.films);
         let bubble_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("bubble tables"),
             layout: &self.layouts.bubble,
@@ -255,8 +245,12 @@ impl GpuRenderer {
                     )),
                 ),
                 bind(3, mips.as_entire_binding()),
-                bind(4, film_info.as_entire_binding()),
-                bind(5, film_texels.as_entire_binding()),
+                bind(
+                    4,
+                    wgpu::BindingResource::TextureView(
+                        &film_texture.create_view(&Default::default()),
+                    ),
+                ),
             ],
         });
         let mut encoder = device.create_command_encoder(&Default::default());
@@ -461,12 +455,18 @@ impl GpuRenderer {
         )
     }
 
-    /// The stacked LUT tables as an Rgba32Float texture.
-    fn lut_texture(&self, (width, height, texels): &(u32, u32, Vec<u8>)) -> wgpu::Texture {
+    /// A data texture of `format` (the stacked LUT tables, the film fields), read with
+    /// `textureLoad` only.
+    fn data_texture(
+        &self,
+        label: &str,
+        format: wgpu::TextureFormat,
+        (width, height, texels): &(u32, u32, Vec<u8>),
+    ) -> wgpu::Texture {
         self.gpu.device.create_texture_with_data(
             &self.gpu.queue,
             &wgpu::TextureDescriptor {
-                label: Some("luts"),
+                label: Some(label),
                 size: wgpu::Extent3d {
                     width: *width,
                     height: *height,
@@ -475,7 +475,7 @@ impl GpuRenderer {
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba32Float,
+                format,
                 usage: wgpu::TextureUsages::TEXTURE_BINDING,
                 view_formats: &[],
             },

@@ -81,20 +81,10 @@ struct LutInfo {
 // Every bubble's cube mip chain, laid out as cubemap.rs `CubeMap`'s levels: per bubble,
 // per level (level 0 first), six bordered (n + 2)² faces of packed RGB (see `cube_mips`).
 @group(2) @binding(3) var<storage, read> cube_mips: array<f32>;
-
-// A bubble's film field (scene_data.rs `film_fields`): its first texel in `film_texels`,
-// its face size n, and FILM_FIELD when it has one (NO_FILM_FIELD: the vertex thickness).
-struct FilmInfo {
-    offset: u32,
-    face_size: u32,
-    has_film: u32,
-    pad: u32,
-}
-
-@group(2) @binding(4) var<storage, read> film_info: array<FilmInfo>;
 // Every film field's six bordered (n + 2)² faces of [thickness_nm, coverage], laid out as
-// film_field.rs `FilmField::bordered`.
-@group(2) @binding(5) var<storage, read> film_texels: array<vec2<f32>>;
+// film_field.rs `FilmField::bordered`, one field after another; linear texel i sits at
+// (i mod width, i div width) (scene_data.rs `film_fields`).
+@group(2) @binding(4) var film_texels: texture_2d<f32>;
 
 // ---- shared functions ------------------------------------------------------------------
 
@@ -358,6 +348,8 @@ struct BubbleIn {
     @location(4) bubble: u32,
     // where the vertex sits on its bubble's film field (zero without one)
     @location(5) material_dir: vec3<f32>,
+    // the bubble's film field: first texel in `film_texels`, face size (0: no field)
+    @location(6) film: vec2<u32>,
 }
 
 struct BubbleOut {
@@ -374,13 +366,14 @@ struct BubbleOut {
     @location(6) @interpolate(linear, center) inv_w: f32,
     // raster.rs attributes 3..6 of a bubble with a film field: perspective-correct
     @location(7) @interpolate(perspective, centroid) material_dir: vec3<f32>,
+    @location(8) @interpolate(flat) film: vec2<u32>,
 }
 
 @vertex
 fn vs_bubble(in: BubbleIn) -> BubbleOut {
     let clip = clip_of(in.position);
     return BubbleOut(clip, in.position, in.normal, in.thickness_nm, in.pixel_angle_rad,
-        in.bubble, in.normal / clip.w, 1.0 / clip.w, in.material_dir);
+        in.bubble, in.normal / clip.w, 1.0 / clip.w, in.material_dir, in.film);
 }
 
 // lut_sampler.rs `split`: lower sample index and the upper one's weight on an axis of n.
@@ -622,11 +615,17 @@ fn light_visibility(light: Light, p: vec3<f32>, reflected: vec3<f32>, pixel_angl
 
 // film_field.rs `FilmField::sample`: (thickness_nm, coverage) at material direction
 // `dir`, the coverage-weighted bilinear thickness Σ (w c / Σ w c) h (0 when Σ w c = 0) and
-// the plain bilinear coverage, from the bordered faces (seamless across edges).
-fn film_sample(info: FilmInfo, dir: vec3<f32>) -> vec2<f32> {
+// the plain bilinear coverage, from the bordered faces (seamless across edges) of the
+// field whose first texel is `film.x` and face size `film.y`.
+fn film_texel(i: u32) -> vec2<f32> {
+    let width = textureDimensions(film_texels).x;
+    return textureLoad(film_texels, vec2<u32>(i % width, i / width), 0).xy;
+}
+
+fn film_sample(film: vec2<u32>, dir: vec3<f32>) -> vec2<f32> {
     let fst = face_coordinates(dir);
-    let n = f32(info.face_size);
-    let m = info.face_size + 2u;
+    let n = f32(film.y);
+    let m = film.y + 2u;
     let hi = f32(m - 1u);
     // Interior texel i has its centre at s = (2i + 1)/n − 1 and is stored at i + 1.
     let fx = min(max((fst.y + 1.0) * 0.5 * n + 0.5, 0.0), hi);
@@ -635,11 +634,11 @@ fn film_sample(info: FilmInfo, dir: vec3<f32>) -> vec2<f32> {
     let y0 = min(u32(fy), m - 2u);
     let tx = fx - f32(x0);
     let ty = fy - f32(y0);
-    let base = info.offset + (u32(fst.x) * m + y0) * m + x0;
-    let a = film_texels[base];
-    let b = film_texels[base + 1u];
-    let c = film_texels[base + m];
-    let d = film_texels[base + m + 1u];
+    let base = film.x + (u32(fst.x) * m + y0) * m + x0;
+    let a = film_texel(base);
+    let b = film_texel(base + 1u);
+    let c = film_texel(base + m);
+    let d = film_texel(base + m + 1u);
     let w = vec4<f32>((1.0 - tx) * (1.0 - ty), tx * (1.0 - ty), (1.0 - tx) * ty, tx * ty);
     let wc = w * vec4<f32>(a.y, b.y, c.y, d.y);
     let sum = wc.x + wc.y + wc.z + wc.w;
@@ -676,10 +675,9 @@ fn film_of(in: BubbleOut) -> Film {
     }
     var thickness_nm = max(in.thickness_nm, 0.0);
     var coverage = 1.0;
-    let info = film_info[in.bubble];
-    if (info.has_film == FILM_FIELD) {
+    if (in.film.y != 0u) {
         // With a film field the field's thickness replaces the vertex thickness.
-        let s = film_sample(info, in.material_dir);
+        let s = film_sample(in.film, in.material_dir);
         thickness_nm = s.x;
         coverage = s.y;
     }

@@ -39,14 +39,9 @@ pub(super) const VIEW_BYTES: u64 = 9 * 16;
 /// Bytes of one object vertex: position, normal, tag.
 pub(super) const OBJECT_VERTEX_BYTES: u64 = 28;
 /// Bytes of one bubble vertex: position, normal, thickness, pixel angle, bubble index,
-/// material direction (zero without a film field).
-pub(super) const BUBBLE_VERTEX_BYTES: u64 = 48;
-/// Bytes of one WGSL `FilmInfo` (per bubble: its field's place in `film_texels`).
-pub(super) const FILM_INFO_BYTES: u64 = 16;
-/// `FilmInfo.has_film` of a bubble drawn with its vertex thickness.
-pub(super) const NO_FILM_FIELD: u32 = 0;
-/// `FilmInfo.has_film` of a bubble whose film field is read per pixel.
-pub(super) const FILM_FIELD: u32 = 1;
+/// material direction (zero without a film field), and the bubble's film field as
+/// (first texel in the film texture, face size; face size 0: no field).
+pub(super) const BUBBLE_VERTEX_BYTES: u64 = 56;
 
 /// Little-endian bytes for a GPU buffer.
 #[derive(Debug, Default)]
@@ -161,12 +156,10 @@ pub(super) struct SceneData {
     pub luts: LutTexture,
     /// `array<LutInfo>`.
     pub lut_info: Vec<u8>,
-    /// `array<FilmInfo>`, one per bubble (by scene index; one unused entry when none).
-    pub film_info: Vec<u8>,
-    /// `array<vec2<f32>>`: every distinct film field's bordered faces
-    /// (`FilmField::bordered`, `[thickness_nm, coverage]`), one after another (one unused
-    /// texel when no bubble has a field).
-    pub film_texels: Vec<u8>,
+    /// The film texture: every distinct film field's bordered faces
+    /// (`FilmField::bordered`, `[thickness_nm, coverage]` as Rg32Float), one after
+    /// another, texel `i` at `(i mod width, i div width)`.
+    pub films: FilmTexture,
 }
 
 /// Why the wgpu backend cannot draw `what` (it draws the scenes the built-in scenes use).
@@ -229,9 +222,9 @@ impl SceneData {
             push_geometry(&mut object_bytes, &light_spheres);
         }
         let all_vertices = (object_bytes.0.len() as u64 / OBJECT_VERTEX_BYTES) as u32;
-        let (bubbles, bubble_draws) = bubble_vertices(scene, view);
+        let (films, film_places) = film_fields(scene, max_texture_side)?;
+        let (bubbles, bubble_draws) = bubble_vertices(scene, view, &film_places);
         let (luts, lut_info, first_light) = stack_tables(tables, max_texture_side)?;
-        let (film_info, film_texels) = film_fields(scene);
         // A light without a table of its own uses the reflectivity (table 0).
         let light_tables: Vec<u32> = scene
             .lights
@@ -260,8 +253,7 @@ impl SceneData {
             bubble_draws,
             luts,
             lut_info,
-            film_info,
-            film_texels,
+            films,
         })
     }
 }
@@ -364,7 +356,13 @@ fn push_geometry(b: &mut Bytes, g: &Geometry) {
 
 /// Bubble vertices in the CPU's drawing order (renderer.rs `setup_bubbles`): bubbles far
 /// to near, each bubble's back faces then its front faces; one draw range per side.
-fn bubble_vertices(scene: &RenderScene, view: &View) -> (Vec<u8>, Vec<std::ops::Range<u32>>) {
+///
+/// `films[k]` is bubble `k`'s film field as (first texel, face size), `(0, 0)` without one.
+fn bubble_vertices(
+    scene: &RenderScene,
+    view: &View,
+    films: &[[u32; 2]],
+) -> (Vec<u8>, Vec<std::ops::Range<u32>>) {
     let mut b = Bytes::default();
     let mut draws = Vec::new();
     let mut start = 0u32;
@@ -382,8 +380,12 @@ fn bubble_vertices(scene: &RenderScene, view: &View) -> (Vec<u8>, Vec<std::ops::
                     b.f32(bubble.thickness_nm[i]).f32(rate).u32(k as u32);
                     // The CPU's attributes 3..6 (`setup_bubble_tris`): where the vertex
                     // sits on the film field, interpolated and looked up per pixel.
-                    let m = bubble.film.as_ref().map_or(Vec3::ZERO, |f| f.material_dirs[i]);
+                    let m = bubble
+                        .film
+                        .as_ref()
+                        .map_or(Vec3::ZERO, |f| f.material_dirs[i]);
                     b.f32(m.x).f32(m.y).f32(m.z);
+                    b.u32(films[k][0]).u32(films[k][1]);
                 }
             }
             let end = (b.0.len() as u64 / BUBBLE_VERTEX_BYTES) as u32;
@@ -396,23 +398,39 @@ fn bubble_vertices(scene: &RenderScene, view: &View) -> (Vec<u8>, Vec<std::ops::
     (b.0, draws)
 }
 
-/// The film fields as `scene.wgsl` reads them: one `FilmInfo` per bubble (first texel of
-/// its field in the texel array, face size, `FILM_FIELD` or `NO_FILM_FIELD`, 0), and
-/// every distinct field's bordered faces (a field two bubbles share is stored once).
-fn film_fields(scene: &RenderScene) -> (Vec<u8>, Vec<u8>) {
-    let mut info = Bytes::default();
+/// A data texture `(width, height, texels)`.
+pub(super) type FilmTexture = (u32, u32, Vec<u8>);
+
+/// The film fields as `scene.wgsl` reads them: the film texture (every distinct field's
+/// bordered faces, a field two bubbles share stored once, rows of at most `max_side`
+/// texels, the last row padded) and per bubble its field's (first texel, face size), `(0,
+/// 0)` without one.
+///
+/// # Errors
+/// [`GpuError::TooLarge`] when the texture would be taller than `max_side`.
+fn film_fields(
+    scene: &RenderScene,
+    max_side: u32,
+) -> Result<(FilmTexture, Vec<[u32; 2]>), GpuError> {
     let mut texels = Bytes::default();
     let mut stored: Vec<(*const render_scene::FilmField, u32)> = Vec::new();
+    let mut places = Vec::with_capacity(scene.bubbles.len());
     for bubble in &scene.bubbles {
         let Some(film) = &bubble.film else {
-            info.u32(0).u32(0).u32(NO_FILM_FIELD).u32(0);
+            places.push([0, 0]);
             continue;
         };
         let key = std::sync::Arc::as_ptr(&film.field);
         let offset = match stored.iter().find(|(p, _)| *p == key) {
             Some(&(_, offset)) => offset,
             None => {
-                let offset = (texels.0.len() / 8) as u32;
+                let offset = texels.0.len() / 8;
+                let Ok(offset) = u32::try_from(offset) else {
+                    return Err(GpuError::TooLarge {
+                        size: (max_side, u32::MAX),
+                        max_side,
+                    });
+                };
                 for &[h, c] in film.field.bordered() {
                     texels.f32(h).f32(c);
                 }
@@ -420,18 +438,19 @@ fn film_fields(scene: &RenderScene) -> (Vec<u8>, Vec<u8>) {
                 offset
             }
         };
-        info.u32(offset)
-            .u32(film.field.face_size() as u32)
-            .u32(FILM_FIELD)
-            .u32(0);
+        places.push([offset, film.field.face_size() as u32]);
     }
-    if info.0.is_empty() {
-        info.u32(0).u32(0).u32(NO_FILM_FIELD).u32(0);
+    let count = (texels.0.len() / 8).max(1);
+    let width = count.min(max_side as usize);
+    let height = count.div_ceil(width);
+    if height > max_side as usize {
+        return Err(GpuError::TooLarge {
+            size: (width as u32, height.min(u32::MAX as usize) as u32),
+            max_side,
+        });
     }
-    if texels.0.is_empty() {
-        texels.f32(0.0).f32(0.0);
-    }
-    (info.0, texels.0)
+    texels.0.resize(8 * width * height, 0);
+    Ok(((width as u32, height as u32, texels.0), places))
 }
 
 /// The stacked LUT texture `(width, height, texels)`.
@@ -512,7 +531,11 @@ mod tests {
         let (h, c): (Vec<f32>, Vec<f32>) = (0..24).map(|i| (10.0 * i as f32, 0.5)).unzip();
         let shared = Arc::new(FilmField::try_new(2, h, c).unwrap());
         let other = Arc::new(FilmField::try_new(1, vec![700.0; 6], vec![1.0; 6]).unwrap());
-        let dirs = vec![Vec3::new(1.0, 2.0, 3.0), Vec3::NEG_Y, Vec3::new(0.0, 0.0, -5.0)];
+        let dirs = vec![
+            Vec3::new(1.0, 2.0, 3.0),
+            Vec3::NEG_Y,
+            Vec3::new(0.0, 0.0, -5.0),
+        ];
         let film = |field: &Arc<FilmField>| {
             Some(BubbleFilm {
                 field: field.clone(),
@@ -529,29 +552,18 @@ mod tests {
             render_scene::Lut::try_from_fn(4, 4, 1000.0, |_, _| [0.1; 3]).unwrap(),
         );
         let view = scene.camera.view(16, 16);
+        // Rows of at most 50 texels: 6·4² + 6·3² = 150 texels, three rows.
         let data = SceneData::new(
             &scene,
             &tables,
             &settings,
             &view,
-            8192,
+            50,
             ReflectionFilter::Footprint,
         )
         .unwrap();
-        // Bubble 0 none; 1 and 3 share the first field (offset 0, 6·4² texels); 2 after it.
-        let first = 6 * 4 * 4;
-        assert_eq!(
-            words(&data.film_info),
-            [
-                [0, 0, NO_FILM_FIELD, 0],
-                [0, 2, FILM_FIELD, 0],
-                [first, 1, FILM_FIELD, 0],
-                [0, 2, FILM_FIELD, 0]
-            ]
-            .concat()
-        );
-        assert_eq!(data.film_info.len() as u64, 4 * FILM_INFO_BYTES);
-        let texels = floats(&data.film_texels);
+        let (width, height, bytes) = &data.films;
+        assert_eq!((*width, *height), (50, 3));
         let want: Vec<f32> = shared
             .bordered()
             .iter()
@@ -559,32 +571,50 @@ mod tests {
             .flatten()
             .copied()
             .collect();
-        assert_eq!(texels, want);
-        // Every vertex carries its material direction (zero without a field) after its
-        // bubble index.
-        let vertices = floats(&data.bubbles);
+        assert_eq!(floats(bytes), want);
+        // Bubble 0 none; 1 and 3 share the first field (6·4² texels); 2 after it. Every
+        // vertex carries its material direction (zero without a field) and its field.
+        let first = 6 * 4 * 4;
+        let places = [[0, 0], [0, 2], [first, 1], [0, 2]];
+        let vertices = words(&data.bubbles);
         let stride = (BUBBLE_VERTEX_BYTES / 4) as usize;
         assert_eq!(vertices.len() % stride, 0);
         let mut seen = [0usize; 4];
         for v in vertices.chunks_exact(stride) {
-            let k = v[8].to_bits() as usize;
+            let k = v[8] as usize;
             seen[k] += 1;
-            let m = Vec3::new(v[9], v[10], v[11]);
+            let m = Vec3::new(
+                f32::from_bits(v[9]),
+                f32::from_bits(v[10]),
+                f32::from_bits(v[11]),
+            );
             if k == 0 {
                 assert_eq!(m, Vec3::ZERO);
             } else {
                 assert!(dirs.contains(&m), "bubble {k}: {m}");
             }
+            assert_eq!([v[12], v[13]], places[k], "bubble {k}");
         }
         assert_eq!(seen, [3; 4]);
+        // Too tall for the device: named, never drawn otherwise.
+        let err = SceneData::new(
+            &scene,
+            &tables,
+            &settings,
+            &view,
+            10,
+            ReflectionFilter::Footprint,
+        )
+        .unwrap_err();
+        assert!(matches!(err, GpuError::TooLarge { .. }), "{err:?}");
     }
 
     #[test]
-    fn a_scene_without_film_fields_packs_one_unused_entry_each() {
+    fn a_scene_without_film_fields_packs_one_unused_texel() {
         let camera = Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 40.0);
         let scene = RenderScene::new(camera, Environment::Uniform([1.0; 3]));
-        let (info, texels) = film_fields(&scene);
-        assert_eq!(words(&info), [0, 0, NO_FILM_FIELD, 0]);
-        assert_eq!(floats(&texels), [0.0, 0.0]);
+        let ((w, h, texels), places) = film_fields(&scene, 8192).unwrap();
+        assert_eq!((w, h, floats(&texels)), (1, 1, vec![0.0, 0.0]));
+        assert!(places.is_empty());
     }
 }

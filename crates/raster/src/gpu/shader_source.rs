@@ -6,8 +6,8 @@
 #![cfg_attr(not(feature = "wgpu"), allow(dead_code))]
 
 use super::scene_data::{
-    ENV_SKY, ENV_UNIFORM, FILM_FIELD, NO_FILM_FIELD, NO_TABLE, PATTERN_CHECKER, PATTERN_SOLID,
-    REFLECTION_CUBE, REFLECTION_CUBE_BILINEAR, REFLECTION_ENVIRONMENT,
+    ENV_SKY, ENV_UNIFORM, NO_TABLE, PATTERN_CHECKER, PATTERN_SOLID, REFLECTION_CUBE,
+    REFLECTION_CUBE_BILINEAR, REFLECTION_ENVIRONMENT,
 };
 use render_scene::shader_constants::{
     ACES_DENOMINATOR, ACES_NUMERATOR, FACE_BASES, SCENE_SCALARS, SCENE_WORDS, TONE_MATRICES,
@@ -77,8 +77,6 @@ fn scene_constants() -> String {
         ("REFLECTION_ENVIRONMENT", REFLECTION_ENVIRONMENT),
         ("REFLECTION_CUBE_BILINEAR", REFLECTION_CUBE_BILINEAR),
         ("NO_TABLE", NO_TABLE),
-        ("NO_FILM_FIELD", NO_FILM_FIELD),
-        ("FILM_FIELD", FILM_FIELD),
     ];
     for (name, value) in SCENE_WORDS.into_iter().chain(packing_words) {
         out += &format!("const {name}: u32 = {value}u;\n");
