@@ -613,15 +613,16 @@ fn light_visibility(light: Light, p: vec3<f32>, reflected: vec3<f32>, pixel_angl
     return clamp((alpha - gamma) / w + 0.5, 0.0, 1.0);
 }
 
-// film_field.rs `FilmField::sample`: (thickness_nm, coverage) at material direction
-// `dir`, the coverage-weighted bilinear thickness Σ (w c / Σ w c) h (0 when Σ w c = 0) and
-// the plain bilinear coverage, from the bordered faces (seamless across edges) of the
-// field whose first texel is `film.x` and face size `film.y`.
+// Linear texel `i` of the film texture: [thickness_nm, coverage].
 fn film_texel(i: u32) -> vec2<f32> {
     let width = textureDimensions(film_texels).x;
     return textureLoad(film_texels, vec2<u32>(i % width, i / width), 0).xy;
 }
 
+// film_field.rs `FilmField::sample`: (thickness_nm, coverage) at material direction
+// `dir`, the coverage-weighted bilinear thickness Σ (w c / Σ w c) h (0 when Σ w c = 0) and
+// the plain bilinear coverage, from the bordered faces (seamless across edges) of the
+// field whose first texel is `film.x` and face size `film.y`.
 fn film_sample(film: vec2<u32>, dir: vec3<f32>) -> vec2<f32> {
     let fst = face_coordinates(dir);
     let n = f32(film.y);
