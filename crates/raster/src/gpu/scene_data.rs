@@ -407,11 +407,18 @@ pub(super) type FilmTexture = (u32, u32, Vec<u8>);
 /// 0)` without one.
 ///
 /// # Errors
-/// [`GpuError::TooLarge`] when the texture would be taller than `max_side`.
+/// [`GpuError::Unsupported`], naming the film fields, when the texture would be taller
+/// than `max_side`.
 fn film_fields(
     scene: &RenderScene,
     max_side: u32,
 ) -> Result<(FilmTexture, Vec<[u32; 2]>), GpuError> {
+    let too_large = |texels: usize| {
+        unsupported(format!(
+            "film fields of {texels} texels (their texture's rows hold {max_side}, at most \
+             {max_side} rows on this device)"
+        ))
+    };
     let mut texels = Bytes::default();
     let mut stored: Vec<(*const render_scene::FilmField, u32)> = Vec::new();
     let mut places = Vec::with_capacity(scene.bubbles.len());
@@ -425,12 +432,7 @@ fn film_fields(
             Some(&(_, offset)) => offset,
             None => {
                 let offset = texels.0.len() / 8;
-                let Ok(offset) = u32::try_from(offset) else {
-                    return Err(GpuError::TooLarge {
-                        size: (max_side, u32::MAX),
-                        max_side,
-                    });
-                };
+                let offset = u32::try_from(offset).map_err(|_| too_large(offset))?;
                 for &[h, c] in film.field.bordered() {
                     texels.f32(h).f32(c);
                 }
@@ -444,10 +446,7 @@ fn film_fields(
     let width = count.min(max_side as usize);
     let height = count.div_ceil(width);
     if height > max_side as usize {
-        return Err(GpuError::TooLarge {
-            size: (width as u32, height.min(u32::MAX as usize) as u32),
-            max_side,
-        });
+        return Err(too_large(count));
     }
     texels.0.resize(8 * width * height, 0);
     Ok(((width as u32, height as u32, texels.0), places))
@@ -606,7 +605,11 @@ mod tests {
             ReflectionFilter::Footprint,
         )
         .unwrap_err();
-        assert!(matches!(err, GpuError::TooLarge { .. }), "{err:?}");
+        assert!(matches!(err, GpuError::Unsupported(_)), "{err:?}");
+        assert!(
+            err.to_string().contains("film fields of 150 texels"),
+            "{err}"
+        );
     }
 
     #[test]
