@@ -72,12 +72,36 @@ fn paper_through_wgpu_matches_the_cpu_backend_in_ciede2000() {
     );
 }
 
+/// `swirl`: one bubble whose film flow reaches the renderers as a film field (thickness
+/// and coverage per pixel, black spots included), drawn by the GPU as by the CPU.
+#[test]
+fn swirl_film_field_through_wgpu_matches_the_cpu_backend_in_ciede2000() {
+    let dir = tempfile::tempdir().unwrap();
+    if !render("swirl", "wgpu", "gpu.png", dir.path()) {
+        return;
+    }
+    let per_triangle = ["--partial-shading", "per-triangle"];
+    assert!(render_with(
+        "swirl",
+        "cpu",
+        "cpu.png",
+        dir.path(),
+        &per_triangle
+    ));
+    let (mean, p99) = compare(dir.path(), "cpu.png", "gpu.png");
+    // Lavapipe measured mean 0.052, p99 1.03, max 1.22 (a film read at the wrong place
+    // or coverage ignored is several ΔE): above the paper's p99 (0.76) on this dark frame
+    // that the film covers, within gpu_scene's 2.0; the cause is not analysed yet.
+    assert!(mean <= 0.25, "mean ΔE2000 {mean} > 0.25");
+    assert!(p99 <= 1.5, "99th percentile ΔE2000 {p99} > 1.5");
+}
+
 /// Mean and 99th-percentile ΔE2000 of `a` against `b` through `bubbles compare`.
 fn compare(dir: &Path, a: &str, b: &str) -> (f64, f64) {
     let out = bubbles(&["compare", a, b, "--json"], dir);
     assert!(out.status.success(), "{}", stderr(&out));
     let json = String::from_utf8_lossy(&out.stdout);
-    eprintln!("paper, {a} vs {b}: {json}");
+    eprintln!("{a} vs {b}: {json}");
     (json_field(&json, "mean"), json_field(&json, "p99"))
 }
 

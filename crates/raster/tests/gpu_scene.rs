@@ -1,6 +1,7 @@
 //! The wgpu backend's whole frame against the CPU backend (the specification): opaque
 //! objects (specular sphere, checker box), ground, sky with sun, lights, SH irradiance and
-//! bubbles, with dynamic cube maps and with the static environment, in CIEDE2000.
+//! bubbles, with dynamic cube maps and with the static environment, in CIEDE2000; bubbles
+//! with film fields (thickness and coverage read per pixel).
 //!
 //! Runs with `cargo test -p raster --features wgpu --test gpu_scene`. Without an adapter it
 //! skips with a message, except under `CI=true`, where a missing adapter fails.
@@ -8,7 +9,9 @@
 
 mod common;
 
-use common::{lossless_tables, paper_scene, settings, synthetic_reflectivity};
+use common::{
+    bubble, film_field, lossless_tables, paper_scene, settings, synthetic_reflectivity, with_film,
+};
 use raster::gpu::{GpuError, GpuOptions, GpuRenderer};
 use raster::{
     Environment, FilmTables, Irradiance, Material, Object, Pattern, ReflectionMode, RenderScene,
@@ -301,5 +304,186 @@ fn gpu_bubble_reads_the_lut_at_the_cpu_texel_centres() {
     assert!(
         mean <= 0.5 && p99 <= 2.0,
         "coarse LUT: mean {mean}, p99 {p99}"
+    );
+}
+
+/// Per-pixel CIEDE2000 between `a` and `b` over the pixels `keep` selects: its mean and
+/// how many pixels it selected.
+fn mean_over(a: &[u8], b: &[u8], keep: impl Fn(usize) -> bool) -> (f64, usize) {
+    let de = per_pixel_delta_e(a, b);
+    let picked: Vec<f64> = (0..de.len()).filter(|&i| keep(i)).map(|i| de[i]).collect();
+    (
+        picked.iter().sum::<f64>() / picked.len().max(1) as f64,
+        picked.len(),
+    )
+}
+
+/// A swirl of thickness over the material sphere (nm), stripes a few texels wide.
+fn swirl(d: Vec3) -> f32 {
+    550.0 + 350.0 * (4.0 * d.y + 3.0 * d.x.atan2(d.z)).sin()
+}
+
+/// The test scene with film fields: bubble 0 a whole film whose field thickness (a swirl)
+/// replaces its 300 nm vertex thickness; bubble 1 a film with partial coverage and holes.
+fn film_scene() -> RenderScene {
+    let mut scene = scene();
+    scene.bubbles[0] = with_film(
+        bubble(Vec3::new(-0.55, 0.6, 0.0), 0.5, 3, |_| 300.0),
+        film_field(24, |d| (swirl(d), 1.0)),
+    );
+    let holes = film_field(16, |d| {
+        let c = (0.8 * d.x + 0.6 * d.y + 0.2).clamp(0.0, 1.0);
+        // A hole's thickness is meaningless: the sample must never blend it in.
+        if c > 0.0 {
+            (350.0 + 400.0 * d.z.abs(), c)
+        } else {
+            (1.0e3, 0.0)
+        }
+    });
+    scene.bubbles[1] = with_film(scene.bubbles[1].clone(), holes);
+    scene
+}
+
+#[test]
+fn gpu_film_field_thickness_replaces_the_vertex_thickness_as_on_the_cpu() {
+    let Some(mut gpu) = gpu() else { return };
+    let (scene, tables) = (film_scene(), tables());
+    // The same meshes drawn with their vertex thickness: what a backend ignoring the
+    // field would draw.
+    let mut by_vertex = scene.clone();
+    for b in &mut by_vertex.bubbles {
+        b.film = None;
+    }
+    for (reflection, samples) in [
+        (ReflectionMode::DynamicCubeMap { face_size: 48 }, 4),
+        (ReflectionMode::StaticEnvironment, 1),
+    ] {
+        let s = settings(200, 150, samples, reflection.clone());
+        let cpu_render = |scene: &RenderScene| {
+            cpu_renderer()
+                .render(scene, &tables, &s)
+                .unwrap()
+                .to_srgb8(s.exposure_ev, s.tonemap)
+        };
+        let cpu = cpu_render(&scene);
+        let cpu_vertex = cpu_render(&by_vertex);
+        let got = gpu.render_srgb8(&scene, &tables, &s).unwrap();
+        let (mean, p99) = delta_e(&cpu, &got);
+        // Where the field shows (ΔE > 1 from the vertex-thickness frame on the CPU).
+        let effect = per_pixel_delta_e(&cpu, &cpu_vertex);
+        let (film_error, film_pixels) = mean_over(&cpu, &got, |i| effect[i] > 1.0);
+        let film_effect = effect.iter().filter(|&&e| e > 1.0).sum::<f64>() / film_pixels as f64;
+        eprintln!(
+            "film fields, {reflection:?}, {samples} samples: mean ΔE2000 {mean:.3}, p99 \
+             {p99:.3}; on {film_pixels} film pixels {film_error:.3} (vertex thickness: \
+             {film_effect:.3})"
+        );
+        assert!(
+            film_pixels >= 1000,
+            "only {film_pixels} pixels show the field"
+        );
+        assert!(mean <= 0.5 && p99 <= 2.0, "mean {mean}, p99 {p99}");
+        assert!(
+            film_error <= 0.1 * film_effect,
+            "film pixels: GPU ΔE {film_error} from the CPU, vertex thickness {film_effect}"
+        );
+    }
+}
+
+#[test]
+fn gpu_film_with_coverage_zero_is_no_bubble_at_all() {
+    let Some(mut gpu) = gpu() else { return };
+    let tables = tables();
+    let s = settings(
+        200,
+        150,
+        4,
+        ReflectionMode::DynamicCubeMap { face_size: 32 },
+    );
+    let mut hole = scene();
+    hole.bubbles[0] = with_film(hole.bubbles[0].clone(), film_field(8, |_| (500.0, 0.0)));
+    let mut without = scene();
+    without.bubbles.remove(0);
+    let got = gpu.render_srgb8(&hole, &tables, &s).unwrap();
+    let want = gpu.render_srgb8(&without, &tables, &s).unwrap();
+    let worst = got.iter().zip(&want).map(|(a, b)| a.abs_diff(*b)).max();
+    assert_eq!(worst, Some(0), "a coverage-0 film shows");
+    // The same bubble with coverage 1 shows: the comparison above can fail.
+    let mut whole = scene();
+    whole.bubbles[0] = with_film(whole.bubbles[0].clone(), film_field(8, |_| (500.0, 1.0)));
+    let shown = gpu.render_srgb8(&whole, &tables, &s).unwrap();
+    let (mean, _) = delta_e(&shown, &want);
+    let shows = per_pixel_delta_e(&shown, &want)
+        .iter()
+        .filter(|&&e| e > 1.0)
+        .count();
+    assert!(
+        shows >= 500,
+        "the whole film shows on {shows} pixels only (mean ΔE {mean})"
+    );
+}
+
+#[test]
+fn gpu_film_with_coverage_half_matches_the_cpu_blend() {
+    let Some(mut gpu) = gpu() else { return };
+    let tables = tables();
+    // film_field.rs's flat layer over a lit checker wall, its material directions spread
+    // over face +Z so the thickness varies over it.
+    let camera = raster::Camera::look_at(Vec3::new(0.2, 0.3, 2.0), Vec3::ZERO, Vec3::Y, 40.0);
+    let mut flat = RenderScene::new(camera, Environment::Sky(Sky::default()));
+    // A dim wall: a whole film (B·T + R·sky) and half of one differ by (R·sky − B·R)/2,
+    // which a wall as bright as the sky would cancel.
+    flat.ambient_rgb = [0.2; 3];
+    // Its front face off the checker's cell boundaries (z = −1.53; on one it flips with
+    // rounding, differently on the two backends).
+    flat.objects = vec![Object::Box {
+        center: Vec3::new(0.0, 0.0, -2.03),
+        half_extents_m: Vec3::new(10.0, 10.0, 0.5),
+        material: Material::checker([0.9; 3], [0.2; 3], 0.1),
+    }];
+    let quad = |coverage: f32| {
+        let positions = vec![
+            Vec3::new(-0.5, -0.4, 0.0),
+            Vec3::new(0.5, -0.4, 0.0),
+            Vec3::new(0.5, 0.4, 0.0),
+            Vec3::new(-0.5, 0.4, 0.0),
+        ];
+        raster::BubbleMesh {
+            film: Some(raster::BubbleFilm {
+                field: std::sync::Arc::new(film_field(16, |d| (400.0 + 300.0 * d.x, coverage))),
+                material_dirs: positions.iter().map(|p| *p + Vec3::Z).collect(),
+            }),
+            positions,
+            normals: vec![Vec3::Z; 4],
+            thickness_nm: vec![100.0; 4],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+        }
+    };
+    let s = settings(96, 80, 4, ReflectionMode::StaticEnvironment);
+    let cpu_at = |coverage: f32| {
+        let mut scene = flat.clone();
+        scene.bubbles = vec![quad(coverage)];
+        cpu_renderer()
+            .render(&scene, &tables, &s)
+            .unwrap()
+            .to_srgb8(s.exposure_ev, s.tonemap)
+    };
+    let (cpu_half, cpu_full) = (cpu_at(0.5), cpu_at(1.0));
+    flat.bubbles = vec![quad(0.5)];
+    let got = gpu.render_srgb8(&flat, &tables, &s).unwrap();
+    let (mean, p99) = delta_e(&cpu_half, &got);
+    // On the film's pixels: how far coverage ½ is from a whole film (the blend's effect).
+    let effect = per_pixel_delta_e(&cpu_half, &cpu_full);
+    let (film_error, film_pixels) = mean_over(&cpu_half, &got, |i| effect[i] > 1.0);
+    let blend_effect = effect.iter().filter(|&&e| e > 1.0).sum::<f64>() / film_pixels as f64;
+    eprintln!(
+        "coverage ½: mean ΔE2000 {mean:.3}, p99 {p99:.3}; on {film_pixels} film pixels \
+         {film_error:.3} (a whole film: {blend_effect:.3})"
+    );
+    assert!(film_pixels >= 1000, "only {film_pixels} film pixels");
+    assert!(mean <= 0.5 && p99 <= 2.0, "mean {mean}, p99 {p99}");
+    assert!(
+        film_error <= 0.1 * blend_effect,
+        "film pixels: GPU ΔE {film_error} from the CPU's blend, a whole film {blend_effect}"
     );
 }

@@ -146,6 +146,14 @@ impl FilmField {
         &self.coverage
     }
 
+    /// The six bordered faces `sample` reads, `[thickness_nm, coverage]` per texel: face
+    /// `f`'s bordered texel `(x, y)` (interior texel `(x − 1, y − 1)`, `x, y ∈ [0, n + 1]`)
+    /// at `f·(n + 2)² + y·(n + 2) + x`. For a backend that ports [`FilmField::sample`]
+    /// (the wgpu backend uploads it as it is).
+    pub fn bordered(&self) -> &[[f32; 2]] {
+        &self.bordered
+    }
+
     /// Centre direction (unit) of texel `(x, y)` of face `face`:
     /// `normalize(major + s·U + t·V)` with `s = (x + 0.5)/n·2 − 1`, `t = (y + 0.5)/n·2 − 1`.
     ///

@@ -4,6 +4,13 @@
 //! (back faces, then front faces) in a multiplicative and an additive blend pass, then
 //! the resolve and the tone-map pass.
 //!
+//! Bubbles with a film field (`BubbleMesh::film`) are drawn as the CPU draws them: every
+//! distinct field's bordered faces (`FilmField::bordered`) sit in one Rg32Float data
+//! texture of `[thickness_nm, coverage]`, each bubble vertex carries its material direction
+//! and its field's (first texel, face size), and the bubble fragment shader ports
+//! `FilmField::sample` with `textureLoad` (`film_sample`), shades with the field's thickness and blends by the
+//! coverage `c`: `1 − T' = c·(1 − T)`, `add' = c·add`; `c = 0` leaves the pixel as it is.
+//!
 //! The CPU backend is the specification: every shader function names the Rust function it
 //! ports. Constants the two must share (tone curve, sRGB encoding, highlight filter, tag
 //! bits) are injected into the WGSL from the Rust constants, never retyped; see

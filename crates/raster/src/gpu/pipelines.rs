@@ -8,7 +8,8 @@ pub(super) const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Fl
 /// Depth format; depth is `near / view depth`, larger nearer, cleared to 0.
 pub(super) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
-/// The three bind group layouts: view (dynamic offset), scene, bubble tables.
+/// The three bind group layouts: view (dynamic offset), scene, bubble tables (LUTs, cube
+/// maps and film fields).
 #[derive(Debug)]
 pub(super) struct Layouts {
     pub view: wgpu::BindGroupLayout,
@@ -90,6 +91,8 @@ impl Layouts {
                 entry(1, storage()),
                 entry(2, texture(wgpu::TextureViewDimension::D2Array)),
                 entry(3, storage()),
+                // The film fields' bordered texels (Rg32Float, read with textureLoad).
+                entry(4, texture(wgpu::TextureViewDimension::D2)),
             ],
         );
         let compute = |binding, ty| wgpu::BindGroupLayoutEntry {
@@ -217,7 +220,8 @@ impl Pipelines {
             attributes: &ground_attrs,
         })];
         let bubble_attrs = wgpu::vertex_attr_array![
-            0 => Float32x3, 1 => Float32x3, 2 => Float32, 3 => Float32, 4 => Uint32
+            0 => Float32x3, 1 => Float32x3, 2 => Float32, 3 => Float32, 4 => Uint32,
+            5 => Float32x3, 6 => Uint32x2
         ];
         let bubbles = [Some(wgpu::VertexBufferLayout {
             array_stride: BUBBLE_VERTEX_BYTES,

@@ -221,7 +221,9 @@ impl GpuRenderer {
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        let lut_texture = self.lut_texture(&data.luts);
+        let lut_texture = self.data_texture("luts", wgpu::TextureFormat::Rgba32Float, &data.luts);
+        let film_texture =
+            self.data_texture("film fields", wgpu::TextureFormat::Rg32Float, &data.films);
         let bubble_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("bubble tables"),
             layout: &self.layouts.bubble,
@@ -243,6 +245,12 @@ impl GpuRenderer {
                     )),
                 ),
                 bind(3, mips.as_entire_binding()),
+                bind(
+                    4,
+                    wgpu::BindingResource::TextureView(
+                        &film_texture.create_view(&Default::default()),
+                    ),
+                ),
             ],
         });
         let mut encoder = device.create_command_encoder(&Default::default());
@@ -447,12 +455,18 @@ impl GpuRenderer {
         )
     }
 
-    /// The stacked LUT tables as an Rgba32Float texture.
-    fn lut_texture(&self, (width, height, texels): &(u32, u32, Vec<u8>)) -> wgpu::Texture {
+    /// A data texture of `format` (the stacked LUT tables, the film fields), read with
+    /// `textureLoad` only.
+    fn data_texture(
+        &self,
+        label: &str,
+        format: wgpu::TextureFormat,
+        (width, height, texels): &(u32, u32, Vec<u8>),
+    ) -> wgpu::Texture {
         self.gpu.device.create_texture_with_data(
             &self.gpu.queue,
             &wgpu::TextureDescriptor {
-                label: Some("luts"),
+                label: Some(label),
                 size: wgpu::Extent3d {
                     width: *width,
                     height: *height,
@@ -461,7 +475,7 @@ impl GpuRenderer {
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba32Float,
+                format,
                 usage: wgpu::TextureUsages::TEXTURE_BINDING,
                 view_formats: &[],
             },

@@ -1,7 +1,8 @@
 // The frame's passes in WGSL, each a port of the CPU backend (the specification):
 // background sky (passes.rs `OpaqueCtx::sky`), ground plane (`shade_ground`), opaque
 // objects and light spheres (`OpaqueCtx::shade`, shading.rs `lit`), and the bubble film
-// (`BubbleCtx::shade`, `LightSight::visibility`). Constants shared with Rust are injected below.
+// (`BubbleCtx::shade`, `LightSight::visibility`, film_field.rs `FilmField::sample` for a
+// bubble with a film field). Constants shared with Rust are injected below.
 
 {{SHARED_CONSTANTS}}
 
@@ -80,6 +81,10 @@ struct LutInfo {
 // Every bubble's cube mip chain, laid out as cubemap.rs `CubeMap`'s levels: per bubble,
 // per level (level 0 first), six bordered (n + 2)² faces of packed RGB (see `cube_mips`).
 @group(2) @binding(3) var<storage, read> cube_mips: array<f32>;
+// Every film field's six bordered (n + 2)² faces of [thickness_nm, coverage], laid out as
+// film_field.rs `FilmField::bordered`, one field after another; linear texel i sits at
+// (i mod width, i div width) (scene_data.rs `film_fields`).
+@group(2) @binding(4) var film_texels: texture_2d<f32>;
 
 // ---- shared functions ------------------------------------------------------------------
 
@@ -341,6 +346,10 @@ struct BubbleIn {
     // renderer.rs `reflection_rate` of the vertex's triangle
     @location(3) pixel_angle_rad: f32,
     @location(4) bubble: u32,
+    // where the vertex sits on its bubble's film field (zero without one)
+    @location(5) material_dir: vec3<f32>,
+    // the bubble's film field: first texel in `film_texels`, face size (0: no field)
+    @location(6) film: vec2<u32>,
 }
 
 struct BubbleOut {
@@ -355,13 +364,16 @@ struct BubbleOut {
     // `inv_w`), from which the normal's derivative follows as on the CPU.
     @location(5) @interpolate(linear, center) normal_over_w: vec3<f32>,
     @location(6) @interpolate(linear, center) inv_w: f32,
+    // raster.rs attributes 3..6 of a bubble with a film field: perspective-correct
+    @location(7) @interpolate(perspective, centroid) material_dir: vec3<f32>,
+    @location(8) @interpolate(flat) film: vec2<u32>,
 }
 
 @vertex
 fn vs_bubble(in: BubbleIn) -> BubbleOut {
     let clip = clip_of(in.position);
     return BubbleOut(clip, in.position, in.normal, in.thickness_nm, in.pixel_angle_rad,
-        in.bubble, in.normal / clip.w, 1.0 / clip.w);
+        in.bubble, in.normal / clip.w, 1.0 / clip.w, in.material_dir, in.film);
 }
 
 // lut_sampler.rs `split`: lower sample index and the upper one's weight on an axis of n.
@@ -601,13 +613,56 @@ fn light_visibility(light: Light, p: vec3<f32>, reflected: vec3<f32>, pixel_angl
     return clamp((alpha - gamma) / w + 0.5, 0.0, 1.0);
 }
 
-// The film as passes.rs `BubbleCtx::shade` sees it from the viewer.
+// Linear texel `i` of the film texture: [thickness_nm, coverage].
+fn film_texel(i: u32) -> vec2<f32> {
+    let width = textureDimensions(film_texels).x;
+    return textureLoad(film_texels, vec2<u32>(i % width, i / width), 0).xy;
+}
+
+// film_field.rs `FilmField::sample`: (thickness_nm, coverage) at material direction
+// `dir`, the coverage-weighted bilinear thickness Σ (w c / Σ w c) h (0 when Σ w c = 0) and
+// the plain bilinear coverage, from the bordered faces (seamless across edges) of the
+// field whose first texel is `film.x` and face size `film.y`.
+fn film_sample(film: vec2<u32>, dir: vec3<f32>) -> vec2<f32> {
+    let fst = face_coordinates(dir);
+    let n = f32(film.y);
+    let m = film.y + 2u;
+    let hi = f32(m - 1u);
+    // Interior texel i has its centre at s = (2i + 1)/n − 1 and is stored at i + 1.
+    let fx = min(max((fst.y + 1.0) * 0.5 * n + 0.5, 0.0), hi);
+    let fy = min(max((fst.z + 1.0) * 0.5 * n + 0.5, 0.0), hi);
+    let x0 = min(u32(fx), m - 2u);
+    let y0 = min(u32(fy), m - 2u);
+    let tx = fx - f32(x0);
+    let ty = fy - f32(y0);
+    let base = film.x + (u32(fst.x) * m + y0) * m + x0;
+    let a = film_texel(base);
+    let b = film_texel(base + 1u);
+    let c = film_texel(base + m);
+    let d = film_texel(base + m + 1u);
+    let w = vec4<f32>((1.0 - tx) * (1.0 - ty), tx * (1.0 - ty), (1.0 - tx) * ty, tx * ty);
+    let wc = w * vec4<f32>(a.y, b.y, c.y, d.y);
+    let sum = wc.x + wc.y + wc.z + wc.w;
+    var thickness_nm = 0.0;
+    if (sum > 0.0) {
+        // Each weight divided on its own: at a texel's centre it is exactly 1.
+        let k = wc / sum;
+        thickness_nm = k.x * a.x + k.y * b.x + k.z * c.x + k.w * d.x;
+    }
+    let top = a.y + (b.y - a.y) * tx;
+    let bottom = c.y + (d.y - c.y) * tx;
+    return vec2<f32>(thickness_nm, clamp(top + (bottom - top) * ty, 0.0, 1.0));
+}
+
+// The film as passes.rs `BubbleCtx::shade` sees it from the viewer, with its coverage
+// (1 without a film field; 0 is a hole: no film at all).
 struct Film {
     v: vec3<f32>,
     n: vec3<f32>,
     c: f32,
     cos_theta: f32,
     thickness_nm: f32,
+    coverage: f32,
 }
 
 fn film_of(in: BubbleOut) -> Film {
@@ -619,7 +674,15 @@ fn film_of(in: BubbleOut) -> Film {
         n = -n;
         c = -c;
     }
-    return Film(v, n, c, min(-c, 1.0), max(in.thickness_nm, 0.0));
+    var thickness_nm = max(in.thickness_nm, 0.0);
+    var coverage = 1.0;
+    if (in.film.y != 0u) {
+        // With a film field the field's thickness replaces the vertex thickness.
+        let s = film_sample(in.film, in.material_dir);
+        thickness_nm = s.x;
+        coverage = s.y;
+    }
+    return Film(v, n, c, min(-c, 1.0), thickness_nm, coverage);
 }
 
 fn film_reflectivity(f: Film) -> vec3<f32> {
@@ -630,11 +693,16 @@ fn film_reflectivity(f: Film) -> vec3<f32> {
 @fragment
 fn fs_bubble_transmit(in: BubbleOut) -> @location(0) vec4<f32> {
     let f = film_of(in);
+    if (f.coverage <= 0.0) {
+        // A hole: T = 1, the destination stays as it is.
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    }
     var t = vec3<f32>(1.0) - film_reflectivity(f);
     if (scene.transmittance_table != NO_TABLE) {
         t = lut_sample(scene.transmittance_table, f.thickness_nm, f.cos_theta);
     }
-    return vec4<f32>(vec3<f32>(1.0) - t, 1.0);
+    // Blended by coverage: 1 − T' = c·(1 − T) (exactly 1 − T at c = 1).
+    return vec4<f32>((vec3<f32>(1.0) - t) * f.coverage, 1.0);
 }
 
 // The additive pass, blended (One, One): dest ← dest + R ⊙ env(reflect) + highlights.
@@ -648,6 +716,10 @@ fn fs_bubble_add(in: BubbleOut) -> @location(0) vec4<f32> {
         (dpdxFine(in.normal_over_w) - n_centre * dpdxFine(in.inv_w)) * w,
         (dpdyFine(in.normal_over_w) - n_centre * dpdyFine(in.inv_w)) * w);
     let f = film_of(in);
+    if (f.coverage <= 0.0) {
+        // A hole adds nothing.
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    }
     let r = film_reflectivity(f);
     let reflected = f.v - f.n * (2.0 * f.c);
     let rel = in.world - view.eye.xyz;
@@ -664,7 +736,8 @@ fn fs_bubble_add(in: BubbleOut) -> @location(0) vec4<f32> {
             add += l * light.gain.xyz * vis;
         }
     }
-    return vec4<f32>(add, 1.0);
+    // Blended by coverage: add' = c·add.
+    return vec4<f32>(add * f.coverage, 1.0);
 }
 
 // ---- cube mip chain ------------------------------------------------------------------------

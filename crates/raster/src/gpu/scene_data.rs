@@ -38,8 +38,10 @@ pub(super) const NO_TABLE: u32 = u32::MAX;
 pub(super) const VIEW_BYTES: u64 = 9 * 16;
 /// Bytes of one object vertex: position, normal, tag.
 pub(super) const OBJECT_VERTEX_BYTES: u64 = 28;
-/// Bytes of one bubble vertex: position, normal, thickness, pixel angle, bubble index.
-pub(super) const BUBBLE_VERTEX_BYTES: u64 = 36;
+/// Bytes of one bubble vertex: position, normal, thickness, pixel angle, bubble index,
+/// material direction (zero without a film field), and the bubble's film field as
+/// (first texel in the film texture, face size; face size 0: no field).
+pub(super) const BUBBLE_VERTEX_BYTES: u64 = 56;
 
 /// Little-endian bytes for a GPU buffer.
 #[derive(Debug, Default)]
@@ -154,6 +156,10 @@ pub(super) struct SceneData {
     pub luts: LutTexture,
     /// `array<LutInfo>`.
     pub lut_info: Vec<u8>,
+    /// The film texture: every distinct film field's bordered faces
+    /// (`FilmField::bordered`, `[thickness_nm, coverage]` as Rg32Float), one after
+    /// another, texel `i` at `(i mod width, i div width)`.
+    pub films: FilmTexture,
 }
 
 /// Why the wgpu backend cannot draw `what` (it draws the scenes the built-in scenes use).
@@ -189,12 +195,6 @@ pub(super) fn check_supported(
             return Err(unsupported("a textured material"));
         }
     }
-    if let Some(k) = scene.bubbles.iter().position(|b| b.film.is_some()) {
-        // Never drawn with the vertex thickness instead: that would be a different film.
-        return Err(unsupported(format!(
-            "film fields (bubble {k} carries one: per-pixel film thickness and coverage)"
-        )));
-    }
     Ok(())
 }
 
@@ -222,7 +222,8 @@ impl SceneData {
             push_geometry(&mut object_bytes, &light_spheres);
         }
         let all_vertices = (object_bytes.0.len() as u64 / OBJECT_VERTEX_BYTES) as u32;
-        let (bubbles, bubble_draws) = bubble_vertices(scene, view);
+        let (films, film_places) = film_fields(scene, max_texture_side)?;
+        let (bubbles, bubble_draws) = bubble_vertices(scene, view, &film_places);
         let (luts, lut_info, first_light) = stack_tables(tables, max_texture_side)?;
         // A light without a table of its own uses the reflectivity (table 0).
         let light_tables: Vec<u32> = scene
@@ -252,6 +253,7 @@ impl SceneData {
             bubble_draws,
             luts,
             lut_info,
+            films,
         })
     }
 }
@@ -354,7 +356,13 @@ fn push_geometry(b: &mut Bytes, g: &Geometry) {
 
 /// Bubble vertices in the CPU's drawing order (renderer.rs `setup_bubbles`): bubbles far
 /// to near, each bubble's back faces then its front faces; one draw range per side.
-fn bubble_vertices(scene: &RenderScene, view: &View) -> (Vec<u8>, Vec<std::ops::Range<u32>>) {
+///
+/// `films[k]` is bubble `k`'s film field as (first texel, face size), `(0, 0)` without one.
+fn bubble_vertices(
+    scene: &RenderScene,
+    view: &View,
+    films: &[[u32; 2]],
+) -> (Vec<u8>, Vec<std::ops::Range<u32>>) {
     let mut b = Bytes::default();
     let mut draws = Vec::new();
     let mut start = 0u32;
@@ -370,6 +378,14 @@ fn bubble_vertices(scene: &RenderScene, view: &View) -> (Vec<u8>, Vec<std::ops::
                     let (p, n) = (bubble.positions[i], bubble.normals[i]);
                     b.f32(p.x).f32(p.y).f32(p.z).f32(n.x).f32(n.y).f32(n.z);
                     b.f32(bubble.thickness_nm[i]).f32(rate).u32(k as u32);
+                    // The CPU's attributes 3..6 (`setup_bubble_tris`): where the vertex
+                    // sits on the film field, interpolated and looked up per pixel.
+                    let m = bubble
+                        .film
+                        .as_ref()
+                        .map_or(Vec3::ZERO, |f| f.material_dirs[i]);
+                    b.f32(m.x).f32(m.y).f32(m.z);
+                    b.u32(films[k][0]).u32(films[k][1]);
                 }
             }
             let end = (b.0.len() as u64 / BUBBLE_VERTEX_BYTES) as u32;
@@ -380,6 +396,60 @@ fn bubble_vertices(scene: &RenderScene, view: &View) -> (Vec<u8>, Vec<std::ops::
         }
     }
     (b.0, draws)
+}
+
+/// A data texture `(width, height, texels)`.
+pub(super) type FilmTexture = (u32, u32, Vec<u8>);
+
+/// The film fields as `scene.wgsl` reads them: the film texture (every distinct field's
+/// bordered faces, a field two bubbles share stored once, rows of at most `max_side`
+/// texels, the last row padded) and per bubble its field's (first texel, face size), `(0,
+/// 0)` without one.
+///
+/// # Errors
+/// [`GpuError::Unsupported`], naming the film fields, when the texture would be taller
+/// than `max_side`.
+fn film_fields(
+    scene: &RenderScene,
+    max_side: u32,
+) -> Result<(FilmTexture, Vec<[u32; 2]>), GpuError> {
+    let too_large = |texels: usize| {
+        unsupported(format!(
+            "film fields of {texels} texels (their texture's rows hold {max_side}, at most \
+             {max_side} rows on this device)"
+        ))
+    };
+    let mut texels = Bytes::default();
+    let mut stored: Vec<(*const render_scene::FilmField, u32)> = Vec::new();
+    let mut places = Vec::with_capacity(scene.bubbles.len());
+    for bubble in &scene.bubbles {
+        let Some(film) = &bubble.film else {
+            places.push([0, 0]);
+            continue;
+        };
+        let key = std::sync::Arc::as_ptr(&film.field);
+        let offset = match stored.iter().find(|(p, _)| *p == key) {
+            Some(&(_, offset)) => offset,
+            None => {
+                let offset = texels.0.len() / 8;
+                let offset = u32::try_from(offset).map_err(|_| too_large(offset))?;
+                for &[h, c] in film.field.bordered() {
+                    texels.f32(h).f32(c);
+                }
+                stored.push((key, offset));
+                offset
+            }
+        };
+        places.push([offset, film.field.face_size() as u32]);
+    }
+    let count = (texels.0.len() / 8).max(1);
+    let width = count.min(max_side as usize);
+    let height = count.div_ceil(width);
+    if height > max_side as usize {
+        return Err(too_large(count));
+    }
+    texels.0.resize(8 * width * height, 0);
+    Ok(((width as u32, height as u32, texels.0), places))
 }
 
 /// The stacked LUT texture `(width, height, texels)`.
@@ -434,9 +504,20 @@ mod tests {
 
     use super::*;
 
+    fn words(bytes: &[u8]) -> Vec<u32> {
+        bytes
+            .chunks_exact(4)
+            .map(|w| u32::from_le_bytes(w.try_into().unwrap()))
+            .collect()
+    }
+
+    fn floats(bytes: &[u8]) -> Vec<f32> {
+        words(bytes).into_iter().map(f32::from_bits).collect()
+    }
+
     #[test]
-    fn a_bubble_with_a_film_field_is_refused_naming_it() {
-        let camera = Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 40.0);
+    fn film_fields_are_packed_once_each_with_every_vertex_material_direction() {
+        let camera = Camera::look_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y, 40.0);
         let mut scene = RenderScene::new(camera, Environment::Uniform([1.0; 3]));
         let settings = RenderSettings::default();
         let plain = BubbleMesh {
@@ -446,20 +527,97 @@ mod tests {
             triangles: vec![[0, 1, 2]],
             film: None,
         };
-        scene.bubbles = vec![plain.clone(), plain.clone()];
-        assert!(check_supported(&scene, &settings).is_ok());
-        let field = FilmField::try_new(1, vec![500.0; 6], vec![1.0; 6]).unwrap();
-        scene.bubbles[1].film = Some(BubbleFilm {
-            field: Arc::new(field),
-            material_dirs: plain.normals.clone(),
-        });
-        let err = check_supported(&scene, &settings).unwrap_err();
-        assert!(matches!(err, GpuError::Unsupported(_)), "{err:?}");
-        let text = err.to_string();
-        assert!(text.contains("bubble 1"), "{text}");
-        assert!(
-            text.contains("does not support film fields (bubble 1"),
-            "{text}"
+        let (h, c): (Vec<f32>, Vec<f32>) = (0..24).map(|i| (10.0 * i as f32, 0.5)).unzip();
+        let shared = Arc::new(FilmField::try_new(2, h, c).unwrap());
+        let other = Arc::new(FilmField::try_new(1, vec![700.0; 6], vec![1.0; 6]).unwrap());
+        let dirs = vec![
+            Vec3::new(1.0, 2.0, 3.0),
+            Vec3::NEG_Y,
+            Vec3::new(0.0, 0.0, -5.0),
+        ];
+        let film = |field: &Arc<FilmField>| {
+            Some(BubbleFilm {
+                field: field.clone(),
+                material_dirs: dirs.clone(),
+            })
+        };
+        scene.bubbles = vec![plain.clone(); 4];
+        scene.bubbles[1].film = film(&shared);
+        scene.bubbles[2].film = film(&other);
+        scene.bubbles[3].film = film(&shared);
+        // The wgpu backend draws film fields: nothing refuses them.
+        check_supported(&scene, &settings).unwrap();
+        let tables = FilmTables::from_reflectivity(
+            render_scene::Lut::try_from_fn(4, 4, 1000.0, |_, _| [0.1; 3]).unwrap(),
         );
+        let view = scene.camera.view(16, 16);
+        // Rows of at most 50 texels: 6·4² + 6·3² = 150 texels, three rows.
+        let data = SceneData::new(
+            &scene,
+            &tables,
+            &settings,
+            &view,
+            50,
+            ReflectionFilter::Footprint,
+        )
+        .unwrap();
+        let (width, height, bytes) = &data.films;
+        assert_eq!((*width, *height), (50, 3));
+        let want: Vec<f32> = shared
+            .bordered()
+            .iter()
+            .chain(other.bordered())
+            .flatten()
+            .copied()
+            .collect();
+        assert_eq!(floats(bytes), want);
+        // Bubble 0 none; 1 and 3 share the first field (6·4² texels); 2 after it. Every
+        // vertex carries its material direction (zero without a field) and its field.
+        let first = 6 * 4 * 4;
+        let places = [[0, 0], [0, 2], [first, 1], [0, 2]];
+        let vertices = words(&data.bubbles);
+        let stride = (BUBBLE_VERTEX_BYTES / 4) as usize;
+        assert_eq!(vertices.len() % stride, 0);
+        let mut seen = [0usize; 4];
+        for v in vertices.chunks_exact(stride) {
+            let k = v[8] as usize;
+            seen[k] += 1;
+            let m = Vec3::new(
+                f32::from_bits(v[9]),
+                f32::from_bits(v[10]),
+                f32::from_bits(v[11]),
+            );
+            if k == 0 {
+                assert_eq!(m, Vec3::ZERO);
+            } else {
+                assert!(dirs.contains(&m), "bubble {k}: {m}");
+            }
+            assert_eq!([v[12], v[13]], places[k], "bubble {k}");
+        }
+        assert_eq!(seen, [3; 4]);
+        // Too tall for the device: named, never drawn otherwise.
+        let err = SceneData::new(
+            &scene,
+            &tables,
+            &settings,
+            &view,
+            10,
+            ReflectionFilter::Footprint,
+        )
+        .unwrap_err();
+        assert!(matches!(err, GpuError::Unsupported(_)), "{err:?}");
+        assert!(
+            err.to_string().contains("film fields of 150 texels"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn a_scene_without_film_fields_packs_one_unused_texel() {
+        let camera = Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 40.0);
+        let scene = RenderScene::new(camera, Environment::Uniform([1.0; 3]));
+        let ((w, h, texels), places) = film_fields(&scene, 8192).unwrap();
+        assert_eq!((w, h, floats(&texels)), (1, 1, vec![0.0, 0.0]));
+        assert!(places.is_empty());
     }
 }
