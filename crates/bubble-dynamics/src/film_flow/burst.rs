@@ -16,6 +16,7 @@
 use glam::DVec3;
 
 use super::FilmFlow;
+use super::grid::arc;
 use crate::rng::SplitMix64;
 
 /// Time for a film that fell under the black threshold to reach the black film, s.
@@ -260,8 +261,4 @@ impl BurstState {
             }
         }
     }
-}
-
-fn arc(a: DVec3, b: DVec3) -> f64 {
-    a.cross(b).length().atan2(a.dot(b))
 }

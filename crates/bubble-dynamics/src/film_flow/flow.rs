@@ -99,6 +99,8 @@ pub struct FilmFlow {
     hierarchy: std::sync::Arc<Hierarchy>,
     pub(crate) params: FlowParams,
     burst: Option<Box<BurstState>>,
+    /// The viscous operator's Gershgorin bound per unit ν/R², fixed by the grid.
+    viscous_bound: f64,
     pub(crate) h_m: Vec<f64>,
     pub(crate) gamma: Vec<f64>,
     pub(crate) u_m_per_s: Vec<f64>,
@@ -135,6 +137,7 @@ impl FilmFlow {
         let edges = grid.edges().len();
         Self {
             burst: Some(Box::new(BurstState::new(params.burst, cells, params.seed))),
+            viscous_bound: viscous_bound(&grid),
             params,
             h_m: h,
             gamma: vec![1.0; cells],
@@ -246,22 +249,6 @@ impl FilmFlow {
             * r2
     }
 
-    /// Kinetic energy per unit film density, ½∫h|u|² dA with each edge's normal
-    /// velocity on its dual area (`l·d`), m⁵/s².
-    pub fn kinetic_measure(&self) -> f64 {
-        let r2 = self.params.radius_m * self.params.radius_m;
-        let g = &self.grid;
-        g.edges()
-            .iter()
-            .zip(&self.u_m_per_s)
-            .map(|(e, u)| {
-                let h = 0.5 * (self.h_m[e.a as usize] + self.h_m[e.b as usize]);
-                h * u * u * e.length * e.dual_length
-            })
-            .sum::<f64>()
-            * r2
-    }
-
     /// Advances the film by `dt_s` under `forcing`; returns the Marangoni solve's report.
     /// A film the rims have swept away stays as it is.
     pub fn step(&mut self, dt_s: f64, forcing: &Forcing) -> SolveReport {
@@ -315,21 +302,7 @@ impl FilmFlow {
     /// An upper bound of the viscous operator's eigenvalues (Gershgorin), 1/s.
     fn viscous_rate_bound(&self, nu: f64) -> f64 {
         let r = self.params.radius_m;
-        let g = &self.grid;
-        let (cells, verts) = (g.areas_sr(), g.vertex_areas_sr());
-        g.edges()
-            .iter()
-            .map(|e| {
-                let curl =
-                    2.0 * e.dual_length / e.length / verts[e.v0 as usize].min(verts[e.v1 as usize]);
-                let div = 4.0 * 2.0 * e.length
-                    / e.dual_length
-                    / cells[e.a as usize].min(cells[e.b as usize]);
-                4.0 * (curl + div) + 2.0
-            })
-            .fold(0.0, f64::max)
-            * nu
-            / (r * r)
+        self.viscous_bound * nu / (r * r)
     }
 
     /// One explicit step of the sheet's viscous stress over `dt_s`.
@@ -509,7 +482,7 @@ impl FilmFlow {
                 let up = if u >= 0.0 { e.a } else { e.b } as usize;
                 *f = self.gamma[up] * u * e.length;
             }
-            limit_outflow(&g, flux, dt_s / r, &self.gamma);
+            limit_outflow(&g, flux, dt_s / r, &self.gamma, &mut s.cell);
             apply_fluxes(&g, flux, dt_s / r, &mut self.gamma);
         }
         s.drag = drag;
@@ -578,10 +551,8 @@ impl FilmFlow {
             *grad /= *a;
             *grad -= *c * grad.dot(*c);
         }
-        let (speed, volume, outflow) = (&s.edge, &mut s.edge2, &mut s.cell);
+        let (speed, volume) = (&s.edge, &mut s.edge2);
         volume.clear();
-        outflow.clear();
-        outflow.resize(g.cells(), 0.0);
         // Volume across each edge over the step, per R² (m × sr).
         for (e, &v) in g.edges().iter().zip(speed.iter()) {
             let (up, down) = if v >= 0.0 { (e.a, e.b) } else { (e.b, e.a) };
@@ -589,30 +560,27 @@ impl FilmFlow {
             let (h_up, h_down) = (self.h_m[up], self.h_m[down]);
             let reach = s.gradient[up].dot(e.midpoint - g.centres()[up]);
             let h_face = (h_up + reach).clamp(h_up.min(h_down), h_up.max(h_down));
-            let moved = h_face * v * e.length * dt_s / r;
-            outflow[up] += moved.abs();
-            volume.push(moved);
+            volume.push(h_face * v * e.length * dt_s / r);
         }
-        let scale = &mut s.cell2;
-        scale.clear();
-        scale.extend(
-            areas
-                .iter()
-                .zip(&self.h_m)
-                .zip(outflow.iter())
-                .map(|((a, h), out)| {
-                    let budget = MAX_OUTFLOW_FRACTION * a * h;
-                    if *out > budget { budget / out } else { 1.0 }
-                }),
-        );
-        for (e, moved) in g.edges().iter().zip(volume.iter()) {
-            let (a, b) = (e.a as usize, e.b as usize);
-            let up = if *moved >= 0.0 { a } else { b };
-            let m = moved * scale[up];
-            self.h_m[a] -= m / areas[a];
-            self.h_m[b] += m / areas[b];
-        }
+        limit_outflow(g, volume, 1.0, &self.h_m, &mut s.cell);
+        apply_fluxes(g, volume, 1.0, &mut self.h_m);
     }
+}
+
+/// The viscous operator's Gershgorin bound on the unit sphere for ν = 1: per edge, the
+/// curl-curl, grad-div and curvature terms' row sums, the largest of them.
+fn viscous_bound(g: &CubeSphere) -> f64 {
+    let (cells, verts) = (g.areas_sr(), g.vertex_areas_sr());
+    g.edges()
+        .iter()
+        .map(|e| {
+            let curl =
+                2.0 * e.dual_length / e.length / verts[e.v0 as usize].min(verts[e.v1 as usize]);
+            let div =
+                4.0 * 2.0 * e.length / e.dual_length / cells[e.a as usize].min(cells[e.b as usize]);
+            4.0 * (curl + div) + 2.0
+        })
+        .fold(0.0, f64::max)
 }
 
 /// Moves `scale·flux_e` (per unit sphere area) from cell `a` to `b` of every edge.
@@ -626,9 +594,16 @@ fn apply_fluxes(g: &CubeSphere, flux: &[f64], scale: f64, values: &mut [f64]) {
 }
 
 /// Scales each donor's outgoing fluxes so no cell gives more than
-/// [`MAX_OUTFLOW_FRACTION`] of its content in one step.
-fn limit_outflow(g: &CubeSphere, flux: &mut [f64], scale: f64, values: &[f64]) {
-    let mut outflow = vec![0.0; g.cells()];
+/// [`MAX_OUTFLOW_FRACTION`] of its content in one step (`outflow` is scratch).
+fn limit_outflow(
+    g: &CubeSphere,
+    flux: &mut [f64],
+    scale: f64,
+    values: &[f64],
+    outflow: &mut Vec<f64>,
+) {
+    outflow.clear();
+    outflow.resize(g.cells(), 0.0);
     for (e, f) in g.edges().iter().zip(flux.iter()) {
         let donor = if *f >= 0.0 { e.a } else { e.b } as usize;
         outflow[donor] += (scale * f).abs();

@@ -175,7 +175,8 @@ fn gnomonic_area(n: usize, x: usize, y: usize) -> f64 {
     f(s1, t1) - f(s0, t1) - f(s1, t0) + f(s0, t0)
 }
 
-fn arc(a: DVec3, b: DVec3) -> f64 {
+/// Great-circle angle between two unit directions, rad.
+pub(crate) fn arc(a: DVec3, b: DVec3) -> f64 {
     a.cross(b).length().atan2(a.dot(b))
 }
 

@@ -24,6 +24,15 @@ struct Level {
     coarse_edge_of_fine: Vec<u32>,
 }
 
+/// The face size a grid of `n` coarsens to: halved while even and above
+/// [`COARSEST_FACE`].
+fn coarsest_face(mut n: usize) -> usize {
+    while n % 2 == 0 && n > COARSEST_FACE {
+        n /= 2;
+    }
+    n
+}
+
 /// Largest number of cells solved directly on the coarsest level.
 const DENSE_CELLS: usize = 6 * 8 * 8;
 /// Face size the hierarchy coarsens down to when it can (a dense Cholesky of 6·4² cells
@@ -77,7 +86,7 @@ impl Hierarchy {
         let fine_edges: Vec<(u32, u32)> = grid.edges().iter().map(|e| (e.a, e.b)).collect();
         let mut levels = vec![Level::new(grid.cells(), fine_edges)];
         let mut n = grid.face_size();
-        while n % 2 == 0 && n > COARSEST_FACE {
+        while n > coarsest_face(n) {
             let fine = levels.last().expect("one level");
             let parent: Vec<u32> = (0..fine.cells).map(|c| parent_cell(n, c) as u32).collect();
             let (coarse, coarse_edge_of_fine) = coarsen(fine, &parent, 6 * (n / 2) * (n / 2));
@@ -92,10 +101,7 @@ impl Hierarchy {
 
     /// Whether a face size coarsens down to a directly solvable level.
     pub fn supports(face_size: usize) -> bool {
-        let mut n = face_size;
-        while n % 2 == 0 && n > COARSEST_FACE {
-            n /= 2;
-        }
+        let n = coarsest_face(face_size);
         n >= 1 && 6 * n * n <= DENSE_CELLS
     }
 
