@@ -1,0 +1,446 @@
+//! The fringe orders, resolved globally: quality-guided growth over the pixel grid (as in
+//! quality-guided phase unwrapping, the quality being how fast the colour changes with
+//! thickness), each pixel taking the minimum of its colour cost nearest the thickness its
+//! labelled neighbours predict; each connected region starts from the pixel whose colour
+//! names its thickness most clearly, and the region's order as a whole is then put to a
+//! vote of the colour evidence of all its pixels.
+
+use crate::camera::{EncodedTable, dist2};
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+/// Pixel states during growth.
+pub(crate) const EXCLUDED: u8 = 0;
+pub(crate) const SATURATED: u8 = 1;
+pub(crate) const FREE: u8 = 2;
+pub(crate) const LABELLED: u8 = 3;
+pub(crate) const UNEXPLAINED: u8 = 4;
+
+/// The least colour cost that stops the growth (an RMS error of 0.03 per encoded
+/// channel, 8 levels of 8 bits); noisier photos raise it to 4 σ (see
+/// [`unexplained_cost`]).
+const MIN_UNEXPLAINED_RMS: f32 = 0.03;
+
+/// The colour cost above which a pixel is no film colour at all and stops the growth:
+/// 4 σ per channel of the photo's noise, estimated from the quality map (a neighbour
+/// difference has variance 2σ², the smoothest half of the photo is mostly noise).
+fn unexplained_cost(quality: &[u32], state: &[u8]) -> f32 {
+    let mut q: Vec<u32> = quality
+        .iter()
+        .zip(state)
+        .filter(|(_, s)| **s == FREE)
+        .map(|(q, _)| *q)
+        .collect();
+    if q.is_empty() {
+        return 3.0 * MIN_UNEXPLAINED_RMS * MIN_UNEXPLAINED_RMS;
+    }
+    let mid = q.len() / 4;
+    let (_, quarter, _) = q.select_nth_unstable(mid);
+    let sigma2 = *quarter as f32 / (1u32 << 20) as f32 / 6.0;
+    3.0 * (16.0 * sigma2).max(MIN_UNEXPLAINED_RMS * MIN_UNEXPLAINED_RMS)
+}
+/// Orders tried either side of a region's first guess.
+const MAX_ORDER_SHIFT: i64 = 8;
+/// Pixels of a region that vote on its order.
+const VOTERS: usize = 1500;
+
+/// The growth's inputs and state.
+pub(crate) struct Grower<'a> {
+    pub(crate) table: &'a EncodedTable,
+    pub(crate) encoded: &'a [[f32; 3]],
+    pub(crate) rows: &'a [u16],
+    pub(crate) width: usize,
+    pub(crate) state: Vec<u8>,
+    /// Thickness as a table sample index, for labelled pixels.
+    pub(crate) h: Vec<f32>,
+    /// Weight of the continuity prior per squared sample of distance from the prediction.
+    pub(crate) prior: f32,
+    /// Colour cost above which a pixel is unexplained.
+    unexplained: f32,
+    heap: BinaryHeap<Reverse<u64>>,
+    /// Region-search marks: a pixel is visited when its mark equals `generation`.
+    mark: Vec<u32>,
+    generation: u32,
+}
+
+/// The best seed candidate found so far.
+struct Clearest {
+    margin: f32,
+    pixel: usize,
+    first: usize,
+    minima: Vec<(usize, f32)>,
+}
+
+/// What a region's order vote decided.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RegionReport {
+    /// Regions grown.
+    pub regions: usize,
+    /// Regions grown from the user's anchors.
+    pub anchored: usize,
+    /// Regions whose first guess was moved by one or more orders by the vote.
+    pub shifted: usize,
+}
+
+impl<'a> Grower<'a> {
+    /// A grower over `state` (each pixel [`EXCLUDED`], [`SATURATED`] or [`FREE`]).
+    pub(crate) fn new(
+        table: &'a EncodedTable,
+        encoded: &'a [[f32; 3]],
+        rows: &'a [u16],
+        width: usize,
+        state: Vec<u8>,
+        prior: f32,
+    ) -> Grower<'a> {
+        let quality = quality_map(encoded, &state, width);
+        let unexplained = unexplained_cost(&quality, &state);
+        let n = encoded.len();
+        Grower {
+            table,
+            encoded,
+            rows,
+            width,
+            state,
+            h: vec![0.0; n],
+            prior,
+            unexplained,
+            heap: BinaryHeap::new(),
+            mark: vec![0; n],
+            generation: 0,
+        }
+    }
+
+    /// Colour cost of pixel `p` at sample `i`.
+    #[inline]
+    fn cost(&self, p: usize, i: usize) -> f32 {
+        dist2(
+            self.encoded[p],
+            self.table.row(usize::from(self.rows[p]))[i],
+        )
+    }
+
+    /// The local minimum of cost + prior reached by descending from the prediction.
+    fn descend(&self, p: usize, pred: f32) -> (usize, f32) {
+        let last = self.table.len - 1;
+        let row = self.table.row(usize::from(self.rows[p]));
+        let e = self.encoded[p];
+        let total = |i: usize| {
+            let d = i as f32 - pred;
+            dist2(e, row[i]) + self.prior * d * d
+        };
+        let mut i = (pred.round().max(0.0) as usize).min(last);
+        let mut here = total(i);
+        loop {
+            let down = (i > 0).then(|| total(i - 1)).filter(|&t| t < here);
+            let up = (i < last).then(|| total(i + 1)).filter(|&t| t < here);
+            match (down, up) {
+                (Some(a), Some(b)) if a <= b => (i, here) = (i - 1, a),
+                (_, Some(b)) => (i, here) = (i + 1, b),
+                (Some(a), None) => (i, here) = (i - 1, a),
+                (None, None) => break,
+            }
+        }
+        (i, self.cost(p, i))
+    }
+
+    /// The 4-neighbours of `p`.
+    fn neighbours(&self, p: usize) -> impl Iterator<Item = (usize, isize)> + use<> {
+        let (w, n) = (self.width, self.encoded.len());
+        let (x, y) = (p % w, p / w);
+        let left = (x > 0).then(|| (p - 1, -1));
+        let right = (x + 1 < w).then(|| (p + 1, 1));
+        let up = (y > 0).then(|| (p - w, -(w as isize)));
+        let down = (p + w < n).then(|| (p + w, w as isize));
+        [left, right, up, down].into_iter().flatten()
+    }
+
+    /// The thickness the labelled neighbours of `p` predict: their mean. (Extrapolating
+    /// each neighbour's slope was tried and made no difference on the wedge tests where
+    /// the data is strong, while amplifying noise along paths where it is weak.)
+    fn predict(&self, p: usize) -> Option<f32> {
+        let (mut sum, mut count) = (0.0f32, 0.0f32);
+        for (q, _) in self.neighbours(p) {
+            if self.state[q] == LABELLED {
+                sum += self.h[q];
+                count += 1.0;
+            }
+        }
+        (count > 0.0).then(|| sum / count)
+    }
+
+    /// Labels `p` from `pred`, or marks it unexplained; queues its free neighbours.
+    fn settle(&mut self, p: usize, pred: f32, touched: &mut Vec<usize>) {
+        let (i, d) = self.descend(p, pred);
+        touched.push(p);
+        if d > self.unexplained {
+            self.state[p] = UNEXPLAINED;
+            return;
+        }
+        self.state[p] = LABELLED;
+        self.h[p] = i as f32;
+        for (q, _) in self.neighbours(p) {
+            if self.state[q] == FREE {
+                let key = self.information_key(q, i);
+                self.heap.push(Reverse((u64::from(key) << 32) | q as u64));
+            }
+        }
+    }
+
+    /// Priority of reaching `q` from a neighbour at sample `i`: pixels whose colour
+    /// changes fast with thickness there are settled first, so that where colours barely
+    /// change (pale high orders) the growth arrives last, from every side, rather than
+    /// wandering through them (lower keys first).
+    fn information_key(&self, q: usize, i: usize) -> u32 {
+        let row = self.table.row(usize::from(self.rows[q]));
+        let (lo, hi) = (i.saturating_sub(2), (i + 2).min(self.table.len - 1));
+        let slope2 = dist2(row[lo], row[hi]) / ((hi - lo).max(1) * (hi - lo).max(1)) as f32;
+        let key = 1.0 / (slope2 * 1e6 + 1e-3);
+        (key * 1e3).min(u32::MAX as f32) as u32
+    }
+
+    /// Grows from `seeds` (pixel, predicted sample) until nothing reachable is free;
+    /// returns every pixel it labelled or marked unexplained.
+    pub(crate) fn grow(&mut self, seeds: &[(usize, f32)]) -> Vec<usize> {
+        let mut touched = Vec::new();
+        for &(p, pred) in seeds {
+            if self.state[p] == FREE {
+                self.settle(p, pred, &mut touched);
+            }
+        }
+        while let Some(Reverse(key)) = self.heap.pop() {
+            let p = (key & 0xFFFF_FFFF) as usize;
+            if self.state[p] != FREE {
+                continue;
+            }
+            if let Some(pred) = self.predict(p) {
+                self.settle(p, pred, &mut touched);
+            }
+        }
+        touched
+    }
+
+    /// Local minima of pixel `p`'s colour cost over the whole thickness range.
+    fn minima(&self, p: usize) -> Vec<(usize, f32)> {
+        let row = self.table.row(usize::from(self.rows[p]));
+        let e = self.encoded[p];
+        let d: Vec<f32> = row.iter().map(|t| dist2(e, *t)).collect();
+        (0..d.len())
+            .filter(|&i| (i == 0 || d[i] <= d[i - 1]) && (i + 1 == d.len() || d[i] < d[i + 1]))
+            .map(|i| (i, d[i]))
+            .collect()
+    }
+
+    /// Resolves every pixel: anchored regions first, then each remaining region from its
+    /// smoothest pixel, its order chosen by vote.
+    pub(crate) fn resolve(&mut self, anchors: &[(usize, f32)]) -> RegionReport {
+        let mut report = RegionReport::default();
+        if !anchors.is_empty() {
+            let touched = self.grow(anchors);
+            report.anchored = usize::from(!touched.is_empty());
+        }
+        let mut cursor = 0;
+        while let Some(start) = (cursor..self.state.len()).find(|&p| self.state[p] == FREE) {
+            cursor = start;
+            let (seed, minima, first) = self.clearest_in_region(start);
+            if minima.is_empty() {
+                self.state[seed] = UNEXPLAINED;
+                continue;
+            }
+            report.regions += 1;
+            let touched = self.grow(&[(seed, first as f32)]);
+            if self.revote(seed, &minima, first, &touched) {
+                report.shifted += 1;
+            }
+        }
+        report.regions += report.anchored;
+        report
+    }
+
+    /// The pixel of `start`'s free region whose colour names its thickness most clearly:
+    /// among up to [`VOTERS`] of its pixels, the one whose best colour match beats its
+    /// second best by the widest margin (vivid low orders, black film), with that match.
+    fn clearest_in_region(&mut self, start: usize) -> (usize, Vec<(usize, f32)>, usize) {
+        let region = self.region(start);
+        let stride = region.len().div_ceil(VOTERS).max(1);
+        let mut best: Option<Clearest> = None;
+        for &p in region.iter().step_by(stride) {
+            let minima = self.minima(p);
+            let mut costs: Vec<(f32, usize)> = minima.iter().map(|m| (m.1, m.0)).collect();
+            costs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            let margin = match costs.as_slice() {
+                [a, b, ..] => b.0 - a.0,
+                [_] => f32::INFINITY,
+                [] => continue,
+            };
+            if best.as_ref().is_none_or(|b| margin > b.margin) {
+                let first = costs[0].1;
+                best = Some(Clearest {
+                    margin,
+                    pixel: p,
+                    first,
+                    minima,
+                });
+            }
+        }
+        best.map_or((start, self.minima(start), 0), |b| {
+            (b.pixel, b.minima, b.first)
+        })
+    }
+
+    /// The free pixels 4-connected to `start` through free pixels.
+    fn region(&mut self, start: usize) -> Vec<usize> {
+        self.generation += 1;
+        let generation = self.generation;
+        self.mark[start] = generation;
+        let mut seen = vec![start];
+        let mut k = 0;
+        while k < seen.len() {
+            let p = seen[k];
+            k += 1;
+            for (q, _) in self.neighbours(p) {
+                if self.state[q] == FREE && self.mark[q] != generation {
+                    self.mark[q] = generation;
+                    seen.push(q);
+                }
+            }
+        }
+        seen
+    }
+
+    /// Lets the region just grown vote on its order; regrows it shifted if the vote and
+    /// the regrown region's own cost both say so. Returns whether it moved.
+    fn revote(
+        &mut self,
+        seed: usize,
+        minima: &[(usize, f32)],
+        first: usize,
+        touched: &[usize],
+    ) -> bool {
+        let labelled: Vec<usize> = touched
+            .iter()
+            .copied()
+            .filter(|&p| self.state[p] == LABELLED)
+            .collect();
+        let shift = self.vote(&labelled);
+        let j = minima.iter().position(|m| m.0 == first).unwrap_or(0) as i64;
+        let Some(&(moved, _)) = usize::try_from(j + shift).ok().and_then(|k| minima.get(k)) else {
+            return false;
+        };
+        if shift == 0 {
+            return false;
+        }
+        let before = self.mean_cost(&labelled);
+        let saved: Vec<(usize, u8, f32)> = touched
+            .iter()
+            .map(|&p| (p, self.state[p], self.h[p]))
+            .collect();
+        for &p in touched {
+            self.state[p] = FREE;
+        }
+        let regrown = self.grow(&[(seed, moved as f32)]);
+        let relabelled: Vec<usize> = regrown
+            .iter()
+            .copied()
+            .filter(|&p| self.state[p] == LABELLED)
+            .collect();
+        if self.mean_cost(&relabelled) < before {
+            return true;
+        }
+        for &p in &regrown {
+            self.state[p] = FREE;
+        }
+        for (p, s, h) in saved {
+            (self.state[p], self.h[p]) = (s, h);
+        }
+        false
+    }
+
+    /// The order shift under which a sample of the region's pixels fit best.
+    fn vote(&self, labelled: &[usize]) -> i64 {
+        let stride = labelled.len().div_ceil(VOTERS).max(1);
+        let shifts = 2 * MAX_ORDER_SHIFT as usize + 1;
+        let mut score = vec![0.0f64; shifts];
+        for &p in labelled.iter().step_by(stride) {
+            let minima = self.minima(p);
+            let here = self.h[p] as usize;
+            let Some(j) = minima
+                .iter()
+                .enumerate()
+                .min_by_key(|(_, m)| m.0.abs_diff(here))
+                .map(|(j, _)| j)
+            else {
+                continue;
+            };
+            for (k, s) in score.iter_mut().enumerate() {
+                let at = j as i64 + k as i64 - MAX_ORDER_SHIFT;
+                let d = usize::try_from(at)
+                    .ok()
+                    .and_then(|a| minima.get(a))
+                    .map_or(self.unexplained, |m| m.1);
+                *s += f64::from(d.min(self.unexplained));
+            }
+        }
+        let best = (0..shifts)
+            .min_by(|&a, &b| {
+                score[a].total_cmp(&score[b]).then(
+                    (a as i64 - MAX_ORDER_SHIFT)
+                        .abs()
+                        .cmp(&(b as i64 - MAX_ORDER_SHIFT).abs()),
+                )
+            })
+            .unwrap_or(MAX_ORDER_SHIFT as usize);
+        best as i64 - MAX_ORDER_SHIFT
+    }
+
+    /// Mean colour cost of labelled pixels (infinite for none).
+    fn mean_cost(&self, labelled: &[usize]) -> f64 {
+        if labelled.is_empty() {
+            return f64::INFINITY;
+        }
+        let sum: f64 = labelled
+            .iter()
+            .map(|&p| f64::from(self.cost(p, self.h[p] as usize)))
+            .sum();
+        sum / labelled.len() as f64
+    }
+}
+
+/// Per pixel, the mean squared colour step to its usable 4-neighbours (smooth pixels
+/// are low and grown first), as an integer key.
+fn quality_map(encoded: &[[f32; 3]], state: &[u8], width: usize) -> Vec<u32> {
+    use rayon::prelude::*;
+    let n = encoded.len();
+    (0..n)
+        .into_par_iter()
+        .map(|p| {
+            if state[p] != FREE {
+                return u32::MAX;
+            }
+            let (x, y) = (p % width, p / width);
+            let mut near = [None; 4];
+            if x > 0 {
+                near[0] = Some(p - 1)
+            }
+            if x + 1 < width {
+                near[1] = Some(p + 1)
+            }
+            if y > 0 {
+                near[2] = Some(p - width)
+            }
+            if p + width < n {
+                near[3] = Some(p + width)
+            }
+            let (sum, count) = near
+                .iter()
+                .flatten()
+                .filter(|&&q| state[q] == FREE)
+                .fold((0.0f32, 0u32), |(s, c), &q| {
+                    (s + dist2(encoded[p], encoded[q]), c + 1)
+                });
+            if count == 0 {
+                return 1 << 24;
+            }
+            ((sum / count as f32) * (1 << 20) as f32).min((1u32 << 31) as f32) as u32
+        })
+        .collect()
+}
