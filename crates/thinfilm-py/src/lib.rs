@@ -4,6 +4,8 @@
 //! Every call copies its inputs, releases the GIL and computes in parallel (rayon), so
 //! other Python threads run meanwhile; every bad value raises `ValueError` naming it.
 
+mod inverse;
+
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -595,5 +597,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(graded_rt, m)?)?;
     m.add_function(wrap_pyfunction!(film_xyz, m)?)?;
     m.add_function(wrap_pyfunction!(xyz_to_srgb, m)?)?;
+    m.add_function(wrap_pyfunction!(inverse::thickness_from_rgb, m)?)?;
     Ok(())
 }

@@ -9,7 +9,8 @@ import numpy as np
 
 from . import _native
 
-__all__ = ["rt", "graded_rt", "film_rt", "film_rt_grid", "fit_thickness", "film_xyz", "xyz_to_srgb"]
+__all__ = ["rt", "graded_rt", "film_rt", "film_rt_grid", "fit_thickness", "film_xyz", "xyz_to_srgb",
+           "thickness_from_rgb"]
 
 
 def _flat(*arrays):
@@ -218,3 +219,180 @@ def xyz_to_srgb(xyz):
         raise ValueError(f"xyz has shape {xyz.shape}: its last axis must have length 3")
     rgb = _native.xyz_to_srgb(np.ascontiguousarray(xyz).ravel())
     return rgb.reshape(xyz.shape)
+
+
+# Pixel status codes of thickness_from_rgb.
+FITTED, SATURATED, EXCLUDED, UNEXPLAINED = 0, 1, 2, 3
+
+
+def _index(name, value):
+    """``value`` as a pixel coordinate or size (an int in [0, 2**32)), else ValueError."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) \
+            or not 0 <= value < 2**32:
+        raise ValueError(f"{name} = {value!r} is not a pixel index (an int >= 0)")
+    return int(value)
+
+
+def _rect(name, rect):
+    """A region ``(x, y, w, h)`` in pixels as four ints, else ValueError naming it."""
+    try:
+        x, y, w, h = rect
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} = {rect!r} is not a region (x, y, w, h)") from None
+    return tuple(_index(f"{name} {k}", v) for k, v in zip("xywh", (x, y, w, h)))
+
+
+def _per_pixel(name, array, shape, dtype):
+    """A per-pixel ``(H, W)`` array as a flat contiguous ``dtype`` copy, else ValueError."""
+    array = np.asarray(array)
+    if array.shape != shape:
+        raise ValueError(f"{name} has shape {array.shape}: the image needs {shape} (H, W)")
+    if dtype == np.bool_ and array.dtype != np.bool_:
+        raise ValueError(f"{name} has dtype {array.dtype}: it must be a bool array")
+    return np.ascontiguousarray(array, dtype=dtype).ravel()
+
+
+def _pixels(image):
+    """The image's ``(H, W)`` and its flat pixels in the dtype the native call takes."""
+    image = np.asarray(image)
+    if image.ndim != 3 or image.shape[2] != 3:
+        raise ValueError(f"image has shape {image.shape}: it must be (H, W, 3) RGB")
+    if image.dtype in (np.uint8, np.uint16):
+        flat = np.ascontiguousarray(image).ravel()
+    elif image.dtype in (np.float32, np.float64):
+        flat = np.ascontiguousarray(image, dtype=np.float32).ravel()
+    else:
+        raise ValueError(f"image has dtype {image.dtype}: it must be uint8 or uint16 "
+                         "(sRGB-encoded) or float32/float64 (linear)")
+    return image.shape[:2], flat
+
+
+def _calibration(white, reference, exposure, gains):
+    """The native call's ``(white, reference, camera)``: at most one of them set."""
+    given = [name for name, v in (("white", white), ("reference", reference),
+                                  ("exposure", exposure)) if v is not None]
+    if len(given) > 1:
+        raise ValueError(f"{' and '.join(given)} are given together: "
+                         "give at most one calibration")
+    if gains is not None and exposure is None:
+        raise ValueError(f"gains = {gains!r} needs an exposure")
+    if white is not None:
+        white = _rect("white", white)
+    if reference is not None:
+        try:
+            rect, nm = reference
+        except (TypeError, ValueError):
+            raise ValueError(f"reference = {reference!r} is not ((x, y, w, h), nm)") from None
+        reference = (_rect("reference region", rect), float(nm))
+    camera = None
+    if exposure is not None:
+        g = np.asarray((1.0, 1.0, 1.0) if gains is None else gains, dtype=np.float64)
+        if g.shape != (3,):
+            raise ValueError(f"gains = {gains!r} is not three numbers (red, green, blue)")
+        camera = (float(exposure), [float(v) for v in g])
+    return white, reference, camera
+
+
+def _anchors(anchors):
+    """Anchors as ``(x, y, nm)`` tuples, else ValueError naming the bad one."""
+    out = []
+    for k, a in enumerate(anchors):
+        try:
+            x, y, nm = a
+        except (TypeError, ValueError):
+            raise ValueError(f"anchors[{k}] = {a!r} is not (x, y, nm)") from None
+        out.append((_index(f"anchors[{k}] x", x), _index(f"anchors[{k}] y", y), float(nm)))
+    return out
+
+
+def thickness_from_rgb(
+    image,
+    *,
+    illuminant="d65",
+    n_film=1.33,
+    n_outside=1.0,
+    thickness_max_nm=1500.0,
+    angle_deg=0.0,
+    cos_map=None,
+    sphere=None,
+    white=None,
+    reference=None,
+    exposure=None,
+    gains=None,
+    anchors=(),
+    mask=None,
+    max_residual_de=8.0,
+    smoothness_nm=30.0,
+):
+    """The thickness map of a soap film from an RGB photo of it in reflection.
+
+    ``image`` is ``(H, W, 3)``: uint8 or uint16 sRGB-encoded (a channel at the format's
+    maximum marks its pixel saturated), or float32/float64 linear. The film
+    ``n_outside | n_film | n_outside`` (constant indices) is lit by ``illuminant`` (d65, d50,
+    a, e, f2, f11, sodium; CIE 1931 observer) and is up to ``thickness_max_nm`` thick.
+
+    Viewing: one ``angle_deg`` of incidence for every pixel, or ``cos_map`` (``(H, W)``
+    cos theta per pixel), or ``sphere=(cx, cy, radius_px)`` (a bubble seen from far away;
+    pixels outside its disc are excluded). Calibration, at most one: ``white=(x, y, w, h)``
+    a region showing the light in a perfect mirror, ``reference=((x, y, w, h), nm)`` a
+    region of known thickness, or ``exposure`` (and optional white-balance ``gains``,
+    three numbers) given; by default both are estimated from the photo. ``anchors`` are
+    ``(x, y, nm)`` pixels of known thickness, fixing their region's fringe order; ``mask``
+    (``(H, W)`` bool) leaves out the pixels where it is False. A fitted pixel whose
+    re-rendered colour is further than ``max_residual_de`` (ΔE2000) from the photo is
+    unexplained; ``smoothness_nm`` is the thickness step between neighbours the continuity
+    prior expects. Fringe orders are resolved over the whole image (the Rust crate
+    film-inverse).
+
+    Returns a dict: ``thickness_nm``, ``uncertainty_nm`` (one sigma) and ``residual_de``
+    (ΔE2000), each ``(H, W)`` float32 and NaN where a pixel is not fitted; ``status``
+    (``(H, W)`` uint8: 0 fitted, 1 saturated, 2 excluded, 3 unexplained, also named
+    ``thinfilm.FITTED``, ``SATURATED``, ``EXCLUDED``, ``UNEXPLAINED``); ``rerender``
+    (``(H, W, 3)`` float32, the colours the map predicts, sRGB-encoded in [0, 1], the
+    photo's own where not fitted); and ``summary``, a dict: the camera's ``exposure`` and
+    ``gains``, how it was found (``calibration``: given, white region, reference region
+    or estimated), pixel counts (``fitted``, ``saturated``, ``excluded``,
+    ``unexplained``), the residual's mean, 95th percentile and maximum, ``noise_encoded``,
+    the fitted thickness's minimum, median and maximum, the median uncertainty (these are
+    NaN when nothing is fitted), and the regions grown (``regions``, ``regions_anchored``,
+    ``regions_shifted``). The GIL is released while Rust computes (in parallel). Bad input,
+    a saturated photo or a calibration region that cannot calibrate raise ValueError.
+    """
+    shape, pixels = _pixels(image)
+    if cos_map is not None and sphere is not None:
+        raise ValueError("cos_map and sphere are both given: give at most one viewing geometry")
+    if (cos_map is not None or sphere is not None) and float(angle_deg) != 0.0:
+        raise ValueError(f"angle_deg = {angle_deg!r} with a cos_map or sphere: give one geometry")
+    if cos_map is not None:
+        cos_map = _per_pixel("cos_map", cos_map, shape, np.float32)
+    if sphere is not None:
+        try:
+            cx, cy, radius = (float(v) for v in sphere)
+        except (TypeError, ValueError):
+            raise ValueError(f"sphere = {sphere!r} is not (cx, cy, radius_px)") from None
+        sphere = (cx, cy, radius)
+    if mask is not None:
+        mask = _per_pixel("mask", mask, shape, np.bool_)
+    white, reference, camera = _calibration(white, reference, exposure, gains)
+    height, width = (_index("image height", shape[0]), _index("image width", shape[1]))
+    film = (str(illuminant), float(n_film), float(n_outside), float(thickness_max_nm))
+    h, sigma, de, status, rerender, summary = _native.thickness_from_rgb(
+        pixels, width, height, film, float(angle_deg), cos_map, sphere, white, reference,
+        camera, _anchors(anchors), mask, float(max_residual_de), float(smoothness_nm))
+    status = status.reshape(shape)
+    missing = status != FITTED
+    maps = {"thickness_nm": h, "uncertainty_nm": sigma, "residual_de": de}
+    out = {}
+    for name, values in maps.items():
+        values = values.reshape(shape)
+        values[missing] = np.nan
+        out[name] = values
+    out["status"] = status
+    out["rerender"] = rerender.reshape(shape + (3,))
+    if summary["fitted"] == 0:
+        for key in ("residual_mean_de", "residual_p95_de", "residual_max_de",
+                    "thickness_min_nm", "thickness_median_nm", "thickness_max_nm",
+                    "uncertainty_median_nm"):
+            summary[key] = float("nan")
+    out["summary"] = summary
+    return out

@@ -5,7 +5,8 @@ from typing import Sequence, TypedDict
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["rt", "graded_rt", "film_rt", "film_rt_grid", "fit_thickness", "film_xyz", "xyz_to_srgb"]
+__all__ = ["rt", "graded_rt", "film_rt", "film_rt_grid", "fit_thickness", "film_xyz", "xyz_to_srgb",
+           "thickness_from_rgb"]
 
 def rt(
     n: Sequence[complex] | ArrayLike,
@@ -85,3 +86,63 @@ def film_xyz(
 
 def xyz_to_srgb(xyz: ArrayLike) -> NDArray[np.float64]:
     """Encoded sRGB in [0, 1] of XYZ of shape ``(..., 3)``."""
+
+FITTED: int
+SATURATED: int
+EXCLUDED: int
+UNEXPLAINED: int
+
+class InverseSummary(TypedDict):
+    """The ``summary`` of :func:`thickness_from_rgb`."""
+
+    exposure: float
+    gains: tuple[float, float, float]
+    calibration: str
+    fitted: int
+    saturated: int
+    excluded: int
+    unexplained: int
+    residual_mean_de: float
+    residual_p95_de: float
+    residual_max_de: float
+    noise_encoded: float
+    thickness_min_nm: float
+    thickness_median_nm: float
+    thickness_max_nm: float
+    uncertainty_median_nm: float
+    regions: int
+    regions_anchored: int
+    regions_shifted: int
+
+class ThicknessMap(TypedDict):
+    """What :func:`thickness_from_rgb` returns."""
+
+    thickness_nm: NDArray[np.float32]
+    uncertainty_nm: NDArray[np.float32]
+    residual_de: NDArray[np.float32]
+    status: NDArray[np.uint8]
+    rerender: NDArray[np.float32]
+    summary: InverseSummary
+
+Rect = tuple[int, int, int, int]
+
+def thickness_from_rgb(
+    image: ArrayLike,
+    *,
+    illuminant: str = "d65",
+    n_film: float = 1.33,
+    n_outside: float = 1.0,
+    thickness_max_nm: float = 1500.0,
+    angle_deg: float = 0.0,
+    cos_map: ArrayLike | None = None,
+    sphere: tuple[float, float, float] | None = None,
+    white: Rect | None = None,
+    reference: tuple[Rect, float] | None = None,
+    exposure: float | None = None,
+    gains: Sequence[float] | None = None,
+    anchors: Sequence[tuple[int, int, float]] = (),
+    mask: ArrayLike | None = None,
+    max_residual_de: float = 8.0,
+    smoothness_nm: float = 30.0,
+) -> ThicknessMap:
+    """The thickness map of a soap film from an RGB photo (NaN where not fitted)."""
