@@ -74,6 +74,20 @@ def test_estimated_camera_recovers_the_ramp():
     assert abs(out["summary"]["exposure"] / EXPOSURE - 1) < 0.05
 
 
+def test_white_region_fixes_the_camera_and_is_itself_unexplained():
+    # A perfect mirror of D65 light is sRGB (1, 1, 1) times the exposure: four such columns
+    # left of the film, 16-bit so that the dim film (exposure 0.9) keeps its precision.
+    exposure = 0.9
+    white = np.full((HEIGHT, 4, 3), 1.055 * exposure ** (1 / 2.4) - 0.055)
+    photo = np.concatenate([white, encoded(TRUTH, exposure)], axis=1)
+    out = thinfilm.thickness_from_rgb(np.round(photo * 65535).astype(np.uint16),
+                                      white=(0, 0, 4, HEIGHT))
+    s = out["summary"]
+    assert s["calibration"] == "white region" and abs(s["exposure"] / exposure - 1) < 1e-3
+    assert (out["status"][:, :4] == thinfilm.UNEXPLAINED).all()
+    np.testing.assert_allclose(out["thickness_nm"][:, 4:], TRUTH, rtol=0, atol=5)
+
+
 def test_reference_region_and_anchor():
     x = 64
     out = thinfilm.thickness_from_rgb(srgb8(), reference=((x, 0, 1, HEIGHT), TRUTH[0, x]),
