@@ -42,6 +42,8 @@ enum Command {
     Animate(commands::animate::Args),
     /// CIEDE2000 between two images: mean, 95th percentile, maximum, optional heat map.
     Compare(commands::compare::Args),
+    /// A film's thickness map from a photo of it: EXR map, uncertainty, residual, figures.
+    Thickness(commands::thickness::Args),
     /// Open a live window on the scene (simulated in real time, CPU-rendered).
     #[cfg(feature = "view")]
     #[command(after_help = view::CONTROLS)]
@@ -61,6 +63,7 @@ fn main() -> std::process::ExitCode {
         Command::Bench(args) => commands::bench::run(args),
         Command::Animate(args) => commands::animate::run(args),
         Command::Compare(args) => commands::compare::run(args),
+        Command::Thickness(args) => commands::thickness::run(args),
         #[cfg(feature = "view")]
         Command::View(args) => view::run(args),
     };

@@ -51,8 +51,6 @@ pub use photo::{MAX_PIXELS, Photo};
 pub use settings::{ANGLE_ROWS, Anchor, Calibration, MIN_COS, Rect, Settings, Viewing};
 pub use unwrap::RegionReport;
 
-use rayon::prelude::*;
-
 /// What became of a pixel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Status {
@@ -124,6 +122,29 @@ pub struct Summary {
     pub regions: RegionReport,
 }
 
+impl Summary {
+    /// A summary with only the noise level known yet.
+    fn empty(noise_encoded: f64) -> Summary {
+        Summary {
+            camera: Camera::balanced(1.0),
+            calibration: "",
+            fitted: 0,
+            saturated: 0,
+            excluded: 0,
+            unexplained: 0,
+            residual_mean_de: 0.0,
+            residual_p95_de: 0.0,
+            residual_max_de: 0.0,
+            noise_encoded,
+            thickness_min_nm: 0.0,
+            thickness_median_nm: 0.0,
+            thickness_max_nm: 0.0,
+            uncertainty_median_nm: 0.0,
+            regions: RegionReport::default(),
+        }
+    }
+}
+
 /// Recovers the thickness map of `photo`.
 ///
 /// # Errors
@@ -167,13 +188,15 @@ pub fn recover(
         })
         .collect();
     let regions = grower.resolve(&anchors);
-    Ok(finish_map(
-        photo,
+    let tables = finish::Tables {
+        encoded: &encoded,
+        linear: &table,
+        camera,
+    };
+    let map = finish::finish_map(photo, settings, &tables, &cos, &grower);
+    Ok(finish::with_summary(
+        map,
         settings,
-        &encoded,
-        &table,
-        &cos,
-        grower,
         camera,
         calibration,
         regions,
@@ -332,140 +355,4 @@ fn auto_camera(photo: &Photo, table: &ColourTable, rows: &[u16], state: &[u8]) -
         .unwrap_or(1.0)
         .max(1e-4);
     camera::estimate(table, &samples, p99)
-}
-
-#[allow(clippy::too_many_arguments)]
-fn finish_map(
-    photo: &Photo,
-    settings: &Settings,
-    encoded: &EncodedTable,
-    table: &ColourTable,
-    cos: &[Option<f32>],
-    grower: unwrap::Grower<'_>,
-    camera: Camera,
-    calibration: &'static str,
-    regions: RegionReport,
-) -> ThicknessMap {
-    let n = photo.len();
-    let fits: Vec<Option<finish::Fit>> = (0..n)
-        .into_par_iter()
-        .map(|p| {
-            (grower.state[p] == unwrap::LABELLED).then(|| {
-                let row = table.row_of(f64::from(cos[p].unwrap_or(1.0)));
-                finish::refine(encoded, photo.encoded()[p], f64::from(grower.h[p]), row)
-            })
-        })
-        .collect();
-    let explained: Vec<finish::Fit> = fits
-        .iter()
-        .flatten()
-        .filter(|f| f.residual_de <= settings.max_residual_de)
-        .copied()
-        .collect();
-    let noise = finish::noise_level(&explained);
-    let cap = table.len() as f64 * TABLE_STEP_NM;
-    let status: Vec<Status> = (0..n)
-        .map(|p| match (grower.state[p], fits[p]) {
-            (unwrap::LABELLED, Some(f)) if f.residual_de <= settings.max_residual_de => {
-                Status::Fitted
-            }
-            (unwrap::LABELLED | unwrap::UNEXPLAINED, _) => Status::Unexplained,
-            (unwrap::SATURATED, _) => Status::Saturated,
-            _ => Status::Excluded,
-        })
-        .collect();
-    let fitted = |p: usize| (status[p] == Status::Fitted).then(|| fits[p]).flatten();
-    let thickness_nm = (0..n)
-        .map(|p| fitted(p).map_or(0.0, |f| f.thickness_nm as f32))
-        .collect();
-    let uncertainty_nm: Vec<f32> = (0..n)
-        .map(|p| fitted(p).map_or(0.0, |f| finish::uncertainty_nm(&f, noise, cap) as f32))
-        .collect();
-    let residual_de = (0..n)
-        .map(|p| fitted(p).map_or(0.0, |f| f.residual_de as f32))
-        .collect();
-    let rerender = (0..n)
-        .map(|p| match fitted(p) {
-            Some(f) => f.rerender.map(|v| v.clamp(0.0, 1.0) as f32),
-            None => photo.encoded()[p].map(|v| v.clamp(0.0, 1.0)),
-        })
-        .collect();
-    let mut map = ThicknessMap {
-        width: photo.width(),
-        height: photo.height(),
-        thickness_nm,
-        uncertainty_nm,
-        residual_de,
-        rerender,
-        status,
-        summary: Summary {
-            camera,
-            calibration,
-            fitted: 0,
-            saturated: 0,
-            excluded: 0,
-            unexplained: 0,
-            residual_mean_de: 0.0,
-            residual_p95_de: 0.0,
-            residual_max_de: 0.0,
-            noise_encoded: noise,
-            thickness_min_nm: 0.0,
-            thickness_median_nm: 0.0,
-            thickness_max_nm: 0.0,
-            uncertainty_median_nm: 0.0,
-            regions,
-        },
-    };
-    map.summary = summarise(&map, noise, camera, calibration, regions);
-    map
-}
-
-/// Counts and percentiles of a finished map.
-fn summarise(
-    map: &ThicknessMap,
-    noise: f64,
-    camera: Camera,
-    calibration: &'static str,
-    regions: RegionReport,
-) -> Summary {
-    let count = |s: Status| map.status.iter().filter(|&&x| x == s).count();
-    let pick = |v: &[f32]| -> Vec<f64> {
-        let mut out: Vec<f64> = (0..v.len())
-            .filter(|&p| map.status[p] == Status::Fitted)
-            .map(|p| f64::from(v[p]))
-            .collect();
-        out.sort_by(f64::total_cmp);
-        out
-    };
-    let quantile = |v: &[f64], q: f64| {
-        if v.is_empty() {
-            0.0
-        } else {
-            v[((q * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1]
-        }
-    };
-    let de = pick(&map.residual_de);
-    let h = pick(&map.thickness_nm);
-    let sigma = pick(&map.uncertainty_nm);
-    Summary {
-        camera,
-        calibration,
-        fitted: count(Status::Fitted),
-        saturated: count(Status::Saturated),
-        excluded: count(Status::Excluded),
-        unexplained: count(Status::Unexplained),
-        residual_mean_de: if de.is_empty() {
-            0.0
-        } else {
-            de.iter().sum::<f64>() / de.len() as f64
-        },
-        residual_p95_de: quantile(&de, 0.95),
-        residual_max_de: de.last().copied().unwrap_or(0.0),
-        noise_encoded: noise,
-        thickness_min_nm: h.first().copied().unwrap_or(0.0),
-        thickness_median_nm: quantile(&h, 0.5),
-        thickness_max_nm: h.last().copied().unwrap_or(0.0),
-        uncertainty_median_nm: quantile(&sigma, 0.5),
-        regions,
-    }
 }

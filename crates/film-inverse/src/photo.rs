@@ -17,6 +17,14 @@ pub struct Photo {
     height: u32,
     encoded: Vec<[f32; 3]>,
     saturated: Vec<bool>,
+    /// Whether every value is a multiple of 1/255 (an 8-bit photo): decoded by table.
+    eight_bit: bool,
+}
+
+/// Linear values of the 256 8-bit codes.
+fn decode8() -> &'static [f64; 256] {
+    static TABLE: std::sync::OnceLock<[f64; 256]> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| std::array::from_fn(|k| srgb_decode(k as f64 / 255.0)))
 }
 
 impl Photo {
@@ -32,7 +40,9 @@ impl Photo {
             .map(|p| [0, 1, 2].map(|c| f32::from(p[c]) / 255.0))
             .collect();
         let saturated = rgb.chunks_exact(3).map(|p| p.contains(&255)).collect();
-        Ok(Photo::checked(width, height, encoded, saturated, n))
+        let mut photo = Photo::checked(width, height, encoded, saturated, n);
+        photo.eight_bit = true;
+        Ok(photo)
     }
 
     /// A 16-bit sRGB photo from interleaved RGB words; a channel at 65535 marks saturation.
@@ -79,6 +89,7 @@ impl Photo {
             height: h,
             encoded,
             saturated,
+            eight_bit: false,
         }
     }
 
@@ -114,6 +125,10 @@ impl Photo {
 
     /// The linear value of pixel `i`.
     pub fn linear(&self, i: usize) -> [f64; 3] {
+        if self.eight_bit {
+            let table = decode8();
+            return self.encoded[i].map(|v| table[(v * 255.0).round() as usize]);
+        }
         self.encoded[i].map(|v| srgb_decode(f64::from(v)))
     }
 }

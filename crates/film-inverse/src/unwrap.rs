@@ -15,6 +15,8 @@ pub(crate) const SATURATED: u8 = 1;
 pub(crate) const FREE: u8 = 2;
 pub(crate) const LABELLED: u8 = 3;
 pub(crate) const UNEXPLAINED: u8 = 4;
+/// Free, and already waiting in the growth's queue (queued once, at its first key).
+const QUEUED: u8 = 5;
 
 /// The least colour cost that stops the growth (an RMS error of 0.03 per encoded
 /// channel, 8 levels of 8 bits); noisier photos raise it to 4 σ (see
@@ -181,6 +183,7 @@ impl<'a> Grower<'a> {
         for (q, _) in self.neighbours(p) {
             if self.state[q] == FREE {
                 let key = self.information_key(q, i);
+                self.state[q] = QUEUED;
                 self.heap.push(Reverse((u64::from(key) << 32) | q as u64));
             }
         }
@@ -209,7 +212,7 @@ impl<'a> Grower<'a> {
         }
         while let Some(Reverse(key)) = self.heap.pop() {
             let p = (key & 0xFFFF_FFFF) as usize;
-            if self.state[p] != FREE {
+            if self.state[p] != QUEUED {
                 continue;
             }
             if let Some(pred) = self.predict(p) {

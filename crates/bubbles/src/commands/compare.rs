@@ -253,8 +253,9 @@ pub fn stats(de: &[f64]) -> Stats {
     }
 }
 
-mod heatmap {
-    //! The ΔE map in a magma-like ramp, with a labelled colour bar on the right.
+pub(crate) mod heatmap {
+    //! A map of values (ΔE, thickness) in a magma-like ramp, with a labelled colour bar on
+    //! the right; non-finite values (masked pixels) show grey.
 
     use super::CliError;
     use std::path::Path;
@@ -287,7 +288,10 @@ mod heatmap {
         ('.', [0, 0, 0, 0, 2]),
     ];
 
-    pub(super) fn colour(t: f64) -> [u8; 3] {
+    pub(crate) fn colour(t: f64) -> [u8; 3] {
+        if !t.is_finite() {
+            return [128, 128, 128];
+        }
         let x = (t.clamp(0.0, 1.0) * 4.0) as f32;
         let i = (x as usize).min(3);
         let f = x - i as f32;
@@ -295,7 +299,7 @@ mod heatmap {
     }
 
     /// Writes the map, `max` at the top of the scale, through a temporary file.
-    pub(super) fn write(
+    pub(crate) fn write(
         out: &Path,
         de: &[f64],
         (w, h): (u32, u32),
@@ -348,7 +352,8 @@ mod heatmap {
         }
     }
 
-    fn save(out: &Path, img: &image::RgbImage) -> Result<(), CliError> {
+    /// Writes an RGB image as PNG through a temporary file beside `out`.
+    pub(crate) fn save(out: &Path, img: &image::RgbImage) -> Result<(), CliError> {
         let mut png = Vec::new();
         img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
             .map_err(|e| CliError::runtime(format!("cannot encode PNG: {e}")))?;

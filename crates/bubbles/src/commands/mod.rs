@@ -10,3 +10,4 @@ pub mod fit;
 pub mod reflectance;
 pub mod render;
 pub mod simulate;
+pub mod thickness;
