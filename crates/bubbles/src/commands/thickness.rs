@@ -33,46 +33,46 @@ pub struct Args {
     #[arg(long, default_value = "1.33")]
     pub n_film: String,
     /// Index around the film.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     pub n_outside: f64,
     /// CIE standard observer: 1931 (2°) or 1964 (10°).
     #[arg(long, default_value = "1931")]
     pub observer: String,
     /// Thickest film to consider (nm); fits may exceed it by up to a fifth.
-    #[arg(long, default_value_t = 1500.0)]
+    #[arg(long, default_value_t = 1500.0, allow_negative_numbers = true)]
     pub thickness_max_nm: f64,
     /// Angle of incidence of the whole photo (degrees).
-    #[arg(long, conflicts_with_all = ["angle_map", "sphere"])]
+    #[arg(long, conflicts_with_all = ["angle_map", "sphere"], allow_negative_numbers = true)]
     pub angle_deg: Option<f64>,
     /// Per-pixel angle of incidence (degrees) in the R channel of an EXR of the photo's size.
     #[arg(long, conflicts_with = "sphere")]
     pub angle_map: Option<PathBuf>,
     /// A bubble seen from afar: `CX,CY,R` in pixels (outside the disc is excluded).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub sphere: Option<String>,
     /// A region showing the light in a perfect mirror, `X,Y,W,H`: fixes exposure and white balance.
-    #[arg(long, conflicts_with_all = ["reference", "exposure"])]
+    #[arg(long, conflicts_with_all = ["reference", "exposure"], allow_hyphen_values = true)]
     pub white: Option<String>,
     /// A region of known thickness, `X,Y,W,H=NM`: fixes exposure and white balance.
-    #[arg(long, conflicts_with = "exposure")]
+    #[arg(long, conflicts_with = "exposure", allow_hyphen_values = true)]
     pub reference: Option<String>,
     /// Known exposure (linear value of a perfect mirror of the light); default: estimated.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub exposure: Option<f64>,
     /// Known white-balance gains `R,G,B` (with --exposure).
-    #[arg(long, requires = "exposure")]
+    #[arg(long, requires = "exposure", allow_hyphen_values = true)]
     pub gains: Option<String>,
     /// A known thickness `X,Y=NM` (repeatable): fixes the fringe order around it.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub anchor: Vec<String>,
     /// Pixels to use: a PNG of the photo's size, white (non-zero) where the film is.
     #[arg(long)]
     pub mask: Option<PathBuf>,
     /// ΔE2000 above which a fitted pixel counts as unexplained.
-    #[arg(long, default_value_t = 8.0)]
+    #[arg(long, default_value_t = 8.0, allow_negative_numbers = true)]
     pub max_residual_de: f64,
     /// Thickness step (nm) between neighbouring pixels that the continuity prior expects.
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
     pub smoothness_nm: f64,
     /// Print the summary as JSON.
     #[arg(long)]
