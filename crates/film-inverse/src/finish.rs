@@ -131,6 +131,7 @@ pub(crate) fn finish_map(
             *st = match grower.state[p] {
                 unwrap::SATURATED => Status::Saturated,
                 unwrap::UNEXPLAINED => Status::Unexplained,
+                unwrap::AMBIGUOUS => Status::Ambiguous,
                 unwrap::LABELLED => Status::Fitted,
                 _ => Status::Excluded,
             };
@@ -227,6 +228,7 @@ pub(crate) fn with_summary(
         saturated: count(Status::Saturated),
         excluded: count(Status::Excluded),
         unexplained: count(Status::Unexplained),
+        ambiguous: count(Status::Ambiguous),
         residual_mean_de: de_mean,
         residual_p95_de: de[0],
         residual_max_de: de[1],

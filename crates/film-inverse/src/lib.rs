@@ -36,6 +36,7 @@
 mod camera;
 mod error;
 mod finish;
+mod fold;
 mod model;
 mod photo;
 mod settings;
@@ -63,6 +64,9 @@ pub enum Status {
     /// No film thickness explains the colour within the residual bound (background,
     /// glints, dirt): no thickness is given.
     Unexplained,
+    /// Colours that film explains, in a patch (cut off by masked or unexplained pixels)
+    /// too small, or too pale, for its fringe order to be known: no thickness.
+    Ambiguous,
 }
 
 /// The recovered map and everything measured along the way.
@@ -102,6 +106,8 @@ pub struct Summary {
     pub excluded: usize,
     /// Pixels whose colour no thickness explains.
     pub unexplained: usize,
+    /// Pixels in patches too small or too pale to place.
+    pub ambiguous: usize,
     /// Mean ΔE2000 residual over fitted pixels.
     pub residual_mean_de: f64,
     /// 95th-percentile ΔE2000 residual over fitted pixels.
@@ -132,6 +138,7 @@ impl Summary {
             saturated: 0,
             excluded: 0,
             unexplained: 0,
+            ambiguous: 0,
             residual_mean_de: 0.0,
             residual_p95_de: 0.0,
             residual_max_de: 0.0,
@@ -187,7 +194,9 @@ pub fn recover(
             )
         })
         .collect();
-    let regions = grower.resolve(&anchors);
+    let mut regions = grower.resolve(&anchors);
+    let folds = grower.refold();
+    (regions.refolded, regions.lost) = (folds.moved, folds.lost);
     let tables = finish::Tables {
         encoded: &encoded,
         linear: &table,

@@ -16,17 +16,23 @@ pub(crate) const FREE: u8 = 2;
 pub(crate) const LABELLED: u8 = 3;
 pub(crate) const UNEXPLAINED: u8 = 4;
 /// Free, and already waiting in the growth's queue (queued once, at its first key).
-const QUEUED: u8 = 5;
+pub(crate) const QUEUED: u8 = 5;
+/// Labelled, but in an isolated patch too small to fix its fringe order.
+pub(crate) const AMBIGUOUS: u8 = 6;
+/// A region grown from its own seed (no anchor) with fewer labelled pixels than this is
+/// too small for continuity and the order vote to place it.
+const MIN_REGION: usize = 64;
 
 /// The least colour cost that stops the growth (an RMS error of 0.03 per encoded
 /// channel, 8 levels of 8 bits); noisier photos raise it to 4 σ (see
-/// [`unexplained_cost`]).
+/// [`noise_variance`]).
 const MIN_UNEXPLAINED_RMS: f32 = 0.03;
 
-/// The colour cost above which a pixel is no film colour at all and stops the growth:
-/// 4 σ per channel of the photo's noise, estimated from the quality map (a neighbour
-/// difference has variance 2σ², the smoothest half of the photo is mostly noise).
-fn unexplained_cost(quality: &[u32], state: &[u8]) -> f32 {
+/// The photo's noise variance per encoded channel: a neighbour difference has variance
+/// 2σ² per channel, and the smoothest quarter of the photo is mostly noise. (The growth
+/// stops at pixels whose colour cost exceeds 4 σ per channel, or an RMS error of
+/// [`MIN_UNEXPLAINED_RMS`] in quiet photos.)
+fn noise_variance(quality: &[u32], state: &[u8]) -> f32 {
     let mut q: Vec<u32> = quality
         .iter()
         .zip(state)
@@ -34,13 +40,17 @@ fn unexplained_cost(quality: &[u32], state: &[u8]) -> f32 {
         .map(|(q, _)| *q)
         .collect();
     if q.is_empty() {
-        return 3.0 * MIN_UNEXPLAINED_RMS * MIN_UNEXPLAINED_RMS;
+        return 0.0;
     }
     let mid = q.len() / 4;
     let (_, quarter, _) = q.select_nth_unstable(mid);
-    let sigma2 = *quarter as f32 / (1u32 << 20) as f32 / 6.0;
-    3.0 * (16.0 * sigma2).max(MIN_UNEXPLAINED_RMS * MIN_UNEXPLAINED_RMS)
+    *quarter as f32 / (1u32 << 20) as f32 / 6.0
 }
+
+/// How much of a neighbour's slope carries into a prediction.
+const SLOPE_WEIGHT: f32 = 1.0;
+/// The largest slope (samples per pixel) carried on.
+const MAX_SLOPE: f32 = 40.0;
 /// Orders tried either side of a region's first guess.
 const MAX_ORDER_SHIFT: i64 = 8;
 /// Pixels of a region that vote on its order.
@@ -59,10 +69,12 @@ pub(crate) struct Grower<'a> {
     pub(crate) prior: f32,
     /// Colour cost above which a pixel is unexplained.
     unexplained: f32,
-    heap: BinaryHeap<Reverse<u64>>,
+    /// The photo's noise variance per encoded channel, estimated from the quality map.
+    pub(crate) noise2: f32,
+    pub(crate) heap: BinaryHeap<Reverse<u64>>,
     /// Region-search marks: a pixel is visited when its mark equals `generation`.
-    mark: Vec<u32>,
-    generation: u32,
+    pub(crate) mark: Vec<u32>,
+    pub(crate) generation: u32,
 }
 
 /// The best seed candidate found so far.
@@ -71,6 +83,32 @@ struct Clearest {
     pixel: usize,
     first: usize,
     minima: Vec<(usize, f32)>,
+}
+
+/// A region's order vote: the winning shift and Student's t of its lead per pixel over
+/// the runner-up (a region whose winner leads by less than [`MIN_T`] is ambiguous).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Vote {
+    pub(crate) shift: i64,
+    pub(crate) t: f64,
+}
+
+/// The least significance of a region's order (Student's t of the vote's lead).
+const MIN_T: f64 = 5.0;
+
+/// Student's t of the mean of `x` against zero (infinite for a positive mean with no
+/// spread, zero for no samples).
+fn t_statistic(x: &[f64]) -> f64 {
+    if x.len() < 2 {
+        return 0.0;
+    }
+    let n = x.len() as f64;
+    let mean = x.iter().sum::<f64>() / n;
+    let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    if var <= 0.0 {
+        return if mean > 0.0 { f64::INFINITY } else { 0.0 };
+    }
+    mean / (var / n).sqrt()
 }
 
 /// What a region's order vote decided.
@@ -82,6 +120,14 @@ pub struct RegionReport {
     pub anchored: usize,
     /// Regions whose first guess was moved by one or more orders by the vote.
     pub shifted: usize,
+    /// Regions too small, or too pale, to place: their pixels are reported ambiguous.
+    pub unplaced: usize,
+    /// Stretches between turns of the colour curve moved to another branch (see
+    /// docs/inverse.md, "Folds").
+    pub refolded: usize,
+    /// Stretches whose colours fit far worse than the rest (the growth lost the film
+    /// there): their pixels are reported ambiguous.
+    pub lost: usize,
 }
 
 impl<'a> Grower<'a> {
@@ -95,7 +141,8 @@ impl<'a> Grower<'a> {
         prior: f32,
     ) -> Grower<'a> {
         let quality = quality_map(encoded, &state, width);
-        let unexplained = unexplained_cost(&quality, &state);
+        let noise2 = noise_variance(&quality, &state);
+        let unexplained = 3.0 * (16.0 * noise2).max(MIN_UNEXPLAINED_RMS * MIN_UNEXPLAINED_RMS);
         let n = encoded.len();
         Grower {
             table,
@@ -106,6 +153,7 @@ impl<'a> Grower<'a> {
             h: vec![0.0; n],
             prior,
             unexplained,
+            noise2,
             heap: BinaryHeap::new(),
             mark: vec![0; n],
             generation: 0,
@@ -146,7 +194,7 @@ impl<'a> Grower<'a> {
     }
 
     /// The 4-neighbours of `p`.
-    fn neighbours(&self, p: usize) -> impl Iterator<Item = (usize, isize)> + use<> {
+    pub(crate) fn neighbours(&self, p: usize) -> impl Iterator<Item = (usize, isize)> + use<> {
         let (w, n) = (self.width, self.encoded.len());
         let (x, y) = (p % w, p / w);
         let left = (x > 0).then(|| (p - 1, -1));
@@ -156,16 +204,27 @@ impl<'a> Grower<'a> {
         [left, right, up, down].into_iter().flatten()
     }
 
-    /// The thickness the labelled neighbours of `p` predict: their mean. (Extrapolating
-    /// each neighbour's slope was tried and made no difference on the wedge tests where
-    /// the data is strong, while amplifying noise along paths where it is weak.)
+    /// The thickness the labelled neighbours of `p` predict: each neighbour's value,
+    /// carried on along its line by the slope to the pixel beyond it when that one is
+    /// labelled too (so a front crossing a turn of the colour curve keeps the film's
+    /// trend rather than folding back).
     fn predict(&self, p: usize) -> Option<f32> {
         let (mut sum, mut count) = (0.0f32, 0.0f32);
-        for (q, _) in self.neighbours(p) {
-            if self.state[q] == LABELLED {
-                sum += self.h[q];
-                count += 1.0;
+        for (q, step) in self.neighbours(p) {
+            if self.state[q] != LABELLED {
+                continue;
             }
+            let beyond = q as isize + step;
+            let on_line = beyond >= 0
+                && (beyond as usize) < self.state.len()
+                && (step.abs() != 1 || (beyond as usize) / self.width == q / self.width);
+            let slope = if on_line && self.state[beyond as usize] == LABELLED {
+                SLOPE_WEIGHT * (self.h[q] - self.h[beyond as usize]).clamp(-MAX_SLOPE, MAX_SLOPE)
+            } else {
+                0.0
+            };
+            sum += self.h[q] + slope;
+            count += 1.0;
         }
         (count > 0.0).then(|| sum / count)
     }
@@ -193,7 +252,7 @@ impl<'a> Grower<'a> {
     /// changes fast with thickness there are settled first, so that where colours barely
     /// change (pale high orders) the growth arrives last, from every side, rather than
     /// wandering through them (lower keys first).
-    fn information_key(&self, q: usize, i: usize) -> u32 {
+    pub(crate) fn information_key(&self, q: usize, i: usize) -> u32 {
         let row = self.table.row(usize::from(self.rows[q]));
         let (lo, hi) = (i.saturating_sub(2), (i + 2).min(self.table.len - 1));
         let slope2 = dist2(row[lo], row[hi]) / ((hi - lo).max(1) * (hi - lo).max(1)) as f32;
@@ -223,7 +282,7 @@ impl<'a> Grower<'a> {
     }
 
     /// Local minima of pixel `p`'s colour cost over the whole thickness range.
-    fn minima(&self, p: usize) -> Vec<(usize, f32)> {
+    pub(crate) fn minima(&self, p: usize) -> Vec<(usize, f32)> {
         let row = self.table.row(usize::from(self.rows[p]));
         let e = self.encoded[p];
         let d: Vec<f32> = row.iter().map(|t| dist2(e, *t)).collect();
@@ -254,9 +313,29 @@ impl<'a> Grower<'a> {
             if self.revote(seed, &minima, first, &touched) {
                 report.shifted += 1;
             }
+            self.set_aside_if_unplaced(&touched, &mut report);
         }
         report.regions += report.anchored;
         report
+    }
+
+    /// Marks a just-grown region ambiguous if it is too small, or its colours too
+    /// indifferent between orders, to place.
+    fn set_aside_if_unplaced(&mut self, touched: &[usize], report: &mut RegionReport) {
+        let labelled: Vec<usize> = touched
+            .iter()
+            .copied()
+            .filter(|&p| self.state[p] == LABELLED)
+            .collect();
+        if labelled.len() >= MIN_REGION && self.vote(&labelled).t >= MIN_T {
+            return;
+        }
+        report.unplaced += 1;
+        for &p in touched {
+            if self.state[p] == LABELLED {
+                self.state[p] = AMBIGUOUS;
+            }
+        }
     }
 
     /// The pixel of `start`'s free region whose colour names its thickness most clearly:
@@ -324,7 +403,7 @@ impl<'a> Grower<'a> {
             .copied()
             .filter(|&p| self.state[p] == LABELLED)
             .collect();
-        let shift = self.vote(&labelled);
+        let shift = self.vote(&labelled).shift;
         let j = minima.iter().position(|m| m.0 == first).unwrap_or(0) as i64;
         let Some(&(moved, _)) = usize::try_from(j + shift).ok().and_then(|k| minima.get(k)) else {
             return false;
@@ -358,45 +437,62 @@ impl<'a> Grower<'a> {
         false
     }
 
-    /// The order shift under which a sample of the region's pixels fit best.
-    fn vote(&self, labelled: &[usize]) -> i64 {
+    /// The order shift under which a sample of the region's pixels fit best, and how
+    /// significant its lead over the runner-up is.
+    pub(crate) fn vote(&self, labelled: &[usize]) -> Vote {
         let stride = labelled.len().div_ceil(VOTERS).max(1);
         let shifts = 2 * MAX_ORDER_SHIFT as usize + 1;
-        let mut score = vec![0.0f64; shifts];
-        for &p in labelled.iter().step_by(stride) {
-            let minima = self.minima(p);
-            let here = self.h[p] as usize;
-            let Some(j) = minima
-                .iter()
-                .enumerate()
-                .min_by_key(|(_, m)| m.0.abs_diff(here))
-                .map(|(j, _)| j)
-            else {
-                continue;
-            };
-            for (k, s) in score.iter_mut().enumerate() {
-                let at = j as i64 + k as i64 - MAX_ORDER_SHIFT;
-                let d = usize::try_from(at)
-                    .ok()
-                    .and_then(|a| minima.get(a))
-                    .map_or(self.unexplained, |m| m.1);
-                *s += f64::from(d.min(self.unexplained));
-            }
+        let costs: Vec<Vec<f32>> = labelled
+            .iter()
+            .step_by(stride)
+            .filter_map(|&p| self.shifted_costs(p, shifts))
+            .collect();
+        let score: Vec<f64> = (0..shifts)
+            .map(|k| costs.iter().map(|c| f64::from(c[k])).sum())
+            .collect();
+        let offset = |k: usize| (k as i64 - MAX_ORDER_SHIFT).abs();
+        let mut order: Vec<usize> = (0..shifts).collect();
+        order.sort_by(|&a, &b| {
+            score[a]
+                .total_cmp(&score[b])
+                .then(offset(a).cmp(&offset(b)))
+        });
+        let (best, runner_up) = (order[0], order[1]);
+        let lead: Vec<f64> = costs
+            .iter()
+            .map(|c| f64::from(c[runner_up] - c[best]))
+            .collect();
+        Vote {
+            shift: best as i64 - MAX_ORDER_SHIFT,
+            t: t_statistic(&lead),
         }
-        let best = (0..shifts)
-            .min_by(|&a, &b| {
-                score[a].total_cmp(&score[b]).then(
-                    (a as i64 - MAX_ORDER_SHIFT)
-                        .abs()
-                        .cmp(&(b as i64 - MAX_ORDER_SHIFT).abs()),
-                )
-            })
-            .unwrap_or(MAX_ORDER_SHIFT as usize);
-        best as i64 - MAX_ORDER_SHIFT
+    }
+
+    /// Pixel `p`'s colour cost at the local minimum nearest its label, shifted by each of
+    /// `shifts` orders (capped at the unexplained cost; off the table costs the cap).
+    fn shifted_costs(&self, p: usize, shifts: usize) -> Option<Vec<f32>> {
+        let minima = self.minima(p);
+        let here = self.h[p] as usize;
+        let (j, _) = minima
+            .iter()
+            .enumerate()
+            .min_by_key(|(_, m)| m.0.abs_diff(here))?;
+        Some(
+            (0..shifts)
+                .map(|k| {
+                    let at = j as i64 + k as i64 - MAX_ORDER_SHIFT;
+                    let d = usize::try_from(at)
+                        .ok()
+                        .and_then(|a| minima.get(a))
+                        .map_or(self.unexplained, |m| m.1);
+                    d.min(self.unexplained)
+                })
+                .collect(),
+        )
     }
 
     /// Mean colour cost of labelled pixels (infinite for none).
-    fn mean_cost(&self, labelled: &[usize]) -> f64 {
+    pub(crate) fn mean_cost(&self, labelled: &[usize]) -> f64 {
         if labelled.is_empty() {
             return f64::INFINITY;
         }

@@ -118,13 +118,14 @@ fn calibration(
     }
 }
 
-/// Pixel status as a code: 0 fitted, 1 saturated, 2 excluded, 3 unexplained.
+/// Pixel status as a code: 0 fitted, 1 saturated, 2 excluded, 3 unexplained, 4 ambiguous.
 fn status_code(s: Status) -> u8 {
     match s {
         Status::Fitted => 0,
         Status::Saturated => 1,
         Status::Excluded => 2,
         Status::Unexplained => 3,
+        Status::Ambiguous => 4,
     }
 }
 
@@ -141,6 +142,7 @@ fn summary_dict<'py>(py: Python<'py>, s: &Summary) -> PyResult<Bound<'py, PyDict
     d.set_item("saturated", s.saturated)?;
     d.set_item("excluded", s.excluded)?;
     d.set_item("unexplained", s.unexplained)?;
+    d.set_item("ambiguous", s.ambiguous)?;
     d.set_item("residual_mean_de", s.residual_mean_de)?;
     d.set_item("residual_p95_de", s.residual_p95_de)?;
     d.set_item("residual_max_de", s.residual_max_de)?;
@@ -152,6 +154,8 @@ fn summary_dict<'py>(py: Python<'py>, s: &Summary) -> PyResult<Bound<'py, PyDict
     d.set_item("regions", s.regions.regions)?;
     d.set_item("regions_anchored", s.regions.anchored)?;
     d.set_item("regions_shifted", s.regions.shifted)?;
+    d.set_item("regions_unplaced", s.regions.unplaced)?;
+    d.set_item("regions_refolded", s.regions.refolded)?;
     Ok(d)
 }
 

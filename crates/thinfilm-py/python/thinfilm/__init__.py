@@ -222,7 +222,7 @@ def xyz_to_srgb(xyz):
 
 
 # Pixel status codes of thickness_from_rgb.
-FITTED, SATURATED, EXCLUDED, UNEXPLAINED = 0, 1, 2, 3
+FITTED, SATURATED, EXCLUDED, UNEXPLAINED, AMBIGUOUS = 0, 1, 2, 3, 4
 
 
 def _index(name, value):
@@ -347,7 +347,7 @@ def thickness_from_rgb(
     Returns a dict: ``thickness_nm``, ``uncertainty_nm`` (one sigma) and ``residual_de``
     (ΔE2000), each ``(H, W)`` float32 and NaN where a pixel is not fitted; ``status``
     (``(H, W)`` uint8: 0 fitted, 1 saturated, 2 excluded, 3 unexplained, also named
-    ``thinfilm.FITTED``, ``SATURATED``, ``EXCLUDED``, ``UNEXPLAINED``); ``rerender``
+    ``thinfilm.FITTED``, ``SATURATED``, ``EXCLUDED``, ``UNEXPLAINED``, ``AMBIGUOUS``: a patch too small or too pale to place its fringe order); ``rerender``
     (``(H, W, 3)`` float32, the colours the map predicts, sRGB-encoded in [0, 1], the
     photo's own where not fitted); and ``summary``, a dict: the camera's ``exposure`` and
     ``gains``, how it was found (``calibration``: given, white region, reference region

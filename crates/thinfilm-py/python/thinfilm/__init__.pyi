@@ -91,6 +91,7 @@ FITTED: int
 SATURATED: int
 EXCLUDED: int
 UNEXPLAINED: int
+AMBIGUOUS: int
 
 class InverseSummary(TypedDict):
     """The ``summary`` of :func:`thickness_from_rgb`."""
@@ -102,6 +103,7 @@ class InverseSummary(TypedDict):
     saturated: int
     excluded: int
     unexplained: int
+    ambiguous: int
     residual_mean_de: float
     residual_p95_de: float
     residual_max_de: float
@@ -113,6 +115,8 @@ class InverseSummary(TypedDict):
     regions: int
     regions_anchored: int
     regions_shifted: int
+    regions_unplaced: int
+    regions_refolded: int
 
 class ThicknessMap(TypedDict):
     """What :func:`thickness_from_rgb` returns."""

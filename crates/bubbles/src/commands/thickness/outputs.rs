@@ -139,16 +139,17 @@ pub fn print_summary(map: &ThicknessMap, paths: &Paths, json: bool) {
     let c = &s.camera;
     if json {
         println!(
-            "{{\"width\": {}, \"height\": {}, \"fitted\": {}, \"saturated\": {}, \"excluded\": {}, \"unexplained\": {}, \
+            "{{\"width\": {}, \"height\": {}, \"fitted\": {}, \"saturated\": {}, \"excluded\": {}, \"unexplained\": {}, \"ambiguous\": {}, \
 \"thickness_min_nm\": {}, \"thickness_median_nm\": {}, \"thickness_max_nm\": {}, \"uncertainty_median_nm\": {}, \
 \"residual_mean_de\": {}, \"residual_p95_de\": {}, \"residual_max_de\": {}, \"noise_encoded\": {}, \
-\"calibration\": \"{}\", \"exposure\": {}, \"gains\": [{}, {}, {}], \"regions\": {}, \"regions_anchored\": {}, \"regions_shifted\": {}}}",
+\"calibration\": \"{}\", \"exposure\": {}, \"gains\": [{}, {}, {}], \"regions\": {}, \"regions_anchored\": {}, \"regions_shifted\": {}, \"regions_unplaced\": {}, \"regions_refolded\": {}}}",
             map.width,
             map.height,
             s.fitted,
             s.saturated,
             s.excluded,
             s.unexplained,
+            s.ambiguous,
             s.thickness_min_nm,
             s.thickness_median_nm,
             s.thickness_max_nm,
@@ -164,13 +165,15 @@ pub fn print_summary(map: &ThicknessMap, paths: &Paths, json: bool) {
             c.gains[2],
             s.regions.regions,
             s.regions.anchored,
-            s.regions.shifted
+            s.regions.shifted,
+            s.regions.unplaced,
+            s.regions.refolded
         );
         return;
     }
     println!(
-        "{}x{}: {} pixels fitted, {} saturated, {} excluded, {} unexplained",
-        map.width, map.height, s.fitted, s.saturated, s.excluded, s.unexplained
+        "{}x{}: {} pixels fitted, {} saturated, {} excluded, {} unexplained, {} ambiguous",
+        map.width, map.height, s.fitted, s.saturated, s.excluded, s.unexplained, s.ambiguous
     );
     println!(
         "thickness {:.1} to {:.1} nm (median {:.1}), median uncertainty {:.1} nm",
