@@ -8,7 +8,7 @@
 //! from both sides.
 
 use crate::model::TABLE_STEP_NM;
-use crate::unwrap::{AMBIGUOUS, FREE, Grower, LABELLED, QUEUED};
+use crate::unwrap::{AMBIGUOUS, FREE, Grower, LABELLED, QUEUED, UNEXPLAINED};
 use std::cmp::Reverse;
 
 /// A labelled pixel whose colour alone fixes its thickness no better than this (one
@@ -87,9 +87,10 @@ impl Grower<'_> {
                 report.moved += 1;
             }
         }
-        if report.moved > 0 {
-            self.regrow(&loose);
-        }
+        // Pixels the first growth reached with a poor prediction (typically in a turn)
+        // are tried again now that the map around them is known.
+        loose.extend((0..self.state.len()).filter(|&p| self.state[p] == UNEXPLAINED));
+        self.regrow(&loose);
         report.lost = self.set_aside_lost(&stretches);
         report
     }
@@ -217,10 +218,11 @@ impl Grower<'_> {
         false
     }
 
-    /// Frees the turns (and the stretches too small to vote) and grows them again from
-    /// the stretches around them; a pixel no stretch reaches keeps its label.
+    /// Frees the turns, the stretches too small to vote and the unexplained pixels, and
+    /// grows them again from the stretches around them; a pixel no stretch reaches keeps
+    /// its former state.
     fn regrow(&mut self, weak: &[usize]) {
-        let old: Vec<f32> = weak.iter().map(|&p| self.h[p]).collect();
+        let old: Vec<(u8, f32)> = weak.iter().map(|&p| (self.state[p], self.h[p])).collect();
         for &p in weak {
             self.state[p] = FREE;
         }
@@ -233,9 +235,9 @@ impl Grower<'_> {
             }
         }
         self.grow(&[]);
-        for (&p, &h) in weak.iter().zip(&old) {
+        for (&p, &(state, h)) in weak.iter().zip(&old) {
             if self.state[p] == FREE || self.state[p] == QUEUED {
-                (self.state[p], self.h[p]) = (LABELLED, h);
+                (self.state[p], self.h[p]) = (state, h);
             }
         }
     }
