@@ -146,14 +146,14 @@ pub(crate) fn estimate(table: &ColourTable, samples: &[Sample], linear_p99: f64)
     };
     let mut best = [0.0; 3];
     let mut best_cost = f64::INFINITY;
-    for k in -16..=16 {
-        let x = [f64::from(k) / 8.0, 0.0, 0.0];
+    for k in -8..=8 {
+        let x = [f64::from(k) / 4.0, 0.0, 0.0];
         let c = objective(table, &at(x), samples);
         if c < best_cost {
             (best, best_cost) = (x, c);
         }
     }
-    let mut step = 1.0 / 16.0;
+    let mut step = 1.0 / 8.0;
     let mut rounds = 0;
     while step > 1.0 / 512.0 && rounds < 64 {
         rounds += 1;

@@ -334,12 +334,12 @@ fn region_mean(
     Ok(mean)
 }
 
-/// Estimates the camera from up to 4096 usable pixels spread evenly over the photo.
+/// Estimates the camera from up to 2048 usable pixels spread evenly over the photo.
 fn auto_camera(photo: &Photo, table: &ColourTable, rows: &[u16], state: &[u8]) -> Camera {
     let usable: Vec<usize> = (0..photo.len())
         .filter(|&p| state[p] == unwrap::FREE)
         .collect();
-    let stride = usable.len().div_ceil(4096).max(1);
+    let stride = usable.len().div_ceil(2048).max(1);
     let samples: Vec<camera::Sample> = usable
         .iter()
         .step_by(stride)
