@@ -26,6 +26,10 @@ fn main() {
         exposure: nominal_exposure(&model) * 1.1,
         gains: [1.05, 1.0, 0.95],
     };
+    println!(
+        "true camera: exposure {:.4}, gains {:?}",
+        camera.exposure, camera.gains
+    );
     let px = photograph8(
         &colours,
         &CameraModel {

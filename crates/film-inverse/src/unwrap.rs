@@ -32,19 +32,13 @@ const MIN_UNEXPLAINED_RMS: f32 = 0.03;
 /// 2σ² per channel, and the smoothest quarter of the photo is mostly noise. (The growth
 /// stops at pixels whose colour cost exceeds 4 σ per channel, or an RMS error of
 /// [`MIN_UNEXPLAINED_RMS`] in quiet photos.)
-fn noise_variance(quality: &[u32], state: &[u8]) -> f32 {
-    let mut q: Vec<u32> = quality
-        .iter()
-        .zip(state)
-        .filter(|(_, s)| **s == FREE)
-        .map(|(q, _)| *q)
-        .collect();
-    if q.is_empty() {
+fn noise_variance(mut roughness: Vec<f32>) -> f32 {
+    if roughness.is_empty() {
         return 0.0;
     }
-    let mid = q.len() / 4;
-    let (_, quarter, _) = q.select_nth_unstable(mid);
-    *quarter as f32 / (1u32 << 20) as f32 / 6.0
+    let mid = roughness.len() / 4;
+    let (_, quarter, _) = roughness.select_nth_unstable_by(mid, f32::total_cmp);
+    *quarter / 6.0
 }
 
 /// How much of a neighbour's slope carries into a prediction.
@@ -76,6 +70,21 @@ pub(crate) struct Grower<'a> {
     pub(crate) mark: Vec<u32>,
     pub(crate) generation: u32,
 }
+
+/// How clearly a pixel's matches name its thickness: the margin of the best match's
+/// cost under the second best's (infinite for a single match), and the best match.
+fn clearness(minima: &[(usize, f32)]) -> Option<(f32, usize)> {
+    let mut costs: Vec<(f32, usize)> = minima.iter().map(|m| (m.1, m.0)).collect();
+    costs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    match costs.as_slice() {
+        [a, b, ..] => Some((b.0 - a.0, a.1)),
+        [a] => Some((f32::INFINITY, a.1)),
+        [] => None,
+    }
+}
+
+/// Pixels sampled evenly over the photo as seed candidates for its large regions.
+const SEED_SAMPLES: usize = 4096;
 
 /// The best seed candidate found so far.
 struct Clearest {
@@ -140,8 +149,7 @@ impl<'a> Grower<'a> {
         state: Vec<u8>,
         prior: f32,
     ) -> Grower<'a> {
-        let quality = quality_map(encoded, &state, width);
-        let noise2 = noise_variance(&quality, &state);
+        let noise2 = noise_variance(roughness(encoded, &state, width));
         let unexplained = 3.0 * (16.0 * noise2).max(MIN_UNEXPLAINED_RMS * MIN_UNEXPLAINED_RMS);
         let n = encoded.len();
         Grower {
@@ -300,23 +308,66 @@ impl<'a> Grower<'a> {
             let touched = self.grow(anchors);
             report.anchored = usize::from(!touched.is_empty());
         }
+        // The large regions first, each from the clearest of an even sample of the
+        // photo's pixels that it holds (no pass over a whole region to find its seed) ...
+        for (seed, minima, first) in self.clear_samples() {
+            if self.state[seed] == FREE {
+                self.grow_region(seed, &minima, first, &mut report);
+            }
+        }
+        // ... then whatever the sample missed, each from its own clearest pixel.
         let mut cursor = 0;
         while let Some(start) = (cursor..self.state.len()).find(|&p| self.state[p] == FREE) {
             cursor = start;
             let (seed, minima, first) = self.clearest_in_region(start);
-            if minima.is_empty() {
-                self.state[seed] = UNEXPLAINED;
-                continue;
-            }
-            report.regions += 1;
-            let touched = self.grow(&[(seed, first as f32)]);
-            if self.revote(seed, &minima, first, &touched) {
-                report.shifted += 1;
-            }
-            self.set_aside_if_unplaced(&touched, &mut report);
+            self.grow_region(seed, &minima, first, &mut report);
         }
         report.regions += report.anchored;
         report
+    }
+
+    /// Grows one region from `seed` at its match `first`, lets it vote on its order, and
+    /// sets it aside if it cannot be placed.
+    fn grow_region(
+        &mut self,
+        seed: usize,
+        minima: &[(usize, f32)],
+        first: usize,
+        report: &mut RegionReport,
+    ) {
+        if minima.is_empty() {
+            self.state[seed] = UNEXPLAINED;
+            return;
+        }
+        report.regions += 1;
+        let touched = self.grow(&[(seed, first as f32)]);
+        if self.revote(seed, minima, first, &touched) {
+            report.shifted += 1;
+        }
+        self.set_aside_if_unplaced(&touched, report);
+    }
+
+    /// Up to [`SEED_SAMPLES`] free pixels spread evenly over the photo, clearest first,
+    /// each with its matches and its best one.
+    fn clear_samples(&self) -> Vec<(usize, Vec<(usize, f32)>, usize)> {
+        let free: Vec<usize> = (0..self.state.len())
+            .filter(|&p| self.state[p] == FREE)
+            .collect();
+        let stride = free.len().div_ceil(SEED_SAMPLES).max(1);
+        let mut scored: Vec<(f32, usize, Vec<(usize, f32)>, usize)> = free
+            .iter()
+            .step_by(stride)
+            .filter_map(|&p| {
+                let minima = self.minima(p);
+                let (margin, first) = clearness(&minima)?;
+                Some((margin, p, minima, first))
+            })
+            .collect();
+        scored.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        scored
+            .into_iter()
+            .map(|(_, p, m, first)| (p, m, first))
+            .collect()
     }
 
     /// Marks a just-grown region ambiguous if it is too small, or its colours too
@@ -504,31 +555,22 @@ impl<'a> Grower<'a> {
     }
 }
 
-/// Per pixel, the mean squared colour step to its usable 4-neighbours (smooth pixels
-/// are low and grown first), as an integer key.
-fn quality_map(encoded: &[[f32; 3]], state: &[u8], width: usize) -> Vec<u32> {
-    use rayon::prelude::*;
+/// For free pixels spread evenly over the photo (at most [`ROUGHNESS_SAMPLES`]), the
+/// mean squared colour step to their free 4-neighbours.
+fn roughness(encoded: &[[f32; 3]], state: &[u8], width: usize) -> Vec<f32> {
     let n = encoded.len();
+    let stride = n.div_ceil(ROUGHNESS_SAMPLES).max(1);
     (0..n)
-        .into_par_iter()
-        .map(|p| {
-            if state[p] != FREE {
-                return u32::MAX;
-            }
+        .step_by(stride)
+        .filter(|&p| state[p] == FREE)
+        .filter_map(|p| {
             let (x, y) = (p % width, p / width);
-            let mut near = [None; 4];
-            if x > 0 {
-                near[0] = Some(p - 1)
-            }
-            if x + 1 < width {
-                near[1] = Some(p + 1)
-            }
-            if y > 0 {
-                near[2] = Some(p - width)
-            }
-            if p + width < n {
-                near[3] = Some(p + width)
-            }
+            let near = [
+                (x > 0).then(|| p - 1),
+                (x + 1 < width).then(|| p + 1),
+                (y > 0).then(|| p - width),
+                (p + width < n).then(|| p + width),
+            ];
             let (sum, count) = near
                 .iter()
                 .flatten()
@@ -536,10 +578,10 @@ fn quality_map(encoded: &[[f32; 3]], state: &[u8], width: usize) -> Vec<u32> {
                 .fold((0.0f32, 0u32), |(s, c), &q| {
                     (s + dist2(encoded[p], encoded[q]), c + 1)
                 });
-            if count == 0 {
-                return 1 << 24;
-            }
-            ((sum / count as f32) * (1 << 20) as f32).min((1u32 << 31) as f32) as u32
+            (count > 0).then(|| sum / count as f32)
         })
         .collect()
 }
+
+/// Pixels whose roughness estimates the noise.
+const ROUGHNESS_SAMPLES: usize = 1 << 20;
