@@ -86,7 +86,7 @@ fn clearness(minima: &[(usize, f32)]) -> Option<(f32, usize)> {
 /// Pixels sampled evenly over the photo as seed candidates for its large regions.
 const SEED_SAMPLES: usize = 4096;
 
-/// The best seed candidate found so far.
+/// A seed candidate: how clearly its colour names its thickness, and its matches.
 struct Clearest {
     margin: f32,
     pixel: usize,
@@ -310,9 +310,9 @@ impl<'a> Grower<'a> {
         }
         // The large regions first, each from the clearest of an even sample of the
         // photo's pixels that it holds (no pass over a whole region to find its seed) ...
-        for (seed, minima, first) in self.clear_samples() {
-            if self.state[seed] == FREE {
-                self.grow_region(seed, &minima, first, &mut report);
+        for c in self.clear_samples() {
+            if self.state[c.pixel] == FREE {
+                self.grow_region(c.pixel, &c.minima, c.first, &mut report);
             }
         }
         // ... then whatever the sample missed, each from its own clearest pixel.
@@ -349,25 +349,27 @@ impl<'a> Grower<'a> {
 
     /// Up to [`SEED_SAMPLES`] free pixels spread evenly over the photo, clearest first,
     /// each with its matches and its best one.
-    fn clear_samples(&self) -> Vec<(usize, Vec<(usize, f32)>, usize)> {
+    fn clear_samples(&self) -> Vec<Clearest> {
         let free: Vec<usize> = (0..self.state.len())
             .filter(|&p| self.state[p] == FREE)
             .collect();
         let stride = free.len().div_ceil(SEED_SAMPLES).max(1);
-        let mut scored: Vec<(f32, usize, Vec<(usize, f32)>, usize)> = free
+        let mut scored: Vec<Clearest> = free
             .iter()
             .step_by(stride)
-            .filter_map(|&p| {
-                let minima = self.minima(p);
+            .filter_map(|&pixel| {
+                let minima = self.minima(pixel);
                 let (margin, first) = clearness(&minima)?;
-                Some((margin, p, minima, first))
+                Some(Clearest {
+                    margin,
+                    pixel,
+                    first,
+                    minima,
+                })
             })
             .collect();
-        scored.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        scored.sort_by(|a, b| b.margin.total_cmp(&a.margin).then(a.pixel.cmp(&b.pixel)));
         scored
-            .into_iter()
-            .map(|(_, p, m, first)| (p, m, first))
-            .collect()
     }
 
     /// Marks a just-grown region ambiguous if it is too small, or its colours too
