@@ -9,7 +9,7 @@ use std::sync::Arc;
 
 use bubble_dynamics::film_flow::{CubeSphere, FilmFlow, FlowParams, Forcing, Hierarchy};
 use film_inverse::synth::{CameraModel, film_colours, nominal_exposure, photograph8};
-use film_inverse::{Camera, FilmModel, Photo, Settings, Status, Viewing, recover};
+use film_inverse::{Camera, FilmModel, Photo, Settings, Viewing, recover};
 use glam::{DVec3, Vec3};
 use render_scene::film_field::FilmField;
 use thinfilm::Illuminant;
@@ -105,23 +105,10 @@ fn a_swirled_bubble_cap_is_recovered_within_20_nm_with_no_order_errors() {
     )
     .unwrap();
 
-    let (mut sum2, mut ok, mut wrong, mut fitted) = (0.0, 0usize, 0usize, 0usize);
-    for (p, t) in truth.iter().enumerate() {
-        if map.status[p] != Status::Fitted {
-            continue;
-        }
-        fitted += 1;
-        let e = f64::from(map.thickness_nm[p] - t);
-        if e.abs() > 100.0 {
-            wrong += 1;
-        } else {
-            sum2 += e * e;
-            ok += 1;
-        }
-    }
+    let e = film_inverse::synth::errors(&map, &truth);
+    let fitted = map.summary.fitted;
     let inside = pixels.iter().filter(|p| p.is_some()).count();
-    let rms = (sum2 / ok.max(1) as f64).sqrt();
-    let order_errors = wrong as f64 / fitted.max(1) as f64;
+    let (rms, order_errors) = (e.rms_nm, e.order_errors);
     let (lo, hi) = truth
         .iter()
         .zip(&pixels)

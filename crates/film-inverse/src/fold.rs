@@ -164,22 +164,7 @@ impl Grower<'_> {
 
     /// The labelled, non-weak pixels 4-connected to `start`.
     fn stretch(&mut self, start: usize, is_weak: &[bool]) -> Vec<usize> {
-        self.generation += 1;
-        let generation = self.generation;
-        self.mark[start] = generation;
-        let mut seen = vec![start];
-        let mut k = 0;
-        while k < seen.len() {
-            let p = seen[k];
-            k += 1;
-            for (q, _) in self.neighbours(p) {
-                if self.state[q] == LABELLED && !is_weak[q] && self.mark[q] != generation {
-                    self.mark[q] = generation;
-                    seen.push(q);
-                }
-            }
-        }
-        seen
+        self.flood(start, |g, q| g.state[q] == LABELLED && !is_weak[q])
     }
 
     /// Moves `stretch` by the vote's shift if its colours then fit clearly better.

@@ -4,6 +4,7 @@
 
 use crate::camera::Camera;
 use crate::model::{ColourTable, FilmModel};
+use crate::{Status, ThicknessMap};
 use rayon::prelude::*;
 
 /// SplitMix64: a small, well-mixed generator, seeded per pixel so that photos made in
@@ -121,4 +122,58 @@ pub fn photograph8(colours: &[[f64; 3]], camera: &CameraModel) -> Vec<u8> {
             })
         })
         .collect()
+}
+
+/// A recovered map's errors against the thickness it was made from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MapErrors {
+    /// RMS error (nm) over fitted pixels that are not order errors.
+    pub rms_nm: f64,
+    /// Fraction of fitted pixels more than 100 nm (half an order) off.
+    pub order_errors: f64,
+    /// Fraction of the pixels not excluded (saturated ones included) that were fitted.
+    pub fitted: f64,
+    /// Fraction of fitted pixels whose error is within 2 σ of their uncertainty.
+    pub within_2_sigma: f64,
+}
+
+/// Compares `map` with the `truth` (nm per pixel) it was recovered from.
+///
+/// # Panics
+/// If `truth` is not one value per pixel of the map.
+pub fn errors(map: &ThicknessMap, truth: &[f32]) -> MapErrors {
+    assert_eq!(
+        truth.len(),
+        map.status.len(),
+        "one true thickness per pixel"
+    );
+    let (mut sum2, mut ok, mut wrong, mut covered, mut fitted) =
+        (0.0, 0usize, 0usize, 0usize, 0usize);
+    for (p, t) in truth.iter().enumerate() {
+        if map.status[p] != Status::Fitted {
+            continue;
+        }
+        fitted += 1;
+        let e = f64::from(map.thickness_nm[p] - t);
+        if e.abs() > 100.0 {
+            wrong += 1;
+        } else {
+            sum2 += e * e;
+            ok += 1;
+        }
+        if e.abs() <= 2.0 * f64::from(map.uncertainty_nm[p]) {
+            covered += 1;
+        }
+    }
+    let usable = map
+        .status
+        .iter()
+        .filter(|s| **s != Status::Excluded)
+        .count();
+    MapErrors {
+        rms_nm: (sum2 / ok.max(1) as f64).sqrt(),
+        order_errors: wrong as f64 / fitted.max(1) as f64,
+        fitted: fitted as f64 / usable.max(1) as f64,
+        within_2_sigma: covered as f64 / fitted.max(1) as f64,
+    }
 }

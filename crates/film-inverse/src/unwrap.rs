@@ -67,8 +67,8 @@ pub(crate) struct Grower<'a> {
     pub(crate) noise2: f32,
     pub(crate) heap: BinaryHeap<Reverse<u64>>,
     /// Region-search marks: a pixel is visited when its mark equals `generation`.
-    pub(crate) mark: Vec<u32>,
-    pub(crate) generation: u32,
+    mark: Vec<u32>,
+    generation: u32,
 }
 
 /// How clearly a pixel's matches name its thickness: the margin of the best match's
@@ -424,6 +424,15 @@ impl<'a> Grower<'a> {
 
     /// The free pixels 4-connected to `start` through free pixels.
     fn region(&mut self, start: usize) -> Vec<usize> {
+        self.flood(start, |g, q| g.state[q] == FREE)
+    }
+
+    /// The pixels 4-connected to `start` through pixels that `inside` accepts.
+    pub(crate) fn flood(
+        &mut self,
+        start: usize,
+        inside: impl Fn(&Self, usize) -> bool,
+    ) -> Vec<usize> {
         self.generation += 1;
         let generation = self.generation;
         self.mark[start] = generation;
@@ -433,7 +442,7 @@ impl<'a> Grower<'a> {
             let p = seen[k];
             k += 1;
             for (q, _) in self.neighbours(p) {
-                if self.state[q] == FREE && self.mark[q] != generation {
+                if self.mark[q] != generation && inside(self, q) {
                     self.mark[q] = generation;
                     seen.push(q);
                 }

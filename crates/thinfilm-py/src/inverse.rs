@@ -156,6 +156,7 @@ fn summary_dict<'py>(py: Python<'py>, s: &Summary) -> PyResult<Bound<'py, PyDict
     d.set_item("regions_shifted", s.regions.shifted)?;
     d.set_item("regions_unplaced", s.regions.unplaced)?;
     d.set_item("regions_refolded", s.regions.refolded)?;
+    d.set_item("regions_lost", s.regions.lost)?;
     Ok(d)
 }
 

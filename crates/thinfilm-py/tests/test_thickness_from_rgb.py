@@ -54,7 +54,8 @@ def test_given_exposure_recovers_the_ramp_within_5_nm():
     expected = {"exposure", "gains", "calibration", "fitted", "saturated", "excluded",
                 "unexplained", "residual_mean_de", "residual_p95_de", "residual_max_de",
                 "noise_encoded", "thickness_min_nm", "thickness_median_nm", "thickness_max_nm",
-                "uncertainty_median_nm", "regions", "regions_anchored", "regions_shifted"}
+                "uncertainty_median_nm", "regions", "regions_anchored", "regions_shifted",
+                "ambiguous", "regions_unplaced", "regions_refolded", "regions_lost"}
     assert set(s) == expected
 
 

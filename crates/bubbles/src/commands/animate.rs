@@ -3,7 +3,7 @@
 
 mod apng;
 mod gif;
-mod sink;
+pub(crate) mod sink;
 
 use crate::error::{CliError, CliResult};
 use crate::frame::progress::Progress;

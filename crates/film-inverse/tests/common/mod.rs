@@ -4,55 +4,9 @@
 #![allow(dead_code)]
 
 use film_inverse::synth::{self, CameraModel};
-use film_inverse::{
-    Calibration, Camera, FilmModel, Photo, Settings, Status, ThicknessMap, recover,
-};
+use film_inverse::{Calibration, Camera, FilmModel, Photo, Settings, ThicknessMap, recover};
 
-/// Errors of a recovery against the truth.
-#[derive(Debug, Clone, Copy)]
-pub struct Errors {
-    /// RMS thickness error (nm) over fitted pixels that are not order errors.
-    pub rms_nm: f64,
-    /// Fraction of fitted pixels off by more than 100 nm (half an order).
-    pub order_errors: f64,
-    /// Fraction of usable pixels fitted.
-    pub fitted: f64,
-    /// Fraction of fitted pixels whose error is within 2 sigma of their uncertainty.
-    pub within_2_sigma: f64,
-}
-
-/// Compares a map with the truth.
-pub fn errors(map: &ThicknessMap, truth: &[f32]) -> Errors {
-    let (mut sum2, mut ok, mut wrong, mut covered, mut fitted) =
-        (0.0, 0usize, 0usize, 0usize, 0usize);
-    for (p, t) in truth.iter().enumerate() {
-        if map.status[p] != Status::Fitted {
-            continue;
-        }
-        fitted += 1;
-        let e = f64::from(map.thickness_nm[p] - t);
-        if e.abs() > 100.0 {
-            wrong += 1;
-        } else {
-            sum2 += e * e;
-            ok += 1;
-        }
-        if e.abs() <= 2.0 * f64::from(map.uncertainty_nm[p]) {
-            covered += 1;
-        }
-    }
-    let usable = map
-        .status
-        .iter()
-        .filter(|s| **s != Status::Excluded)
-        .count();
-    Errors {
-        rms_nm: (sum2 / ok.max(1) as f64).sqrt(),
-        order_errors: wrong as f64 / fitted.max(1) as f64,
-        fitted: fitted as f64 / usable.max(1) as f64,
-        within_2_sigma: covered as f64 / fitted.max(1) as f64,
-    }
-}
+pub use film_inverse::synth::{MapErrors as Errors, errors};
 
 /// The generator's settings for one photo.
 #[derive(Debug, Clone, Copy)]

@@ -117,6 +117,7 @@ class InverseSummary(TypedDict):
     regions_shifted: int
     regions_unplaced: int
     regions_refolded: int
+    regions_lost: int
 
 class ThicknessMap(TypedDict):
     """What :func:`thickness_from_rgb` returns."""

@@ -115,15 +115,7 @@ fn write_exr(out: &Path, map: &ThicknessMap) -> Result<(), CliError> {
         .ok_or_else(|| CliError::runtime("the map's buffer does not match its size"))?;
     let cannot =
         |e: &dyn std::fmt::Display| CliError::input(format!("cannot write {}: {e}", out.display()));
-    let dir = match out.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".bubbles-").suffix(".tmp");
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
-    let tmp = builder.tempfile_in(dir).map_err(|e| cannot(&e))?;
+    let tmp = crate::commands::animate::sink::temporary_beside(out).map_err(CliError::input)?;
     image::DynamicImage::ImageRgba32F(img)
         .write_to(
             &mut std::io::BufWriter::new(tmp.as_file()),
@@ -142,7 +134,7 @@ pub fn print_summary(map: &ThicknessMap, paths: &Paths, json: bool) {
             "{{\"width\": {}, \"height\": {}, \"fitted\": {}, \"saturated\": {}, \"excluded\": {}, \"unexplained\": {}, \"ambiguous\": {}, \
 \"thickness_min_nm\": {}, \"thickness_median_nm\": {}, \"thickness_max_nm\": {}, \"uncertainty_median_nm\": {}, \
 \"residual_mean_de\": {}, \"residual_p95_de\": {}, \"residual_max_de\": {}, \"noise_encoded\": {}, \
-\"calibration\": \"{}\", \"exposure\": {}, \"gains\": [{}, {}, {}], \"regions\": {}, \"regions_anchored\": {}, \"regions_shifted\": {}, \"regions_unplaced\": {}, \"regions_refolded\": {}}}",
+\"calibration\": \"{}\", \"exposure\": {}, \"gains\": [{}, {}, {}], \"regions\": {}, \"regions_anchored\": {}, \"regions_shifted\": {}, \"regions_unplaced\": {}, \"regions_refolded\": {}, \"regions_lost\": {}}}",
             map.width,
             map.height,
             s.fitted,
@@ -167,7 +159,8 @@ pub fn print_summary(map: &ThicknessMap, paths: &Paths, json: bool) {
             s.regions.anchored,
             s.regions.shifted,
             s.regions.unplaced,
-            s.regions.refolded
+            s.regions.refolded,
+            s.regions.lost
         );
         return;
     }
