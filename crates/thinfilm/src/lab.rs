@@ -32,11 +32,21 @@ pub fn lab_from_xyz(xyz: [f64; 3], white_xyz: [f64; 3]) -> Lab {
     }
 }
 
+/// `√(a² + b²)`: directly for any colour (|a|, |b| < 1e150), where it is exact to an
+/// ulp and several times faster than `hypot`, whose overflow guard only matters beyond.
+fn chroma(a: f64, b: f64) -> f64 {
+    if a.abs().max(b.abs()) < 1e150 {
+        (a * a + b * b).sqrt()
+    } else {
+        a.hypot(b)
+    }
+}
+
 /// The CIEDE2000 colour difference ΔE₀₀ (CIE 142-2001) with kL = kC = kH = 1,
 /// following Sharma, Wu & Dalal (2005), including their conventions for the
 /// mean hue at exactly opposite hues.
 pub fn ciede2000(a: Lab, b: Lab) -> f64 {
-    let c_mean_ab = 0.5 * (a.a.hypot(a.b) + b.a.hypot(b.b));
+    let c_mean_ab = 0.5 * (chroma(a.a, a.b) + chroma(b.a, b.b));
     let g = 0.5 * (1.0 - (c_mean_ab.powi(7) / (c_mean_ab.powi(7) + 25f64.powi(7))).sqrt());
     let (c1, h1) = chroma_hue(a, g);
     let (c2, h2) = chroma_hue(b, g);
@@ -73,7 +83,7 @@ const HUE_EPS_DEG: f64 = 1e-9;
 /// C′ and h′ (degrees in [0, 360)) after CIEDE2000's a* rescaling by 1 + G.
 fn chroma_hue(lab: Lab, g: f64) -> (f64, f64) {
     let a = (1.0 + g) * lab.a;
-    let c = a.hypot(lab.b);
+    let c = chroma(a, lab.b);
     let h = if c == 0.0 {
         0.0
     } else {
