@@ -54,6 +54,7 @@ pub fn run(args: Args) -> CliResult {
     }
     if let Some(out) = &args.heatmap {
         refuse_overwriting_an_input(out, [&args.a, &args.b])?;
+        crate::output::check_file("--heatmap", out)?;
     }
     let size_a = check_header(&args.a)?;
     let size_b = check_header(&args.b)?;

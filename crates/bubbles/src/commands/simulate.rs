@@ -84,6 +84,7 @@ pub fn run(args: Args) -> CliResult {
         ("--export-film", &args.export_film),
     ] {
         if let Some(dir) = dir {
+            crate::output::check_dir(flag, dir)?;
             std::fs::create_dir_all(dir).map_err(|e| {
                 CliError::input(format!(
                     "{flag} {}: cannot create directory: {e}",
@@ -271,7 +272,7 @@ fn write_films(world: &World, dir: &Path, frame: usize) -> CliResult {
         let path = dir.join(format!("film_{}_{frame:05}.exr", b.id()));
         image
             .write_exr(&path)
-            .map_err(|e| CliError::runtime(format!("cannot write {}: {e}", path.display())))?;
+            .map_err(|e| CliError::input(e.to_string()))?;
     }
     Ok(())
 }
@@ -283,7 +284,7 @@ fn write_atomic(path: &Path, text: &str) -> CliResult {
         .and_then(|()| std::fs::rename(&tmp, path))
         .map_err(|e| {
             let _ = std::fs::remove_file(&tmp);
-            CliError::runtime(format!("cannot write {}: {e}", path.display()))
+            CliError::input(format!("cannot write {}: {e}", path.display()))
         })
 }
 

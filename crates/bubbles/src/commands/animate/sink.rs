@@ -30,15 +30,23 @@ impl Output {
     /// extension (or an existing directory) is a frame directory.
     ///
     /// # Errors
-    /// Any other extension, naming it.
+    /// Any other extension, naming it, or a file extension on an existing directory.
     pub fn from_path(path: &Path) -> Result<Self, String> {
-        if path.is_dir() {
-            return Ok(Self::Dir(path.to_path_buf()));
-        }
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
+        let file = matches!(ext.as_deref(), Some("apng" | "png" | "gif"));
+        if path.is_dir() && file {
+            return Err(format!(
+                "--out {}: is a directory, but .{} names one animation file",
+                path.display(),
+                ext.unwrap_or_default()
+            ));
+        }
+        if path.is_dir() {
+            return Ok(Self::Dir(path.to_path_buf()));
+        }
         match ext.as_deref() {
             None => Ok(Self::Dir(path.to_path_buf())),
             Some("apng" | "png") => Ok(Self::Apng(path.to_path_buf())),
@@ -87,9 +95,16 @@ impl Sink {
     /// Adds frame `k`.
     pub fn push(&mut self, k: u64, frame: &Rgb8) -> Result<(), String> {
         match self {
-            Sink::Dir(dir) => write_png(&frame_path(dir, k), frame),
-            Sink::Apng(apng) => apng.push(frame),
-            Sink::Gif(gif) => gif.push(frame),
+            Sink::Dir(dir) => {
+                let path = frame_path(dir, k);
+                write_png(&path, frame).map_err(|e| format!("cannot write {}: {e}", path.display()))
+            }
+            Sink::Apng(apng) => apng
+                .push(frame)
+                .map_err(|e| format!("cannot write {}: {e}", apng.path().display())),
+            Sink::Gif(gif) => gif
+                .push(frame)
+                .map_err(|e| format!("cannot write {}: {e}", gif.path().display())),
         }
     }
 

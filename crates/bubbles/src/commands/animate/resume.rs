@@ -1,0 +1,93 @@
+//! `--resume`: which frames in a frame directory are whole and can be kept. A frame is
+//! kept only if it decodes completely (PNG's chunk CRCs and zlib's Adler-32 checksum
+//! catch a truncated or damaged file) at the animation's size; any other is rendered
+//! again. Temporaries a killed run left behind are removed first.
+
+use super::sink::frame_path;
+use crate::error::CliError;
+use std::ops::Range;
+use std::path::Path;
+
+/// Prefix and suffix of the temporary files the frame writers create.
+const TEMP_PREFIX: &str = ".bubbles-";
+const TEMP_SUFFIX: &str = ".tmp";
+
+/// Removes the temporaries (`.bubbles-*.tmp`) a killed run left in `dir`; returns how many.
+pub fn remove_stale_temporaries(dir: &Path) -> usize {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return 0;
+    };
+    entries
+        .filter_map(Result::ok)
+        .filter(|e| {
+            let name = e.file_name();
+            let name = name.to_string_lossy();
+            name.starts_with(TEMP_PREFIX) && name.ends_with(TEMP_SUFFIX)
+        })
+        .filter(|e| std::fs::remove_file(e.path()).is_ok())
+        .count()
+}
+
+/// For each frame of `range`, whether `dir` holds it whole at `width × height`. A damaged
+/// frame is reported on stderr and left to be rendered again.
+///
+/// # Errors
+/// A frame path that is a directory (it could never be written), naming the frame.
+pub fn whole_frames(
+    dir: &Path,
+    range: Range<u64>,
+    (width, height): (usize, usize),
+) -> Result<Vec<bool>, CliError> {
+    range
+        .map(|k| {
+            let path = frame_path(dir, k);
+            if path.is_dir() {
+                return Err(CliError::input(format!(
+                    "frame {k}: {} is a directory, not a frame: remove it",
+                    path.display()
+                )));
+            }
+            if !path.exists() {
+                return Ok(false);
+            }
+            match check_frame(&path, width, height) {
+                Ok(()) => Ok(true),
+                Err(why) => {
+                    eprintln!("frame {k}: {} {why}: rendering it again", path.display());
+                    Ok(false)
+                }
+            }
+        })
+        .collect()
+}
+
+/// Whether a directory holds frames (`frame_*.png`) of some earlier run.
+pub fn has_frames(dir: &Path) -> bool {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return false;
+    };
+    entries.filter_map(Result::ok).any(|e| {
+        let name = e.file_name();
+        let name = name.to_string_lossy();
+        name.starts_with("frame_") && name.ends_with(".png")
+    })
+}
+
+/// Decodes the whole PNG at `path` and checks its size.
+fn check_frame(path: &Path, width: usize, height: usize) -> Result<(), String> {
+    let file = std::fs::File::open(path).map_err(|e| format!("cannot be read ({e})"))?;
+    let decoder = png::Decoder::new(std::io::BufReader::new(file));
+    let mut reader = decoder
+        .read_info()
+        .map_err(|e| format!("is no PNG ({e})"))?;
+    let info = reader.info();
+    let size = (info.width as usize, info.height as usize);
+    if size != (width, height) {
+        return Err(format!("is {}x{}, not {width}x{height}", size.0, size.1));
+    }
+    let mut buf = vec![0; reader.output_buffer_size().ok_or("is too large")?];
+    reader
+        .next_frame(&mut buf)
+        .map_err(|e| format!("is damaged ({e})"))?;
+    reader.finish().map_err(|e| format!("is damaged ({e})"))
+}
