@@ -172,6 +172,23 @@ fn color_thickness_of_1e30_is_refused_as_input_not_an_optics_failure() {
 }
 
 #[test]
+fn fit_over_a_thickness_range_of_1e308_is_refused_not_a_panic_or_an_abort() {
+    let dir = tempfile::tempdir().unwrap();
+    let spectrum = "wavelength_nm,r\n400,0.05\n500,0.08\n600,0.03\n700,0.06\n";
+    std::fs::write(dir.path().join("r.csv"), spectrum).unwrap();
+    // 1e308 overflowed a capacity (exit 101), 1e12 asked for 851 GB (abort).
+    for max in ["1e308", "1e12"] {
+        let out = bubbles(&["fit", "--spectrum", "r.csv", "--max-nm", max], dir.path());
+        refused(&out, &[max, "more than 1e8: narrow the range"]);
+    }
+    let out = bubbles(
+        &["fit", "--spectrum", "r.csv", "--max-nm", "2000"],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+#[test]
 fn reflectance_at_the_edges_of_the_ranges_stays_physical() {
     for stack in [
         "1.0 | 1.38 @ 1e9 | 1.0",
@@ -347,6 +364,34 @@ fn resume_renders_truncated_and_empty_frames_again_and_removes_temporaries() {
         files_in(&frames),
         ["animation.txt", "frame_00000.png", "frame_00001.png"]
     );
+}
+
+#[test]
+fn resume_renders_swapped_frames_again_by_their_recorded_checksums() {
+    let dir = scene("");
+    assert!(animate(dir.path(), &[]).status.success());
+    let frames = dir.path().join("f");
+    let manifest = std::fs::read_to_string(frames.join("animation.txt")).unwrap();
+    assert_eq!(manifest.matches("fnv1a64").count(), 2, "{manifest}");
+    let (a, b) = (
+        frames.join("frame_00000.png"),
+        frames.join("frame_00001.png"),
+    );
+    let (first, second) = (std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    assert_ne!(first, second);
+    // Both decode at the right size: only the checksums tell them apart.
+    std::fs::write(&a, &second).unwrap();
+    std::fs::write(&b, &first).unwrap();
+    let out = animate(dir.path(), &["--resume"]);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert_eq!(
+        err.matches("does not match its checksum").count(),
+        2,
+        "{err}"
+    );
+    assert_eq!(std::fs::read(&a).unwrap(), first);
+    assert_eq!(std::fs::read(&b).unwrap(), second);
 }
 
 #[test]

@@ -16,6 +16,7 @@ use num_complex::Complex64;
 use std::fmt;
 
 mod error;
+pub(crate) use error::Num;
 pub use error::OpticsError;
 
 /// Complex amplitude coefficients of a surface or a stack, for s and p polarisation.

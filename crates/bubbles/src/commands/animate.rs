@@ -33,10 +33,11 @@ pub const MANIFEST: &str = "animation.txt";
     and fps <= 240.\n\n\
     --out DIR writes DIR/frame_00000.png, … each through a temporary file renamed into \
     place, so an interrupted run leaves only whole frames, and DIR/animation.txt records \
-    the scene and settings (a DIR made with other settings, or holding frames without it, \
-    is refused). --resume decodes the frames in DIR and renders only those missing, \
-    truncated or of another size, after removing stale temporaries; --frames A..B renders \
-    frames A to B − 1 only. Both give frames byte-identical to those of one uninterrupted run, so one animation can be split \
+    the scene and settings and a checksum per frame (a DIR made with other settings, or \
+    holding frames without it, is refused). --resume checks and decodes the frames in DIR \
+    and renders only those missing, damaged or of another size, after removing stale \
+    temporaries; --frames A..B renders frames A to B − 1 only. Both give frames \
+    byte-identical to those of one uninterrupted run, so one animation can be split \
     across machines (e.g. a Slurm array job, one --frames range per task).\n\n\
     --out PATH.apng or PATH.png writes one animated PNG: the exact 8-bit frames. \
     --out PATH.gif writes a preview with a 256-colour palette per frame (NeuQuant, \
@@ -252,7 +253,9 @@ fn open_dir(dir: &Path, manifest: &str) -> Result<(), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create the directory: {e}"))?;
     let path = dir.join(MANIFEST);
     if let Ok(existing) = std::fs::read_to_string(&path) {
-        if existing == manifest {
+        // The settings, then one checksum line per frame written.
+        let frames_only = |rest: &str| rest.lines().all(|l| l.starts_with("frame "));
+        if existing.strip_prefix(manifest).is_some_and(frames_only) {
             return Ok(());
         }
         return Err(format!(

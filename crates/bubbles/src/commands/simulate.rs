@@ -125,7 +125,7 @@ fn check_args(args: &Args) -> CliResult {
     if !(args.seconds.is_finite() && args.seconds >= 0.0) {
         return Err(CliError::input(format!(
             "--seconds {} must be a finite number >= 0",
-            args.seconds
+            plain(args.seconds)
         )));
     }
     if let Some(r) = args.radius_m
@@ -136,7 +136,7 @@ fn check_args(args: &Args) -> CliResult {
     if !(args.fps.is_finite() && args.fps > 0.0) {
         return Err(CliError::input(format!(
             "--fps {} must be a finite number > 0",
-            args.fps
+            plain(args.fps)
         )));
     }
     Ok(())

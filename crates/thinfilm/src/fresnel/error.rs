@@ -200,7 +200,7 @@ impl std::error::Error for OpticsError {}
 
 /// A number as a message shows it: the shortest decimal between 1e-4 and 1e7, and the
 /// short exponent form (`1e-300`, `1e308`) outside, never hundreds of digits.
-struct Num(f64);
+pub(crate) struct Num(pub(crate) f64);
 
 impl fmt::Display for Num {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

@@ -1,10 +1,12 @@
 //! `--resume`: which frames in a frame directory are whole and can be kept. A frame is
-//! kept only if it decodes completely (PNG's chunk CRCs and zlib's Adler-32 checksum
+//! kept only if its bytes match the checksum the manifest recorded when it was written
+//! (when there is one), and it decodes completely (PNG's chunk CRCs and zlib's Adler-32
 //! catch a truncated or damaged file) at the animation's size; any other is rendered
 //! again. Temporaries a killed run left behind are removed first.
 
-use super::sink::frame_path;
+use super::sink::{checksum, frame_path};
 use crate::error::CliError;
+use std::collections::HashMap;
 use std::ops::Range;
 use std::path::Path;
 
@@ -38,6 +40,7 @@ pub fn whole_frames(
     range: Range<u64>,
     (width, height): (usize, usize),
 ) -> Result<Vec<bool>, CliError> {
+    let recorded = recorded_checksums(dir);
     range
         .map(|k| {
             let path = frame_path(dir, k);
@@ -50,7 +53,7 @@ pub fn whole_frames(
             if !path.exists() {
                 return Ok(false);
             }
-            match check_frame(&path, width, height) {
+            match check_frame(&path, recorded.get(&k).copied(), width, height) {
                 Ok(()) => Ok(true),
                 Err(why) => {
                     eprintln!("frame {k}: {} {why}: rendering it again", path.display());
@@ -73,10 +76,43 @@ pub fn has_frames(dir: &Path) -> bool {
     })
 }
 
-/// Decodes the whole PNG at `path` and checks its size.
-fn check_frame(path: &Path, width: usize, height: usize) -> Result<(), String> {
-    let file = std::fs::File::open(path).map_err(|e| format!("cannot be read ({e})"))?;
-    let decoder = png::Decoder::new(std::io::BufReader::new(file));
+/// The last checksum the manifest records for each frame (`frame K fnv1a64 HEX` lines;
+/// a line damaged by a crash is skipped, leaving its frame to the decode check).
+fn recorded_checksums(dir: &Path) -> HashMap<u64, u64> {
+    let text = std::fs::read_to_string(dir.join(super::MANIFEST)).unwrap_or_default();
+    text.lines()
+        .filter_map(|line| {
+            let mut words = line.split(' ');
+            let (Some("frame"), Some(k), Some("fnv1a64"), Some(sum), None) = (
+                words.next(),
+                words.next(),
+                words.next(),
+                words.next(),
+                words.next(),
+            ) else {
+                return None;
+            };
+            Some((k.parse().ok()?, u64::from_str_radix(sum, 16).ok()?))
+        })
+        .collect()
+}
+
+/// Checks the frame at `path` against its recorded checksum, then decodes it whole and
+/// checks its size.
+fn check_frame(
+    path: &Path,
+    recorded: Option<u64>,
+    width: usize,
+    height: usize,
+) -> Result<(), String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("cannot be read ({e})"))?;
+    if recorded.is_some_and(|sum| sum != checksum(&bytes)) {
+        return Err(format!(
+            "does not match its checksum in {}",
+            super::MANIFEST
+        ));
+    }
+    let decoder = png::Decoder::new(std::io::Cursor::new(&bytes));
     let mut reader = decoder
         .read_info()
         .map_err(|e| format!("is no PNG ({e})"))?;
