@@ -52,7 +52,23 @@ fn check_creatable(dir: &Path) -> Result<(), String> {
         .suffix(".tmp")
         .tempfile_in(dir)
         .map(drop)
-        .map_err(|e| format!("cannot create a file in {}: {e}", dir.display()))
+        .map_err(|e| {
+            format!(
+                "cannot create a file in {}: {}",
+                dir.display(),
+                os_reason(&e)
+            )
+        })
+}
+
+/// The operating system's reason for `e`, without the ` at path "…"` naming the probe's
+/// random temporary that `tempfile` appends.
+fn os_reason(e: &std::io::Error) -> String {
+    let text = e.to_string();
+    match text.split_once(" at path \"") {
+        Some((reason, _)) => reason.to_string(),
+        None => text,
+    }
 }
 
 #[cfg(test)]

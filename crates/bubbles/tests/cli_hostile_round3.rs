@@ -282,6 +282,10 @@ fn an_unwritable_output_is_refused_before_the_work_and_named_once() {
         &["--out /proc/x.png", "cannot create a file in /proc"],
     );
     assert_eq!(err.matches("cannot").count(), 1, "{err}");
+    assert!(
+        !err.contains(".tmp"),
+        "the probe's temporary name is noise: {err}"
+    );
     let chart = bubbles(&["chart", "--out", "/proc/c.png"], dir.path());
     refused(&chart, &["--out /proc/c.png"]);
     let animate = bubbles(
