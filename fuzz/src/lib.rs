@@ -14,5 +14,7 @@ pub mod input;
 pub mod limits;
 #[path = "../../crates/bubbles/src/scene/mod.rs"]
 pub mod scene;
+#[path = "../../crates/bubbles/src/signals.rs"]
+pub mod signals;
 
 pub mod scenegen;

@@ -121,11 +121,49 @@ pub struct Bubble {
     subdivisions: Option<i64>,
     extra: [Number; 10],
     seed: u64,
+    flow: Option<FilmFlow>,
+}
+
+/// A water wave: amplitude, wavelength, direction (X, Z), optional angular speed.
+#[derive(Arbitrary, Debug)]
+pub struct Wave(Number, Number, [Number; 2], Option<Number>);
+
+/// A ripple: amplitude, wavelength, centre (X, Z), decays in r and t, angular speed.
+#[derive(Arbitrary, Debug)]
+pub struct Ripple(Number, Number, [Number; 2], Option<Number>, Option<Number>, Option<Number>);
+
+/// A `[water]` section.
+#[derive(Arbitrary, Debug)]
+pub struct Pool {
+    min: [Number; 2],
+    max: [Number; 2],
+    /// Slices per side; a third element must be refused (issue 28).
+    slices: Option<(i64, i64, Option<i64>)>,
+    rest_height: Number,
+    ior: Number,
+    floor_depth: Number,
+    floor: Mat,
+    absorption: Option<[Number; 3]>,
+    waves: Vec<Wave>,
+    ripples: Vec<Ripple>,
+}
+
+/// A bubble's living-film settings.
+#[derive(Arbitrary, Debug)]
+pub struct FilmFlow {
+    grid: i64,
+    viscosity: Number,
+    black_threshold: Number,
+    black_film: Number,
+    initial_scale: Option<[Number; 3]>,
 }
 
 /// A whole scene.
 #[derive(Arbitrary, Debug)]
 pub struct FuzzScene {
+    pool: Option<Pool>,
+    film_dt_s: Number,
+    illuminant: u8,
     time_s: Number,
     eye: [Number; 3],
     target: [Number; 3],
@@ -157,6 +195,13 @@ pub fn files() -> &'static Path {
         let small = image::RgbImage::from_pixel(4, 2, image::Rgb([200, 120, 40]));
         small.save(dir.join("small.png")).expect("small.png");
         std::fs::write(dir.join("bomb.png"), bomb_png()).expect("bomb.png");
+        // Linear texels past the radiance range (issue 28: 3.4e38 gave NaN pixels, 1e34
+        // times intensity 1e6 a panic) and one at its edge.
+        for (name, texel) in [("max.exr", 3.4e38f32), ("hot.exr", 1e34), ("edge.exr", 1e6)] {
+            let mut img = image::Rgb32FImage::from_pixel(4, 2, image::Rgb([0.5; 3]));
+            img.put_pixel(1, 0, image::Rgb([texel, 0.5, texel]));
+            img.save(dir.join(name)).expect(name);
+        }
         std::fs::write(
             dir.join("tet.obj"),
             "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
@@ -196,7 +241,15 @@ fn crc32(bytes: &[u8]) -> u32 {
     !crc
 }
 
-const IMAGES: [&str; 4] = ["small.png", "bomb.png", "missing.png", "/dev/zero"];
+const IMAGES: [&str; 7] = [
+    "small.png",
+    "bomb.png",
+    "missing.png",
+    "/dev/zero",
+    "max.exr",
+    "hot.exr",
+    "edge.exr",
+];
 const MESHES: [&str; 4] = ["tet.obj", "huge.obj", "/dev/zero", "missing.obj"];
 const SPECTRA: [&str; 6] = ["d65", "sodium", "f11", "ok.csv", "big.csv", "nope"];
 
@@ -252,6 +305,9 @@ impl FuzzScene {
             let _ = writeln!(o, "spectrum = \"{}\"", pick(&SPECTRA, l.spectrum));
             key(&mut o, "luminance", l.luminance, 100.0);
         }
+        if let Some(pool) = &self.pool {
+            water(&mut o, pool);
+        }
         for (i, b) in self.bubbles.iter().take(3).enumerate() {
             bubble(&mut o, i, b);
         }
@@ -299,8 +355,11 @@ impl FuzzScene {
         if self.water {
             o.push_str("dispersion = \"water\"\n");
         }
+        let illuminants = ["d65", "d50", "a", "e", "f11", "sodium", "nope"];
+        let _ = writeln!(o, "illuminant = \"{}\"", pick(&illuminants, self.illuminant));
         o.push_str("[dynamics]\n");
         key(o, "dt_s", self.dt_s, 1.0 / 240.0);
+        key(o, "film_dt_s", self.film_dt_s, 1.0 / 240.0);
         if let Some(g) = self.gravity {
             triple(o, "gravity_m_per_s2", g, [0.0, -9.81, 0.0]);
         }
@@ -378,4 +437,75 @@ fn bubble(o: &mut String, i: usize, b: &Bubble) {
         key(o, name, *n, plausible);
     }
     let _ = writeln!(o, "seed = {}", b.seed);
+    if let Some(flow) = &b.flow {
+        film_flow(o, flow);
+    }
+}
+
+fn film_flow(o: &mut String, f: &FilmFlow) {
+    // In-range grids above 16 are legal but slow a fuzz run; out-of-range ones stay.
+    let grid = match f.grid {
+        g @ 0..=512 => g.min(16),
+        g => g,
+    };
+    let _ = writeln!(o, "film_grid = {grid}");
+    key(o, "film_viscosity_pa_s", f.viscosity, 1e-3);
+    key(o, "black_threshold_nm", f.black_threshold, 20.0);
+    key(o, "black_film_nm", f.black_film, 10.0);
+    if let Some(s) = f.initial_scale {
+        triple(o, "initial_scale", s, [1.0, 1.0, 1.0]);
+    }
+}
+
+fn pair(n: [Number; 2], plausible: [f64; 2]) -> String {
+    format!("[{}, {}]", lit(n[0].value(plausible[0])), lit(n[1].value(plausible[1])))
+}
+
+/// A `[water]` section with at most 2 waves and 2 ripples and a coarse grid.
+fn water(o: &mut String, p: &Pool) {
+    o.push_str("[water]\n");
+    let _ = writeln!(o, "min_m = {}", pair(p.min, [-1.0, -1.0]));
+    let _ = writeln!(o, "max_m = {}", pair(p.max, [1.0, 1.0]));
+    if let Some((x, z, extra)) = p.slices {
+        // In-range sizes above 32 are legal but slow a fuzz run.
+        let small = |s: i64| if (1..=512).contains(&s) { s.min(32) } else { s };
+        let extra = extra.map(|e| format!(", {e}")).unwrap_or_default();
+        let _ = writeln!(o, "slices = [{}, {}{extra}]", small(x), small(z));
+    }
+    key(o, "rest_height_m", p.rest_height, 0.0);
+    key(o, "ior", p.ior, 1.333);
+    key(o, "floor_depth_m", p.floor_depth, 0.5);
+    let _ = writeln!(o, "floor = {}", material(&p.floor));
+    if let Some(a) = p.absorption {
+        triple(o, "absorption_per_m", a, [0.45, 0.06, 0.02]);
+    }
+    for w in p.waves.iter().take(2) {
+        o.push_str("[[water.waves]]\n");
+        key_always(o, "amplitude_m", w.0, 0.01);
+        key_always(o, "wavelength_m", w.1, 0.3);
+        let _ = writeln!(o, "direction = {}", pair(w.2, [1.0, 0.0]));
+        if let Some(omega) = w.3 {
+            key_always(o, "omega_rad_per_s", omega, 10.0);
+        }
+    }
+    for r in p.ripples.iter().take(2) {
+        o.push_str("[[water.ripples]]\n");
+        key_always(o, "amplitude_m", r.0, 0.005);
+        key_always(o, "wavelength_m", r.1, 0.1);
+        let _ = writeln!(o, "center_m = {}", pair(r.2, [0.0, 0.0]));
+        for (name, n, plausible) in [
+            ("decay_per_m", r.3, 1.0),
+            ("decay_per_s", r.4, 0.5),
+            ("omega_rad_per_s", r.5, 20.0),
+        ] {
+            if let Some(n) = n {
+                key_always(o, name, n, plausible);
+            }
+        }
+    }
+}
+
+/// Like [`key`], but a required key is written even for [`Number::Default`].
+fn key_always(out: &mut String, name: &str, n: Number, plausible: f64) {
+    let _ = writeln!(out, "{name} = {}", lit(n.value(plausible)));
 }

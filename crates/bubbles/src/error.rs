@@ -26,6 +26,19 @@ impl CliError {
         }
     }
 
+    /// Stopped by `signal` (SIGINT, SIGTERM): exit code 128 + its number (130, 143).
+    pub fn interrupted(signal: i32) -> Self {
+        let name = match signal {
+            2 => "SIGINT".to_string(),
+            15 => "SIGTERM".to_string(),
+            n => format!("signal {n}"),
+        };
+        Self {
+            message: format!("interrupted by {name}: stopped, temporary files removed"),
+            exit_code: u8::try_from(128 + signal).unwrap_or(1),
+        }
+    }
+
     /// The process exit code for this error.
     pub fn exit_code(&self) -> u8 {
         self.exit_code

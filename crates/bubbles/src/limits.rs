@@ -67,6 +67,33 @@ pub const MAX_IMAGE_PIXELS: u64 = 64 << 20;
 /// Bytes of one text input: a scene, an OBJ mesh, a spectrum CSV.
 pub const MAX_INPUT_BYTES: u64 = 64 << 20;
 
+/// Largest value of an image texel (environment, cube face, ground or object texture)
+/// times its `intensity`, per channel: the scene's radiance range, in which sums over a
+/// cube map's texels and their products with exposure stay finite in f32.
+pub const MAX_TEXEL_RADIANCE: f64 = 1e6;
+
+/// Smallest refractive index (real part) any command accepts: far below any material's.
+pub const MIN_INDEX: f64 = thinfilm::fresnel::MIN_INDEX;
+
+/// Largest refractive index (real or imaginary part) any command accepts.
+pub const MAX_INDEX: f64 = thinfilm::fresnel::MAX_INDEX;
+
+/// Thickest layer `reflectance`, `fit` and `color` accept, in nm (1 m).
+pub const MAX_LAYER_THICKNESS_NM: f64 = thinfilm::fresnel::MAX_THICKNESS_NM;
+
+/// Film interactions the reference tracer may plan for one frame (2^42, about 4.4e12):
+/// its work bound, see [`reference_film_hits`].
+pub const MAX_REFERENCE_FILM_HITS: f64 = (1u64 << 42) as f64;
+
+/// The most film interactions `--backend reference` can trace for a frame: every camera
+/// ray (`samples_per_side²` per pixel) may split at each film into a reflected and a
+/// transmitted beam until `depth` films, `2^(depth+1) − 1` interactions (the weight
+/// cut-off prunes many, but grazing films reflect almost everything, so it bounds none).
+pub fn reference_film_hits(width: usize, height: usize, samples_per_side: u32, depth: u32) -> f64 {
+    let rays = width as f64 * height as f64 * f64::from(samples_per_side).powi(2);
+    rays * (2f64.powf(f64::from(depth) + 1.0) - 1.0)
+}
+
 /// The limits as printed at the end of `--help`.
 pub const HELP: &str = "Limits (a larger request is refused with exit code 2):
   solver steps per run (time_s / dt_s)        1000000
@@ -85,6 +112,11 @@ pub const HELP: &str = "Limits (a larger request is refused with exit code 2):
   water waves and ripples                     64
   pixels of one image file                    67108864
   bytes of one scene, OBJ or CSV file         67108864
+  image texel times intensity                 0..=1e6
+  refractive index (real part)                0.001..=1e6
+  layer thickness (reflectance, fit, color)   0..=1e9 nm
+  reference film hits per frame               4398046511104
+    (pixels × ref-samples² × (2^(ref-depth+1) − 1))
   planned memory of one run                   3 GiB";
 
 /// Bytes of one dynamic cube map of `face_size` (six bordered faces of RGB f32 and their
@@ -177,6 +209,7 @@ mod tests {
             MAX_OPAQUE_TRIANGLES,
             MAX_IMAGE_PIXELS,
             MAX_INPUT_BYTES,
+            MAX_REFERENCE_FILM_HITS as u64,
         ] {
             assert!(
                 HELP.contains(&value.to_string()),
@@ -189,6 +222,17 @@ mod tests {
             "ripples                     {MAX_WATER_PERTURBATIONS}"
         )));
         assert!(HELP.contains(&format!("{} GiB", MEMORY_BUDGET_BYTES >> 30)));
+    }
+
+    #[test]
+    fn reference_work_counts_every_split_up_to_the_depth() {
+        // 4 × 4 pixels, 4 × 4 rays each, depth 1: the film, then its two beams' films.
+        assert_eq!(reference_film_hits(4, 4, 4, 1), 256.0 * 3.0);
+        // Issue 28: depth 64 on 4 × 4 pixels is far past the bound, the default
+        // 400 × 400 frame at depth 8 and the largest frame at depth 8 are within it.
+        assert!(reference_film_hits(4, 4, 4, 64) > MAX_REFERENCE_FILM_HITS);
+        assert!(reference_film_hits(400, 400, 4, 8) < MAX_REFERENCE_FILM_HITS);
+        assert!(reference_film_hits(16384, 16384, 4, 8) < MAX_REFERENCE_FILM_HITS);
     }
 
     #[test]

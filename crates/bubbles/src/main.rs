@@ -6,7 +6,9 @@ mod error;
 mod frame;
 mod input;
 mod limits;
+mod output;
 mod scene;
+mod signals;
 #[cfg(feature = "view")]
 mod view;
 

@@ -168,7 +168,7 @@ impl RefractiveIndex {
                 water_iapws(wavelength_nm, WATER_TEMPERATURE_K, WATER_DENSITY_KG_PER_M3)?
             }
         };
-        if n.is_finite() && n > 0.0 && n <= crate::fresnel::MAX_INDEX {
+        if n.is_finite() && (crate::fresnel::MIN_INDEX..=crate::fresnel::MAX_INDEX).contains(&n) {
             Ok(n)
         } else {
             Err(OpticsError::IndexAtWavelength {

@@ -19,12 +19,16 @@
 //! The residual (RMS), the offset and the runner-up minimum's thickness and `χ²` are
 //! reported, so an ambiguous fringe order shows as a runner-up with nearly the same `χ²`.
 
-use crate::fresnel::OpticsError;
+use crate::fresnel::{Num, OpticsError};
 use crate::incidence::Incidence;
 use crate::tmm::Stack;
 
 /// Local minima of the scan refined by golden-section search.
 pub const CANDIDATES: usize = 4;
+/// The most model reflectances the global scan may compute (scan points × wavelengths):
+/// a thickness range far wider than the spectrum's fringes, or a huge index, would
+/// otherwise allocate and compute without bound.
+pub const MAX_SCAN_EVALUATIONS: f64 = 1e8;
 /// The normal quantile of a two-sided 95 % interval.
 pub const Z_95: f64 = 1.959_963_984_540_054;
 
@@ -194,7 +198,8 @@ fn validate(measured: &Measurement<'_>, search: Search) -> Result<(), OpticsErro
     let u = measured.wavelength_uncertainty_nm;
     if !(u.is_finite() && u >= 0.0) {
         return bad(format!(
-            "wavelength uncertainty {u} nm is not finite and >= 0"
+            "wavelength uncertainty {} nm is not finite and >= 0",
+            Num(u)
         ));
     }
     let Search {
@@ -204,13 +209,39 @@ fn validate(measured: &Measurement<'_>, search: Search) -> Result<(), OpticsErro
     } = search;
     if !(min_nm.is_finite() && max_nm.is_finite() && 0.0 <= min_nm && min_nm < max_nm) {
         return bad(format!(
-            "thickness range [{min_nm}, {max_nm}] nm is not 0 <= min < max"
+            "thickness range [{}, {}] nm is not 0 <= min < max",
+            Num(min_nm),
+            Num(max_nm)
         ));
     }
     if !(n_max.is_finite() && n_max > 0.0) {
-        return bad(format!("n_max {n_max} is not finite and > 0"));
+        return bad(format!("n_max {} is not finite and > 0", Num(n_max)));
     }
-    Ok(())
+    check_scan_work(measured.wavelength_nm, search)
+}
+
+/// Refuses a scan of more than [`MAX_SCAN_EVALUATIONS`] model reflectances.
+fn check_scan_work(wavelength_nm: &[f64], search: Search) -> Result<(), OpticsError> {
+    let points = (search.max_nm - search.min_nm) / quarter_step(wavelength_nm, search);
+    let evaluations = points * wavelength_nm.len() as f64;
+    if evaluations <= MAX_SCAN_EVALUATIONS {
+        return Ok(());
+    }
+    Err(OpticsError::Fit {
+        reason: format!(
+            "thickness range [{}, {}] nm scanned at {} points (a step of {} nm for the \
+             shortest wavelength and index {}) over {} wavelengths needs {} reflectance \
+             evaluations, more than {}: narrow the range",
+            Num(search.min_nm),
+            Num(search.max_nm),
+            Num(points.ceil()),
+            Num(quarter_step(wavelength_nm, search)),
+            Num(search.n_max),
+            wavelength_nm.len(),
+            Num(evaluations.ceil()),
+            Num(MAX_SCAN_EVALUATIONS)
+        ),
+    })
 }
 
 /// The scan step: an eighth of the closest spacing of `χ²`'s minima, `λ_min / (4 n_max)`.

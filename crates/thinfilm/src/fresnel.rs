@@ -16,6 +16,7 @@ use num_complex::Complex64;
 use std::fmt;
 
 mod error;
+pub(crate) use error::Num;
 pub use error::OpticsError;
 
 /// Complex amplitude coefficients of a surface or a stack, for s and p polarisation.
@@ -249,20 +250,29 @@ impl Interface {
 /// reach a few hundred), and small enough that `n²` and its products stay finite.
 pub const MAX_INDEX: f64 = 1e6;
 
-/// Checks a real refractive index: finite, `> 0` and `≤ MAX_INDEX`.
+/// The smallest real part of an index accepted: far below any material's (the lowest,
+/// silver's in the visible, are about 0.05), and large enough that the ratio of two
+/// indices (at most `MAX_INDEX / MIN_INDEX = 1e9`) and its square stay finite.
+pub const MIN_INDEX: f64 = 1e-3;
+
+/// The largest layer thickness accepted, in nm (1 m): far beyond any film or slide, and
+/// small enough that a layer's phase `2π n d cos θ / λ` stays finite and accurate.
+pub const MAX_THICKNESS_NM: f64 = 1e9;
+
+/// Checks a real refractive index: finite, `≥ MIN_INDEX` and `≤ MAX_INDEX`.
 pub(crate) fn check_real_index(what: &'static str, n: f64) -> Result<(), OpticsError> {
-    if n.is_finite() && n > 0.0 && n <= MAX_INDEX {
+    if n.is_finite() && (MIN_INDEX..=MAX_INDEX).contains(&n) {
         Ok(())
     } else {
         Err(OpticsError::Index { what, value: n })
     }
 }
 
-/// Checks a complex index: finite, `Re > 0`, `Im ≥ 0` (absorbing, never amplifying),
-/// modulus `≤ MAX_INDEX`.
+/// Checks a complex index: finite, `Re ≥ MIN_INDEX`, `Im ≥ 0` (absorbing, never
+/// amplifying), both parts `≤ MAX_INDEX`.
 pub(crate) fn check_complex_index(what: &'static str, n: Complex64) -> Result<(), OpticsError> {
     let bounded = n.re <= MAX_INDEX && n.im <= MAX_INDEX;
-    if n.re.is_finite() && n.im.is_finite() && n.re > 0.0 && n.im >= 0.0 && bounded {
+    if n.re.is_finite() && n.im.is_finite() && n.re >= MIN_INDEX && n.im >= 0.0 && bounded {
         Ok(())
     } else {
         Err(OpticsError::ComplexIndex { what, value: n })
@@ -290,9 +300,9 @@ pub(crate) fn check_wavelength(wavelength_nm: f64) -> Result<(), OpticsError> {
     }
 }
 
-/// Checks a layer thickness: finite and `≥ 0` nm.
+/// Checks a layer thickness: in `0..=MAX_THICKNESS_NM` nm.
 pub(crate) fn check_thickness(thickness_nm: f64) -> Result<(), OpticsError> {
-    if thickness_nm.is_finite() && thickness_nm >= 0.0 {
+    if (0.0..=MAX_THICKNESS_NM).contains(&thickness_nm) {
         Ok(())
     } else {
         Err(OpticsError::Thickness { thickness_nm })

@@ -3,13 +3,15 @@
 
 mod apng;
 mod gif;
+mod resume;
 pub(crate) mod sink;
 
 use crate::error::{CliError, CliResult};
 use crate::frame::progress::Progress;
 use crate::frame::{FrameJob, Options};
 use crate::scene::Scene;
-use sink::{Output, Rgb8, Sink, frame_path};
+use crate::scene::values::plain;
+use sink::{Output, Rgb8, Sink};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -31,9 +33,11 @@ pub const MANIFEST: &str = "animation.txt";
     and fps <= 240.\n\n\
     --out DIR writes DIR/frame_00000.png, … each through a temporary file renamed into \
     place, so an interrupted run leaves only whole frames, and DIR/animation.txt records \
-    the scene and settings (a DIR made with other settings is refused). --resume renders \
-    only the frames missing from DIR; --frames A..B renders frames A to B − 1 only. Both give \
-    frames byte-identical to those of one uninterrupted run, so one animation can be split \
+    the scene and settings and a checksum per frame (a DIR made with other settings, or \
+    holding frames without it, is refused). --resume checks and decodes the frames in DIR \
+    and renders only those missing, damaged or of another size, after removing stale \
+    temporaries; --frames A..B renders frames A to B − 1 only. Both give frames \
+    byte-identical to those of one uninterrupted run, so one animation can be split \
     across machines (e.g. a Slurm array job, one --frames range per task).\n\n\
     --out PATH.apng or PATH.png writes one animated PNG: the exact 8-bit frames. \
     --out PATH.gif writes a preview with a 256-colour palette per frame (NeuQuant, \
@@ -57,7 +61,8 @@ pub struct Args {
     /// Render only frames A..B (A included, B excluded, counted from 0).
     #[arg(long, value_name = "A..B")]
     pub frames: Option<String>,
-    /// Keep the frames already in the output directory; render only the missing ones.
+    /// Keep the whole frames already in the output directory; render only the missing or
+    /// damaged ones.
     #[arg(long)]
     pub resume: bool,
     /// GIF only: no error diffusion (flat palette colours, visible bands in fringes).
@@ -69,6 +74,7 @@ pub struct Args {
 
 /// Runs `bubbles animate`.
 pub fn run(args: Args) -> CliResult {
+    crate::signals::install();
     let count = frame_count(args.seconds, args.fps)?;
     let range = match &args.frames {
         Some(text) => parse_range(text, count)?,
@@ -81,6 +87,7 @@ pub fn run(args: Args) -> CliResult {
             args.out.display()
         )));
     }
+    check_output(&output)?;
     let manifest = manifest(&args)?;
     let mut job = FrameJob::prepare(Some(&args.scene), &args.options)?;
     let (width, height) = (job.settings().width, job.settings().height);
@@ -91,10 +98,11 @@ pub fn run(args: Args) -> CliResult {
         (width, height),
         range.end - range.start,
     )?;
-    render_frames(&mut job, &mut sink, range.clone(), &args)?;
+    let keep = kept_frames(&output, args.resume, range.clone(), (width, height))?;
+    render_frames(&mut job, &mut sink, range.clone(), &keep, &args)?;
     let error = sink
         .finish()
-        .map_err(|e| CliError::runtime(format!("cannot write {}: {e}", args.out.display())))?;
+        .map_err(|e| CliError::input(format!("cannot write {}: {e}", args.out.display())))?;
     eprintln!(
         "wrote frames {}..{} of {count} ({width}x{height}, {} fps) to {}",
         range.start,
@@ -112,27 +120,63 @@ pub fn run(args: Args) -> CliResult {
     Ok(())
 }
 
+/// Refuses, before any work, an output that cannot be created where it is named.
+fn check_output(output: &Output) -> CliResult {
+    match output {
+        Output::Dir(dir) => crate::output::check_dir("--out", dir),
+        Output::Apng(path) | Output::Gif(path) => crate::output::check_file("--out", path),
+    }
+}
+
+/// One flag per frame of `range`: whether a resumed frame directory already holds it
+/// whole (after its stale temporaries are removed); none without `--resume`.
+fn kept_frames(
+    output: &Output,
+    resume: bool,
+    range: Range<u64>,
+    size: (usize, usize),
+) -> Result<Vec<bool>, CliError> {
+    match (output, resume) {
+        (Output::Dir(dir), true) => {
+            resume::remove_stale_temporaries(dir);
+            resume::whole_frames(dir, range, size)
+        }
+        _ => Ok(vec![false; (range.end - range.start) as usize]),
+    }
+}
+
 /// The number of frames in `seconds` at `fps`, checked against the limits.
 fn frame_count(seconds: f64, fps: f64) -> Result<u64, CliError> {
+    let (s, f) = (plain(seconds), plain(fps));
     if !(seconds.is_finite() && seconds > 0.0 && seconds <= MAX_SECONDS) {
         return Err(CliError::input(format!(
-            "--seconds {seconds}: must be a number > 0 and at most {MAX_SECONDS}"
+            "--seconds {s}: must be a number > 0 and at most {MAX_SECONDS}"
         )));
     }
     if !(fps.is_finite() && fps > 0.0 && fps <= MAX_FPS) {
         return Err(CliError::input(format!(
-            "--fps {fps}: must be a number > 0 and at most {MAX_FPS}"
+            "--fps {f}: must be a number > 0 and at most {MAX_FPS}"
         )));
     }
     let count = (seconds * fps).round();
     if count < 1.0 {
+        // round(seconds × fps) >= 1 needs seconds >= 0.5 / fps.
+        let needed = 0.5 / fps;
+        let hint = if needed <= MAX_SECONDS {
+            format!("give at least {} seconds at this rate", plain(needed))
+        } else {
+            format!(
+                "even {MAX_SECONDS} seconds make none, so --fps must be at least 1/{}",
+                2.0 * MAX_SECONDS
+            )
+        };
         return Err(CliError::input(format!(
-            "--seconds {seconds} at --fps {fps} makes no frame: give at least 1 / fps seconds"
+            "--seconds {s} at --fps {f} makes no frame: {hint}"
         )));
     }
     if count > MAX_FRAMES as f64 {
         return Err(CliError::input(format!(
-            "--seconds {seconds} at --fps {fps} makes {count} frames; at most {MAX_FRAMES} are allowed"
+            "--seconds {s} at --fps {f} makes {count} frames; at most {MAX_FRAMES} are allowed"
         )));
     }
     Ok(count as u64)
@@ -209,13 +253,21 @@ fn open_dir(dir: &Path, manifest: &str) -> Result<(), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create the directory: {e}"))?;
     let path = dir.join(MANIFEST);
     if let Ok(existing) = std::fs::read_to_string(&path) {
-        if existing == manifest {
+        // The settings, then one checksum line per frame written.
+        let frames_only = |rest: &str| rest.lines().all(|l| l.starts_with("frame "));
+        if existing.strip_prefix(manifest).is_some_and(frames_only) {
             return Ok(());
         }
         return Err(format!(
             "{} records another scene or other settings: use the same scene, --fps and \
              render options, or another (or emptied) directory",
             path.display()
+        ));
+    }
+    if resume::has_frames(dir) {
+        return Err(format!(
+            "holds frames but no {MANIFEST}, so what they show is unknown: use another \
+             (or emptied) directory"
         ));
     }
     let tmp = sink::temporary_beside(&path)?;
@@ -225,14 +277,20 @@ fn open_dir(dir: &Path, manifest: &str) -> Result<(), String> {
         .map_err(|e| format!("cannot write {MANIFEST}: {}", e.error))
 }
 
-/// Simulates and renders frames `range` into `sink`, skipping finished frames on resume.
-fn render_frames(job: &mut FrameJob, sink: &mut Sink, range: Range<u64>, args: &Args) -> CliResult {
+/// Simulates and renders frames `range` into `sink`, skipping those `keep` marks (one
+/// flag per frame of `range`: whole frames found on resume).
+fn render_frames(
+    job: &mut FrameJob,
+    sink: &mut Sink,
+    range: Range<u64>,
+    keep: &[bool],
+    args: &Args,
+) -> CliResult {
     let mut bar = Progress::frames(range.end - range.start);
     let (exposure_ev, tonemap) = (job.settings().exposure_ev, job.settings().tonemap);
-    for k in range {
-        if let (true, Sink::Dir(dir)) = (args.resume, &*sink)
-            && frame_path(dir, k).is_file()
-        {
+    for (k, &kept) in range.zip(keep) {
+        crate::signals::check()?;
+        if kept {
             bar.skip(1);
             continue;
         }
@@ -240,17 +298,14 @@ fn render_frames(job: &mut FrameJob, sink: &mut Sink, range: Range<u64>, args: &
         // depend on which frames were rendered before it.
         job.advance_to(k as f64 / args.fps, false)?;
         let frame = job.render()?;
+        crate::signals::check()?;
         let rgb = Rgb8 {
             width: frame.width(),
             height: frame.height(),
             bytes: frame.to_srgb8(exposure_ev, tonemap),
         };
-        sink.push(k, &rgb).map_err(|e| {
-            CliError::runtime(format!(
-                "frame {k}: cannot write {}: {e}",
-                args.out.display()
-            ))
-        })?;
+        sink.push(k, &rgb)
+            .map_err(|e| CliError::input(format!("frame {k}: {e}")))?;
         bar.inc(1);
     }
     bar.finish();

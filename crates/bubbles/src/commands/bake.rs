@@ -64,6 +64,7 @@ pub fn run(args: Args) -> CliResult {
     check_numbers(&args)?;
     let config = config_from(&args)?;
     check_memory(&config, &formats)?;
+    crate::output::check_dir("--out", &args.out)?;
     let set = bake_with_bar(&config);
     let written = set.save(&args.out, &formats).map_err(|e| match e {
         lut::SaveError::Encode { .. } => CliError::runtime(e.to_string()),

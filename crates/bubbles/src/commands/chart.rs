@@ -82,23 +82,10 @@ pub fn run(args: Args) -> CliResult {
     write_png(&args.out, &pixmap)
 }
 
-/// Rejects an `--out` whose directory does not exist or that is itself a directory.
+/// Rejects an `--out` that cannot be created (a directory, a missing or read-only
+/// directory) before any drawing.
 fn check_out_path(out: &Path) -> CliResult {
-    if out.is_dir() {
-        return Err(CliError::input(format!(
-            "--out {} is a directory; give a file name",
-            out.display()
-        )));
-    }
-    let dir = out_dir(out);
-    if !dir.is_dir() {
-        return Err(CliError::input(format!(
-            "--out {}: directory {} does not exist",
-            out.display(),
-            dir.display()
-        )));
-    }
-    Ok(())
+    crate::output::check_file("--out", out)
 }
 
 /// The directory `out` will be written in.
@@ -268,7 +255,7 @@ fn write_png(out: &Path, pixmap: &Pixmap) -> CliResult {
     let written = std::fs::write(&tmp, &png).and_then(|()| std::fs::rename(&tmp, out));
     written.map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
-        CliError::runtime(format!("cannot write {}: {e}", out.display()))
+        CliError::input(format!("cannot write {}: {e}", out.display()))
     })
 }
 

@@ -17,6 +17,7 @@ use thinfilm::spectrum::Spectrum;
 
 use crate::csv_table::CsvTable;
 use crate::error::{CliError, CliResult};
+use crate::scene::values::plain;
 
 /// Arguments of `bubbles color`.
 #[derive(Debug, clap::Args)]
@@ -146,7 +147,9 @@ impl FilmColour {
             Ok(xyz)
         } else {
             Err(CliError::runtime(format!(
-                "optics failed for thickness_nm {thickness_nm}, angle_deg {angle_deg}"
+                "optics failed for thickness_nm {}, angle_deg {}",
+                plain(thickness_nm),
+                plain(angle_deg)
             )))
         }
     }
@@ -190,9 +193,9 @@ fn color_table(colour: &FilmColour, input: &str) -> Result<String, CliError> {
     for row in table.rows() {
         let d = row.number("thickness_nm")?;
         let angle = row.number("angle_deg")?;
-        if d < 0.0 {
+        if !(0.0..=crate::limits::MAX_LAYER_THICKNESS_NM).contains(&d) {
             let field = row.get("thickness_nm").unwrap_or_default();
-            return Err(row.bad("thickness_nm", field, "is negative"));
+            return Err(row.bad("thickness_nm", field, "is not a thickness in [0, 1e9] nm"));
         }
         if !(0.0..90.0).contains(&angle) {
             let field = row.get("angle_deg").unwrap_or_default();

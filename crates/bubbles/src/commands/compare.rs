@@ -49,11 +49,12 @@ pub fn run(args: Args) -> CliResult {
     if !(args.heatmap_max.is_finite() && args.heatmap_max > 0.0) {
         return Err(CliError::input(format!(
             "--heatmap-max {}: must be a finite number > 0",
-            args.heatmap_max
+            crate::scene::values::plain(args.heatmap_max)
         )));
     }
     if let Some(out) = &args.heatmap {
         refuse_overwriting_an_input(out, [&args.a, &args.b])?;
+        crate::output::check_file("--heatmap", out)?;
     }
     let size_a = check_header(&args.a)?;
     let size_b = check_header(&args.b)?;

@@ -13,6 +13,7 @@ use thinfilm::{Incidence, Layer, Stack};
 
 use crate::csv_table::CsvTable;
 use crate::error::{CliError, CliResult};
+use crate::scene::values::plain;
 
 /// Arguments of `bubbles fit`.
 #[derive(Debug, clap::Args)]
@@ -98,7 +99,7 @@ pub fn run(args: Args) -> CliResult {
     if !(0.0..90.0).contains(&args.angle_deg) {
         return Err(CliError::input(format!(
             "--angle-deg {} is not an angle in [0, 90) degrees",
-            args.angle_deg
+            plain(args.angle_deg)
         )));
     }
     let incidence = Incidence::try_from_angle_deg(args.angle_deg)
@@ -124,7 +125,8 @@ pub fn run(args: Args) -> CliResult {
             .map_err(|e| {
                 CliError::input(format!(
                     "--n-film {} / --n-outside {}: {e}",
-                    args.n_film, args.n_outside
+                    plain(args.n_film),
+                    plain(args.n_outside)
                 ))
             })?;
             (film, 0)

@@ -15,13 +15,14 @@ pub(crate) mod stack;
 use std::fmt::Write as _;
 use std::io::{Read as _, Write as _};
 
+use crate::limits::{MAX_INDEX, MAX_LAYER_THICKNESS_NM, MIN_INDEX};
 use thinfilm::Incidence;
 use thinfilm::airy::ThinFilm;
 use thinfilm::dispersion::{CONSTANT_RANGE_NM, RefractiveIndex};
-use thinfilm::fresnel::MAX_INDEX;
 
 use crate::csv_table::{CsvRow, CsvTable};
 use crate::error::{CliError, CliResult};
+use crate::scene::values::plain;
 
 /// The film index used when neither a column nor `--n-film` gives one.
 const DEFAULT_N_FILM: f64 = 1.33;
@@ -106,15 +107,16 @@ fn run_stack(text: &str, args: &Args) -> Result<String, CliError> {
     if !(args.graded_tolerance.is_finite() && args.graded_tolerance > 0.0) {
         return Err(CliError::input(format!(
             "--graded-tolerance {} is not finite and > 0",
-            args.graded_tolerance
+            plain(args.graded_tolerance)
         )));
     }
     let queries = match (args.angle_deg, args.wavelength_nm) {
         (None, None) if args.thickness_nm.is_none() => stack::queries_from_csv(&read_stdin()?)?,
         (Some(angle_deg), Some(wavelength_nm)) => {
             if let Some(d) = args.thickness_nm {
-                check_thickness(d)
-                    .map_err(|what| CliError::input(format!("--thickness-nm {d} {what}")))?;
+                check_thickness(d).map_err(|what| {
+                    CliError::input(format!("--thickness-nm {} {what}", plain(d)))
+                })?;
             }
             vec![stack::StackQuery {
                 line: 0,
@@ -149,10 +151,10 @@ fn read_stdin() -> Result<String, CliError> {
 
 fn run_film(args: &Args) -> Result<String, CliError> {
     check_index(args.n_outside)
-        .map_err(|what| CliError::input(format!("--n-outside {:?} {what}", args.n_outside)))?;
+        .map_err(|what| CliError::input(format!("--n-outside {} {what}", plain(args.n_outside))))?;
     let n_film_default = args.n_film.unwrap_or(DEFAULT_N_FILM);
     check_index(n_film_default)
-        .map_err(|what| CliError::input(format!("--n-film {n_film_default:?} {what}")))?;
+        .map_err(|what| CliError::input(format!("--n-film {} {what}", plain(n_film_default))))?;
     let queries = match (args.thickness_nm, args.angle_deg, args.wavelength_nm) {
         (None, None, None) => queries_from_stdin(n_film_default)?,
         (Some(thickness_nm), Some(angle_deg), Some(wavelength_nm)) => {
@@ -216,7 +218,7 @@ fn query_from_flags(
     n_film: f64,
 ) -> Result<Query, CliError> {
     let flag = |name: &str, value: f64, check: fn(f64) -> Result<(), &'static str>| {
-        check(value).map_err(|what| CliError::input(format!("{name} {value:?} {what}")))
+        check(value).map_err(|what| CliError::input(format!("{name} {} {what}", plain(value))))
     };
     flag("--thickness-nm", thickness_nm, check_thickness)?;
     flag("--angle-deg", angle_deg, check_angle)?;
@@ -231,11 +233,12 @@ fn query_from_flags(
     })
 }
 
-fn check_thickness(thickness_nm: f64) -> Result<(), &'static str> {
-    if thickness_nm.is_finite() && thickness_nm >= 0.0 {
+/// A layer thickness the optics keep physical: in `0..=MAX_LAYER_THICKNESS_NM` (1e9 nm).
+pub(crate) fn check_thickness(thickness_nm: f64) -> Result<(), &'static str> {
+    if (0.0..=MAX_LAYER_THICKNESS_NM).contains(&thickness_nm) {
         Ok(())
     } else {
-        Err("is not a thickness >= 0 nm")
+        Err("is not a thickness in [0, 1e9] nm")
     }
 }
 
@@ -257,10 +260,10 @@ fn check_wavelength(wavelength_nm: f64) -> Result<(), &'static str> {
 }
 
 fn check_index(n: f64) -> Result<(), &'static str> {
-    if n.is_finite() && n > 0.0 && n <= MAX_INDEX {
+    if (MIN_INDEX..=MAX_INDEX).contains(&n) {
         Ok(())
     } else {
-        Err("is not a refractive index in (0, 1e6]")
+        Err("is not a refractive index in [0.001, 1e6]")
     }
 }
 

@@ -30,8 +30,9 @@ enum OutputKind {
 
 /// Runs `bubbles render`.
 pub fn run(args: Args) -> CliResult {
+    crate::signals::install();
     let kind = output_kind(&args.out)?;
-    check_parent_dir(&args.out)?;
+    crate::output::check_file("--out", &args.out)?;
     let mut job = FrameJob::prepare(args.scene.as_deref(), &args.options)?;
     let time_s = match args.time_s {
         Some(t) => Num::<Seconds>::try_new(t)
@@ -44,11 +45,13 @@ pub fn run(args: Args) -> CliResult {
     let bubbles = job.bubble_count();
     let time_s = job.time_s();
     let frame = job.render()?;
+    crate::signals::check()?;
     let written = match kind {
         OutputKind::Png => frame.write_png(&args.out, exposure_ev, tonemap),
         OutputKind::Exr => frame.write_exr(&args.out),
     };
-    written.map_err(|e| CliError::input(format!("cannot write {}: {e}", args.out.display())))?;
+    // The error names the file already ("cannot write PATH: why").
+    written.map_err(|e| CliError::input(e.to_string()))?;
     eprintln!(
         "wrote {} ({}x{}, {} bubble(s), t = {:.3} s)",
         args.out.display(),
@@ -73,22 +76,5 @@ fn output_kind(path: &Path) -> Result<OutputKind, CliError> {
             "--out {}: the file name must end in .png or .exr",
             path.display()
         ))),
-    }
-}
-
-/// Fails early, before minutes of work, when the output directory cannot take the file.
-fn check_parent_dir(path: &Path) -> CliResult {
-    let parent = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    if parent.is_dir() {
-        Ok(())
-    } else {
-        Err(CliError::input(format!(
-            "--out {}: directory {} does not exist",
-            path.display(),
-            parent.display()
-        )))
     }
 }

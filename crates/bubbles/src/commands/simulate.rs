@@ -84,6 +84,7 @@ pub fn run(args: Args) -> CliResult {
         ("--export-film", &args.export_film),
     ] {
         if let Some(dir) = dir {
+            crate::output::check_dir(flag, dir)?;
             std::fs::create_dir_all(dir).map_err(|e| {
                 CliError::input(format!(
                     "{flag} {}: cannot create directory: {e}",
@@ -124,7 +125,7 @@ fn check_args(args: &Args) -> CliResult {
     if !(args.seconds.is_finite() && args.seconds >= 0.0) {
         return Err(CliError::input(format!(
             "--seconds {} must be a finite number >= 0",
-            args.seconds
+            plain(args.seconds)
         )));
     }
     if let Some(r) = args.radius_m
@@ -135,7 +136,7 @@ fn check_args(args: &Args) -> CliResult {
     if !(args.fps.is_finite() && args.fps > 0.0) {
         return Err(CliError::input(format!(
             "--fps {} must be a finite number > 0",
-            args.fps
+            plain(args.fps)
         )));
     }
     Ok(())
@@ -271,7 +272,7 @@ fn write_films(world: &World, dir: &Path, frame: usize) -> CliResult {
         let path = dir.join(format!("film_{}_{frame:05}.exr", b.id()));
         image
             .write_exr(&path)
-            .map_err(|e| CliError::runtime(format!("cannot write {}: {e}", path.display())))?;
+            .map_err(|e| CliError::input(e.to_string()))?;
     }
     Ok(())
 }
@@ -283,7 +284,7 @@ fn write_atomic(path: &Path, text: &str) -> CliResult {
         .and_then(|()| std::fs::rename(&tmp, path))
         .map_err(|e| {
             let _ = std::fs::remove_file(&tmp);
-            CliError::runtime(format!("cannot write {}: {e}", path.display()))
+            CliError::input(format!("cannot write {}: {e}", path.display()))
         })
 }
 

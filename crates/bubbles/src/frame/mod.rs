@@ -69,7 +69,10 @@ impl FrameJob {
         let settings = settings(&scene, &render_scene, options)?;
         let film_spec = match options.backend {
             Backend::Cpu | Backend::Wgpu => None,
-            Backend::Reference => Some(scene.film_spec(&render_scene.lights)?),
+            Backend::Reference => {
+                reference::check_work(&options.reference.settings(&settings))?;
+                Some(scene.film_spec(&render_scene.lights)?)
+            }
         };
         let gpu = match options.backend {
             Backend::Wgpu => Some(gpu::GpuBackend::open()?),
@@ -145,7 +148,7 @@ impl FrameJob {
         progress::advance_world(&mut self.world, time_s, &mut bar)
             .map_err(|e| CliError::runtime(format!("simulation failed: {e}")))?;
         bar.finish();
-        Ok(())
+        crate::signals::check()
     }
 
     /// One solver step.

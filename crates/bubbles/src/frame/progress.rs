@@ -96,7 +96,8 @@ pub fn advance_world(
     }
     let target = steps_to(world, time_s);
     let mut events = Vec::new();
-    while world.steps() < target {
+    // A signal stops the loop early; the caller's `signals::check` reports it.
+    while world.steps() < target && !crate::signals::interrupted() {
         events.extend(world.step()?);
         progress.inc(1);
     }

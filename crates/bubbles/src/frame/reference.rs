@@ -2,6 +2,8 @@
 //! its own options and a progress bar with an ETA.
 
 use crate::error::CliError;
+use crate::limits;
+use crate::scene::values::plain;
 use raster::{Frame, RenderScene, RenderSettings};
 use reference_tracer::{FilmSpec, ReferenceSettings, Reflections, render_reference};
 
@@ -82,6 +84,31 @@ impl ReferenceOptions {
             seed: self.ref_seed,
         }
     }
+}
+
+/// Refuses settings whose worst-case work passes [`limits::MAX_REFERENCE_FILM_HITS`],
+/// naming the estimate and the flags that set it.
+pub fn check_work(settings: &ReferenceSettings) -> Result<(), CliError> {
+    let hits = limits::reference_film_hits(
+        settings.width,
+        settings.height,
+        settings.samples_per_side,
+        settings.max_depth,
+    );
+    if hits <= limits::MAX_REFERENCE_FILM_HITS {
+        return Ok(());
+    }
+    Err(CliError::input(format!(
+        "--backend reference at {}x{} with --ref-samples {} and --ref-depth {} may trace up \
+         to {} film hits (pixels × samples² × (2^(depth+1) − 1)), over the limit of {}: lower \
+         --ref-depth, --ref-samples or the size",
+        settings.width,
+        settings.height,
+        settings.samples_per_side,
+        settings.max_depth,
+        plain(hits),
+        plain(limits::MAX_REFERENCE_FILM_HITS)
+    )))
 }
 
 /// Traces one frame, with a progress bar on stderr when `progress` is set.

@@ -11,7 +11,7 @@ use super::values::{
     MeshScale, MolarMass, NucleationRate, Num, Num3, ObjectRadius, PatternScale, Radiance,
     Reflectance, RuptureThickness, Samples, Seconds, Shininess, SloshSpeed, Speed, Subdivisions,
     SurfaceTension, TimeStep, Variation, Viscosity, WaterDepth, WaterIndex, WaterSlices,
-    WaveAmplitude, Wavelength,
+    WaveAmplitude, Wavelength, exact,
 };
 use serde::Deserialize;
 
@@ -127,6 +127,7 @@ pub enum EnvironmentSpec {
     /// Six cube-map face images, in the order +x, −x, +y, −y, +z, −z.
     Cube {
         /// Face paths, relative to the scene file.
+        #[serde(deserialize_with = "exact")]
         faces: [String; 6],
         /// Radiance scale applied to the decoded linear values.
         #[serde(default = "one")]
@@ -307,11 +308,13 @@ fn light_luminance() -> Num<Luminance> {
 #[serde(deny_unknown_fields)]
 pub struct WaterSpec {
     /// Corner of the grid with the smallest X and Z, m.
+    #[serde(deserialize_with = "exact")]
     pub min_m: [Num<Coordinate>; 2],
     /// Corner of the grid with the largest X and Z, m.
+    #[serde(deserialize_with = "exact")]
     pub max_m: [Num<Coordinate>; 2],
     /// Slices along X and along Z (each side has one vertex more).
-    #[serde(default = "water_slices")]
+    #[serde(default = "water_slices", deserialize_with = "exact")]
     pub slices: [Count<WaterSlices>; 2],
     /// Height of the unperturbed surface, m.
     #[serde(default = "finite_zero")]
@@ -374,6 +377,7 @@ pub struct RippleSpec {
     /// Wavelength, m.
     pub wavelength_m: Num<Wavelength>,
     /// Centre (X, Z), m.
+    #[serde(deserialize_with = "exact")]
     pub center_m: [Num<Coordinate>; 2],
     /// Fading with distance α, 1/m (0: none).
     #[serde(default)]

@@ -3,6 +3,7 @@
 use super::Scene;
 use super::schema::{EnvironmentSpec, MaterialSpec, ObjectSpec};
 use crate::error::CliError;
+use crate::scene::values::{plain, plain_f32};
 use bubble_dynamics::World;
 use raster::{
     BubbleFilm, BubbleMesh, Camera, Environment, FilmField, Ground, Irradiance, Material, Object,
@@ -59,11 +60,19 @@ impl Scene {
             EnvironmentSpec::Uniform { rgb: c } => Environment::Uniform(rgb(c.get())),
             EnvironmentSpec::Equirect { path, intensity } => {
                 let tex = Texture::load(self.path(path)).map_err(input)?;
-                Environment::Equirect(scale_texture(tex, intensity.get()))
+                let k = intensity.get();
+                self.check_texels(path, tex.texels(), tex.width(), k)?;
+                Environment::Equirect(scale_texture(tex, k).map_err(input)?)
             }
             EnvironmentSpec::Cube { faces, intensity } => {
                 let paths = faces.clone().map(|f| self.path(&f));
                 let cube = raster::CubeMap::load_faces(paths).map_err(input)?;
+                let n = cube.face_size();
+                for (face, path) in faces.iter().enumerate() {
+                    let texels: Vec<_> =
+                        (0..n * n).map(|i| cube.texel(face, i % n, i / n)).collect();
+                    self.check_texels(path, &texels, n, intensity.get())?;
+                }
                 Environment::CubeFaces(scale_cube(&cube, intensity.get() as f32).map_err(input)?)
             }
         })
@@ -74,14 +83,18 @@ impl Scene {
             MaterialSpec::Checker { a, b, scale_m } => {
                 Material::checker(rgb(a.get()), rgb(b.get()), scale_m.get() as f32)
             }
-            MaterialSpec::Image { path, scale_m } => Material {
-                pattern: Pattern::Textured {
-                    texture: Texture::load(self.path(path))
-                        .map_err(|e| CliError::input(format!("{}: {e}", self.origin)))?,
-                    scale_m: scale_m.get() as f32,
-                },
-                ..Material::matte([1.0; 3])
-            },
+            MaterialSpec::Image { path, scale_m } => {
+                let texture = Texture::load(self.path(path))
+                    .map_err(|e| CliError::input(format!("{}: {e}", self.origin)))?;
+                self.check_texels(path, texture.texels(), texture.width(), 1.0)?;
+                Material {
+                    pattern: Pattern::Textured {
+                        texture,
+                        scale_m: scale_m.get() as f32,
+                    },
+                    ..Material::matte([1.0; 3])
+                }
+            }
             MaterialSpec::Solid {
                 albedo,
                 specular,
@@ -183,13 +196,42 @@ fn bubble_film(b: &bubble_dynamics::Bubble) -> Option<BubbleFilm> {
     })
 }
 
-fn scale_texture(tex: Texture, k: f64) -> Texture {
+impl Scene {
+    /// Refuses an image with a texel whose value times `intensity` leaves
+    /// `0..=MAX_TEXEL_RADIANCE`, naming the file, the texel and its value.
+    fn check_texels(
+        &self,
+        path: &str,
+        texels: &[[f32; 3]],
+        width: usize,
+        intensity: f64,
+    ) -> Result<(), CliError> {
+        let max = crate::limits::MAX_TEXEL_RADIANCE;
+        let too_bright = |t: &[f32; 3]| t.iter().any(|&c| f64::from(c) * intensity > max);
+        let Some(k) = texels.iter().position(too_bright) else {
+            return Ok(());
+        };
+        let value = texels[k].iter().fold(0.0f32, |m, &c| m.max(c));
+        Err(CliError::input(format!(
+            "{}: image {path}: texel ({}, {}) = {} times intensity {} is outside 0..={} \
+             (the radiance range a texel keeps finite through the renderer)",
+            self.origin,
+            k % width,
+            k / width,
+            plain_f32(value),
+            plain(intensity),
+            plain(max)
+        )))
+    }
+}
+
+fn scale_texture(tex: Texture, k: f64) -> Result<Texture, raster::RenderError> {
     if k == 1.0 {
-        return tex;
+        return Ok(tex);
     }
     let k = k as f32;
     let texels = tex.texels().iter().map(|t| t.map(|c| c * k)).collect();
-    Texture::try_new(tex.width(), tex.height(), texels).expect("scaling keeps a valid texture")
+    Texture::try_new(tex.width(), tex.height(), texels)
 }
 
 fn scale_cube(cube: &raster::CubeMap, k: f32) -> Result<raster::CubeMap, raster::RenderError> {

@@ -169,7 +169,7 @@ impl<'de, B: Bounds> Deserialize<'de> for Num<B> {
 
 impl<'de, B: Bounds> Deserialize<'de> for Num3<B> {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let value = <[f64; 3]>::deserialize(d)?;
+        let value: [f64; 3] = exact(d)?;
         Self::new(value).ok_or_else(|| {
             D::Error::custom(format!(
                 "{} has a component outside {}",
@@ -192,7 +192,7 @@ impl<'de, B: Bounds> Deserialize<'de> for Count<B> {
 
 impl<'de> Deserialize<'de> for Direction {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let value = <[f64; 3]>::deserialize(d)?;
+        let value: [f64; 3] = exact(d)?;
         Self::new(value).ok_or_else(|| {
             D::Error::custom(format!(
                 "{} is not a direction: components in -1e6..=1e6, length at least 1e-6",
@@ -204,7 +204,7 @@ impl<'de> Deserialize<'de> for Direction {
 
 impl<'de> Deserialize<'de> for Direction2 {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let value = <[f64; 2]>::deserialize(d)?;
+        let value: [f64; 2] = exact(d)?;
         Self::new(value).ok_or_else(|| {
             D::Error::custom(format!(
                 "[{}, {}] is not a direction: components in -1e6..=1e6, length at least 1e-6",
@@ -215,6 +215,20 @@ impl<'de> Deserialize<'de> for Direction2 {
     }
 }
 
+/// Deserialises an array of exactly `N` elements, refusing a longer or shorter one
+/// (serde's own arrays ignore extra elements in TOML); for `deserialize_with`.
+pub fn exact<'de, D, T, const N: usize>(d: D) -> Result<[T; N], D::Error>
+where
+    D: Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    let items = Vec::<T>::deserialize(d)?;
+    let len = items.len();
+    items
+        .try_into()
+        .map_err(|_| D::Error::custom(format!("an array of {len} elements where {N} are expected")))
+}
+
 /// `[a, b, c]` as [`plain`] numbers.
 pub fn numbers(v: &[f64; 3]) -> String {
     format!("[{}, {}, {}]", plain(v[0]), plain(v[1]), plain(v[2]))
@@ -223,6 +237,15 @@ pub fn numbers(v: &[f64; 3]) -> String {
 /// A number as a user reads it: the shortest round-trip decimal between 1e-4 and 1e7,
 /// scientific (`1e300`, `1e-300`) outside, never hundreds of digits.
 pub fn plain(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e7).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// [`plain`] for an `f32` (an image texel): its own shortest decimal, not its f64 widening.
+pub fn plain_f32(v: f32) -> String {
     if v == 0.0 || !v.is_finite() || (1e-4..1e7).contains(&v.abs()) {
         format!("{v}")
     } else {
@@ -370,6 +393,8 @@ mod tests {
         assert_eq!(plain(1e300), "1e300");
         assert_eq!(plain(-0.5), "-0.5");
         assert_eq!(plain(4294967295.0), "4.294967295e9");
+        assert_eq!(plain_f32(1e34), "1e34");
+        assert_eq!(plain_f32(3.4e38), "3.4e38");
     }
 
     #[test]

@@ -51,7 +51,7 @@ pub fn run(args: Args) -> CliResult {
     if !(args.target_fps.is_finite() && args.target_fps > 0.0) {
         return Err(CliError::input(format!(
             "--target-fps {}: must be a finite number > 0",
-            args.target_fps
+            crate::scene::values::plain(f64::from(args.target_fps))
         )));
     }
     window::run(args)

@@ -111,18 +111,28 @@ impl fmt::Display for OpticsError {
             OpticsError::Index { what, value } => {
                 write!(
                     f,
-                    "{what} = {value:?} is not a refractive index in (0, {:?}]",
-                    super::MAX_INDEX
+                    "{what} = {} is not a refractive index in [{}, {}]",
+                    Num(*value),
+                    Num(super::MIN_INDEX),
+                    Num(super::MAX_INDEX)
                 )
             }
             OpticsError::ComplexIndex { what, value } => write!(
                 f,
-                "{what} = {value} is not a complex index with real part in (0, {max:?}] and \
-                 imaginary part in [0, {max:?}]",
-                max = super::MAX_INDEX
+                "{what} = {}{}{}i is not a complex index with real part in [{min}, {max}] \
+                 and imaginary part in [0, {max}]",
+                Num(value.re),
+                if value.im.is_sign_negative() {
+                    "-"
+                } else {
+                    "+"
+                },
+                Num(value.im.abs()),
+                min = Num(super::MIN_INDEX),
+                max = Num(super::MAX_INDEX)
             ),
             OpticsError::Cosine { what, value } => {
-                write!(f, "{what} = {value} is not a cosine in [0, 1]")
+                write!(f, "{what} = {} is not a cosine in [0, 1]", Num(*value))
             }
             OpticsError::Angle { what, value } => {
                 let range = if *what == "angle_deg" {
@@ -130,22 +140,32 @@ impl fmt::Display for OpticsError {
                 } else {
                     "[0, 1]"
                 };
-                write!(f, "{what} = {value} is not in {range}")
+                write!(f, "{what} = {} is not in {range}", Num(*value))
             }
             OpticsError::Wavelength { wavelength_nm } => {
-                write!(f, "wavelength {wavelength_nm} nm is not finite and > 0")
+                write!(
+                    f,
+                    "wavelength {} nm is not finite and > 0",
+                    Num(*wavelength_nm)
+                )
             }
-            OpticsError::Thickness { thickness_nm } => {
-                write!(f, "thickness {thickness_nm} nm is not finite and >= 0")
-            }
+            OpticsError::Thickness { thickness_nm } => write!(
+                f,
+                "thickness {} nm is not in [0, {}] nm",
+                Num(*thickness_nm),
+                Num(super::MAX_THICKNESS_NM)
+            ),
             OpticsError::Dispersion { reason } => write!(f, "invalid dispersion model: {reason}"),
             OpticsError::IndexAtWavelength {
                 wavelength_nm,
                 value,
             } => write!(
                 f,
-                "dispersion model gives n = {value:?} at {wavelength_nm} nm (not in (0, {:?}])",
-                super::MAX_INDEX
+                "dispersion model gives n = {} at {} nm (not in [{}, {}])",
+                Num(*value),
+                Num(*wavelength_nm),
+                Num(super::MIN_INDEX),
+                Num(super::MAX_INDEX)
             ),
             OpticsError::OutOfRange {
                 model,
@@ -153,7 +173,8 @@ impl fmt::Display for OpticsError {
                 range_nm: [lo, hi],
             } => write!(
                 f,
-                "wavelength {wavelength_nm} nm is outside the {model}'s range [{lo}, {hi}] nm"
+                "wavelength {} nm is outside the {model}'s range [{lo}, {hi}] nm",
+                Num(*wavelength_nm)
             ),
             OpticsError::Table { reason } => write!(f, "invalid n,k table: {reason}"),
             OpticsError::Length {
@@ -162,7 +183,7 @@ impl fmt::Display for OpticsError {
                 expected,
             } => write!(f, "{what} has {len} elements, expected {expected}"),
             OpticsError::NotFinite { what, index, value } => {
-                write!(f, "{what}[{index}] = {value} is not a valid value")
+                write!(f, "{what}[{index}] = {} is not a valid value", Num(*value))
             }
             OpticsError::Fit { reason } => write!(f, "thickness fit: {reason}"),
             OpticsError::Graded { reason } => write!(f, "graded layer: {reason}"),
@@ -176,3 +197,18 @@ impl fmt::Display for OpticsError {
 }
 
 impl std::error::Error for OpticsError {}
+
+/// A number as a message shows it: the shortest decimal between 1e-4 and 1e7, and the
+/// short exponent form (`1e-300`, `1e308`) outside, never hundreds of digits.
+pub(crate) struct Num(pub(crate) f64);
+
+impl fmt::Display for Num {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let v = self.0;
+        if v == 0.0 || !v.is_finite() || (1e-4..1e7).contains(&v.abs()) {
+            write!(f, "{v}")
+        } else {
+            write!(f, "{v:e}")
+        }
+    }
+}

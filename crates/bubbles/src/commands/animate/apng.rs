@@ -14,6 +14,11 @@ pub struct ApngSink {
 }
 
 impl ApngSink {
+    /// The file this sink writes (renamed into place at the end).
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
     /// Starts `path` with room for `frames` frames of `width` × `height` at `fps`.
     pub fn create(
         path: &Path,

@@ -56,6 +56,11 @@ impl DeltaE {
 }
 
 impl GifSink {
+    /// The file this sink writes (renamed into place at the end).
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
     /// Starts `path` for frames of `width` × `height` at `fps`, looping for ever.
     ///
     /// # Errors

@@ -30,15 +30,23 @@ impl Output {
     /// extension (or an existing directory) is a frame directory.
     ///
     /// # Errors
-    /// Any other extension, naming it.
+    /// Any other extension, naming it, or a file extension on an existing directory.
     pub fn from_path(path: &Path) -> Result<Self, String> {
-        if path.is_dir() {
-            return Ok(Self::Dir(path.to_path_buf()));
-        }
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
+        let file = matches!(ext.as_deref(), Some("apng" | "png" | "gif"));
+        if path.is_dir() && file {
+            return Err(format!(
+                "--out {}: is a directory, but .{} names one animation file",
+                path.display(),
+                ext.unwrap_or_default()
+            ));
+        }
+        if path.is_dir() {
+            return Ok(Self::Dir(path.to_path_buf()));
+        }
         match ext.as_deref() {
             None => Ok(Self::Dir(path.to_path_buf())),
             Some("apng" | "png") => Ok(Self::Apng(path.to_path_buf())),
@@ -87,9 +95,18 @@ impl Sink {
     /// Adds frame `k`.
     pub fn push(&mut self, k: u64, frame: &Rgb8) -> Result<(), String> {
         match self {
-            Sink::Dir(dir) => write_png(&frame_path(dir, k), frame),
-            Sink::Apng(apng) => apng.push(frame),
-            Sink::Gif(gif) => gif.push(frame),
+            Sink::Dir(dir) => {
+                let path = frame_path(dir, k);
+                let cannot = |e: String| format!("cannot write {}: {e}", path.display());
+                let sum = write_png(&path, frame).map_err(cannot)?;
+                record_checksum(dir, k, sum)
+            }
+            Sink::Apng(apng) => apng
+                .push(frame)
+                .map_err(|e| format!("cannot write {}: {e}", apng.path().display())),
+            Sink::Gif(gif) => gif
+                .push(frame)
+                .map_err(|e| format!("cannot write {}: {e}", gif.path().display())),
         }
     }
 
@@ -103,15 +120,35 @@ impl Sink {
     }
 }
 
-/// Writes one still PNG through a temporary file, so a killed run leaves no partial frame.
-fn write_png(path: &Path, frame: &Rgb8) -> Result<(), String> {
-    let tmp = temporary_beside(path)?;
-    let file = tmp.reopen().map_err(|e| e.to_string())?;
-    let mut encoder = png::Encoder::new(
-        std::io::BufWriter::new(file),
-        frame.width as u32,
-        frame.height as u32,
-    );
+/// The checksum the manifest records per frame: FNV-1a (64-bit) of the file's bytes.
+pub fn checksum(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+/// The manifest line recording frame `k`'s checksum.
+pub fn checksum_line(k: u64, sum: u64) -> String {
+    format!("frame {k:05} fnv1a64 {sum:016x}\n")
+}
+
+/// Appends frame `k`'s checksum to the directory's manifest (one short line, appended in
+/// one write, so runs of several `--frames` ranges can share the directory).
+fn record_checksum(dir: &Path, k: u64, sum: u64) -> Result<(), String> {
+    use std::io::Write as _;
+    let path = dir.join(super::MANIFEST);
+    std::fs::OpenOptions::new()
+        .append(true)
+        .open(&path)
+        .and_then(|mut f| f.write_all(checksum_line(k, sum).as_bytes()))
+        .map_err(|e| format!("cannot record frame {k} in {}: {e}", path.display()))
+}
+
+/// Writes one still PNG through a temporary file, so a killed run leaves no partial
+/// frame; returns the file's checksum.
+fn write_png(path: &Path, frame: &Rgb8) -> Result<u64, String> {
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, frame.width as u32, frame.height as u32);
     encoder.set_color(png::ColorType::Rgb);
     encoder.set_depth(png::BitDepth::Eight);
     encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
@@ -120,8 +157,11 @@ fn write_png(path: &Path, frame: &Rgb8) -> Result<(), String> {
         .write_image_data(&frame.bytes)
         .map_err(|e| e.to_string())?;
     writer.finish().map_err(|e| e.to_string())?;
+    let tmp = temporary_beside(path)?;
+    std::fs::write(tmp.path(), &bytes).map_err(|e| e.to_string())?;
     tmp.as_file().sync_all().map_err(|e| e.to_string())?;
-    tmp.persist(path).map(drop).map_err(|e| e.error.to_string())
+    tmp.persist(path).map_err(|e| e.error.to_string())?;
+    Ok(checksum(&bytes))
 }
 
 #[cfg(test)]

@@ -70,9 +70,7 @@ fn parse_graded(medium: &str) -> Option<Result<(Profile, f64), String>> {
             .strip_prefix('@')
             .ok_or_else(|| format!("`{medium}` is not `{kind}n_front, n_back) @ thickness_nm`"))?
             .trim();
-        let thickness_nm = parse_real(thickness)
-            .filter(|d| *d >= 0.0)
-            .ok_or_else(|| format!("thickness `{thickness}` is not a number >= 0 nm"))?;
+        let thickness_nm = parse_thickness(thickness)?;
         let index = |t: &str| {
             let t = t.trim();
             parse_real(t)
@@ -148,12 +146,7 @@ pub fn parse_stack_graded(text: &str) -> Result<(Stack, Option<(usize, GradedLay
             Some((d, word)) if word.eq_ignore_ascii_case("incoherent") => (d.trim(), false),
             _ => (thickness.trim(), true),
         };
-        let thickness_nm = parse_real(thickness).filter(|d| *d >= 0.0).ok_or_else(|| {
-            bad(
-                k,
-                format!("thickness `{thickness}` is not a number >= 0 nm"),
-            )
-        })?;
+        let thickness_nm = parse_thickness(thickness).map_err(|e| bad(k, e))?;
         layers.push(Layer {
             coherent,
             ..Layer::new(index, thickness_nm)
@@ -163,6 +156,13 @@ pub fn parse_stack_graded(text: &str) -> Result<(Stack, Option<(usize, GradedLay
     let stack = Stack::new(n_incident, layers, substrate)
         .map_err(|e| CliError::input(format!("--stack \"{text}\": {e}")))?;
     Ok((stack, graded))
+}
+
+/// A layer thickness token, in `0..=MAX_THICKNESS_NM` nm.
+fn parse_thickness(token: &str) -> Result<f64, String> {
+    parse_real(token)
+        .filter(|d| super::check_thickness(*d).is_ok())
+        .ok_or_else(|| format!("thickness `{token}` is not a number in [0, 1e9] nm"))
 }
 
 fn parse_real(token: &str) -> Option<f64> {
@@ -234,15 +234,13 @@ pub fn queries_from_csv(text: &str) -> Result<Vec<StackQuery>, CliError> {
 
 fn thickness(row: &CsvRow<'_>) -> Result<f64, CliError> {
     let d = row.number("thickness_nm")?;
-    if d >= 0.0 {
-        Ok(d)
-    } else {
-        Err(row.bad(
+    super::check_thickness(d).map(|()| d).map_err(|what| {
+        row.bad(
             "thickness_nm",
             row.get("thickness_nm").unwrap_or_default(),
-            "is not a thickness >= 0 nm",
-        ))
-    }
+            what,
+        )
+    })
 }
 
 /// The output CSV for `queries` on `stack`, varying layer `vary_layer` (1-based) where a
@@ -290,7 +288,12 @@ pub fn render(
         let incidence = Incidence::try_from_angle_deg(q.angle_deg)
             .ok()
             .filter(|_| q.angle_deg < 90.0)
-            .ok_or_else(|| at(format!("angle_deg {} is not in [0, 90)", q.angle_deg)))?;
+            .ok_or_else(|| {
+                at(format!(
+                    "angle_deg {} is not in [0, 90)",
+                    crate::scene::values::plain(q.angle_deg)
+                ))
+            })?;
         if let Some(d) = q.thickness_nm {
             varied.layers[vary_layer - 1].thickness_nm = d;
             let _ = write!(out, "{d},");
