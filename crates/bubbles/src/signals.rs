@@ -1,4 +1,4 @@
-//! Ctrl-C (SIGINT) and SIGTERM during `render` and `animate`: the handler only records
+//! Ctrl-C (SIGINT) and SIGTERM during `render`, `animate` and `thickness`: the handler only records
 //! the signal; the work stops at its next safe point (between solver steps, before a
 //! file is written, between frames), every temporary is removed as the error unwinds,
 //! and the process exits 128 + the signal's number (130, 143) with one line on stderr.

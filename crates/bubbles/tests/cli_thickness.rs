@@ -156,6 +156,21 @@ fn an_angle_map_of_the_wrong_size_is_refused() {
 }
 
 #[test]
+fn an_unwritable_output_is_refused_before_the_work() {
+    let dir = tempfile::tempdir().unwrap();
+    write_photo(&dir.path().join("film.png"), 600.0);
+    std::fs::create_dir(dir.path().join("map.png")).unwrap();
+    let out = bubbles(&["thickness", "film.png", "--out", "map.exr"], dir.path());
+    assert_refused(&out, &["--out map.png: is a directory"]);
+    let out = bubbles(
+        &["thickness", "film.png", "--out", "no/such/dir/m.exr"],
+        dir.path(),
+    );
+    assert_refused(&out, &["does not exist"]);
+    assert!(!dir.path().join("map.exr").exists(), "nothing is written");
+}
+
+#[test]
 fn a_saturated_photo_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     image::RgbImage::from_pixel(20, 20, image::Rgb([255, 255, 240]))

@@ -81,12 +81,17 @@ pub struct Args {
 
 /// Runs `bubbles thickness`.
 pub fn run(args: Args) -> CliResult {
+    crate::signals::install();
     let paths = outputs::Paths::from_out(&args.out, &args.photo)?;
+    for path in [&paths.exr, &paths.png, &paths.rerender, &paths.residual] {
+        crate::output::check_file("--out", path)?;
+    }
     let photo = options::load_photo(&args.photo)?;
     let model = options::model(&args)?;
     let settings = options::settings(&args, &photo)?;
     let map = film_inverse::recover(&photo.photo, &model, &settings)
         .map_err(|e| CliError::input(format!("{}: {e}", args.photo.display())))?;
+    crate::signals::check()?;
     outputs::write_all(&paths, &photo.photo, &map)?;
     outputs::print_summary(&map, &paths, args.json);
     Ok(())
