@@ -51,8 +51,27 @@ impl OwnedPixels {
     }
 }
 
-/// The film and its light: illuminant name, film index, outside index, thickest film (nm).
-type FilmArgs = (String, f64, f64, f64);
+/// The light: a built-in illuminant's name, or a sampled spectrum
+/// `(wavelength_nm, value)`.
+#[derive(FromPyObject)]
+pub(crate) enum LightArg {
+    /// d65, d50, a, e, f2, f11 or sodium.
+    Name(String),
+    /// Samples of a spectrum, wavelengths strictly increasing.
+    Samples(Vec<f64>, Vec<f64>),
+}
+
+/// The film's index: a constant, or `"water"` (IAPWS dispersion).
+#[derive(FromPyObject)]
+pub(crate) enum IndexArg {
+    /// A constant index.
+    Constant(f64),
+    /// A named dispersive model.
+    Name(String),
+}
+
+/// The film and its light: light, film index, outside index, thickest film (nm), observer.
+type FilmArgs = (LightArg, IndexArg, f64, f64, String);
 /// A region `(x, y, w, h)` in pixels.
 type RectArgs = (u32, u32, u32, u32);
 /// The thickness map's arrays and the summary, as `thickness_from_rgb` returns them.
@@ -69,21 +88,31 @@ fn value_error(err: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(err.to_string())
 }
 
-/// The film model: a constant-index film under a named illuminant, CIE 1931 observer.
+/// The film model from the light, index and observer arguments.
 fn film_model(film: &FilmArgs) -> PyResult<FilmModel> {
-    let (illuminant, n_film, n_outside, thickness_max_nm) = film;
-    let light = Illuminant::from_name(illuminant)
-        .map_err(|e| PyValueError::new_err(format!("illuminant = {illuminant:?}: {e}")))?;
-    let index = RefractiveIndex::constant(*n_film)
-        .map_err(|e| PyValueError::new_err(format!("n_film = {n_film}: {e}")))?;
-    FilmModel::try_new(
-        *n_outside,
-        index,
-        &light.spectrum(),
-        Observer::Cie1931,
-        *thickness_max_nm,
-    )
-    .map_err(value_error)
+    let (light, n_film, n_outside, thickness_max_nm, observer) = film;
+    let spectrum = match light {
+        LightArg::Name(name) => Illuminant::from_name(name)
+            .map(Illuminant::spectrum)
+            .map_err(|e| PyValueError::new_err(format!("illuminant = {name:?}: {e}")))?,
+        LightArg::Samples(w, v) => thinfilm::Spectrum::try_from_samples(w.clone(), v.clone())
+            .map_err(|e| PyValueError::new_err(format!("illuminant spectrum: {e}")))?,
+    };
+    let index = match n_film {
+        IndexArg::Constant(n) => RefractiveIndex::constant(*n)
+            .map_err(|e| PyValueError::new_err(format!("n_film = {n}: {e}")))?,
+        IndexArg::Name(name) if name == "water" => RefractiveIndex::Water,
+        IndexArg::Name(name) => {
+            return Err(PyValueError::new_err(format!(
+                "n_film = {name:?} is neither a number nor 'water'"
+            )));
+        }
+    };
+    let observer = Observer::from_name(observer).ok_or_else(|| {
+        PyValueError::new_err(format!("observer = {observer:?} is not '1931' or '1964'"))
+    })?;
+    FilmModel::try_new(*n_outside, index, &spectrum, observer, *thickness_max_nm)
+        .map_err(value_error)
 }
 
 /// The viewing geometry: a cos θ map, a sphere `(cx, cy, radius)`, or one angle.

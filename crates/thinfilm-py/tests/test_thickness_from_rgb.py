@@ -187,3 +187,44 @@ def test_gil_is_released_during_recovery():
     stop.set()
     worker.join()
     assert during > 0
+
+
+def test_a_sampled_flat_spectrum_gives_the_map_of_the_equal_energy_illuminant():
+    image = srgb8()
+    named = thinfilm.thickness_from_rgb(image, exposure=EXPOSURE, illuminant="e")
+    sampled = thinfilm.thickness_from_rgb(
+        image, exposure=EXPOSURE, illuminant=(np.array([360.0, 830.0]), np.array([2.0, 2.0])))
+    assert (named["status"] == thinfilm.FITTED).all()
+    np.testing.assert_allclose(sampled["thickness_nm"], named["thickness_nm"], rtol=0, atol=1e-3)
+
+
+def test_water_and_the_1964_observer_are_models_of_their_own():
+    image = srgb8()
+    const = thinfilm.thickness_from_rgb(image, exposure=EXPOSURE)
+    water = thinfilm.thickness_from_rgb(image, exposure=EXPOSURE, n_film="water")
+    assert (water["status"] == thinfilm.FITTED).all()
+    # Water's index is about 1.333 against the photo's 1.33: the optical thickness n·h is
+    # what the colours fix, so the map shrinks by about that ratio (dispersion moves the
+    # thinnest, bluest fringes most), never by an order.
+    ratio = water["thickness_nm"] / const["thickness_nm"]
+    assert 0.98 < np.median(ratio) < 1.0 and np.abs(ratio - 1.0).max() < 0.04
+    # The photo was made for the 1931 observer: the 10° one reads it a little differently.
+    wide = thinfilm.thickness_from_rgb(image, exposure=EXPOSURE, observer="1964")
+    assert (wide["status"] == thinfilm.FITTED).mean() > 0.9
+    diff = np.abs(wide["thickness_nm"] - const["thickness_nm"])
+    assert 0.0 < np.nanmax(diff) < 30.0
+
+
+@pytest.mark.parametrize(
+    "kwargs, needle",
+    [
+        ({"observer": "1900"}, 'observer = "1900"'),
+        ({"n_film": "glass"}, 'n_film = "glass"'),
+        ({"illuminant": ([500.0], [1.0])}, "illuminant spectrum"),
+        ({"illuminant": 42}, "illuminant = 42"),
+    ],
+)
+def test_bad_light_index_and_observer_name_the_value(kwargs, needle):
+    with pytest.raises(ValueError, match=None) as err:
+        thinfilm.thickness_from_rgb(srgb8(), exposure=EXPOSURE, **kwargs)
+    assert needle in str(err.value), str(err.value)

@@ -305,6 +305,27 @@ def _anchors(anchors):
     return out
 
 
+def _light(illuminant):
+    """A built-in illuminant's name, or a sampled spectrum as two float lists."""
+    if isinstance(illuminant, str):
+        return illuminant
+    try:
+        wavelength_nm, value = illuminant
+    except (TypeError, ValueError):
+        raise ValueError(f"illuminant = {illuminant!r} is neither a name nor "
+                         "(wavelength_nm, value)") from None
+    w = np.asarray(wavelength_nm, dtype=np.float64).ravel()
+    v = np.asarray(value, dtype=np.float64).ravel()
+    return (w.tolist(), v.tolist())
+
+
+def _film_index(n_film):
+    """A constant index as a float, or a named dispersive model."""
+    if isinstance(n_film, str):
+        return n_film
+    return float(n_film)
+
+
 def thickness_from_rgb(
     image,
     *,
@@ -312,6 +333,7 @@ def thickness_from_rgb(
     n_film=1.33,
     n_outside=1.0,
     thickness_max_nm=1500.0,
+    observer="1931",
     angle_deg=0.0,
     cos_map=None,
     sphere=None,
@@ -328,8 +350,10 @@ def thickness_from_rgb(
 
     ``image`` is ``(H, W, 3)``: uint8 or uint16 sRGB-encoded (a channel at the format's
     maximum marks its pixel saturated), or float32/float64 linear. The film
-    ``n_outside | n_film | n_outside`` (constant indices) is lit by ``illuminant`` (d65, d50,
-    a, e, f2, f11, sodium; CIE 1931 observer) and is up to ``thickness_max_nm`` thick.
+    ``n_outside | n_film | n_outside`` (``n_film`` a number or ``"water"``, the IAPWS
+    dispersion) is lit by ``illuminant`` (d65, d50, a, e, f2, f11, sodium, or a spectrum
+    ``(wavelength_nm, value)`` of two 1-D arrays), seen by the CIE ``observer`` ("1931" or
+    "1964"), and is up to ``thickness_max_nm`` thick.
 
     Viewing: one ``angle_deg`` of incidence for every pixel, or ``cos_map`` (``(H, W)``
     cos theta per pixel), or ``sphere=(cx, cy, radius_px)`` (a bubble seen from far away;
@@ -375,7 +399,8 @@ def thickness_from_rgb(
         mask = _per_pixel("mask", mask, shape, np.bool_)
     white, reference, camera = _calibration(white, reference, exposure, gains)
     height, width = (_index("image height", shape[0]), _index("image width", shape[1]))
-    film = (str(illuminant), float(n_film), float(n_outside), float(thickness_max_nm))
+    film = (_light(illuminant), _film_index(n_film), float(n_outside),
+            float(thickness_max_nm), str(observer))
     h, sigma, de, status, rerender, summary = _native.thickness_from_rgb(
         pixels, width, height, film, float(angle_deg), cos_map, sphere, white, reference,
         camera, _anchors(anchors), mask, float(max_residual_de), float(smoothness_nm))

@@ -134,10 +134,11 @@ Rect = tuple[int, int, int, int]
 def thickness_from_rgb(
     image: ArrayLike,
     *,
-    illuminant: str = "d65",
-    n_film: float = 1.33,
+    illuminant: str | tuple[ArrayLike, ArrayLike] = "d65",
+    n_film: float | str = 1.33,
     n_outside: float = 1.0,
     thickness_max_nm: float = 1500.0,
+    observer: str = "1931",
     angle_deg: float = 0.0,
     cos_map: ArrayLike | None = None,
     sphere: tuple[float, float, float] | None = None,
