@@ -2,7 +2,7 @@
 //! records them (sRGB-encoded), and the estimation of both from the photo.
 
 use crate::error::{InverseError, short};
-use crate::model::{ColourTable, TABLE_STEP_NM};
+use crate::model::ColourTable;
 use rayon::prelude::*;
 use thinfilm::colorspace::srgb_encode;
 
@@ -85,14 +85,9 @@ impl EncodedTable {
         &self.values[r * self.len..(r + 1) * self.len]
     }
 
-    /// Encoded colour at fractional sample `i` (thickness / [`TABLE_STEP_NM`]) and row `r`.
+    /// Encoded colour at fractional sample `i` (thickness / [`crate::TABLE_STEP_NM`]) and row `r`.
     pub fn sample(&self, i: f64, r: f64) -> [f64; 3] {
         crate::model::sample_bilinear(&self.values, self.len, self.rows, i, r)
-    }
-
-    /// The thickness (nm) of fractional sample `i`.
-    pub fn thickness_nm(i: f64) -> f64 {
-        i * TABLE_STEP_NM
     }
 }
 
@@ -101,6 +96,14 @@ impl EncodedTable {
 pub(crate) fn dist2(p: [f32; 3], t: [f32; 3]) -> f32 {
     let d = [p[0] - t[0], p[1] - t[1], p[2] - t[2]];
     d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+}
+
+/// How fast a row's colour moves at sample `i`: the squared colour change per sample
+/// squared, over the samples two either side (fewer at the ends).
+pub(crate) fn speed2(row: &[[f32; 3]], i: usize) -> f32 {
+    let (lo, hi) = (i.saturating_sub(2), (i + 2).min(row.len() - 1));
+    let span = (hi - lo).max(1) as f32;
+    dist2(row[lo], row[hi]) / (span * span)
 }
 
 /// The smallest distance from `p` to a row, sampled every `stride` entries.

@@ -17,6 +17,8 @@ pub(crate) struct Tables<'a> {
     pub(crate) linear: &'a ColourTable,
     /// The camera.
     pub(crate) camera: Camera,
+    /// How the camera was found.
+    pub(crate) calibration: &'static str,
 }
 
 /// One fitted pixel.
@@ -168,6 +170,7 @@ pub(crate) fn finish_map(
     tables: &Tables<'_>,
     cos: &[Option<f32>],
     grower: &Grower<'_>,
+    regions: RegionReport,
 ) -> ThicknessMap {
     let n = photo.len();
     let mut thickness_nm = vec![0.0f32; n];
@@ -233,6 +236,13 @@ pub(crate) fn finish_map(
             }
         })
         .collect();
+    let fitted = Fitted {
+        status: &status,
+        thickness_nm: &thickness_nm,
+        uncertainty_nm: &uncertainty_nm,
+        residual_de: &residual_de,
+    };
+    let summary = summarise(&fitted, noise, tables, regions);
     ThicknessMap {
         width: photo.width(),
         height: photo.height(),
@@ -241,8 +251,16 @@ pub(crate) fn finish_map(
         residual_de,
         rerender,
         status,
-        summary: Summary::empty(noise),
+        summary,
     }
+}
+
+/// The per-pixel results the totals are taken over.
+struct Fitted<'a> {
+    status: &'a [Status],
+    thickness_nm: &'a [f32],
+    uncertainty_nm: &'a [f32],
+    residual_de: &'a [f32],
 }
 
 /// The `q` quantile (nearest rank) of the fitted pixels' values, and their mean.
@@ -268,21 +286,15 @@ fn fitted_stats(values: &[f32], status: &[Status], qs: &[f64]) -> (Vec<f64>, f64
     (out, mean)
 }
 
-/// Adds the totals to a finished map.
-pub(crate) fn with_summary(
-    mut map: ThicknessMap,
-    _settings: &Settings,
-    camera: Camera,
-    calibration: &'static str,
-    regions: RegionReport,
-) -> ThicknessMap {
+/// The totals of a finished map.
+fn summarise(map: &Fitted<'_>, noise: f64, tables: &Tables<'_>, regions: RegionReport) -> Summary {
     let count = |s: Status| map.status.iter().filter(|&&x| x == s).count();
-    let (de, de_mean) = fitted_stats(&map.residual_de, &map.status, &[0.95, 1.0]);
-    let (h, _) = fitted_stats(&map.thickness_nm, &map.status, &[0.0, 0.5, 1.0]);
-    let (sigma, _) = fitted_stats(&map.uncertainty_nm, &map.status, &[0.5]);
-    map.summary = Summary {
-        camera,
-        calibration,
+    let (de, de_mean) = fitted_stats(map.residual_de, map.status, &[0.95, 1.0]);
+    let (h, _) = fitted_stats(map.thickness_nm, map.status, &[0.0, 0.5, 1.0]);
+    let (sigma, _) = fitted_stats(map.uncertainty_nm, map.status, &[0.5]);
+    Summary {
+        camera: tables.camera,
+        calibration: tables.calibration,
         fitted: count(Status::Fitted),
         saturated: count(Status::Saturated),
         excluded: count(Status::Excluded),
@@ -291,14 +303,13 @@ pub(crate) fn with_summary(
         residual_mean_de: de_mean,
         residual_p95_de: de[0],
         residual_max_de: de[1],
-        noise_encoded: map.summary.noise_encoded,
+        noise_encoded: noise,
         thickness_min_nm: h[0],
         thickness_median_nm: h[1],
         thickness_max_nm: h[2],
         uncertainty_median_nm: sigma[0],
         regions,
-    };
-    map
+    }
 }
 
 #[cfg(test)]

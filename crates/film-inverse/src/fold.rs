@@ -7,6 +7,7 @@
 //! its own, moved if its colours fit clearly better, and the turns are then regrown
 //! from both sides.
 
+use crate::camera::speed2;
 use crate::model::TABLE_STEP_NM;
 use crate::unwrap::{AMBIGUOUS, FREE, Grower, LABELLED, QUEUED, UNEXPLAINED};
 use std::cmp::Reverse;
@@ -40,16 +41,6 @@ const MIN_STRETCH: usize = 64;
 const CLEARLY_BETTER: f64 = 0.8;
 
 impl Grower<'_> {
-    /// Squared rate of change of pixel `p`'s colour with thickness at sample `i`, per
-    /// sample².
-    fn slope2(&self, p: usize, i: usize) -> f32 {
-        let row = self.table.row(usize::from(self.rows[p]));
-        let (lo, hi) = (i.saturating_sub(2), (i + 2).min(self.table.len - 1));
-        let span = (hi - lo).max(1) as f32;
-        let d = [0, 1, 2].map(|c| row[hi][c] - row[lo][c]);
-        (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) / (span * span)
-    }
-
     /// Finds the stretches between turns, moves those whose colours fit another branch
     /// clearly better, regrows the turns, and sets aside stretches that fit far worse
     /// than the rest.
@@ -61,7 +52,8 @@ impl Grower<'_> {
             .filter(|&p| self.state[p] == LABELLED)
             .filter(|&p| {
                 let i = self.h[p] as usize;
-                turns[usize::from(self.rows[p])][i] || self.slope2(p, i) < threshold
+                turns[usize::from(self.rows[p])][i]
+                    || speed2(self.table.row(usize::from(self.rows[p])), i) < threshold
             })
             .collect();
         let is_weak = self.dilate(&weak, DILATE_PX);
@@ -120,12 +112,7 @@ impl Grower<'_> {
         (0..self.table.rows)
             .map(|r| {
                 let row = self.table.row(r);
-                let speed: Vec<f32> = (0..len)
-                    .map(|i| {
-                        let (lo, hi) = (i.saturating_sub(2), (i + 2).min(len - 1));
-                        crate::camera::dist2(row[lo], row[hi]) / ((hi - lo).max(1) as f32).powi(2)
-                    })
-                    .collect();
+                let speed: Vec<f32> = (0..len).map(|i| speed2(row, i)).collect();
                 let mut sorted = speed.clone();
                 let median = *sorted.select_nth_unstable_by(len / 2, f32::total_cmp).1;
                 let mut near = vec![false; len];

@@ -128,30 +128,6 @@ pub struct Summary {
     pub regions: RegionReport,
 }
 
-impl Summary {
-    /// A summary with only the noise level known yet.
-    fn empty(noise_encoded: f64) -> Summary {
-        Summary {
-            camera: Camera::balanced(1.0),
-            calibration: "",
-            fitted: 0,
-            saturated: 0,
-            excluded: 0,
-            unexplained: 0,
-            ambiguous: 0,
-            residual_mean_de: 0.0,
-            residual_p95_de: 0.0,
-            residual_max_de: 0.0,
-            noise_encoded,
-            thickness_min_nm: 0.0,
-            thickness_median_nm: 0.0,
-            thickness_max_nm: 0.0,
-            uncertainty_median_nm: 0.0,
-            regions: RegionReport::default(),
-        }
-    }
-}
-
 /// Recovers the thickness map of `photo`.
 ///
 /// # Errors
@@ -201,14 +177,10 @@ pub fn recover(
         encoded: &encoded,
         linear: &table,
         camera,
-    };
-    let map = finish::finish_map(photo, settings, &tables, &cos, &grower);
-    Ok(finish::with_summary(
-        map,
-        settings,
-        camera,
         calibration,
-        regions,
+    };
+    Ok(finish::finish_map(
+        photo, settings, &tables, &cos, &grower, regions,
     ))
 }
 

@@ -5,7 +5,7 @@
 //! names its thickness most clearly, and the region's order as a whole is then put to a
 //! vote of the colour evidence of all its pixels.
 
-use crate::camera::{EncodedTable, dist2};
+use crate::camera::{EncodedTable, dist2, speed2};
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
@@ -261,9 +261,7 @@ impl<'a> Grower<'a> {
     /// change (pale high orders) the growth arrives last, from every side, rather than
     /// wandering through them (lower keys first).
     pub(crate) fn information_key(&self, q: usize, i: usize) -> u32 {
-        let row = self.table.row(usize::from(self.rows[q]));
-        let (lo, hi) = (i.saturating_sub(2), (i + 2).min(self.table.len - 1));
-        let slope2 = dist2(row[lo], row[hi]) / ((hi - lo).max(1) * (hi - lo).max(1)) as f32;
+        let slope2 = speed2(self.table.row(usize::from(self.rows[q])), i);
         let key = 1.0 / (slope2 * 1e6 + 1e-3);
         (key * 1e3).min(u32::MAX as f32) as u32
     }
@@ -312,39 +310,38 @@ impl<'a> Grower<'a> {
         // photo's pixels that it holds (no pass over a whole region to find its seed) ...
         for c in self.clear_samples() {
             if self.state[c.pixel] == FREE {
-                self.grow_region(c.pixel, &c.minima, c.first, &mut report);
+                self.grow_region(&c, &mut report);
             }
         }
         // ... then whatever the sample missed, each from its own clearest pixel.
         let mut cursor = 0;
         while let Some(start) = (cursor..self.state.len()).find(|&p| self.state[p] == FREE) {
             cursor = start;
-            let (seed, minima, first) = self.clearest_in_region(start);
-            self.grow_region(seed, &minima, first, &mut report);
+            let seed = self.clearest_in_region(start);
+            self.grow_region(&seed, &mut report);
         }
         report.regions += report.anchored;
         report
     }
 
-    /// Grows one region from `seed` at its match `first`, lets it vote on its order, and
+    /// Grows one region from a seed at its best match, lets it vote on its order, and
     /// sets it aside if it cannot be placed.
-    fn grow_region(
-        &mut self,
-        seed: usize,
-        minima: &[(usize, f32)],
-        first: usize,
-        report: &mut RegionReport,
-    ) {
+    fn grow_region(&mut self, seed: &Clearest, report: &mut RegionReport) {
+        let Clearest {
+            pixel: seed,
+            first,
+            ref minima,
+            ..
+        } = *seed;
         if minima.is_empty() {
             self.state[seed] = UNEXPLAINED;
             return;
         }
         report.regions += 1;
         let touched = self.grow(&[(seed, first as f32)]);
-        if self.revote(seed, minima, first, &touched) {
-            report.shifted += 1;
-        }
-        self.set_aside_if_unplaced(&touched, report);
+        let (moved, region, vote) = self.revote(seed, minima, first, touched);
+        report.shifted += usize::from(moved);
+        self.set_aside_if_unplaced(&region, vote, report);
     }
 
     /// Up to [`SEED_SAMPLES`] free pixels spread evenly over the photo, clearest first,
@@ -357,68 +354,57 @@ impl<'a> Grower<'a> {
         let mut scored: Vec<Clearest> = free
             .iter()
             .step_by(stride)
-            .filter_map(|&pixel| {
-                let minima = self.minima(pixel);
-                let (margin, first) = clearness(&minima)?;
-                Some(Clearest {
-                    margin,
-                    pixel,
-                    first,
-                    minima,
-                })
-            })
+            .filter_map(|&p| self.clearest_of(p))
             .collect();
         scored.sort_by(|a, b| b.margin.total_cmp(&a.margin).then(a.pixel.cmp(&b.pixel)));
         scored
     }
 
     /// Marks a just-grown region ambiguous if it is too small, or its colours too
-    /// indifferent between orders, to place.
-    fn set_aside_if_unplaced(&mut self, touched: &[usize], report: &mut RegionReport) {
-        let labelled: Vec<usize> = touched
-            .iter()
-            .copied()
-            .filter(|&p| self.state[p] == LABELLED)
-            .collect();
-        if labelled.len() >= MIN_REGION && self.vote(&labelled).t >= MIN_T {
+    /// indifferent between orders (its final `vote`), to place.
+    fn set_aside_if_unplaced(&mut self, region: &[usize], vote: Vote, report: &mut RegionReport) {
+        let labelled = self.labelled_of(region);
+        if labelled.len() >= MIN_REGION && vote.t >= MIN_T {
             return;
         }
         report.unplaced += 1;
-        for &p in touched {
-            if self.state[p] == LABELLED {
-                self.state[p] = AMBIGUOUS;
-            }
+        for p in labelled {
+            self.state[p] = AMBIGUOUS;
         }
     }
 
     /// The pixel of `start`'s free region whose colour names its thickness most clearly:
     /// among up to [`VOTERS`] of its pixels, the one whose best colour match beats its
     /// second best by the widest margin (vivid low orders, black film), with that match.
-    fn clearest_in_region(&mut self, start: usize) -> (usize, Vec<(usize, f32)>, usize) {
+    fn clearest_in_region(&mut self, start: usize) -> Clearest {
         let region = self.region(start);
         let stride = region.len().div_ceil(VOTERS).max(1);
         let mut best: Option<Clearest> = None;
         for &p in region.iter().step_by(stride) {
-            let minima = self.minima(p);
-            let mut costs: Vec<(f32, usize)> = minima.iter().map(|m| (m.1, m.0)).collect();
-            costs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            let margin = match costs.as_slice() {
-                [a, b, ..] => b.0 - a.0,
-                [_] => f32::INFINITY,
-                [] => continue,
+            let Some(c) = self.clearest_of(p) else {
+                continue;
             };
-            if best.as_ref().is_none_or(|b| margin > b.margin) {
-                let first = costs[0].1;
-                best = Some(Clearest {
-                    margin,
-                    pixel: p,
-                    first,
-                    minima,
-                });
+            if best.as_ref().is_none_or(|b| c.margin > b.margin) {
+                best = Some(c);
             }
         }
-        best.map_or((start, self.minima(start), 0), |b| {
-            (b.pixel, b.minima, b.first)
+        best.unwrap_or(Clearest {
+            margin: 0.0,
+            pixel: start,
+            first: 0,
+            minima: Vec::new(),
+        })
+    }
+
+    /// Pixel `p` as a seed candidate, or `None` if its colour matches no thickness.
+    fn clearest_of(&self, pixel: usize) -> Option<Clearest> {
+        let minima = self.minima(pixel);
+        let (margin, first) = clearness(&minima)?;
+        Some(Clearest {
+            margin,
+            pixel,
+            first,
+            minima,
         })
     }
 
@@ -452,43 +438,37 @@ impl<'a> Grower<'a> {
     }
 
     /// Lets the region just grown vote on its order; regrows it shifted if the vote and
-    /// the regrown region's own cost both say so. Returns whether it moved.
+    /// the regrown region's own cost both say so. Returns whether it moved, the pixels
+    /// the region now holds, and the vote of its final labelling.
     fn revote(
         &mut self,
         seed: usize,
         minima: &[(usize, f32)],
         first: usize,
-        touched: &[usize],
-    ) -> bool {
-        let labelled: Vec<usize> = touched
-            .iter()
-            .copied()
-            .filter(|&p| self.state[p] == LABELLED)
-            .collect();
-        let shift = self.vote(&labelled).shift;
+        touched: Vec<usize>,
+    ) -> (bool, Vec<usize>, Vote) {
+        let labelled = self.labelled_of(&touched);
+        let vote = self.vote(&labelled);
         let j = minima.iter().position(|m| m.0 == first).unwrap_or(0) as i64;
-        let Some(&(moved, _)) = usize::try_from(j + shift).ok().and_then(|k| minima.get(k)) else {
-            return false;
+        let target = usize::try_from(j + vote.shift)
+            .ok()
+            .and_then(|k| minima.get(k));
+        let Some(&(moved, _)) = target.filter(|_| vote.shift != 0) else {
+            return (false, touched, vote);
         };
-        if shift == 0 {
-            return false;
-        }
         let before = self.mean_cost(&labelled);
         let saved: Vec<(usize, u8, f32)> = touched
             .iter()
             .map(|&p| (p, self.state[p], self.h[p]))
             .collect();
-        for &p in touched {
+        for &p in &touched {
             self.state[p] = FREE;
         }
         let regrown = self.grow(&[(seed, moved as f32)]);
-        let relabelled: Vec<usize> = regrown
-            .iter()
-            .copied()
-            .filter(|&p| self.state[p] == LABELLED)
-            .collect();
+        let relabelled = self.labelled_of(&regrown);
         if self.mean_cost(&relabelled) < before {
-            return true;
+            let vote = self.vote(&relabelled);
+            return (true, regrown, vote);
         }
         for &p in &regrown {
             self.state[p] = FREE;
@@ -496,7 +476,16 @@ impl<'a> Grower<'a> {
         for (p, s, h) in saved {
             (self.state[p], self.h[p]) = (s, h);
         }
-        false
+        (false, touched, vote)
+    }
+
+    /// The labelled ones of `pixels`.
+    fn labelled_of(&self, pixels: &[usize]) -> Vec<usize> {
+        pixels
+            .iter()
+            .copied()
+            .filter(|&p| self.state[p] == LABELLED)
+            .collect()
     }
 
     /// The order shift under which a sample of the region's pixels fit best, and how
