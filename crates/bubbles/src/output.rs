@@ -71,6 +71,42 @@ fn os_reason(e: &std::io::Error) -> String {
     }
 }
 
+/// Refuses, by `flag`, an output `out` that names one of the `inputs`, however spelled
+/// (`./a.png`, `dir/../a.png`, a symbolic or hard link): `what` would replace it.
+pub fn refuse_overwriting(flag: &str, out: &Path, inputs: &[&Path], what: &str) -> CliResult {
+    // A path that does not exist yet cannot be an input that does.
+    let Ok(out_meta) = std::fs::metadata(out) else {
+        return Ok(());
+    };
+    let out_real = std::fs::canonicalize(out).ok();
+    for input in inputs.iter().copied() {
+        let same_path = out_real.is_some() && std::fs::canonicalize(input).ok() == out_real;
+        let same_file = std::fs::metadata(input).is_ok_and(|m| same_inode(&m, &out_meta));
+        if same_path || same_file {
+            return Err(CliError::input(format!(
+                "{flag} {} is the input {}: {what} would overwrite it; write it elsewhere",
+                out.display(),
+                input.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Whether two metadata describe the same file (device and inode; never on non-Unix).
+fn same_inode(a: &std::fs::Metadata, b: &std::fs::Metadata) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        a.dev() == b.dev() && a.ino() == b.ino()
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (a, b);
+        false
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -171,6 +171,16 @@ fn an_unwritable_output_is_refused_before_the_work() {
 }
 
 #[test]
+fn an_output_that_would_overwrite_the_photo_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    write_photo(&dir.path().join("map.png"), 600.0);
+    let before = std::fs::read(dir.path().join("map.png")).unwrap();
+    let out = bubbles(&["thickness", "map.png", "--out", "./map.exr"], dir.path());
+    assert_refused(&out, &["--out ./map.png is the input map.png"]);
+    assert_eq!(std::fs::read(dir.path().join("map.png")).unwrap(), before);
+}
+
+#[test]
 fn a_saturated_photo_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     image::RgbImage::from_pixel(20, 20, image::Rgb([255, 255, 240]))

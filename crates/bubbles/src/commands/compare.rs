@@ -53,7 +53,7 @@ pub fn run(args: Args) -> CliResult {
         )));
     }
     if let Some(out) = &args.heatmap {
-        refuse_overwriting_an_input(out, [&args.a, &args.b])?;
+        crate::output::refuse_overwriting("--heatmap", out, &[&args.a, &args.b], "the heat map")?;
         crate::output::check_file("--heatmap", out)?;
     }
     let size_a = check_header(&args.a)?;
@@ -98,42 +98,6 @@ pub fn run(args: Args) -> CliResult {
         );
     }
     Ok(())
-}
-
-/// Refuses a heat map path that names one of the `inputs`, however spelled (`./a.png`,
-/// `dir/../a.png`, a symbolic or hard link): the heat map would replace it.
-fn refuse_overwriting_an_input(out: &Path, inputs: [&Path; 2]) -> Result<(), CliError> {
-    // A path that does not exist yet cannot be an input that does.
-    let Ok(out_meta) = std::fs::metadata(out) else {
-        return Ok(());
-    };
-    let out_real = std::fs::canonicalize(out).ok();
-    for input in inputs {
-        let same_path = out_real.is_some() && std::fs::canonicalize(input).ok() == out_real;
-        let same_file = std::fs::metadata(input).is_ok_and(|m| same_inode(&m, &out_meta));
-        if same_path || same_file {
-            return Err(CliError::input(format!(
-                "--heatmap {} is the input {}: the heat map would overwrite it; write it elsewhere",
-                out.display(),
-                input.display()
-            )));
-        }
-    }
-    Ok(())
-}
-
-/// Whether two metadata describe the same file (device and inode; never on non-Unix).
-fn same_inode(a: &std::fs::Metadata, b: &std::fs::Metadata) -> bool {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        a.dev() == b.dev() && a.ino() == b.ino()
-    }
-    #[cfg(not(unix))]
-    {
-        let _ = (a, b);
-        false
-    }
 }
 
 /// Checks an input from its header alone, before anything decodes it: within the pixel

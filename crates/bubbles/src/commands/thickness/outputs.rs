@@ -38,16 +38,8 @@ impl Paths {
             rerender: beside(".rerender.png"),
             residual: beside(".residual.png"),
         };
-        let photo_real = std::fs::canonicalize(photo).ok();
         for p in [&paths.exr, &paths.png, &paths.rerender, &paths.residual] {
-            if photo_real.is_some() && std::fs::canonicalize(p).ok() == photo_real {
-                return Err(CliError::input(format!(
-                    "--out {} would overwrite the photo {} with {}",
-                    out.display(),
-                    photo.display(),
-                    p.display()
-                )));
-            }
+            crate::output::refuse_overwriting("--out", p, &[photo], "the thickness map's outputs")?;
         }
         Ok(paths)
     }
