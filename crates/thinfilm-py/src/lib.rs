@@ -14,6 +14,7 @@ use thinfilm::airy::ThinFilm;
 use thinfilm::colorspace::{SRGB_FROM_XYZ, apply, srgb_encode};
 use thinfilm::dispersion::RefractiveIndex;
 use thinfilm::grid::{FilmGrid, Polarisation as GridPol};
+use thinfilm::stack_grid::StackGrid;
 use thinfilm::{Complex64, Incidence, Layer, Observer, OpticsError, SpectralIntegrator, Stack};
 
 /// Points per rayon task: small enough to balance, large enough to amortise.
@@ -49,6 +50,14 @@ fn pol_from(name: &str) -> PyResult<Pol> {
         other => Err(PyValueError::new_err(format!(
             "pol = '{other}' is not one of 's', 'p', 'u'"
         ))),
+    }
+}
+
+fn grid_pol(pol: Pol) -> GridPol {
+    match pol {
+        Pol::S => GridPol::S,
+        Pol::P => GridPol::P,
+        Pol::Mean => GridPol::Unpolarised,
     }
 }
 
@@ -88,6 +97,21 @@ fn rt<'py>(
     coherent: Vec<bool>,
 ) -> PyResult<Pair<'py>> {
     let pol = pol_from(pol)?;
+    let stack = stack_from(n, d_nm, coherent)?;
+    let (wl, angle) = (copy(&wavelength_nm), copy(&angle_deg));
+    let (r, t) = py
+        .allow_threads(|| {
+            par_rt(wl.len(), |i| {
+                let incidence = Incidence::try_from_angle_deg(angle[i])?;
+                Ok(pick(pol, stack.try_response_at(wl[i], incidence)?))
+            })
+        })
+        .map_err(value_error)?;
+    Ok((r.into_pyarray(py), t.into_pyarray(py)))
+}
+
+/// The stack of `rt`'s arguments, with errors naming the bad argument.
+fn stack_from(n: Vec<Complex64>, d_nm: Vec<f64>, coherent: Vec<bool>) -> PyResult<Stack> {
     if n.len() != d_nm.len() + 2 {
         return Err(PyValueError::new_err(format!(
             "n has {} media and d_nm {} thicknesses: n needs len(d_nm) + 2 (both semi-infinite ends)",
@@ -117,14 +141,38 @@ fn rt<'py>(
             ..Layer::new(index, d)
         })
         .collect();
-    let stack = Stack::new(n0.re, layers, n[n.len() - 1]).map_err(value_error)?;
+    Stack::new(n0.re, layers, n[n.len() - 1]).map_err(value_error)
+}
+
+/// `(R, T)` of a stack (as `rt`) on the grid `angle_deg × wavelength_nm`, flattened
+/// angle-major: [`thinfilm::stack_grid::StackGrid`] computes each interface once per
+/// angle, then the angles' rows in parallel.
+#[pyfunction]
+#[pyo3(signature = (n, d_nm, wavelength_nm, angle_deg, pol, coherent))]
+fn rt_grid<'py>(
+    py: Python<'py>,
+    n: Vec<Complex64>,
+    d_nm: Vec<f64>,
+    wavelength_nm: PyReadonlyArray1<'py, f64>,
+    angle_deg: PyReadonlyArray1<'py, f64>,
+    pol: &str,
+    coherent: Vec<bool>,
+) -> PyResult<Pair<'py>> {
+    let pol = grid_pol(pol_from(pol)?);
+    let stack = stack_from(n, d_nm, coherent)?;
     let (wl, angle) = (copy(&wavelength_nm), copy(&angle_deg));
     let (r, t) = py
         .allow_threads(|| {
-            par_rt(wl.len(), |i| {
-                let incidence = Incidence::try_from_angle_deg(angle[i])?;
-                Ok(pick(pol, stack.try_response_at(wl[i], incidence)?))
-            })
+            let grid = StackGrid::try_new(&stack, &angle, &wl)?;
+            let (mut r, mut t) = (zeroed(grid.len()), zeroed(grid.len()));
+            if !grid.is_empty() {
+                let width = grid.wavelengths();
+                r.par_chunks_mut(width)
+                    .zip(t.par_chunks_mut(width))
+                    .enumerate()
+                    .try_for_each(|(a, (r, t))| grid.try_fill_row(a, pol, r, t))?;
+            }
+            Ok::<_, OpticsError>((r, t))
         })
         .map_err(value_error)?;
     Ok((r.into_pyarray(py), t.into_pyarray(py)))
@@ -285,11 +333,7 @@ fn film_rt_grid<'py>(
     pol: &str,
     angle_major: bool,
 ) -> PyResult<Pair<'py>> {
-    let pol = match pol_from(pol)? {
-        Pol::S => GridPol::S,
-        Pol::P => GridPol::P,
-        Pol::Mean => GridPol::Unpolarised,
-    };
+    let pol = grid_pol(pol_from(pol)?);
     let (d, angle, wl) = (copy(&thickness_nm), copy(&angle_deg), copy(&wavelength_nm));
     let (r, t) = py
         .allow_threads(|| {
@@ -590,6 +634,7 @@ fn xyz_to_srgb<'py>(
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rt, m)?)?;
+    m.add_function(wrap_pyfunction!(rt_grid, m)?)?;
     m.add_function(wrap_pyfunction!(film_rt, m)?)?;
     m.add_function(wrap_pyfunction!(film_rt_fast, m)?)?;
     m.add_function(wrap_pyfunction!(film_rt_grid, m)?)?;

@@ -5,6 +5,7 @@ use criterion::{BenchmarkId, Criterion, Throughput, black_box, criterion_group, 
 use thinfilm::airy::ThinFilm;
 use thinfilm::batch;
 use thinfilm::dispersion::RefractiveIndex;
+use thinfilm::{Layer, Stack};
 
 /// The LUT baker's shape: one row of thicknesses, many wavelengths.
 const THICKNESSES: usize = 1024;
@@ -114,5 +115,49 @@ fn bench_batch(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_reference, bench_batch);
+/// The 5-layer stack of `bench/vs_colour_multilayer.py` over λ 360–830 nm by 1 and angles
+/// 0–75° by 7.5 (5 181 points): the transfer matrix per point against the grid.
+fn bench_stack_grid(c: &mut Criterion) {
+    use thinfilm::grid::Polarisation;
+    use thinfilm::stack_grid::StackGrid;
+    let layers = [
+        (1.38, 100.0),
+        (2.1, 60.0),
+        (1.46, 90.0),
+        (2.1, 60.0),
+        (1.38, 100.0),
+    ]
+    .map(|(n, d)| Layer::lossless(n, d))
+    .to_vec();
+    let stack = Stack::new(1.0, layers, 1.52).unwrap();
+    let wavelengths: Vec<f64> = (360..=830).map(f64::from).collect();
+    let angles: Vec<f64> = (0..=10).map(|k| 7.5 * f64::from(k)).collect();
+    let points = (wavelengths.len() * angles.len()) as u64;
+    let mut group = c.benchmark_group("stack_5_layers_5181_points");
+    group.throughput(Throughput::Elements(points));
+    group.bench_function("transfer_matrix_per_point", |b| {
+        b.iter(|| {
+            let mut sum = 0.0;
+            for &angle in &angles {
+                let incidence = thinfilm::Incidence::try_from_angle_deg(angle).unwrap();
+                for &wl in &wavelengths {
+                    sum += stack.try_response_at(wl, incidence).unwrap().r();
+                }
+            }
+            black_box(sum)
+        })
+    });
+    let (mut r, mut t) = (vec![0.0; points as usize], vec![0.0; points as usize]);
+    group.bench_function("stack_grid", |b| {
+        b.iter(|| {
+            let grid = StackGrid::try_new(&stack, &angles, &wavelengths).unwrap();
+            grid.try_fill(Polarisation::Unpolarised, &mut r, &mut t)
+                .unwrap();
+            black_box(r[0])
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench_reference, bench_batch, bench_stack_grid);
 criterion_main!(benches);

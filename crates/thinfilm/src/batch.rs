@@ -27,7 +27,9 @@ use crate::fresnel::{self, OpticsError};
 mod cells;
 pub(crate) mod film_f64;
 mod kernel;
+pub(crate) mod stack_f64;
 mod term;
+mod trig_f64;
 
 use kernel::{RowOut, Samples};
 use term::Term;

@@ -34,6 +34,7 @@ pub mod graded;
 pub mod grid;
 pub mod incidence;
 pub mod index;
+pub mod stack_grid;
 pub mod tmm;
 
 pub mod cells;

@@ -1,50 +1,12 @@
 //! The f64 row kernel of [`crate::grid::FilmGrid`]: one thickness over every closed-form
 //! (angle, wavelength) cell, exact to a few ulp, autovectorised (4 lanes with AVX2, picked
-//! at run time; no FMA contraction, so bit-identical to the portable build).
-//!
-//! `sin²β` is evaluated without a libm call: `β` is reduced by `k π/2` with a three-part
-//! Cody–Waite split of π/2 (the first two parts have 33 significant bits, so `k · part` is
-//! exact for `|k| < 2^20`), then `sin r` on `|r| ≤ π/4` is fdlibm's degree-13 minimax
-//! polynomial (relative error below 2^-58) and `sin²β = sin²r` for even `k`, `1 − sin²r`
-//! for odd `k` (at least 1/2 there, so no cancellation). Callers keep `|β| ≤ MAX_BETA`.
+//! at run time; no FMA contraction, so bit-identical to the portable build). `sin²β` comes
+//! from [`super::trig_f64`], without a libm call.
 
-/// Largest `|β|` the reduction takes: `|k| ≤ 2^19`, far inside the exact range.
-pub(crate) const MAX_BETA: f64 = 8.0e5;
+use super::trig_f64::sin_squared;
 
-const TWO_OVER_PI: f64 = std::f64::consts::FRAC_2_PI;
-#[allow(clippy::excessive_precision)] // fdlibm's published digits
-const PIO2_1: f64 = 1.570_796_326_734_125_614_17e+00;
-#[allow(clippy::excessive_precision)] // fdlibm's published digits
-const PIO2_2: f64 = 6.077_100_506_303_965_976_60e-11;
-#[allow(clippy::excessive_precision)] // fdlibm's published digits
-const PIO2_3: f64 = 2.022_266_248_711_166_455_80e-21;
-#[allow(clippy::excessive_precision)] // fdlibm's published digits
-const S1: f64 = -1.666_666_666_666_663_243_48e-01;
-#[allow(clippy::excessive_precision)] // fdlibm's published digits
-const S2: f64 = 8.333_333_333_322_489_461_24e-03;
-#[allow(clippy::excessive_precision)] // fdlibm's published digits
-const S3: f64 = -1.984_126_982_985_794_931_34e-04;
-#[allow(clippy::excessive_precision)] // fdlibm's published digits
-const S4: f64 = 2.755_731_370_707_006_767_89e-06;
-#[allow(clippy::excessive_precision)] // fdlibm's published digits
-const S5: f64 = -2.505_076_025_340_686_341_95e-08;
-#[allow(clippy::excessive_precision)] // fdlibm's published digits
-const S6: f64 = 1.589_690_995_211_550_102_21e-10;
-/// `1.5 · 2^52`: adding and subtracting it rounds to the nearest integer (`|y| < 2^51`).
-const ROUND: f64 = 6_755_399_441_055_744.0;
-
-/// `sin²x` for `|x| ≤ MAX_BETA`.
-#[inline(always)]
-pub(crate) fn sin_squared(x: f64) -> f64 {
-    let shifted = x * TWO_OVER_PI + ROUND;
-    let odd = (shifted.to_bits() & 1) as f64;
-    let k = shifted - ROUND;
-    let r = ((x - k * PIO2_1) - k * PIO2_2) - k * PIO2_3;
-    let z = r * r;
-    let s = r + r * z * (S1 + z * (S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)))));
-    let s2 = s * s;
-    s2 + odd * (1.0 - 2.0 * s2)
-}
+/// Largest `|β|` the row takes (see [`super::trig_f64::MAX_ARG`]).
+pub(crate) const MAX_BETA: f64 = super::trig_f64::MAX_ARG;
 
 /// Per-cell constants, structure of arrays: `β/nm`, then `ρ` and `(1 − ρ)²` for s and p.
 #[derive(Clone, Debug)]
@@ -136,34 +98,5 @@ fn row_body(cells: &CellsRef<'_>, d: f64, which: Which, r: &mut [f64], t: &mut [
                 t[i] = (gap_s[i] * dp + gap_p[i] * ds) * half_inv;
             }
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn sin_squared_matches_libm_over_its_range() {
-        let mut worst = 0.0f64;
-        let mut x = -MAX_BETA;
-        let mut k = 0u64;
-        while x <= MAX_BETA {
-            let exact = x.sin() * x.sin();
-            worst = worst.max((sin_squared(x) - exact).abs());
-            k += 1;
-            // An irregular step, so that every quadrant and phase is visited.
-            x += 0.377 + (k % 7) as f64 * 0.0131;
-        }
-        for x in [
-            0.0,
-            1e-300,
-            1e-8,
-            std::f64::consts::FRAC_PI_4,
-            std::f64::consts::PI,
-        ] {
-            worst = worst.max((sin_squared(x) - x.sin() * x.sin()).abs());
-        }
-        assert!(worst < 4.0 * f64::EPSILON, "worst |diff| {worst:e}");
     }
 }
