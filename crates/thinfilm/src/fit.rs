@@ -18,10 +18,16 @@
 //!
 //! The residual (RMS), the offset and the runner-up minimum's thickness and `χ²` are
 //! reported, so an ambiguous fringe order shows as a runner-up with nearly the same `χ²`.
+//!
+//! [`fit_thickness_and_index`] also fits the layer's Cauchy index (see [`cauchy`]).
 
 use crate::fresnel::{Num, OpticsError};
 use crate::incidence::Incidence;
 use crate::tmm::Stack;
+
+mod cauchy;
+
+pub use cauchy::{A_GRID, CauchyRange, Estimate, IndexFit, fit_thickness_and_index};
 
 /// Local minima of the scan refined by golden-section search.
 pub const CANDIDATES: usize = 4;
