@@ -181,7 +181,7 @@ impl<F: Fn(f64, RefractiveIndex) -> Result<Stack, OpticsError>> Problem<'_, F> {
     fn residuals(&self, wl: &[f64], p: [f64; 3]) -> Result<(Vec<f64>, f64), OpticsError> {
         let index = self.index(wl, p[1], p[2])?;
         let curve = Curve {
-            model: &|d: f64| (self.model)(d, index.clone()),
+            model: &|d: f64| (self.model)(d, index),
             incidence: self.measured.incidence,
             reflectance: self.measured.reflectance,
         };
@@ -207,7 +207,7 @@ impl<F: Fn(f64, RefractiveIndex) -> Result<Stack, OpticsError>> Problem<'_, F> {
             let a = a_lo + (a_hi - a_lo) * k as f64 / (grid - 1).max(1) as f64;
             let index = self.index(wl, a, b)?;
             let curve = Curve {
-                model: &|d: f64| (self.model)(d, index.clone()),
+                model: &|d: f64| (self.model)(d, index),
                 incidence: self.measured.incidence,
                 reflectance: self.measured.reflectance,
             };
@@ -343,9 +343,9 @@ fn normal_equations(jac: &[Vec<f64>; 3], residuals: &[f64]) -> ([[f64; 3]; 3], [
     let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
     let mut normal: [[f64; 3]; 3] =
         std::array::from_fn(|i| std::array::from_fn(|j| dot(&jac[i], &jac[j])));
-    for k in 0..3 {
-        if normal[k][k] == 0.0 {
-            normal[k][k] = 1.0;
+    for (k, row) in normal.iter_mut().enumerate() {
+        if row[k] == 0.0 {
+            row[k] = 1.0;
         }
     }
     let gradient = std::array::from_fn(|i| dot(&jac[i], residuals));
@@ -356,15 +356,16 @@ fn normal_equations(jac: &[Vec<f64>; 3], residuals: &[f64]) -> ([[f64; 3]; 3], [
 fn solve3(mut m: [[f64; 3]; 3], mut v: [f64; 3]) -> Option<[f64; 3]> {
     for col in 0..3 {
         let pivot = (col..3).max_by(|&a, &b| m[a][col].abs().total_cmp(&m[b][col].abs()))?;
-        if !(m[pivot][col].abs() > 0.0) {
+        if m[pivot][col] == 0.0 || m[pivot][col].is_nan() {
             return None;
         }
         m.swap(col, pivot);
         v.swap(col, pivot);
         for row in col + 1..3 {
             let factor = m[row][col] / m[col][col];
-            for k in col..3 {
-                m[row][k] -= factor * m[col][k];
+            let pivot_row = m[col];
+            for (x, p) in m[row].iter_mut().zip(pivot_row).skip(col) {
+                *x -= factor * p;
             }
             v[row] -= factor * v[col];
         }
