@@ -366,23 +366,9 @@ fn film_rt_grid<'py>(
     Ok((r.into_pyarray(py), t.into_pyarray(py)))
 }
 
-/// The thickness of inner layer `layer` of the stack `n`, `d_nm` fitted to a measured
-/// spectrum (see `thinfilm::fit`): `(thickness, low, high, sigma, systematic, offset,
-/// rms residual, runner-up thickness, runner-up rms)`.
-#[pyfunction]
-#[allow(clippy::too_many_arguments)]
-fn fit_thickness<'py>(
-    py: Python<'py>,
-    wavelength_nm: PyReadonlyArray1<'py, f64>,
-    reflectance: PyReadonlyArray1<'py, f64>,
-    n: Vec<Complex64>,
-    d_nm: Vec<f64>,
-    layer: usize,
-    angle_deg: f64,
-    min_nm: f64,
-    max_nm: f64,
-    wavelength_uncertainty_nm: f64,
-) -> PyResult<[f64; 9]> {
+/// Checks the stack of a fit: `n` one longer than `d_nm` at both ends, `layer` an inner
+/// layer, a real incidence medium.
+fn check_fit_stack(n: &[Complex64], d_nm: &[f64], layer: usize) -> PyResult<()> {
     if n.len() != d_nm.len() + 2 {
         return Err(PyValueError::new_err(format!(
             "n has {} media and d_nm {} thicknesses: n needs len(d_nm) + 2",
@@ -402,19 +388,101 @@ fn fit_thickness<'py>(
             n[0]
         )));
     }
+    Ok(())
+}
+
+/// The stack `n`, `d_nm` with inner layer `layer` of thickness `d` and index `index`.
+fn stack_with_layer(
+    n: &[Complex64],
+    d_nm: &[f64],
+    layer: usize,
+    d: f64,
+    index: thinfilm::IndexModel,
+) -> Result<Stack, OpticsError> {
+    let layers = (n[1..n.len() - 1].iter().zip(d_nm).enumerate())
+        .map(|(k, (&own, &thickness))| {
+            if k == layer {
+                Layer::new(index.clone(), d)
+            } else {
+                Layer::new(own, thickness)
+            }
+        })
+        .collect();
+    Stack::new(n[0].re, layers, n[n.len() - 1])
+}
+
+/// The thickness and Cauchy index `a + b/λ²` of inner layer `layer` fitted together (see
+/// `thinfilm::fit::cauchy`): for the thickness, `a` and `b` in turn `(value, low, high,
+/// sigma, systematic)`, then the offset and the rms residual.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn fit_thickness_cauchy<'py>(
+    py: Python<'py>,
+    wavelength_nm: PyReadonlyArray1<'py, f64>,
+    reflectance: PyReadonlyArray1<'py, f64>,
+    n: Vec<Complex64>,
+    d_nm: Vec<f64>,
+    layer: usize,
+    angle_deg: f64,
+    thickness_range_nm: (f64, f64),
+    a_range: (f64, f64),
+    b_range_nm2: (f64, f64),
+    wavelength_uncertainty_nm: f64,
+) -> PyResult<Vec<f64>> {
+    check_fit_stack(&n, &d_nm, layer)?;
     let incidence = Incidence::try_from_angle_deg(angle_deg).map_err(value_error)?;
     let (wl, r) = (copy(&wavelength_nm), copy(&reflectance));
-    let model = |d: f64| {
-        let layers = n[1..n.len() - 1]
-            .iter()
-            .zip(&d_nm)
-            .enumerate()
-            .map(|(k, (&index, &thickness))| {
-                Layer::new(index, if k == layer { d } else { thickness })
-            })
-            .collect();
-        Stack::new(n[0].re, layers, n[n.len() - 1])
-    };
+    let model =
+        |d: f64, index: RefractiveIndex| stack_with_layer(&n, &d_nm, layer, d, index.into());
+    let fit = py
+        .allow_threads(|| {
+            thinfilm::fit::fit_thickness_and_index(
+                model,
+                &thinfilm::fit::Measurement {
+                    wavelength_nm: &wl,
+                    reflectance: &r,
+                    incidence,
+                    wavelength_uncertainty_nm,
+                },
+                thickness_range_nm.0,
+                thickness_range_nm.1,
+                thinfilm::fit::CauchyRange {
+                    a: [a_range.0, a_range.1],
+                    b_nm2: [b_range_nm2.0, b_range_nm2.1],
+                },
+            )
+        })
+        .map_err(value_error)?;
+    let mut out = Vec::with_capacity(17);
+    for e in [fit.thickness_nm, fit.a, fit.b_nm2] {
+        out.extend([e.value, e.low, e.high, e.sigma, e.systematic]);
+    }
+    out.extend([fit.offset, fit.rms_residual]);
+    Ok(out)
+}
+
+/// The thickness of inner layer `layer` of the stack `n`, `d_nm` fitted to a measured
+/// spectrum (see `thinfilm::fit`): `(thickness, low, high, sigma, systematic, offset,
+/// rms residual, runner-up thickness, runner-up rms)`.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn fit_thickness<'py>(
+    py: Python<'py>,
+    wavelength_nm: PyReadonlyArray1<'py, f64>,
+    reflectance: PyReadonlyArray1<'py, f64>,
+    n: Vec<Complex64>,
+    d_nm: Vec<f64>,
+    layer: usize,
+    angle_deg: f64,
+    min_nm: f64,
+    max_nm: f64,
+    wavelength_uncertainty_nm: f64,
+) -> PyResult<[f64; 9]> {
+    check_fit_stack(&n, &d_nm, layer)?;
+    let incidence = Incidence::try_from_angle_deg(angle_deg).map_err(value_error)?;
+    let (wl, r) = (copy(&wavelength_nm), copy(&reflectance));
+    let own = thinfilm::IndexModel::from(n[layer + 1]);
+    let model = |d: f64| stack_with_layer(&n, &d_nm, layer, d, own.clone());
     let fit = py
         .allow_threads(|| {
             thinfilm::fit::fit_thickness(
@@ -639,6 +707,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(film_rt_fast, m)?)?;
     m.add_function(wrap_pyfunction!(film_rt_grid, m)?)?;
     m.add_function(wrap_pyfunction!(fit_thickness, m)?)?;
+    m.add_function(wrap_pyfunction!(fit_thickness_cauchy, m)?)?;
     m.add_function(wrap_pyfunction!(graded_rt, m)?)?;
     m.add_function(wrap_pyfunction!(film_xyz, m)?)?;
     m.add_function(wrap_pyfunction!(xyz_to_srgb, m)?)?;

@@ -9,8 +9,8 @@ import numpy as np
 
 from . import _native
 
-__all__ = ["rt", "graded_rt", "film_rt", "film_rt_grid", "fit_thickness", "film_xyz", "xyz_to_srgb",
-           "thickness_from_rgb"]
+__all__ = ["rt", "graded_rt", "film_rt", "film_rt_grid", "fit_thickness", "fit_thickness_and_index",
+           "film_xyz", "xyz_to_srgb", "thickness_from_rgb"]
 
 
 def _flat(*arrays):
@@ -225,6 +225,58 @@ def fit_thickness(
             "rms_residual", "runner_up_nm", "runner_up_rms"]
     fit = dict(zip(keys, out))
     fit["interval_nm"] = (fit.pop("low"), fit.pop("high"))
+    return fit
+
+
+def fit_thickness_and_index(
+    wavelength_nm,
+    reflectance,
+    n=(1.0, 1.46, 3.88 + 0.02j),
+    d_nm=None,
+    layer=0,
+    angle_deg=0.0,
+    thickness_range_nm=(0.0, 5000.0),
+    a_range=(1.3, 1.7),
+    b_range_nm2=(0.0, 10000.0),
+    wavelength_uncertainty_nm=0.0,
+):
+    """Fit one layer's thickness together with its Cauchy index ``n(λ) = a + b/λ²``.
+
+    As :func:`fit_thickness` (the stack ``n``, ``d_nm``, the unknown ``layer``, whose own
+    entry in ``n`` is replaced by the fitted index), with ``a`` searched in ``a_range``
+    and ``b`` (nm²) in ``b_range_nm2``: a global thickness search at three values of
+    ``a``, then Levenberg-Marquardt over thickness, ``a`` and ``b``. Returns a dict with
+    ``thickness_nm``, ``cauchy_a``, ``cauchy_b_nm2``, each with its 95 % ``..._interval``
+    (statistical plus the shift ``wavelength_uncertainty_nm`` of calibration causes) and
+    ``..._sigma``, and ``offset``, ``rms_residual``. A film thinner than about one fringe
+    measures only its optical thickness: the intervals then widen to say so.
+    Silica on silicon: ``fit_thickness_and_index(wl, r)``.
+    """
+    n = [complex(x) for x in np.atleast_1d(n)]
+    if d_nm is None:
+        d_nm = [0.0] * max(len(n) - 2, 0)
+    d_nm = [float(x) for x in np.atleast_1d(d_nm)] if np.size(d_nm) else []
+    wl = np.ascontiguousarray(np.asarray(wavelength_nm, dtype=np.float64).ravel())
+    r = np.ascontiguousarray(np.asarray(reflectance, dtype=np.float64).ravel())
+    if isinstance(layer, bool) or not isinstance(layer, (int, np.integer)) or layer < 0:
+        raise ValueError(f"layer = {layer!r} is not an index >= 0 into d_nm")
+    pairs = []
+    for name, pair in [("thickness_range_nm", thickness_range_nm), ("a_range", a_range),
+                       ("b_range_nm2", b_range_nm2)]:
+        values = np.atleast_1d(np.asarray(pair, dtype=np.float64))
+        if values.shape != (2,):
+            raise ValueError(f"{name} = {pair!r} is not a (low, high) pair")
+        pairs.append((float(values[0]), float(values[1])))
+    out = _native.fit_thickness_cauchy(wl, r, n, d_nm, int(layer), float(angle_deg), *pairs,
+                                       float(wavelength_uncertainty_nm))
+    fit = {}
+    for k, name in enumerate(["thickness_nm", "cauchy_a", "cauchy_b_nm2"]):
+        value, low, high, sigma, systematic = out[5 * k:5 * k + 5]
+        fit[name] = value
+        fit[name + "_interval"] = (low, high)
+        fit[name + "_sigma"] = sigma
+        fit[name + "_systematic"] = systematic
+    fit["offset"], fit["rms_residual"] = out[15], out[16]
     return fit
 
 

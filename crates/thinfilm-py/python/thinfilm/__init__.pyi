@@ -75,6 +75,38 @@ def fit_thickness(
 ) -> FitResult:
     """Fit the thickness of one layer to a measured unpolarised reflectance spectrum."""
 
+class IndexFitResult(TypedDict):
+    """What :func:`fit_thickness_and_index` returns."""
+
+    thickness_nm: float
+    thickness_nm_interval: tuple[float, float]
+    thickness_nm_sigma: float
+    thickness_nm_systematic: float
+    cauchy_a: float
+    cauchy_a_interval: tuple[float, float]
+    cauchy_a_sigma: float
+    cauchy_a_systematic: float
+    cauchy_b_nm2: float
+    cauchy_b_nm2_interval: tuple[float, float]
+    cauchy_b_nm2_sigma: float
+    cauchy_b_nm2_systematic: float
+    offset: float
+    rms_residual: float
+
+def fit_thickness_and_index(
+    wavelength_nm: ArrayLike,
+    reflectance: ArrayLike,
+    n: Sequence[complex] | ArrayLike = (1.0, 1.46, 3.88 + 0.02j),
+    d_nm: Sequence[float] | ArrayLike | None = None,
+    layer: int = 0,
+    angle_deg: float = 0.0,
+    thickness_range_nm: tuple[float, float] = (0.0, 5000.0),
+    a_range: tuple[float, float] = (1.3, 1.7),
+    b_range_nm2: tuple[float, float] = (0.0, 10000.0),
+    wavelength_uncertainty_nm: float = 0.0,
+) -> IndexFitResult:
+    """Fit one layer's thickness together with its Cauchy index ``n(λ) = a + b/λ²``."""
+
 def film_xyz(
     thickness_nm: ArrayLike,
     angle_deg: ArrayLike,
