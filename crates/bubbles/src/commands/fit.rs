@@ -5,10 +5,17 @@
 //! Input: `--spectrum F.csv` with columns `wavelength_nm,r` (unpolarised reflectance; `-`
 //! reads stdin). Output: one CSV row
 //! `thickness_nm,low_nm,high_nm,sigma_nm,systematic_nm,offset,rms_residual,runner_up_nm,runner_up_rms`.
+//! With `--cauchy-a LO,HI` (and optionally `--cauchy-b-nm2 LO,HI`) the layer's index is
+//! fitted too, as `a + b/λ²` (`thinfilm::fit::fit_thickness_and_index`), and the row is
+//! `thickness_nm,low_nm,high_nm,sigma_nm,systematic_nm,a,a_low,a_high,a_sigma,a_systematic,
+//! b_nm2,b_low,b_high,b_sigma,b_systematic,offset,rms_residual`.
 
 use std::io::{Read as _, Write as _};
 
-use thinfilm::fit::{Fit, Measurement, Search, fit_thickness};
+use thinfilm::dispersion::RefractiveIndex;
+use thinfilm::fit::{
+    CauchyRange, Fit, Measurement, Search, fit_thickness, fit_thickness_and_index,
+};
 use thinfilm::{Incidence, Layer, Stack};
 
 use crate::csv_table::CsvTable;
@@ -76,6 +83,50 @@ pub struct Args {
         allow_negative_numbers = true
     )]
     wavelength_uncertainty_nm: f64,
+    /// Fit the layer's index too, as Cauchy's `a + b/λ²`, with `a` in `LO,HI`.
+    #[arg(long, value_name = "LO,HI", num_args = 1, value_delimiter = ',')]
+    cauchy_a: Option<Vec<f64>>,
+    /// With --cauchy-a: the range of Cauchy's `b` in nm² (default 0,10000).
+    #[arg(
+        long,
+        value_name = "LO,HI",
+        num_args = 1,
+        value_delimiter = ',',
+        requires = "cauchy_a"
+    )]
+    cauchy_b_nm2: Option<Vec<f64>>,
+}
+
+/// The names of the row `--cauchy-a` writes.
+const INDEX_FIELDS: [&str; 17] = [
+    "thickness_nm",
+    "low_nm",
+    "high_nm",
+    "sigma_nm",
+    "systematic_nm",
+    "a",
+    "a_low",
+    "a_high",
+    "a_sigma",
+    "a_systematic",
+    "b_nm2",
+    "b_low",
+    "b_high",
+    "b_sigma",
+    "b_systematic",
+    "offset",
+    "rms_residual",
+];
+
+/// A `LO,HI` flag's pair, or an error naming the flag.
+fn pair(flag: &str, values: &[f64]) -> Result<[f64; 2], CliError> {
+    match values {
+        [lo, hi] => Ok([*lo, *hi]),
+        _ => Err(CliError::input(format!(
+            "{flag} takes two numbers LO,HI, not {} value(s)",
+            values.len()
+        ))),
+    }
 }
 
 /// Runs `bubbles fit`.
@@ -137,31 +188,55 @@ pub fn run(args: Args) -> CliResult {
         .iter()
         .filter_map(|&w| base.layers[layer].index.try_n_at(w).ok())
         .fold(0.0f64, |m, n| m.max(n.re));
-    let model = |d: f64| {
-        let mut stack = base.clone();
-        stack.layers[layer].thickness_nm = d;
-        Ok(stack)
+    let measurement = Measurement {
+        wavelength_nm: &wavelength_nm,
+        reflectance: &reflectance,
+        incidence,
+        wavelength_uncertainty_nm: args.wavelength_uncertainty_nm,
     };
-    let fit = fit_thickness(
-        model,
-        &Measurement {
-            wavelength_nm: &wavelength_nm,
-            reflectance: &reflectance,
-            incidence,
-            wavelength_uncertainty_nm: args.wavelength_uncertainty_nm,
-        },
-        Search {
+    let out = if let Some(a) = &args.cauchy_a {
+        let b = args.cauchy_b_nm2.as_deref().unwrap_or(&[0.0, 10000.0]);
+        let range = CauchyRange {
+            a: pair("--cauchy-a", a)?,
+            b_nm2: pair("--cauchy-b-nm2", b)?,
+        };
+        let model = |d: f64, index: RefractiveIndex| {
+            let mut stack = base.clone();
+            stack.layers[layer] = Layer::new(index, d);
+            Ok(stack)
+        };
+        let fit = fit_thickness_and_index(model, &measurement, args.min_nm, args.max_nm, range)
+            .map_err(|e| CliError::input(e.to_string()))?;
+        let mut values = Vec::new();
+        for e in [fit.thickness_nm, fit.a, fit.b_nm2] {
+            values.extend([e.value, e.low, e.high, e.sigma, e.systematic]);
+        }
+        values.extend([fit.offset, fit.rms_residual]);
+        csv_row(&INDEX_FIELDS, &values)
+    } else {
+        let model = |d: f64| {
+            let mut stack = base.clone();
+            stack.layers[layer].thickness_nm = d;
+            Ok(stack)
+        };
+        let search = Search {
             min_nm: args.min_nm,
             max_nm: args.max_nm,
             n_max: if n_max > 0.0 { n_max } else { 1.0 },
-        },
-    )
-    .map_err(|e| CliError::input(e.to_string()))?;
-    let values: Vec<String> = fit.values().iter().map(f64::to_string).collect();
-    let out = format!("{}\n{}\n", Fit::FIELDS.join(","), values.join(","));
+        };
+        let fit = fit_thickness(model, &measurement, search)
+            .map_err(|e| CliError::input(e.to_string()))?;
+        csv_row(&Fit::FIELDS, &fit.values())
+    };
     let mut stdout = std::io::stdout().lock();
     stdout
         .write_all(out.as_bytes())
         .and_then(|()| stdout.flush())
         .map_err(|e| CliError::runtime(format!("cannot write to stdout: {e}")))
+}
+
+/// A header line and one row of values.
+fn csv_row(fields: &[&str], values: &[f64]) -> String {
+    let values: Vec<String> = values.iter().map(f64::to_string).collect();
+    format!("{}\n{}\n", fields.join(","), values.join(","))
 }
