@@ -19,6 +19,8 @@ use thinfilm::{Complex64, Incidence, Layer, Observer, OpticsError, SpectralInteg
 
 /// Points per rayon task: small enough to balance, large enough to amortise.
 const CHUNK: usize = 1024;
+/// Wavelengths per task of a stack grid's row (each task folds its own span).
+const SPAN: usize = 128;
 
 type Pair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
 type Triple<'py> = (
@@ -166,11 +168,17 @@ fn rt_grid<'py>(
             let grid = StackGrid::try_new(&stack, &angle, &wl)?;
             let (mut r, mut t) = (zeroed(grid.len()), zeroed(grid.len()));
             if !grid.is_empty() {
+                // Spans of a row, so that a grid of one or a few angles still fills both cores.
                 let width = grid.wavelengths();
                 r.par_chunks_mut(width)
                     .zip(t.par_chunks_mut(width))
                     .enumerate()
-                    .try_for_each(|(a, (r, t))| grid.try_fill_row(a, pol, r, t))?;
+                    .try_for_each(|(a, (r, t))| {
+                        r.par_chunks_mut(SPAN)
+                            .zip(t.par_chunks_mut(SPAN))
+                            .enumerate()
+                            .try_for_each(|(k, (r, t))| grid.try_fill_span(a, k * SPAN, pol, r, t))
+                    })?;
             }
             Ok::<_, OpticsError>((r, t))
         })

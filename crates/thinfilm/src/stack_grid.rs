@@ -146,12 +146,38 @@ impl StackGrid {
         t: &mut [f64],
     ) -> Result<(), OpticsError> {
         check_len("r", r.len(), self.wavelengths())?;
-        check_len("t", t.len(), self.wavelengths())?;
+        self.try_fill_span(angle, 0, pol, r, t)
+    }
+
+    /// `R` and `T` at angle `angle` for the wavelengths `first..first + r.len()` (spans are
+    /// independent too: split long rows to share them between threads).
+    ///
+    /// # Errors
+    /// `angle` or the span beyond the grid, or `t` not as long as `r`.
+    pub fn try_fill_span(
+        &self,
+        angle: usize,
+        first: usize,
+        pol: Polarisation,
+        r: &mut [f64],
+        t: &mut [f64],
+    ) -> Result<(), OpticsError> {
+        check_len("t", t.len(), r.len())?;
         let row = self.rows.get(angle).ok_or(OpticsError::Length {
             what: "angle row",
             len: angle,
             expected: self.angles(),
         })?;
+        let span = first
+            .checked_add(r.len())
+            .filter(|&end| end <= self.wavelengths())
+            .map(|end| first..end)
+            .ok_or(OpticsError::Length {
+                what: "wavelengths from first",
+                len: first.saturating_add(r.len()),
+                expected: self.wavelengths(),
+            })?;
+        let wavelengths = &self.wavelength_nm[span.clone()];
         match row {
             AngleRow::Folded {
                 incidence,
@@ -160,25 +186,25 @@ impl StackGrid {
                 power_ratio,
             } => {
                 let mut kernel = Row::default();
-                let (first, pols) = match pol {
+                let (lead, pols) = match pol {
                     Polarisation::P => (1, 1),
                     Polarisation::S => (0, 1),
                     Polarisation::Unpolarised => (0, 2),
                 };
-                let pick = |k: [Coeffs; 2]| [k[first], k[1 - first]];
+                let pick = |k: [Coeffs; 2]| [k[lead], k[1 - lead]];
                 let layers: Vec<_> = (layers.iter())
                     .map(|l| LayerTerms {
                         front: pick(l.front),
                         ..*l
                     })
                     .collect();
-                kernel.fold(&self.inv_wavelength_nm, pick(*exit), &layers, pols);
-                let ratio = [power_ratio[first], power_ratio[1 - first]];
+                kernel.fold(&self.inv_wavelength_nm[span], pick(*exit), &layers, pols);
+                let ratio = [power_ratio[lead], power_ratio[1 - lead]];
                 write_row(&kernel, ratio, pols, r, t);
-                self.repair_poles(*incidence, pol, r, t)
+                self.repair_poles(wavelengths, *incidence, pol, r, t)
             }
             AngleRow::General(incidence) => {
-                for (k, &wavelength) in self.wavelength_nm.iter().enumerate() {
+                for (k, &wavelength) in wavelengths.iter().enumerate() {
                     (r[k], t[k]) = self.exact_at(wavelength, *incidence, pol)?;
                 }
                 Ok(())
@@ -189,12 +215,13 @@ impl StackGrid {
     /// Points the recursion could not evaluate (a pole of a sub-stack), by the matrix.
     fn repair_poles(
         &self,
+        wavelengths: &[f64],
         incidence: Incidence,
         pol: Polarisation,
         r: &mut [f64],
         t: &mut [f64],
     ) -> Result<(), OpticsError> {
-        for (k, &wavelength) in self.wavelength_nm.iter().enumerate() {
+        for (k, &wavelength) in wavelengths.iter().enumerate() {
             if !(r[k].is_finite() && t[k].is_finite()) {
                 (r[k], t[k]) = self.exact_at(wavelength, incidence, pol)?;
             }

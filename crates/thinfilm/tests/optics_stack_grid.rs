@@ -187,3 +187,30 @@ fn bad_wavelengths_angles_and_lengths_are_named() {
             .is_err()
     );
 }
+
+#[test]
+fn spans_of_a_row_fill_what_the_row_fills() {
+    let layers = vec![
+        Layer::lossless(1.38, 100.0),
+        Layer::new(Complex64::new(0.2, 3.0), 20.0),
+    ];
+    let stack = Stack::new(1.0, layers, 1.52).unwrap();
+    let wavelengths: Vec<f64> = (0..37).map(|k| 380.0 + 11.0 * k as f64).collect();
+    let grid = StackGrid::try_new(&stack, &[0.0, 50.0, 90.0], &wavelengths).unwrap();
+    for pol in POLS {
+        let (whole_r, whole_t) = filled(&grid, pol);
+        for angle in 0..3 {
+            let (mut r, mut t) = (vec![0.0; 37], vec![0.0; 37]);
+            for (k, (r, t)) in r.chunks_mut(8).zip(t.chunks_mut(8)).enumerate() {
+                grid.try_fill_span(angle, 8 * k, pol, r, t).unwrap();
+            }
+            assert_eq!(r, whole_r[37 * angle..37 * (angle + 1)]);
+            assert_eq!(t, whole_t[37 * angle..37 * (angle + 1)]);
+        }
+    }
+    let (mut r, mut t) = (vec![0.0; 8], vec![0.0; 8]);
+    let err = grid
+        .try_fill_span(0, 30, Polarisation::S, &mut r, &mut t)
+        .unwrap_err();
+    assert!(err.to_string().contains("38"), "{err}");
+}

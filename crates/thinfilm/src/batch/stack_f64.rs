@@ -85,8 +85,9 @@ impl Row {
         }
         self.phi_re.resize(n, 0.0);
         self.phi_im.resize(n, 0.0);
+        let largest = inv_wavelength_nm.iter().fold(0.0f64, |m, &x| m.max(x));
         for layer in layers {
-            self.phase(inv_wavelength_nm, layer.beta_nm);
+            self.phase(inv_wavelength_nm, largest, layer.beta_nm);
             let front = layer.front.map(Front::new);
             let phi = (&self.phi_re[..], &self.phi_im[..]);
             if pols == 2 {
@@ -100,8 +101,7 @@ impl Row {
 
     /// `φ = e^{iβ/λ}` over the row: the vector sine and cosine for a lossless layer within
     /// their range, libm's (with the decay `e^{−Im δ}`) otherwise.
-    fn phase(&mut self, inv_wavelength_nm: &[f64], beta_nm: Complex64) {
-        let largest = inv_wavelength_nm.iter().fold(0.0f64, |m, &x| m.max(x));
+    fn phase(&mut self, inv_wavelength_nm: &[f64], largest: f64, beta_nm: Complex64) {
         if beta_nm.im == 0.0 && beta_nm.re.abs() * largest <= MAX_ARG {
             phase_lossless(
                 inv_wavelength_nm,
@@ -249,28 +249,53 @@ fn phase_terms(re: f64, im: f64) -> (f64, f64, f64) {
 /// adds to `100 ε` relative.
 const MIN_DEN_NORM: f64 = 1e-2;
 
-/// One layer for one point: `Γ' = (r + Γφ²) / (1 + rΓφ²)`,
+/// `r + Γφ²` and `1 + rΓφ²` with `|1 + rΓφ²|²`: one layer's numerator and denominator.
+#[derive(Clone, Copy)]
+struct Bounce {
+    num_re: f64,
+    num_im: f64,
+    den_re: f64,
+    den_im: f64,
+    den_norm: f64,
+}
+
+#[inline(always)]
+fn bounce(front: Front, sq: (f64, f64, f64), g_re: f64, g_im: f64) -> Bounce {
+    let (sq_re, sq_im, _) = sq;
+    let x_re = g_re * sq_re - g_im * sq_im;
+    let x_im = g_re * sq_im + g_im * sq_re;
+    let den_re = 1.0 + (front.r_re * x_re - front.r_im * x_im);
+    let den_im = front.r_re * x_im + front.r_im * x_re;
+    Bounce {
+        num_re: front.r_re + x_re,
+        num_im: front.r_im + x_im,
+        den_re,
+        den_im,
+        den_norm: den_re * den_re + den_im * den_im,
+    }
+}
+
+/// One layer for one point, given `1 / |1 + rΓφ²|²`: `Γ' = (r + Γφ²) / (1 + rΓφ²)`,
 /// `|τ'|² = |t|² |τ|² |φ|² / |1 + rΓφ²|²`.
 #[inline(always)]
-fn step(front: Front, sq: (f64, f64, f64), g_re: f64, g_im: f64, t_norm: f64) -> (f64, f64, f64) {
-    let (sq_re, sq_im, phi_norm) = sq;
-    let bounce_re = g_re * sq_re - g_im * sq_im;
-    let bounce_im = g_re * sq_im + g_im * sq_re;
-    let den_re = 1.0 + (front.r_re * bounce_re - front.r_im * bounce_im);
-    let den_im = front.r_re * bounce_im + front.r_im * bounce_re;
-    let den_norm = den_re * den_re + den_im * den_im;
-    let inv_norm = 1.0 / den_norm;
-    let (num_re, num_im) = (front.r_re + bounce_re, front.r_im + bounce_im);
+fn apply(front: Front, b: Bounce, inv_norm: f64, phi_norm: f64, t_norm: f64) -> (f64, f64, f64) {
     // Near a pole (a guided mode of the layers behind) Γ carries a relative error of
     // ε / |den|, which the layers in front can turn into an absolute one: such points
     // are poisoned, so that the caller takes them by the transfer matrix instead.
-    let poison = if den_norm < MIN_DEN_NORM {
+    let poison = if b.den_norm < MIN_DEN_NORM {
         f64::NAN
     } else {
         0.0
     };
     // num / den = num · conj(den) / |den|².
-    let g_re = (num_re * den_re + num_im * den_im) * inv_norm + poison;
-    let g_im = (num_im * den_re - num_re * den_im) * inv_norm;
+    let g_re = (b.num_re * b.den_re + b.num_im * b.den_im) * inv_norm + poison;
+    let g_im = (b.num_im * b.den_re - b.num_re * b.den_im) * inv_norm;
     (g_re, g_im, front.t_norm * t_norm * phi_norm * inv_norm)
+}
+
+/// One layer for one point of one polarisation.
+#[inline(always)]
+fn step(front: Front, sq: (f64, f64, f64), g_re: f64, g_im: f64, t_norm: f64) -> (f64, f64, f64) {
+    let b = bounce(front, sq, g_re, g_im);
+    apply(front, b, 1.0 / b.den_norm, sq.2, t_norm)
 }
