@@ -22,7 +22,7 @@
 //! Each function has a `try_` form that returns an [`OpticsError`] naming a bad input;
 //! the plain form panics with that message.
 
-use crate::fresnel::{self, OpticsError};
+use crate::fresnel::{self, OpticsError, check_len};
 
 mod cells;
 pub(crate) mod film_f64;
@@ -406,18 +406,6 @@ fn check_thicknesses(thickness_nm: &[f32]) -> Result<f64, OpticsError> {
         max = max.max(d);
     }
     Ok(max as f64)
-}
-
-fn check_len(what: &'static str, len: usize, expected: usize) -> Result<(), OpticsError> {
-    if len == expected {
-        Ok(())
-    } else {
-        Err(OpticsError::Length {
-            what,
-            len,
-            expected,
-        })
-    }
 }
 
 fn not_finite(what: &'static str, index: usize, value: f32) -> OpticsError {

@@ -292,6 +292,23 @@ pub(crate) fn check_cos(what: &'static str, cos_theta: f64) -> Result<(), Optics
 }
 
 /// Checks a wavelength: finite and `> 0` nm.
+/// `Ok` if a slice `what` is `expected` long, else [`OpticsError::Length`].
+pub(crate) fn check_len(
+    what: &'static str,
+    len: usize,
+    expected: usize,
+) -> Result<(), OpticsError> {
+    if len == expected {
+        Ok(())
+    } else {
+        Err(OpticsError::Length {
+            what,
+            len,
+            expected,
+        })
+    }
+}
+
 pub(crate) fn check_wavelength(wavelength_nm: f64) -> Result<(), OpticsError> {
     if wavelength_nm.is_finite() && wavelength_nm > 0.0 {
         Ok(())

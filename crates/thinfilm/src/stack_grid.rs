@@ -23,7 +23,7 @@
 
 use crate::batch::stack_f64::{Amplitudes, Coeffs, LayerTerms, Row};
 use crate::dispersion::check_in_range;
-use crate::fresnel::{self, OpticsError};
+use crate::fresnel::{self, OpticsError, check_len};
 use crate::grid::Polarisation;
 use crate::incidence::Incidence;
 use crate::tmm::Stack;
@@ -302,17 +302,5 @@ fn folded(stack: &Stack, media: &[Complex64], incidence: Incidence) -> AngleRow 
         exit: interface(last - 1),
         layers,
         power_ratio: [0, 1].map(|p| y_sub[p].re / y0[p].re),
-    }
-}
-
-fn check_len(what: &'static str, len: usize, expected: usize) -> Result<(), OpticsError> {
-    if len == expected {
-        Ok(())
-    } else {
-        Err(OpticsError::Length {
-            what,
-            len,
-            expected,
-        })
     }
 }

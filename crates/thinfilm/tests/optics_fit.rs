@@ -2,31 +2,11 @@
 //! wavelength-calibration error: the true thickness inside the reported 95 % interval in
 //! at least 95 % of 200 seeded trials from 10 nm to 5 µm.
 
+mod optics_common;
+
+use optics_common::Rng;
 use thinfilm::fit::{Measurement, Search, fit_thickness};
 use thinfilm::{Complex64, Incidence, Layer, OpticsError, Stack};
-
-/// SplitMix64: a small seeded generator, so the trials are the same on every run.
-struct Rng(u64);
-
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1).
-    fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    /// Standard normal (Box–Muller).
-    fn normal(&mut self) -> f64 {
-        let u = 1.0 - self.uniform();
-        let v = self.uniform();
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-    }
-}
 
 const SILICON: Complex64 = Complex64::new(3.88, 0.02);
 const OXIDE: f64 = 1.46;

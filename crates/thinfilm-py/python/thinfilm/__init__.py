@@ -210,15 +210,8 @@ def fit_thickness(
     with nearly the same residual). A free soap film: the defaults. Silica on silicon:
     ``fit_thickness(wl, r, n=[1.0, 1.46, 3.88 + 0.02j])``.
     """
-    n = [complex(x) for x in np.atleast_1d(n)]
-    if d_nm is None:
-        d_nm = [0.0] * max(len(n) - 2, 0)
-    d_nm = [float(x) for x in np.atleast_1d(d_nm)] if np.size(d_nm) else []
-    wl = np.ascontiguousarray(np.asarray(wavelength_nm, dtype=np.float64).ravel())
-    r = np.ascontiguousarray(np.asarray(reflectance, dtype=np.float64).ravel())
+    n, d_nm, wl, r = _fit_inputs(wavelength_nm, reflectance, n, d_nm, layer)
     lo, hi = (float(x) for x in thickness_range_nm)
-    if isinstance(layer, bool) or not isinstance(layer, (int, np.integer)) or layer < 0:
-        raise ValueError(f"layer = {layer!r} is not an index >= 0 into d_nm")
     out = _native.fit_thickness(wl, r, n, d_nm, int(layer), float(angle_deg), lo, hi,
                                 float(wavelength_uncertainty_nm))
     keys = ["thickness_nm", "low", "high", "sigma_nm", "systematic_nm", "offset",
@@ -252,14 +245,7 @@ def fit_thickness_and_index(
     measures only its optical thickness: the intervals then widen to say so.
     Silica on silicon: ``fit_thickness_and_index(wl, r)``.
     """
-    n = [complex(x) for x in np.atleast_1d(n)]
-    if d_nm is None:
-        d_nm = [0.0] * max(len(n) - 2, 0)
-    d_nm = [float(x) for x in np.atleast_1d(d_nm)] if np.size(d_nm) else []
-    wl = np.ascontiguousarray(np.asarray(wavelength_nm, dtype=np.float64).ravel())
-    r = np.ascontiguousarray(np.asarray(reflectance, dtype=np.float64).ravel())
-    if isinstance(layer, bool) or not isinstance(layer, (int, np.integer)) or layer < 0:
-        raise ValueError(f"layer = {layer!r} is not an index >= 0 into d_nm")
+    n, d_nm, wl, r = _fit_inputs(wavelength_nm, reflectance, n, d_nm, layer)
     pairs = []
     for name, pair in [("thickness_range_nm", thickness_range_nm), ("a_range", a_range),
                        ("b_range_nm2", b_range_nm2)]:
@@ -278,6 +264,19 @@ def fit_thickness_and_index(
         fit[name + "_systematic"] = systematic
     fit["offset"], fit["rms_residual"] = out[15], out[16]
     return fit
+
+
+def _fit_inputs(wavelength_nm, reflectance, n, d_nm, layer):
+    """A fit's stack (``d_nm`` all 0 when None) and contiguous spectrum, ``layer`` checked."""
+    n = [complex(x) for x in np.atleast_1d(n)]
+    if d_nm is None:
+        d_nm = [0.0] * max(len(n) - 2, 0)
+    d_nm = [float(x) for x in np.atleast_1d(d_nm)] if np.size(d_nm) else []
+    wl = np.ascontiguousarray(np.asarray(wavelength_nm, dtype=np.float64).ravel())
+    r = np.ascontiguousarray(np.asarray(reflectance, dtype=np.float64).ravel())
+    if isinstance(layer, bool) or not isinstance(layer, (int, np.integer)) or layer < 0:
+        raise ValueError(f"layer = {layer!r} is not an index >= 0 into d_nm")
+    return n, d_nm, wl, r
 
 
 def film_xyz(thickness_nm, angle_deg, n_film=1.33, illuminant="d65", observer="1931"):
