@@ -186,3 +186,41 @@ fn pond_through_wgpu_is_refused_naming_the_water() {
     );
     assert!(!dir.path().join("x.png").exists(), "no image on failure");
 }
+
+/// `--samples 9` has no MSAA count anywhere: the frame is rendered at the nearest count
+/// the device offers, and stderr says so once, naming both counts.
+#[test]
+fn a_sample_count_the_device_lacks_is_replaced_by_the_nearest_and_said() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "render",
+        "paper",
+        "--backend",
+        "wgpu",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--samples",
+        "9",
+        "--out",
+        "x.png",
+    ];
+    let out = bubbles(&args, dir.path());
+    let err = stderr(&out);
+    if err.contains("no wgpu adapter") && std::env::var_os("CI").is_none() {
+        eprintln!("skipped: {err}");
+        return;
+    }
+    assert!(out.status.success(), "{err}");
+    assert!(dir.path().join("x.png").exists());
+    assert_eq!(
+        err.matches("--samples 9 is rendered with").count(),
+        1,
+        "{err}"
+    );
+    assert!(
+        err.contains("with 8 samples") || err.contains("with 4 samples"),
+        "{err}"
+    );
+}

@@ -12,7 +12,7 @@ mod common;
 use common::{
     bubble, film_field, lossless_tables, paper_scene, settings, synthetic_reflectivity, with_film,
 };
-use raster::gpu::{GpuError, GpuOptions, GpuRenderer};
+use raster::gpu::{GpuOptions, GpuRenderer};
 use raster::{
     Environment, FilmTables, Irradiance, Material, Object, Pattern, ReflectionMode, RenderScene,
     Renderer, Sky, Vec3,
@@ -254,10 +254,6 @@ fn gpu_hdr_frame_agrees_with_its_own_tone_mapped_bytes() {
 fn gpu_refuses_what_it_does_not_draw_naming_it() {
     let Some(mut gpu) = gpu() else { return };
     let (scene, tables) = (scene(), tables());
-    let s = settings(32, 32, 8, ReflectionMode::StaticEnvironment);
-    let err = gpu.render(&scene, &tables, &s).unwrap_err();
-    assert!(matches!(err, GpuError::Unsupported(_)), "{err:?}");
-    assert!(err.to_string().contains("samples = 8"), "{err}");
     let s = settings(32, 32, 3, ReflectionMode::StaticEnvironment);
     let err = gpu.render(&scene, &tables, &s).unwrap_err();
     assert!(err.to_string().contains("samples"), "{err}");
@@ -486,4 +482,61 @@ fn gpu_film_with_coverage_half_matches_the_cpu_blend() {
         film_error <= 0.1 * blend_effect,
         "film pixels: GPU ΔE {film_error} from the CPU's blend, a whole film {blend_effect}"
     );
+}
+
+#[test]
+fn every_cpu_sample_count_renders_at_the_nearest_count_the_device_offers() {
+    let Some(mut gpu) = gpu() else { return };
+    let counts = gpu.gpu().sample_counts().to_vec();
+    eprintln!("{}: sample counts {counts:?}", gpu.gpu().adapter_name());
+    assert!(counts.contains(&1) && counts.contains(&4), "{counts:?}");
+    let (scene, tables) = (scene(), tables());
+    for requested in raster::SAMPLE_COUNTS {
+        let used = gpu.gpu().sample_count_for(requested);
+        assert!(
+            counts.contains(&used),
+            "{requested} -> {used}, not in {counts:?}"
+        );
+        let nearer = counts
+            .iter()
+            .any(|n| n.abs_diff(requested) < used.abs_diff(requested));
+        assert!(
+            !nearer,
+            "{requested} -> {used}, but {counts:?} has a nearer one"
+        );
+        if counts.contains(&requested) {
+            assert_eq!(used, requested);
+        }
+        let at = |n| {
+            settings(
+                200,
+                150,
+                n,
+                ReflectionMode::DynamicCubeMap { face_size: 48 },
+            )
+        };
+        let gpu_bytes = gpu.render_srgb8(&scene, &tables, &at(requested)).unwrap();
+        // A substituted count renders exactly what asking for it renders.
+        assert_eq!(
+            gpu_bytes,
+            gpu.render_srgb8(&scene, &tables, &at(used)).unwrap()
+        );
+        // Against the CPU at the count the GPU used (the CPU's own pattern of it).
+        let cpu_count = if raster::SAMPLE_COUNTS.contains(&used) {
+            used
+        } else {
+            requested
+        };
+        let s = at(cpu_count);
+        let cpu = cpu_renderer()
+            .render(&scene, &tables, &s)
+            .unwrap()
+            .to_srgb8(s.exposure_ev, s.tonemap);
+        let (mean, p99) = delta_e(&cpu, &gpu_bytes);
+        eprintln!("{requested} samples (GPU {used}): mean ΔE2000 {mean:.3}, p99 {p99:.3}");
+        assert!(
+            mean <= 0.5 && p99 <= 2.0,
+            "{requested} samples (GPU {used}): mean {mean}, p99 {p99}"
+        );
+    }
 }

@@ -4,9 +4,10 @@
 use crate::error::CliError;
 use raster::{FilmTables, Frame, RenderScene, RenderSettings};
 
-/// The wgpu renderer (only with the `wgpu` feature).
+/// The wgpu renderer (only with the `wgpu` feature), and whether the sample-count notice
+/// was given.
 #[cfg(feature = "wgpu")]
-pub struct GpuBackend(raster::gpu::GpuRenderer);
+pub struct GpuBackend(raster::gpu::GpuRenderer, bool);
 
 /// Stands in for the wgpu renderer in a build without the feature; never constructed.
 #[cfg(not(feature = "wgpu"))]
@@ -18,7 +19,7 @@ impl GpuBackend {
     /// driver package, `VK_DRIVER_FILES` and `--backend cpu`.
     pub fn open() -> Result<Self, CliError> {
         raster::gpu::GpuRenderer::new(raster::gpu::GpuOptions::default())
-            .map(GpuBackend)
+            .map(|renderer| GpuBackend(renderer, false))
             .map_err(|e| CliError::input(format!("--backend wgpu: {e}")))
     }
 
@@ -27,13 +28,25 @@ impl GpuBackend {
         self.0.gpu().adapter_name()
     }
 
-    /// Renders one frame on the GPU and reads it back.
+    /// Renders one frame on the GPU and reads it back. A sample count the device does not
+    /// render is replaced by the nearest one it does, said once on stderr.
     pub fn render(
         &mut self,
         scene: &RenderScene,
         tables: &FilmTables,
         settings: &RenderSettings,
     ) -> Result<&Frame, raster::gpu::GpuError> {
+        let used = self.0.gpu().sample_count_for(settings.samples);
+        if used != settings.samples && !self.1 {
+            self.1 = true;
+            eprintln!(
+                "bubbles: --samples {} is rendered with {used} samples on {} (the nearest count \
+                 it offers: {:?})",
+                settings.samples,
+                self.0.gpu().adapter_name(),
+                self.0.gpu().sample_counts()
+            );
+        }
         self.0.render(scene, tables, settings)
     }
 }

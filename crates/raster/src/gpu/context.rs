@@ -20,6 +20,8 @@ pub struct Gpu {
     pub(super) queue: wgpu::Queue,
     info: wgpu::AdapterInfo,
     pub(super) tone_map: ToneMapPass,
+    /// The frame's sample counts this device renders, ascending (always 1 and 4).
+    sample_counts: Vec<u32>,
 }
 
 impl Gpu {
@@ -37,8 +39,12 @@ impl Gpu {
         .map_err(|e| GpuError::NoAdapter {
             reason: e.to_string(),
         })?;
+        // Sample counts besides 1 and 4 need the adapter's own format features.
+        let specific =
+            adapter.features() & wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("raster"),
+            required_features: specific,
             required_limits: wgpu::Limits {
                 // Six cube faces per bubble, as many as the adapter holds.
                 max_texture_array_layers: adapter.limits().max_texture_array_layers,
@@ -53,6 +59,7 @@ impl Gpu {
             device,
             queue,
             tone_map,
+            sample_counts: sample_counts(&adapter, !specific.is_empty()),
         })
     }
 
@@ -63,6 +70,22 @@ impl Gpu {
             "{} ({:?}), {} {}",
             i.name, i.device_type, i.driver, i.driver_info
         )
+    }
+
+    /// The sample count the frame is rendered with for `requested`: `requested` where the
+    /// device renders it, else the nearest count it does (the lower one on a tie), so 9
+    /// becomes 8 everywhere and 16 becomes 8 where 16 is not offered.
+    pub fn sample_count_for(&self, requested: u32) -> u32 {
+        let nearest = self
+            .sample_counts
+            .iter()
+            .min_by_key(|&&n| (n.abs_diff(requested), n));
+        *nearest.expect("1 and 4 are always offered")
+    }
+
+    /// The frame's sample counts this device renders, ascending.
+    pub fn sample_counts(&self) -> &[u32] {
+        &self.sample_counts
     }
 
     /// Whether the adapter is a CPU (software) implementation.
@@ -81,4 +104,25 @@ impl Gpu {
         }
         Ok(())
     }
+}
+
+/// The frame's sample counts: 1, 4 (every WebGPU device), and with the adapter's own format
+/// features each of 2, 8 and 16 that both the frame's HDR colour (rendered and resolved)
+/// and its depth take.
+fn sample_counts(adapter: &wgpu::Adapter, specific: bool) -> Vec<u32> {
+    use super::pipelines::{DEPTH_FORMAT, HDR_FORMAT};
+    let hdr = adapter.get_texture_format_features(HDR_FORMAT).flags;
+    let depth = adapter.get_texture_format_features(DEPTH_FORMAT).flags;
+    let resolves = hdr.contains(wgpu::TextureFormatFeatureFlags::MULTISAMPLE_RESOLVE);
+    [1, 2, 4, 8, 16]
+        .into_iter()
+        .filter(|&n| {
+            n == 1
+                || n == 4
+                || (specific
+                    && resolves
+                    && hdr.sample_count_supported(n)
+                    && depth.sample_count_supported(n))
+        })
+        .collect()
 }

@@ -153,7 +153,8 @@ impl GpuRenderer {
         } else {
             1
         };
-        let samples = settings.samples;
+        // The nearest count the device renders (the caller is told by `sample_count_for`).
+        let samples = self.gpu.sample_count_for(settings.samples);
         let cubes = self.texture("cube faces", ((m, m, layers), 1), hdr_texture);
         let face_depth = self.texture("face depth", ((m, m, 1), 1), depth_texture);
         let resolved = self.texture("frame", ((w, h, 1), 1), hdr_texture);

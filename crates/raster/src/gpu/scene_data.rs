@@ -172,12 +172,6 @@ pub(super) fn check_supported(
     scene: &RenderScene,
     settings: &RenderSettings,
 ) -> Result<(), GpuError> {
-    if !matches!(settings.samples, 1 | 4) {
-        return Err(unsupported(format!(
-            "samples = {} (the wgpu backend renders 1 or 4)",
-            settings.samples
-        )));
-    }
     if let ReflectionMode::SphereMap(_) = settings.reflection {
         return Err(unsupported("reflection mode sphere-map"));
     }
