@@ -22,8 +22,8 @@ pub const MAX_SECONDS: f64 = 3600.0;
 /// Highest frame rate, frames per second.
 pub const MAX_FPS: f64 = 240.0;
 /// Strongest slow motion: output 10 000× slower than real time (at 24 fps, 240 000
-/// simulated frames per second, about what the fastest cameras film bursts with; the
-/// rims move half a cell per sub-step, a few µs, so finer frames would repeat).
+/// simulated frames per second, about what the fastest cameras film bursts with; a
+/// rim moves half a film cell per sub-step, about 10 µs, so finer frames would repeat).
 pub const MAX_SLOW_MOTION: f64 = 10_000.0;
 /// Name of the file in a frame directory that records what the frames show.
 pub const MANIFEST: &str = "animation.txt";
@@ -41,8 +41,9 @@ pub const MANIFEST: &str = "animation.txt";
     frames for its --seconds of simulated time (T + seconds <= 3600). With K other than \
     1 each frame shows the solver step at or before its t, and the holes of a bursting \
     film exactly at t (their rims move between steps, half a film cell at a time), so \
-    `--start-s 12.3 --seconds 0.2 --fps 30 --slow-motion 200` shows the swirl scene's \
-    burst (a hole opens at t = 12.433 s) as high-speed video does.\n\n\
+    `swirl --start-s 12.433 --seconds 0.008 --fps 30 --slow-motion 200` shows that \
+    scene's burst (a hole opens at t = 12.433 s) in 48 frames, as high-speed video \
+    does.\n\n\
     --out DIR writes DIR/frame_00000.png, … each through a temporary file renamed into \
     place, so an interrupted run leaves only whole frames, and DIR/animation.txt records \
     the scene and settings and a checksum per frame (a DIR made with other settings, or \
