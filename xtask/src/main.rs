@@ -212,6 +212,60 @@ fn figures() -> bool {
     fig2 && chart && paper && furnace && sodium && gallery
 }
 
+/// The swirl scene's burst in slow motion (docs/gallery.md): an animated PNG 200× slower
+/// than real time from just before the hole opens (t = 12.4333 s) until the bubble is
+/// gone, and two larger stills 1 ms apart taken as the frames of a second animation.
+fn swirl_burst(dir: &str, bubbles: &dyn Fn(&[&str]) -> bool) -> bool {
+    let movie = format!("{dir}/swirl_burst.apng");
+    let mut ok = bubbles(&[
+        "animate",
+        "swirl",
+        "--start-s",
+        "12.433",
+        "--seconds",
+        "0.008",
+        "--fps",
+        "30",
+        "--slow-motion",
+        "200",
+        "--out",
+        &movie,
+        "--width",
+        "320",
+        "--height",
+        "240",
+    ]);
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let frames = std::env::temp_dir().join("bubbles-swirl-burst-stills");
+    let _ = std::fs::remove_dir_all(&frames);
+    let frames_arg = frames.to_string_lossy().into_owned();
+    ok &= bubbles(&[
+        "animate",
+        "swirl",
+        "--start-s",
+        "12.435",
+        "--seconds",
+        "0.002",
+        "--fps",
+        "10",
+        "--slow-motion",
+        "100",
+        "--out",
+        &frames_arg,
+        "--width",
+        "640",
+        "--height",
+        "480",
+    ]);
+    for (k, time_s) in [(0, "12.435"), (1, "12.436")] {
+        let from = frames.join(format!("frame_{k:05}.png"));
+        let to = root.join(format!("{dir}/swirl_burst_t{time_s}.png"));
+        ok &= std::fs::copy(from, to).is_ok();
+    }
+    let _ = std::fs::remove_dir_all(&frames);
+    ok
+}
+
 /// The gallery scenes of docs/gallery.md (seed 000 Figs. 5–7, the demo, seed 002's pond
 /// and the living film's swirl): a still and a short animated PNG of each, a GIF preview
 /// of the wind scene, the swirl at three ages, and the pond at two times for
@@ -271,6 +325,7 @@ fn gallery() -> bool {
             "300",
         ]);
     }
+    ok &= swirl_burst(dir, &bubbles);
     let gif = format!("{dir}/wind.gif");
     ok &= bubbles(&[
         "animate",

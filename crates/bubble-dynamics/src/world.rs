@@ -203,6 +203,34 @@ impl World {
         Ok(events)
     }
 
+    /// Advances the rims of the holes in every film-flow bubble to `time_s`, between
+    /// this step and the next; the bubbles' shapes and film flows stay at this step. A
+    /// rim crosses a bubble within a few steps (10–64 m/s), so this is how a burst is
+    /// seen at any instant: the rims reach the last of their own sub-steps (each under a
+    /// cell, `film_flow::RIM_CELLS_PER_SUBSTEP`) that ends by `time_s`, the very
+    /// sub-steps the next step takes, so the states the steps reach do not depend on
+    /// whether or where this was called. A `time_s` before the rims' is a no-op, and one
+    /// from the next step on is taken as the next step's start.
+    ///
+    /// # Errors
+    /// [`SimError::BadDuration`] for a non-finite time; the world's earlier error.
+    pub fn advance_rims_to(&mut self, time_s: f64) -> Result<(), SimError> {
+        if !time_s.is_finite() {
+            return Err(SimError::BadDuration { seconds: time_s });
+        }
+        if let Some(err) = &self.failed {
+            return Err(err.clone());
+        }
+        let dt = self.params.dt_s;
+        let into_step_s = (time_s - self.time_s()).clamp(0.0, dt);
+        for b in &mut self.bubbles {
+            if let Some(film) = b.grid_film.as_mut() {
+                film.advance_rims(into_step_s, dt);
+            }
+        }
+        Ok(())
+    }
+
     /// One fixed step of `dt_s`, split into the substeps the stability bound asks for.
     ///
     /// # Errors

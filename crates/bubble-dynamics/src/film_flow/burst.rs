@@ -12,6 +12,12 @@
 //! thickness along the rim); the film behind the rim is gone (its liquid leaves as the
 //! rim's droplets). A hole is a spherical cap about its site; cells the rim only partly
 //! covers keep a fractional coverage, so renderers draw a sharp, anti-aliased rim.
+//!
+//! The rims run at 10–64 m/s and would cross a 5 cm bubble within one 1/60 s film step,
+//! so they advance in their own sub-steps, in each of which the fastest rim moves
+//! [`RIM_CELLS_PER_SUBSTEP`] of a mean cell width: the film they meet is sampled every
+//! half cell whatever the step, and (on a bubble in a world) the hole grows between film
+//! steps, at every world step and at any instant between two of them.
 
 use glam::DVec3;
 
@@ -21,6 +27,12 @@ use crate::rng::SplitMix64;
 
 /// Time for a film that fell under the black threshold to reach the black film, s.
 pub const BLACK_RELAX_S: f64 = 0.05;
+
+/// How far the fastest rim moves in one of its sub-steps, in mean cell widths
+/// (√(4π/cells)·R; the smallest cells, at the cube corners, are 2.3× narrower). Half a
+/// cell: the thickness ahead of the rim, which sets its speed, is sampled over 1.5 cells,
+/// so every cell the rim meets is sampled at least twice.
+pub const RIM_CELLS_PER_SUBSTEP: f64 = 0.5;
 
 /// A hole in the film: a spherical cap about `site`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,6 +58,19 @@ pub struct BurstParams {
     pub nucleation_per_m2_s: f64,
 }
 
+impl FilmFlow {
+    /// Runs `f` on the film's burst state and the film.
+    pub(crate) fn with_burst<R>(&mut self, f: impl FnOnce(&mut BurstState, &mut Self) -> R) -> R {
+        let mut burst = self
+            .burst
+            .take()
+            .expect("a film always has its burst state");
+        let result = f(&mut burst, self);
+        self.burst = Some(burst);
+        result
+    }
+}
+
 /// The holes of a film and what bursting has removed.
 #[derive(Clone, Debug)]
 pub struct BurstState {
@@ -57,6 +82,9 @@ pub struct BurstState {
     burst_volume_m3: f64,
     /// Thickness of the film where the first hole opened on its own, m.
     first_hole_thickness_m: Option<f64>,
+    /// Whether the rims are advanced from outside (by the world, every world step and
+    /// between them) rather than within [`BurstState::step`].
+    rims_driven_outside: bool,
 }
 
 impl BurstState {
@@ -69,7 +97,14 @@ impl BurstState {
             coverage: vec![1.0; cells],
             burst_volume_m3: 0.0,
             first_hole_thickness_m: None,
+            rims_driven_outside: false,
         }
+    }
+
+    /// Leaves the rims to [`BurstState::advance_rims`] calls from outside: a film step
+    /// then only blackens, nucleates and sweeps (what its transport moved into a hole).
+    pub(crate) fn drive_rims_outside(&mut self) {
+        self.rims_driven_outside = true;
     }
 
     /// The holes.
@@ -106,12 +141,64 @@ impl BurstState {
         });
     }
 
-    /// One step of `dt_s`: black film, nucleation, rim retraction, coverage.
+    /// One step of `dt_s`: black film, nucleation, rim retraction (in sub-steps, unless
+    /// the rims are driven from outside), coverage.
     pub(crate) fn step(&mut self, flow: &mut FilmFlow, dt_s: f64) {
         self.blacken(flow, dt_s);
         self.nucleate_where_due(flow, dt_s);
-        self.retract(flow, dt_s);
+        if !self.rims_driven_outside {
+            self.advance_rims(flow, 0.0, dt_s, dt_s);
+        }
         self.sweep(flow);
+    }
+
+    /// Advances the rims from offset `from_s` towards `to_s` within an interval that ends
+    /// at `end_s` (offsets from its start, s), in sub-steps in which the fastest rim moves
+    /// [`RIM_CELLS_PER_SUBSTEP`] cells (the last one cut to end at `end_s`), sweeping
+    /// after each. Stops at the last sub-step that ends by `to_s` and returns its end
+    /// offset (`to_s` when there is nothing to move). The sub-steps depend only on the
+    /// state and `end_s`, so stopping at an instant and going on later gives the same
+    /// state at `end_s` as going there at once.
+    pub(crate) fn advance_rims(
+        &mut self,
+        flow: &mut FilmFlow,
+        from_s: f64,
+        to_s: f64,
+        end_s: f64,
+    ) -> f64 {
+        // Offsets this close to the end (relative) are the end, so a target computed
+        // from absolute times does not leave a sliver of a sub-step.
+        let slack_s = 1e-9 * end_s;
+        let mut at_s = from_s;
+        while !self.holes.is_empty() && !self.fully_burst() {
+            let speeds = self.rim_speeds(flow);
+            let sub_s = self.rim_substep_s(flow, &speeds);
+            let last = at_s + sub_s >= end_s - slack_s;
+            let next_s = if last { end_s } else { at_s + sub_s };
+            if next_s > to_s + slack_s {
+                return at_s;
+            }
+            self.retract(flow, &speeds, next_s - at_s);
+            self.sweep(flow);
+            at_s = next_s;
+            if last {
+                return at_s;
+            }
+        }
+        to_s
+    }
+
+    /// The sub-step in which the fastest rim moves [`RIM_CELLS_PER_SUBSTEP`] mean cell
+    /// widths, s (infinite when no rim has film ahead of it to move at a finite speed).
+    fn rim_substep_s(&self, flow: &FilmFlow, speeds: &[Option<f64>]) -> f64 {
+        let width_m =
+            (4.0 * std::f64::consts::PI / flow.grid.cells() as f64).sqrt() * flow.params.radius_m;
+        let fastest = speeds.iter().flatten().copied().fold(0.0, f64::max);
+        if fastest.is_finite() && fastest > 0.0 {
+            RIM_CELLS_PER_SUBSTEP * width_m / fastest
+        } else {
+            f64::INFINITY
+        }
     }
 
     /// Thins black cells towards the black film, their liquid shared among the
@@ -206,29 +293,41 @@ impl BurstState {
         }
     }
 
-    /// Moves every rim outwards at the Taylor–Culick speed of the film along it.
-    fn retract(&mut self, flow: &FilmFlow, dt_s: f64) {
+    /// The Taylor–Culick speed of every rim over the mean thickness of the film within
+    /// 1.5 mean cell widths outside it, m/s; `None` where no film is ahead of it.
+    fn rim_speeds(&self, flow: &FilmFlow) -> Vec<Option<f64>> {
         let p = self.params;
         let r = flow.params.radius_m;
         let rho = flow.params.density_kg_per_m3;
         let grid = &flow.grid;
         let width = (4.0 * std::f64::consts::PI / grid.cells() as f64).sqrt() * r;
-        for hole in &mut self.holes {
-            // Mean thickness of the film within a cell width outside the rim.
-            let (mut sum, mut area) = (0.0, 0.0);
-            for ((c, &h), &a) in grid.centres().iter().zip(&flow.h_m).zip(grid.areas_sr()) {
-                let d = arc(hole.site, *c) * r - hole.radius_m;
-                if (0.0..=1.5 * width).contains(&d) && h > 0.0 {
-                    sum += h * a;
-                    area += a;
+        self.holes
+            .iter()
+            .map(|hole| {
+                let (mut sum, mut area) = (0.0, 0.0);
+                for ((c, &h), &a) in grid.centres().iter().zip(&flow.h_m).zip(grid.areas_sr()) {
+                    let d = arc(hole.site, *c) * r - hole.radius_m;
+                    if (0.0..=1.5 * width).contains(&d) && h > 0.0 {
+                        sum += h * a;
+                        area += a;
+                    }
                 }
-            }
-            if area > 0.0 {
-                let h_rim = sum / area;
-                hole.radius_m += (2.0 * p.sigma_n_per_m / (rho * h_rim)).sqrt() * dt_s;
-            } else {
-                // Nothing left ahead of the rim: it has closed over the far pole.
-                hole.radius_m = std::f64::consts::PI * r;
+                (area > 0.0).then(|| (2.0 * p.sigma_n_per_m / (rho * sum / area)).sqrt())
+            })
+            .collect()
+    }
+
+    /// Moves every rim outwards at its speed for `dt_s`; a rim with no film ahead of it
+    /// has closed over the far pole, and passed it by the widest cell's width, so that
+    /// no cell there keeps part of its film (its coverage ramps over its own width).
+    fn retract(&mut self, flow: &FilmFlow, speeds: &[Option<f64>], dt_s: f64) {
+        let r = flow.params.radius_m;
+        let widest_sr = flow.grid.areas_sr().iter().copied().fold(0.0, f64::max);
+        let past_far_pole_m = std::f64::consts::PI * r + widest_sr.sqrt() * r;
+        for (hole, speed) in self.holes.iter_mut().zip(speeds) {
+            match speed {
+                Some(v) => hole.radius_m += v * dt_s,
+                None => hole.radius_m = past_far_pole_m,
             }
         }
     }

@@ -98,7 +98,7 @@ pub struct FilmFlow {
     pub(crate) grid: std::sync::Arc<CubeSphere>,
     hierarchy: std::sync::Arc<Hierarchy>,
     pub(crate) params: FlowParams,
-    burst: Option<Box<BurstState>>,
+    pub(super) burst: Option<Box<BurstState>>,
     /// The viscous operator's Gershgorin bound per unit ν/R², fixed by the grid.
     viscous_bound: f64,
     pub(crate) h_m: Vec<f64>,

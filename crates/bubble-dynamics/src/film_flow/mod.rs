@@ -9,7 +9,7 @@ pub mod grid;
 pub(crate) mod on_bubble;
 pub mod solve;
 
-pub use burst::{BLACK_RELAX_S, BurstParams, Hole};
+pub use burst::{BLACK_RELAX_S, BurstParams, Hole, RIM_CELLS_PER_SUBSTEP};
 pub use cell_map::CellMap;
 pub use flow::{FilmFlow, FlowParams, Forcing};
 pub use grid::CubeSphere;

@@ -21,6 +21,8 @@ pub(crate) struct GridFilm {
     /// World time gathered since the last flow step, s, and the forcing's integral.
     pending_s: f64,
     pending_forcing: Forcing,
+    /// How far into the world step under way the rims have been advanced, s.
+    rim_ahead_s: f64,
 }
 
 impl GridFilm {
@@ -36,19 +38,25 @@ impl GridFilm {
         let grid = Arc::new(CubeSphere::new(n));
         let hierarchy = Arc::new(Hierarchy::new(&grid));
         let map = CellMap::new(grid.centres(), unit_positions, triangles);
+        let mut flow = FilmFlow::new(grid, hierarchy, params, h_m);
+        flow.with_burst(|burst, _| burst.drive_rims_outside());
         Self {
-            flow: FilmFlow::new(grid, hierarchy, params, h_m),
+            flow,
             map,
             material_dirs: unit_positions.iter().map(|u| u.normalize()).collect(),
             rest_vertex_area_m2: barycentric_vertex_areas_m2(rest_positions_m, triangles),
             pending_s: 0.0,
             pending_forcing: Forcing::default(),
+            rim_ahead_s: 0.0,
         }
     }
 
-    /// Gathers a world step of `dt_s`; once `film_dt_s` has passed, steps the flow over
-    /// the gathered time with the forcing's mean over it.
+    /// Advances the rims of the holes over the world step of `dt_s` (from wherever
+    /// [`GridFilm::advance_rims`] left them), then gathers the step; once `film_dt_s`
+    /// has passed, steps the flow over the gathered time with the forcing's mean over it.
     pub(crate) fn step(&mut self, dt_s: f64, film_dt_s: f64, forcing: &Forcing) {
+        self.advance_rims(dt_s, dt_s);
+        self.rim_ahead_s = 0.0;
         self.pending_s += dt_s;
         self.pending_forcing.g_eff_m_per_s2 += forcing.g_eff_m_per_s2 * dt_s;
         self.pending_forcing.air_m_per_s += forcing.air_m_per_s * dt_s;
@@ -63,6 +71,17 @@ impl GridFilm {
             self.pending_s = 0.0;
             self.pending_forcing = Forcing::default();
         }
+    }
+
+    /// Advances the rims `to_s` into the world step of `step_s` that comes next (s from
+    /// its start), in the sub-steps that step will take, so that the step later goes on
+    /// from there to the same state. Never moves them back.
+    pub(crate) fn advance_rims(&mut self, to_s: f64, step_s: f64) {
+        let from_s = self.rim_ahead_s;
+        let at_s = self
+            .flow
+            .with_burst(|burst, flow| burst.advance_rims(flow, from_s, to_s, step_s));
+        self.rim_ahead_s = at_s.max(from_s);
     }
 
     /// The film's thickness at every cell in nm, stretched by the mesh's deformation

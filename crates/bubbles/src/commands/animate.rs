@@ -21,6 +21,10 @@ pub const MAX_FRAMES: u64 = 10_000;
 pub const MAX_SECONDS: f64 = 3600.0;
 /// Highest frame rate, frames per second.
 pub const MAX_FPS: f64 = 240.0;
+/// Strongest slow motion: output 10 000× slower than real time (at 24 fps, 240 000
+/// simulated frames per second, about what the fastest cameras film bursts with; a
+/// rim moves half a film cell per sub-step, about 10 µs, so finer frames would repeat).
+pub const MAX_SLOW_MOTION: f64 = 10_000.0;
 /// Name of the file in a frame directory that records what the frames show.
 pub const MANIFEST: &str = "animation.txt";
 
@@ -31,6 +35,15 @@ pub const MANIFEST: &str = "animation.txt";
     simulated with the scene's own solver step and rendered with the CPU backend. \
     The animation has round(seconds × fps) frames, at most 10000, with seconds <= 3600 \
     and fps <= 240.\n\n\
+    --start-s T simulates to T without rendering and starts there: frame k shows \
+    t = T + k / (fps × K), where --slow-motion K (default 1, at most 10000) plays the \
+    output K times slower than real time, and the animation has round(seconds × fps × K) \
+    frames for its --seconds of simulated time (T + seconds <= 3600). With K other than \
+    1 each frame shows the solver step at or before its t, and the holes of a bursting \
+    film exactly at t (their rims move between steps, half a film cell at a time), so \
+    `swirl --start-s 12.433 --seconds 0.008 --fps 30 --slow-motion 200` shows that \
+    scene's burst (a hole opens at t = 12.433 s) in 48 frames, as high-speed video \
+    does.\n\n\
     --out DIR writes DIR/frame_00000.png, … each through a temporary file renamed into \
     place, so an interrupted run leaves only whole frames, and DIR/animation.txt records \
     the scene and settings and a checksum per frame (a DIR made with other settings, or \
@@ -54,6 +67,17 @@ pub struct Args {
     /// Frames per second (> 0, at most 240).
     #[arg(long, default_value_t = 15.0, allow_negative_numbers = true)]
     pub fps: f64,
+    /// Simulated time of the first frame, s (>= 0; simulated to, not rendered).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub start_s: f64,
+    /// Time scale: the output plays K times slower than real time (> 0, at most 10000).
+    #[arg(
+        long,
+        value_name = "K",
+        default_value_t = 1.0,
+        allow_negative_numbers = true
+    )]
+    pub slow_motion: f64,
     /// A directory for frame_00000.png …, or one file: PATH.apng / PATH.png (animated PNG,
     /// exact) or PATH.gif (256-colour preview).
     #[arg(long)]
@@ -75,7 +99,8 @@ pub struct Args {
 /// Runs `bubbles animate`.
 pub fn run(args: Args) -> CliResult {
     crate::signals::install();
-    let count = frame_count(args.seconds, args.fps)?;
+    let timing = Timing::checked(&args)?;
+    let count = timing.count;
     let range = match &args.frames {
         Some(text) => parse_range(text, count)?,
         None => 0..count,
@@ -90,6 +115,8 @@ pub fn run(args: Args) -> CliResult {
     check_output(&output)?;
     let manifest = manifest(&args)?;
     let mut job = FrameJob::prepare(Some(&args.scene), &args.options)?;
+    // The last frame's time within the solver-step limit, before any file is written.
+    job.check_reach(timing.frame_s(range.end - 1))?;
     let (width, height) = (job.settings().width, job.settings().height);
     let mut sink = open(
         &output,
@@ -99,15 +126,16 @@ pub fn run(args: Args) -> CliResult {
         range.end - range.start,
     )?;
     let keep = kept_frames(&output, args.resume, range.clone(), (width, height))?;
-    render_frames(&mut job, &mut sink, range.clone(), &keep, &args)?;
+    render_frames(&mut job, &mut sink, range.clone(), &keep, &timing)?;
     let error = sink
         .finish()
         .map_err(|e| CliError::input(format!("cannot write {}: {e}", args.out.display())))?;
     eprintln!(
-        "wrote frames {}..{} of {count} ({width}x{height}, {} fps) to {}",
+        "wrote frames {}..{} of {count} ({width}x{height}, {} fps{}) to {}",
         range.start,
         range.end,
         args.fps,
+        slowed(&timing),
         args.out.display()
     );
     if let Some(e) = error {
@@ -118,6 +146,19 @@ pub fn run(args: Args) -> CliResult {
         );
     }
     Ok(())
+}
+
+/// `, t = T s + k / (fps × K)` for a start or time scale other than the defaults.
+fn slowed(timing: &Timing) -> String {
+    if timing.start_s == 0.0 && timing.slow_motion == 1.0 {
+        return String::new();
+    }
+    format!(
+        ", t = {} s + k / {} (slow motion {}x)",
+        plain(timing.start_s),
+        plain(timing.frames_per_s),
+        plain(timing.slow_motion)
+    )
 }
 
 /// Refuses, before any work, an output that cannot be created where it is named.
@@ -145,8 +186,57 @@ fn kept_frames(
     }
 }
 
-/// The number of frames in `seconds` at `fps`, checked against the limits.
-fn frame_count(seconds: f64, fps: f64) -> Result<u64, CliError> {
+/// When each frame is: the checked `--start-s`, `--fps`, `--slow-motion` and the count.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Timing {
+    start_s: f64,
+    /// Frames per simulated second: fps × K.
+    frames_per_s: f64,
+    slow_motion: f64,
+    count: u64,
+}
+
+impl Timing {
+    /// Checks the timing flags against the limits.
+    fn checked(args: &Args) -> Result<Self, CliError> {
+        let (t, k) = (args.start_s, args.slow_motion);
+        if !(t.is_finite() && (0.0..=MAX_SECONDS).contains(&t)) {
+            return Err(CliError::input(format!(
+                "--start-s {}: must be a number of seconds >= 0 and at most {MAX_SECONDS}",
+                plain(t)
+            )));
+        }
+        if !(k.is_finite() && k > 0.0 && k <= MAX_SLOW_MOTION) {
+            return Err(CliError::input(format!(
+                "--slow-motion {}: must be a number > 0 and at most {MAX_SLOW_MOTION}",
+                plain(k)
+            )));
+        }
+        let count = frame_count(args.seconds, args.fps, k)?;
+        if t + args.seconds > MAX_SECONDS {
+            return Err(CliError::input(format!(
+                "--start-s {} + --seconds {} ends after {MAX_SECONDS} s",
+                plain(t),
+                plain(args.seconds)
+            )));
+        }
+        Ok(Self {
+            start_s: t,
+            frames_per_s: args.fps * k,
+            slow_motion: k,
+            count,
+        })
+    }
+
+    /// Simulated time of frame `k`, s.
+    fn frame_s(&self, k: u64) -> f64 {
+        self.start_s + k as f64 / self.frames_per_s
+    }
+}
+
+/// The number of frames in `seconds` at `fps` slowed `slow_motion` times, checked against
+/// the limits.
+fn frame_count(seconds: f64, fps: f64, slow_motion: f64) -> Result<u64, CliError> {
     let (s, f) = (plain(seconds), plain(fps));
     if !(seconds.is_finite() && seconds > 0.0 && seconds <= MAX_SECONDS) {
         return Err(CliError::input(format!(
@@ -157,6 +247,9 @@ fn frame_count(seconds: f64, fps: f64) -> Result<u64, CliError> {
         return Err(CliError::input(format!(
             "--fps {f}: must be a number > 0 and at most {MAX_FPS}"
         )));
+    }
+    if slow_motion != 1.0 {
+        return slowed_frame_count(seconds, fps, slow_motion);
     }
     let count = (seconds * fps).round();
     if count < 1.0 {
@@ -177,6 +270,26 @@ fn frame_count(seconds: f64, fps: f64) -> Result<u64, CliError> {
     if count > MAX_FRAMES as f64 {
         return Err(CliError::input(format!(
             "--seconds {s} at --fps {f} makes {count} frames; at most {MAX_FRAMES} are allowed"
+        )));
+    }
+    Ok(count as u64)
+}
+
+/// [`frame_count`] at `fps` × `slow_motion` frames per simulated second.
+fn slowed_frame_count(seconds: f64, fps: f64, slow_motion: f64) -> Result<u64, CliError> {
+    let (s, f, k) = (plain(seconds), plain(fps), plain(slow_motion));
+    let count = (seconds * fps * slow_motion).round();
+    if count < 1.0 {
+        return Err(CliError::input(format!(
+            "--seconds {s} at --fps {f} and --slow-motion {k} makes no frame: give at least \
+             {} seconds",
+            plain(0.5 / (fps * slow_motion))
+        )));
+    }
+    if count > MAX_FRAMES as f64 {
+        return Err(CliError::input(format!(
+            "--seconds {s} at --fps {f} and --slow-motion {k} makes {count} frames; at most \
+             {MAX_FRAMES} are allowed"
         )));
     }
     Ok(count as u64)
@@ -206,12 +319,23 @@ fn parse_range(text: &str, count: u64) -> Result<Range<u64>, CliError> {
 }
 
 /// What the frames depend on: the scene's contents, the renderer options, the frame
-/// rate and the program version. `--seconds` and `--frames` are left out on purpose:
-/// frame k is the same whatever the length or the part rendered.
+/// rate, the start and time scale, and the program version. `--seconds` and `--frames`
+/// are left out on purpose: frame k is the same whatever the length or the part
+/// rendered. The start and time scale appear only when not the defaults, so directories
+/// made before they existed still resume.
 fn manifest(args: &Args) -> Result<String, CliError> {
     let scene = Scene::resolve(Some(&args.scene))?;
+    let timing = if args.start_s == 0.0 && args.slow_motion == 1.0 {
+        String::new()
+    } else {
+        format!(
+            "start_s {}\nslow_motion {}\n",
+            plain(args.start_s),
+            plain(args.slow_motion)
+        )
+    };
     Ok(format!(
-        "bubbles {}\nscene {}\nfps {}\n{:#?}\n{:#?}\n",
+        "bubbles {}\nscene {}\nfps {}\n{timing}{:#?}\n{:#?}\n",
         env!("CARGO_PKG_VERSION"),
         scene.origin,
         args.fps,
@@ -259,8 +383,8 @@ fn open_dir(dir: &Path, manifest: &str) -> Result<(), String> {
             return Ok(());
         }
         return Err(format!(
-            "{} records another scene or other settings: use the same scene, --fps and \
-             render options, or another (or emptied) directory",
+            "{} records another scene or other settings: use the same scene, --fps, \
+             --start-s, --slow-motion and render options, or another (or emptied) directory",
             path.display()
         ));
     }
@@ -284,7 +408,7 @@ fn render_frames(
     sink: &mut Sink,
     range: Range<u64>,
     keep: &[bool],
-    args: &Args,
+    timing: &Timing,
 ) -> CliResult {
     let mut bar = Progress::frames(range.end - range.start);
     let (exposure_ev, tonemap) = (job.settings().exposure_ev, job.settings().tonemap);
@@ -294,9 +418,14 @@ fn render_frames(
             bar.skip(1);
             continue;
         }
-        // Each frame is reached from t = 0 by whole solver steps, so frame k does not
-        // depend on which frames were rendered before it.
-        job.advance_to(k as f64 / args.fps, false)?;
+        // Each frame is reached from t = 0 by whole solver steps (and, in slow motion,
+        // the rims' own sub-steps, which do not depend on where they stopped before), so
+        // frame k does not depend on which frames were rendered before it.
+        if timing.slow_motion == 1.0 {
+            job.advance_to(timing.frame_s(k), false)?;
+        } else {
+            job.advance_to_instant(timing.frame_s(k))?;
+        }
         let frame = job.render()?;
         crate::signals::check()?;
         let rgb = Rgb8 {
@@ -318,8 +447,9 @@ mod tests {
 
     #[test]
     fn frame_count_rounds_seconds_times_fps() {
-        assert_eq!(frame_count(2.0, 15.0).unwrap(), 30);
-        assert_eq!(frame_count(0.1, 24.0).unwrap(), 2);
+        assert_eq!(frame_count(2.0, 15.0, 1.0).unwrap(), 30);
+        assert_eq!(frame_count(0.1, 24.0, 1.0).unwrap(), 2);
+        assert_eq!(frame_count(0.01, 30.0, 200.0).unwrap(), 60);
     }
 
     #[test]
@@ -332,7 +462,7 @@ mod tests {
             (0.01, 15.0, "makes no frame"),
             (3600.0, 240.0, "at most 10000"),
         ] {
-            let err = frame_count(s, f).unwrap_err();
+            let err = frame_count(s, f, 1.0).unwrap_err();
             assert_eq!(err.exit_code(), 2);
             assert!(err.to_string().contains(key), "{err} lacks {key}");
         }

@@ -151,6 +151,32 @@ impl FrameJob {
         crate::signals::check()
     }
 
+    /// Refuses, before any work, a `time_s` beyond the solver-step limit from here.
+    pub fn check_reach(&self, time_s: f64) -> Result<(), CliError> {
+        let what = format!("advancing to t = {} s", plain(time_s));
+        let (now_s, dt_s) = (self.world.time_s(), self.world.dt_s());
+        self.scene.check_steps(&what, now_s, time_s, dt_s)
+    }
+
+    /// Advances the simulation to the last step at or before `time_s`, then the rims of
+    /// any bursting film to `time_s` itself (`World::advance_rims_to`): a burst's rims
+    /// cross a bubble within a few steps, and slow motion shows them between steps.
+    pub fn advance_to_instant(&mut self, time_s: f64) -> Result<(), CliError> {
+        if !(time_s.is_finite() && time_s >= 0.0) {
+            return Err(CliError::input(format!(
+                "--start-s {}: must be a finite number of seconds >= 0",
+                plain(time_s)
+            )));
+        }
+        self.check_reach(time_s)?;
+        let target = progress::steps_by(&self.world, time_s);
+        let failed = |e| CliError::runtime(format!("simulation failed: {e}"));
+        progress::advance_world_steps(&mut self.world, target, &mut progress::Progress::off())
+            .map_err(failed)?;
+        crate::signals::check()?;
+        self.world.advance_rims_to(time_s).map_err(failed)
+    }
+
     /// One solver step.
     pub fn step(&mut self) -> Result<(), CliError> {
         self.world

@@ -94,7 +94,18 @@ pub fn advance_world(
     if !(time_s.is_finite() && time_s >= 0.0) {
         return Err(SimError::BadDuration { seconds: time_s });
     }
-    let target = steps_to(world, time_s);
+    advance_world_steps(world, steps_to(world, time_s), progress)
+}
+
+/// Steps `world` until its step count is `target`, counting each step on `progress`.
+///
+/// # Errors
+/// The first step's error.
+pub fn advance_world_steps(
+    world: &mut World,
+    target: u64,
+    progress: &mut Progress,
+) -> Result<Vec<Event>, SimError> {
     let mut events = Vec::new();
     // A signal stops the loop early; the caller's `signals::check` reports it.
     while world.steps() < target && !crate::signals::interrupted() {
@@ -107,6 +118,13 @@ pub fn advance_world(
 /// The step count at which `world` reaches `time_s` (the rule of [`World::advance_to`]).
 pub fn steps_to(world: &World, time_s: f64) -> u64 {
     (time_s / world.dt_s()).round() as u64
+}
+
+/// The count of the last step that ends at or before `time_s` (a step that ends within
+/// a billionth of a step after it counts: `time_s` computed from a frame number lands
+/// on a step only to rounding).
+pub fn steps_by(world: &World, time_s: f64) -> u64 {
+    (time_s / world.dt_s() + 1e-9).floor() as u64
 }
 
 #[cfg(test)]
