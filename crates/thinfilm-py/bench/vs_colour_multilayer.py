@@ -1,18 +1,52 @@
 """Speed of thinfilm.rt against colour-science's multilayer_tmm on a 5-layer stack over
-wavelength 360-830 nm by 1 and angles 0-75 deg by 7.5 (5 181 points), one process, best
-of 7 each, unpolarised R. Needs `pip install colour-science numpy` and this package.
+wavelength 360-830 nm by 1 and angles 0-75 deg by 7.5 (5 181 points), one process,
+unpolarised R. Needs `pip install colour-science numpy` and this package.
+
+The two calls alternate for --rounds rounds (default 41), so a change of load hits both;
+printed: each call's best and median, the ratio of the bests, the median of the rounds'
+own ratios, and the largest |R difference| between the two.
 """
 
-import time, numpy as np, thinfilm, os
+import argparse
+import os
+import time
+
+import numpy as np
+
+import thinfilm
 from colour.phenomena import multilayer_tmm
-wl = np.arange(360, 831.0); angle = np.arange(0, 75.0 + 1e-9, 7.5)
-n = [1.0, 1.38, 2.1, 1.46, 2.1, 1.38, 1.52]; d = [100.0, 60.0, 90.0, 60.0, 100.0]
-def best(f, k=7):
-    ts=[]
-    for _ in range(k):
-        s=time.perf_counter(); out=f(); ts.append(time.perf_counter()-s)
-    return min(ts), out
-t1,(r1,_) = best(lambda: thinfilm.rt(n, d, wl[None,:], angle[:,None]))
-t2,res = best(lambda: multilayer_tmm(n, d, wl, angle))
-R = np.asarray(res[0]); Ru = np.squeeze(0.5*(R[...,0]+R[...,1])).T
-print("load %.2f: rt %.2f ms, colour multilayer_tmm %.2f ms, ratio %.1fx, max|dR| %.1e" % (os.getloadavg()[0], 1e3*t1, 1e3*t2, t2/t1, np.abs(Ru - r1).max()))
+
+WL = np.arange(360, 831.0)
+ANGLE = np.arange(0, 75.0 + 1e-9, 7.5)
+N = [1.0, 1.38, 2.1, 1.46, 2.1, 1.38, 1.52]
+D = [100.0, 60.0, 90.0, 60.0, 100.0]
+
+
+def timed(call):
+    start = time.perf_counter()
+    out = call()
+    return time.perf_counter() - start, out
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--rounds", type=int, default=41)
+    args = parser.parse_args()
+    ours, theirs = [], []
+    for _ in range(args.rounds):
+        t, (r_ours, _) = timed(lambda: thinfilm.rt(N, D, WL[None, :], ANGLE[:, None]))
+        ours.append(t)
+        t, res = timed(lambda: multilayer_tmm(N, D, WL, ANGLE))
+        theirs.append(t)
+    r_theirs = np.asarray(res[0])
+    r_theirs = np.squeeze(0.5 * (r_theirs[..., 0] + r_theirs[..., 1])).T  # (A, W) as ours
+    ours, theirs = np.array(ours), np.array(theirs)
+    print(f"points {WL.size * ANGLE.size}, cpus {os.cpu_count()}, load {os.getloadavg()}")
+    print(f"thinfilm.rt           best {1e3 * ours.min():.3f} ms, median {1e3 * np.median(ours):.3f} ms")
+    print(f"colour multilayer_tmm best {1e3 * theirs.min():.3f} ms, median {1e3 * np.median(theirs):.3f} ms")
+    print(f"ratio of bests {theirs.min() / ours.min():.1f}x, median of the rounds' ratios "
+          f"{np.median(theirs / ours):.1f}x, max |dR| {np.abs(r_theirs - r_ours).max():.1e}")
+
+
+if __name__ == "__main__":
+    main()
