@@ -148,6 +148,17 @@ impl CubeMap {
         mip_sizes(face_size).map(|n| 6 * (n + 2) * (n + 2)).sum()
     }
 
+    /// Level `level`'s six bordered `(n + 2)²` faces row-major, `n` its face size (the
+    /// layout the wgpu backend's mip buffer mirrors).
+    ///
+    /// # Panics
+    /// Panics if `level >= self.levels()`.
+    pub fn level_texels(&self, level: usize) -> &[[f32; 3]] {
+        let l = &self.levels[level];
+        let m = l.face_size + 2;
+        &l.texels[..6 * m * m]
+    }
+
     /// Interior texel `(x, y)` of face `face` (0..6 in +X, −X, +Y, −Y, +Z, −Z order).
     ///
     /// # Panics

@@ -39,6 +39,8 @@ pub struct GpuRenderer {
     textures: Vec<(&'static str, TextureKey, wgpu::Texture)>,
     /// How bubbles read their dynamic cube maps.
     filter: ReflectionFilter,
+    /// The last frame's cube mip chains, for [`GpuRenderer::read_cube_mips`].
+    last_mips: Option<wgpu::Buffer>,
 }
 
 /// The targets one view renders into.
@@ -60,6 +62,7 @@ impl GpuRenderer {
             frame: Frame::default(),
             textures: Vec::new(),
             filter: ReflectionFilter::default(),
+            last_mips: None,
         })
     }
 
@@ -72,6 +75,21 @@ impl GpuRenderer {
     /// The device.
     pub fn gpu(&self) -> &Gpu {
         &self.gpu
+    }
+
+    /// The cube mip chains the GPU built for the last frame's bubbles, as f32 RGB laid out
+    /// as `CubeMap`'s levels one bubble after another (see [`CubeMap::level_texels`]), or
+    /// `None` when that frame had no dynamic cube maps: for checking them against the
+    /// CPU's `CubeMap::build_mips`.
+    pub fn read_cube_mips(&self) -> Result<Option<Vec<f32>>, GpuError> {
+        let Some(mips) = &self.last_mips else {
+            return Ok(None);
+        };
+        let bytes = self.gpu.read_buffer(mips)?;
+        let floats = bytes
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        Ok(Some(floats.collect()))
     }
 
     /// Renders one frame: cube maps, opaque scene, sorted bubble blend, resolve; the linear
@@ -219,7 +237,7 @@ impl GpuRenderer {
         let mips = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("cube mips"),
             size: 4 * mip_floats,
-            usage: wgpu::BufferUsages::STORAGE,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
         let lut_texture = self.data_texture("luts", wgpu::TextureFormat::Rgba32Float, &data.luts);
@@ -285,6 +303,7 @@ impl GpuRenderer {
         if let Some(n) = face_size {
             self.encode_mips(&mut encoder, (&cubes, &mips), &scene_group, n, layers);
         }
+        self.last_mips = face_size.map(|_| mips.clone());
         let main = self.pipelines_for(samples);
         let resolved_view = resolved.create_view(&Default::default());
         let msaa_view = msaa.as_ref().map(|t| t.create_view(&Default::default()));

@@ -184,6 +184,33 @@ impl Gpu {
             },
             size,
         );
+        let view = self.submit_and_map(encoder, &buffer)?;
+        let mut out = Vec::with_capacity((row_bytes * size.height) as usize);
+        for row in view.chunks_exact(padded as usize) {
+            out.extend_from_slice(&row[..row_bytes as usize]);
+        }
+        Ok(out)
+    }
+
+    /// The bytes of a storage `buffer` made with `COPY_SRC` (after the work submitted).
+    pub(super) fn read_buffer(&self, source: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("read back"),
+            size: source.size(),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(source, 0, &buffer, 0, source.size());
+        Ok(self.submit_and_map(encoder, &buffer)?.to_vec())
+    }
+
+    /// Submits `encoder`, waits, and maps `buffer` for reading.
+    fn submit_and_map(
+        &self,
+        encoder: wgpu::CommandEncoder,
+        buffer: &wgpu::Buffer,
+    ) -> Result<wgpu::BufferView, GpuError> {
         self.queue.submit([encoder.finish()]);
         let (tx, rx) = std::sync::mpsc::channel();
         buffer.map_async(wgpu::MapMode::Read, .., move |r| {
@@ -195,14 +222,9 @@ impl Gpu {
         rx.recv()
             .map_err(|e| GpuError::Readback(e.to_string()))?
             .map_err(|e| GpuError::Readback(e.to_string()))?;
-        let view = buffer
+        buffer
             .get_mapped_range(..)
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
-        let mut out = Vec::with_capacity((row_bytes * size.height) as usize);
-        for row in view.chunks_exact(padded as usize) {
-            out.extend_from_slice(&row[..row_bytes as usize]);
-        }
-        Ok(out)
+            .map_err(|e| GpuError::Readback(e.to_string()))
     }
 }
 
