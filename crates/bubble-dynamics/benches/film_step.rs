@@ -1,5 +1,5 @@
 //! Criterion bench: one film-flow step (1/60 s: gravity, viscosity, air shear, the
-//! implicit Marangoni solve, transport) of a 5 cm bubble's film at n = 64, 128 and 256
+//! implicit Marangoni solve, transport) of a 5 cm bubble's film at n = 32, 64, 128 and 256
 //! cells a face, on one core: the `swirl` scene's film (drainage μ 1e-6 Pa·s,
 //! evaporation 40 nm/s), 600 nm ± 5 %, hovering in gravity in still air.
 
@@ -18,7 +18,7 @@ fn bench_film_step(c: &mut Criterion) {
         air_m_per_s: DVec3::ZERO,
     };
     let mut group = c.benchmark_group("film_step");
-    for n in [64, 128, 256] {
+    for n in [32, 64, 128, 256] {
         let mut f = swirl_film(n);
         // Past the start-up transient: the film sags onto its Marangoni balance.
         for _ in 0..30 {
