@@ -280,6 +280,7 @@ impl FilmFlow {
     }
 
     /// `u ← u + dt (g_t + viscous)`.
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn momentum_explicit(&mut self, s: &mut Scratch, dt_s: f64, forcing: &Forcing) {
         // Gravity as the discrete gradient of the potential g·x between cell centres, so
         // a discrete Marangoni gradient can balance it exactly (the edge projection g·n
@@ -306,6 +307,7 @@ impl FilmFlow {
     }
 
     /// One explicit step of the sheet's viscous stress over `dt_s`.
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn viscous_substep(&mut self, s: &mut Scratch, nu: f64, dt_s: f64) {
         let r = self.params.radius_m;
         let g = &self.grid;
@@ -344,6 +346,7 @@ impl FilmFlow {
     /// each edge's implicit factor `1/(1 + dt k)`, by which the Marangoni step's own
     /// velocity change is damped too: drag and Marangoni stress are then one backward-Euler
     /// step, and a film they hold together stays at rest.
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn air_shear(&mut self, s: &mut Scratch, dt_s: f64, air_m_per_s: DVec3) {
         let p = &self.params;
         s.drag.clear();
@@ -383,6 +386,7 @@ impl FilmFlow {
     /// Backward-Euler Marangoni step: solves for the surfactant the step ends with, sets
     /// the velocities from its gradient, and moves the surfactant with fluxes that sum to
     /// zero (so it is conserved to rounding whatever the solver's residual).
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn marangoni_implicit(&mut self, s: &mut Scratch, dt_s: f64) -> SolveReport {
         let p = self.params;
         let r = p.radius_m;
@@ -491,6 +495,7 @@ impl FilmFlow {
 
     /// Moves liquid with the surfaces (upwind) and by the drainage flux relative to them,
     /// in sub-steps that keep each cell's outflow below half its content.
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn transport_thickness(&mut self, s: &mut Scratch, dt_s: f64, g_eff: DVec3) {
         let p = self.params;
         let r = p.radius_m;
@@ -534,6 +539,7 @@ impl FilmFlow {
     /// One transport of `h` with the edge speeds in `s.edge`: second-order upwind (the
     /// upwind cell's Green–Gauss gradient carried to the edge midpoint, clamped between
     /// the two cells' values so no new extremum appears), outflow-limited.
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn upwind_substep(&mut self, s: &mut Scratch, dt_s: f64) {
         let r = self.params.radius_m;
         let g = &self.grid;

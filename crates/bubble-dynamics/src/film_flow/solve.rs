@@ -9,19 +9,24 @@
 
 use super::grid::{CubeSphere, parent_cell};
 
+/// Sides of every cell: each level is itself a cube-sphere, whose cells all have four
+/// neighbours, so the stencils are fixed-size arrays (no per-cell loop bounds to load).
+const SIDES: usize = 4;
+
 /// A level's cells and edges (`a`, `b` cell indices), with per-cell neighbour lists.
 #[derive(Clone, Debug)]
 struct Level {
     cells: usize,
     edges: Vec<(u32, u32)>,
-    /// CSR: the edges of cell `i` are `adjacency[start[i]..start[i + 1]]` as
-    /// (neighbour, edge index).
-    start: Vec<u32>,
-    adjacency: Vec<(u32, u32)>,
+    /// The four neighbours of each cell, and the edges to them, in matching order.
+    neighbours: Vec<[u32; SIDES]>,
+    neighbour_edges: Vec<[u32; SIDES]>,
     /// Fine cell → this level's cell, for the level below (finer) this one.
     parent_of_fine: Vec<u32>,
     /// Fine edge → coarse edge it lies along (`u32::MAX` inside a coarse cell).
     coarse_edge_of_fine: Vec<u32>,
+    /// The order Gauss–Seidel visits the cells in (backwards for the way up).
+    sweep_order: Vec<u32>,
 }
 
 /// The face size a grid of `n` coarsens to: halved while even and above
@@ -51,9 +56,10 @@ pub struct Work {
     alpha: Vec<Vec<f64>>,
     weight: Vec<Vec<f64>>,
     coarse_factor: Vec<f64>,
-    /// Per level: each cell's diagonal, and the edge weights in adjacency order.
-    diag: Vec<Vec<f64>>,
-    csr_weight: Vec<Vec<f64>>,
+    /// Per level: each cell's inverse diagonal, and its four edge weights in neighbour
+    /// order (the smoother and the operator then read one cell's numbers contiguously).
+    inv_diag: Vec<Vec<f64>>,
+    stencil: Vec<Vec<[f64; SIDES]>>,
     residual: Vec<Vec<f64>>,
     correction: Vec<Vec<f64>>,
     r: Vec<f64>,
@@ -84,8 +90,9 @@ impl Hierarchy {
     /// Halves the grid while its face size stays even and above [`COARSEST_FACE`].
     pub fn new(grid: &CubeSphere) -> Self {
         let fine_edges: Vec<(u32, u32)> = grid.edges().iter().map(|e| (e.a, e.b)).collect();
-        let mut levels = vec![Level::new(grid.cells(), fine_edges)];
         let mut n = grid.face_size();
+        let mut levels = vec![Level::new(grid.cells(), fine_edges)];
+        levels[0].sweep_order = chequered_order(n);
         while n > coarsest_face(n) {
             let fine = levels.last().expect("one level");
             let parent: Vec<u32> = (0..fine.cells).map(|c| parent_cell(n, c) as u32).collect();
@@ -93,6 +100,7 @@ impl Hierarchy {
             levels.last_mut().expect("one level").coarse_edge_of_fine = coarse_edge_of_fine;
             let mut coarse = coarse;
             coarse.parent_of_fine = parent;
+            coarse.sweep_order = chequered_order(n / 2);
             levels.push(coarse);
             n /= 2;
         }
@@ -135,7 +143,7 @@ impl Hierarchy {
         let mut z = std::mem::take(&mut work.z);
         let mut p = std::mem::take(&mut work.p);
         let mut q = std::mem::take(&mut work.q);
-        apply(fine, &work.alpha[0], &work.weight[0], x, &mut q);
+        apply(fine, &work.alpha[0], &work.stencil[0], x, &mut q);
         for i in 0..nc {
             r[i] = b[i] - q[i];
         }
@@ -154,7 +162,7 @@ impl Hierarchy {
             p.copy_from_slice(&z);
             let mut rz = dot(&r, &z);
             while report.iterations < max_iterations {
-                apply(fine, &work.alpha[0], &work.weight[0], &p, &mut q);
+                apply(fine, &work.alpha[0], &work.stencil[0], &p, &mut q);
                 let pq = dot(&p, &q);
                 if pq <= 0.0 || !pq.is_finite() {
                     break;
@@ -213,23 +221,26 @@ impl Hierarchy {
                 }
             }
         }
-        work.diag.resize(count, Vec::new());
-        work.csr_weight.resize(count, Vec::new());
+        work.inv_diag.resize(count, Vec::new());
+        work.stencil.resize(count, Vec::new());
         for (k, level) in self.levels.iter().enumerate() {
-            let (diag, csr) = (&mut work.diag[k], &mut work.csr_weight[k]);
-            diag.clear();
-            csr.clear();
-            for i in 0..level.cells {
-                let mut d = work.alpha[k][i];
-                for &(_, e) in
-                    &level.adjacency[level.start[i] as usize..level.start[i + 1] as usize]
-                {
-                    let w = work.weight[k][e as usize];
-                    d += w;
-                    csr.push(w);
-                }
-                diag.push(d);
-            }
+            let (weight, alpha) = (&work.weight[k], &work.alpha[k]);
+            let stencil = &mut work.stencil[k];
+            stencil.clear();
+            stencil.extend(
+                level
+                    .neighbour_edges
+                    .iter()
+                    .map(|es| es.map(|e| weight[e as usize])),
+            );
+            let inv_diag = &mut work.inv_diag[k];
+            inv_diag.clear();
+            inv_diag.extend(
+                stencil
+                    .iter()
+                    .zip(alpha)
+                    .map(|(w, a)| 1.0 / (a + w[0] + w[1] + w[2] + w[3])),
+            );
         }
         work.coarse_factor.clear();
         let last = self.levels.len() - 1;
@@ -245,12 +256,12 @@ impl Hierarchy {
             dense_solve(&work.coarse_factor, level.cells, r, z);
             return;
         }
-        gauss_seidel(level, &work.diag[k], &work.csr_weight[k], r, z, false);
-        gauss_seidel(level, &work.diag[k], &work.csr_weight[k], r, z, false);
+        gauss_seidel(level, &work.inv_diag[k], &work.stencil[k], r, z, false);
+        gauss_seidel(level, &work.inv_diag[k], &work.stencil[k], r, z, false);
         // Residual, restricted by summing children (the equations are area-integrated).
         let mut az = std::mem::take(&mut work.residual[k]);
         az.resize(level.cells, 0.0);
-        apply(level, &work.alpha[k], &work.weight[k], z, &mut az);
+        apply(level, &work.alpha[k], &work.stencil[k], z, &mut az);
         let coarse = &self.levels[k + 1];
         let mut rc = std::mem::take(&mut work.residual[k + 1]);
         rc.clear();
@@ -267,38 +278,53 @@ impl Hierarchy {
         work.residual[k] = az;
         work.residual[k + 1] = rc;
         work.correction[k + 1] = zc;
-        gauss_seidel(level, &work.diag[k], &work.csr_weight[k], r, z, true);
-        gauss_seidel(level, &work.diag[k], &work.csr_weight[k], r, z, true);
+        gauss_seidel(level, &work.inv_diag[k], &work.stencil[k], r, z, true);
+        gauss_seidel(level, &work.inv_diag[k], &work.stencil[k], r, z, true);
     }
 }
 
 impl Level {
+    /// # Panics
+    /// If a cell does not have exactly [`SIDES`] edges (the level is not a cube-sphere).
     fn new(cells: usize, edges: Vec<(u32, u32)>) -> Self {
-        let mut count = vec![0u32; cells + 1];
-        for &(a, b) in &edges {
-            count[a as usize + 1] += 1;
-            count[b as usize + 1] += 1;
-        }
-        for i in 0..cells {
-            count[i + 1] += count[i];
-        }
-        let mut fill = count.clone();
-        let mut adjacency = vec![(0, 0); edges.len() * 2];
+        let mut count = vec![0usize; cells];
+        let mut neighbours = vec![[0u32; SIDES]; cells];
+        let mut neighbour_edges = vec![[0u32; SIDES]; cells];
         for (e, &(a, b)) in edges.iter().enumerate() {
-            adjacency[fill[a as usize] as usize] = (b, e as u32);
-            fill[a as usize] += 1;
-            adjacency[fill[b as usize] as usize] = (a, e as u32);
-            fill[b as usize] += 1;
+            for (cell, other) in [(a, b), (b, a)] {
+                let (cell, k) = (cell as usize, &mut count[cell as usize]);
+                assert!(*k < SIDES, "cell {cell} has more than {SIDES} sides");
+                neighbours[cell][*k] = other;
+                neighbour_edges[cell][*k] = e as u32;
+                *k += 1;
+            }
         }
+        assert!(
+            count.iter().all(|&k| k == SIDES),
+            "a cell has under {SIDES} sides"
+        );
         Self {
             cells,
             edges,
-            start: count,
-            adjacency,
+            neighbours,
+            neighbour_edges,
             parent_of_fine: Vec::new(),
             coarse_edge_of_fine: Vec::new(),
+            sweep_order: (0..cells as u32).collect(),
         }
     }
+}
+
+/// The cells of a grid of face size `n`, those with `x + y` even on their face first, then
+/// the odd ones. Within a face an even cell's neighbours are all odd, so a sweep's
+/// consecutive updates do not wait on one another (the core overlaps them, where the
+/// lexicographic order chained every cell on the one before); only the cells along the
+/// cube's seams see a same-coloured neighbour, which Gauss–Seidel in any fixed order allows.
+fn chequered_order(n: usize) -> Vec<u32> {
+    let cells = (0..6 * n * n).map(|c| c as u32);
+    let colour = |&c: &u32| (c as usize % n + (c as usize / n) % n) % 2;
+    let even = cells.clone().filter(|c| colour(c) == 0);
+    even.chain(cells.filter(|c| colour(c) == 1)).collect()
 }
 
 fn coarsen(fine: &Level, parent: &[u32], coarse_cells: usize) -> (Level, Vec<u32>) {
@@ -321,40 +347,50 @@ fn coarsen(fine: &Level, parent: &[u32], coarse_cells: usize) -> (Level, Vec<u32
     (Level::new(coarse_cells, edges), map)
 }
 
-/// `out = (diag(alpha) + L_w) x`.
-fn apply(level: &Level, alpha: &[f64], weight: &[f64], x: &[f64], out: &mut [f64]) {
-    for i in 0..level.cells {
-        out[i] = alpha[i] * x[i];
-    }
-    for (&(a, b), w) in level.edges.iter().zip(weight) {
-        let flux = w * (x[a as usize] - x[b as usize]);
-        out[a as usize] += flux;
-        out[b as usize] -= flux;
+/// `out = (diag(alpha) + L_w) x`, as `αᵢxᵢ + Σ w (xᵢ − xⱼ)`: the differences keep the
+/// result accurate where the weights dwarf `α` and `x` is nearly uniform (a stiff step's
+/// surfactant), which `diag·xᵢ − Σ w xⱼ` would lose to cancellation.
+fn apply(level: &Level, alpha: &[f64], stencil: &[[f64; SIDES]], x: &[f64], out: &mut [f64]) {
+    let rows = out
+        .iter_mut()
+        .zip(alpha)
+        .zip(stencil)
+        .zip(&level.neighbours);
+    for (i, (((o, a), w), nb)) in rows.enumerate() {
+        let xi = x[i];
+        let mut sum = a * xi;
+        for k in 0..SIDES {
+            sum += w[k] * (xi - x[nb[k] as usize]);
+        }
+        *o = sum;
     }
 }
 
-/// One Gauss–Seidel sweep of `M z = r`, forwards or backwards, with the diagonal and
-/// the neighbour weights in adjacency order at hand.
+/// One Gauss–Seidel sweep of `M z = r`, forwards or backwards.
 fn gauss_seidel(
     level: &Level,
-    diag: &[f64],
-    csr_weight: &[f64],
+    inv_diag: &[f64],
+    stencil: &[[f64; SIDES]],
     r: &[f64],
     z: &mut [f64],
     back: bool,
 ) {
     let relax = |i: usize, z: &mut [f64]| {
-        let (from, to) = (level.start[i] as usize, level.start[i + 1] as usize);
+        let (nb, w) = (&level.neighbours[i], &stencil[i]);
         let mut sum = r[i];
-        for (&(j, _), w) in level.adjacency[from..to].iter().zip(&csr_weight[from..to]) {
-            sum += w * z[j as usize];
+        for k in 0..SIDES {
+            sum += w[k] * z[nb[k] as usize];
         }
-        z[i] = sum / diag[i];
+        z[i] = sum * inv_diag[i];
     };
     if back {
-        (0..level.cells).rev().for_each(|i| relax(i, z));
+        level
+            .sweep_order
+            .iter()
+            .rev()
+            .for_each(|&i| relax(i as usize, z));
     } else {
-        (0..level.cells).for_each(|i| relax(i, z));
+        level.sweep_order.iter().for_each(|&i| relax(i as usize, z));
     }
 }
 
@@ -446,7 +482,7 @@ mod tests {
             assert!(report.iterations <= 20, "n {n}: {report:?}");
             let level = &h.levels[0];
             let mut ax = vec![0.0; grid.cells()];
-            apply(level, &alpha, &weight, &x, &mut ax);
+            apply(level, &alpha, &work.stencil[0], &x, &mut ax);
             let err = ax
                 .iter()
                 .zip(&b)
