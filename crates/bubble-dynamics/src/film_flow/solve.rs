@@ -168,12 +168,9 @@ impl Hierarchy {
                     break;
                 }
                 let step = rz / pq;
-                for i in 0..nc {
-                    x[i] += step * p[i];
-                    r[i] -= step * q[i];
-                }
+                let rr = update_and_norm2(step, &p, &q, x, &mut r);
                 report.iterations += 1;
-                report.relative_residual = dot(&r, &r).sqrt() / b_norm;
+                report.relative_residual = rr.sqrt() / b_norm;
                 if report.relative_residual <= tolerance {
                     break;
                 }
@@ -258,24 +255,24 @@ impl Hierarchy {
         }
         gauss_seidel(level, &work.inv_diag[k], &work.stencil[k], r, z, false);
         gauss_seidel(level, &work.inv_diag[k], &work.stencil[k], r, z, false);
-        // Residual, restricted by summing children (the equations are area-integrated).
-        let mut az = std::mem::take(&mut work.residual[k]);
-        az.resize(level.cells, 0.0);
-        apply(level, &work.alpha[k], &work.stencil[k], z, &mut az);
         let coarse = &self.levels[k + 1];
         let mut rc = std::mem::take(&mut work.residual[k + 1]);
-        rc.clear();
         rc.resize(coarse.cells, 0.0);
-        for c in 0..level.cells {
-            rc[coarse.parent_of_fine[c] as usize] += r[c] - az[c];
-        }
+        restrict_residual(
+            level,
+            &coarse.parent_of_fine,
+            &work.alpha[k],
+            &work.stencil[k],
+            r,
+            z,
+            &mut rc,
+        );
         let mut zc = std::mem::take(&mut work.correction[k + 1]);
         zc.resize(coarse.cells, 0.0);
         self.v_cycle(work, k + 1, &rc, &mut zc);
         for c in 0..level.cells {
             z[c] += zc[coarse.parent_of_fine[c] as usize];
         }
-        work.residual[k] = az;
         work.residual[k + 1] = rc;
         work.correction[k + 1] = zc;
         gauss_seidel(level, &work.inv_diag[k], &work.stencil[k], r, z, true);
@@ -394,8 +391,63 @@ fn gauss_seidel(
     }
 }
 
+/// Lanes of the dot products' partial sums: independent adds the core can overlap (one
+/// running sum waits on every add before it), in a fixed order, so results stay the same.
+const LANES: usize = 4;
+
 fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
+    let mut lanes = [0.0; LANES];
+    let (a_main, b_main) = (a.chunks_exact(LANES), b.chunks_exact(LANES));
+    let tail: f64 = a_main
+        .remainder()
+        .iter()
+        .zip(b_main.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    for (x, y) in a_main.zip(b_main) {
+        for k in 0..LANES {
+            lanes[k] += x[k] * y[k];
+        }
+    }
+    (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
+}
+
+/// `x += step·p`, `r −= step·q`, and returns `r·r` (one pass, as [`dot`] sums).
+fn update_and_norm2(step: f64, p: &[f64], q: &[f64], x: &mut [f64], r: &mut [f64]) -> f64 {
+    for (xi, pi) in x.iter_mut().zip(p) {
+        *xi += step * pi;
+    }
+    for (ri, qi) in r.iter_mut().zip(q) {
+        *ri -= step * qi;
+    }
+    dot(r, r)
+}
+
+/// `rc` = the residual `r − M z` of a level, restricted by summing each coarse cell's
+/// children (the equations are area-integrated), without storing the fine residual.
+fn restrict_residual(
+    level: &Level,
+    parent_of_fine: &[u32],
+    alpha: &[f64],
+    stencil: &[[f64; SIDES]],
+    r: &[f64],
+    z: &[f64],
+    rc: &mut Vec<f64>,
+) {
+    rc.iter_mut().for_each(|v| *v = 0.0);
+    let rows = alpha
+        .iter()
+        .zip(stencil)
+        .zip(&level.neighbours)
+        .zip(parent_of_fine);
+    for (i, (((a, w), nb), &parent)) in rows.enumerate() {
+        let zi = z[i];
+        let mut mz = a * zi;
+        for k in 0..SIDES {
+            mz += w[k] * (zi - z[nb[k] as usize]);
+        }
+        rc[parent as usize] += r[i] - mz;
+    }
 }
 
 /// The lower Cholesky factor of the coarsest level's matrix, row-major.
