@@ -104,6 +104,9 @@ pub struct FilmFlow {
     pub(crate) h_m: Vec<f64>,
     pub(crate) gamma: Vec<f64>,
     pub(crate) u_m_per_s: Vec<f64>,
+    /// The last Marangoni solve's change of Γ (empty before the first): the next solve's
+    /// first guess.
+    surfactant_change: Vec<f64>,
     scratch: Scratch,
 }
 
@@ -118,6 +121,7 @@ struct Scratch {
     weight: Vec<f64>,
     u_start: Vec<f64>,
     stiffness: Vec<f64>,
+    guess: Vec<f64>,
     gradient: Vec<DVec3>,
     drag: Vec<f64>,
 }
@@ -143,6 +147,7 @@ impl FilmFlow {
             h_m: h,
             gamma: vec![1.0; cells],
             u_m_per_s: vec![0.0; edges],
+            surfactant_change: Vec::new(),
             hierarchy,
             grid,
             scratch: Scratch::default(),
@@ -450,17 +455,27 @@ impl FilmFlow {
         let solution = &mut s.cell2;
         solution.clear();
         solution.extend_from_slice(&self.gamma);
-        let report = self.hierarchy.solve(
+        // The last step's change again as the first guess: a film in steady motion
+        // changes alike from step to step. The tolerance stays relative to Γⁿ's residual.
+        let guess = &mut s.guess;
+        guess.clear();
+        let change = &self.surfactant_change;
+        guess.extend(self.gamma.iter().zip(change).map(|(gm, d)| gm + d));
+        let report = self.hierarchy.solve_with_guess(
             &mut s.work,
             g.areas_sr(),
             &s.weight,
             rhs,
             solution,
+            Some(guess.as_slice()),
             SolveLimits {
                 tolerance: SOLVE_TOLERANCE,
                 max_iterations: SOLVE_MAX_ITERATIONS,
             },
         );
+        self.surfactant_change.clear();
+        let changes = solution.iter().zip(&self.gamma).map(|(x, gm)| x - gm);
+        self.surfactant_change.extend(changes);
         // Velocity correction and the conservative surfactant update.
         let flux = &mut s.edge2;
         flux.clear();
