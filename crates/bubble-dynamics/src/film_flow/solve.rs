@@ -25,8 +25,6 @@ struct Level {
     parent_of_fine: Vec<u32>,
     /// Fine edge → coarse edge it lies along (`u32::MAX` inside a coarse cell).
     coarse_edge_of_fine: Vec<u32>,
-    /// The order Gauss–Seidel visits the cells in (backwards for the way up).
-    sweep_order: Vec<u32>,
 }
 
 /// The face size a grid of `n` coarsens to: halved while even and above
@@ -48,6 +46,8 @@ const COARSEST_FACE: usize = 4;
 #[derive(Clone, Debug)]
 pub struct Hierarchy {
     levels: Vec<Level>,
+    /// The grid's cell at each position of the finest level's numbering.
+    fine_order: Vec<u32>,
 }
 
 /// The numbers of one system: per level, the mass term and the edge weights.
@@ -66,6 +66,10 @@ pub struct Work {
     z: Vec<f64>,
     p: Vec<f64>,
     q: Vec<f64>,
+    /// `b`, `x` and the guess in the finest level's numbering.
+    b: Vec<f64>,
+    x: Vec<f64>,
+    guess: Vec<f64>,
 }
 
 /// When a solve stops.
@@ -92,7 +96,7 @@ impl Hierarchy {
         let fine_edges: Vec<(u32, u32)> = grid.edges().iter().map(|e| (e.a, e.b)).collect();
         let mut n = grid.face_size();
         let mut levels = vec![Level::new(grid.cells(), fine_edges)];
-        levels[0].sweep_order = chequered_order(n);
+        let mut orders = vec![chequered_order(n)];
         while n > coarsest_face(n) {
             let fine = levels.last().expect("one level");
             let parent: Vec<u32> = (0..fine.cells).map(|c| parent_cell(n, c) as u32).collect();
@@ -100,11 +104,13 @@ impl Hierarchy {
             levels.last_mut().expect("one level").coarse_edge_of_fine = coarse_edge_of_fine;
             let mut coarse = coarse;
             coarse.parent_of_fine = parent;
-            coarse.sweep_order = chequered_order(n / 2);
             levels.push(coarse);
+            orders.push(chequered_order(n / 2));
             n /= 2;
         }
-        Self { levels }
+        let levels = renumber(&levels, &orders);
+        let fine_order = orders.swap_remove(0);
+        Self { levels, fine_order }
     }
 
     /// Whether a face size coarsens down to a directly solvable level.
@@ -148,14 +154,44 @@ impl Hierarchy {
         guess: Option<&[f64]>,
         limits: SolveLimits,
     ) -> SolveReport {
+        let nc = self.levels[0].cells;
+        assert!(b.len() == nc && x.len() == nc, "system size mismatch");
+        self.prepare(work, alpha, weight);
+        let order = &self.fine_order;
+        let (mut bo, mut xo, mut go) = (
+            std::mem::take(&mut work.b),
+            std::mem::take(&mut work.x),
+            std::mem::take(&mut work.guess),
+        );
+        gather(order, b, &mut bo);
+        gather(order, x, &mut xo);
+        let guess = guess.filter(|g| g.len() == nc).map(|g| {
+            gather(order, g, &mut go);
+            go.as_slice()
+        });
+        let report = self.solve_ordered(work, &bo, &mut xo, guess, limits);
+        for (&cell, v) in order.iter().zip(&xo) {
+            x[cell as usize] = *v;
+        }
+        (work.b, work.x, work.guess) = (bo, xo, go);
+        report
+    }
+
+    /// The solve in the levels' own (chequered) numbering.
+    fn solve_ordered(
+        &self,
+        work: &mut Work,
+        b: &[f64],
+        x: &mut [f64],
+        guess: Option<&[f64]>,
+        limits: SolveLimits,
+    ) -> SolveReport {
         let SolveLimits {
             tolerance,
             max_iterations,
         } = limits;
-        self.prepare(work, alpha, weight);
         let fine = &self.levels[0];
         let nc = fine.cells;
-        assert!(b.len() == nc && x.len() == nc, "system size mismatch");
         work.r.resize(nc, 0.0);
         work.z.resize(nc, 0.0);
         work.p.resize(nc, 0.0);
@@ -171,7 +207,7 @@ impl Hierarchy {
         // Relative to the warm start's residual: the step's change, not the whole field.
         let mut start_norm = dot(&r, &r).sqrt();
         let b_norm = if start_norm > 0.0 { start_norm } else { 1.0 };
-        if let Some(guess) = guess.filter(|g| g.len() == nc && start_norm > 0.0) {
+        if let Some(guess) = guess.filter(|_| start_norm > 0.0) {
             apply(fine, &work.alpha[0], &work.stencil[0], guess, &mut q);
             for i in 0..nc {
                 z[i] = b[i] - q[i];
@@ -224,8 +260,7 @@ impl Hierarchy {
         work.weight.resize(count, Vec::new());
         work.residual.resize(count, Vec::new());
         work.correction.resize(count, Vec::new());
-        work.alpha[0].clear();
-        work.alpha[0].extend_from_slice(alpha);
+        gather(&self.fine_order, alpha, &mut work.alpha[0]);
         work.weight[0].clear();
         work.weight[0].extend_from_slice(weight);
         for k in 1..count {
@@ -337,16 +372,16 @@ impl Level {
             neighbour_edges,
             parent_of_fine: Vec::new(),
             coarse_edge_of_fine: Vec::new(),
-            sweep_order: (0..cells as u32).collect(),
         }
     }
 }
 
 /// The cells of a grid of face size `n`, those with `x + y` even on their face first, then
-/// the odd ones. Within a face an even cell's neighbours are all odd, so a sweep's
-/// consecutive updates do not wait on one another (the core overlaps them, where the
-/// lexicographic order chained every cell on the one before); only the cells along the
-/// cube's seams see a same-coloured neighbour, which Gauss–Seidel in any fixed order allows.
+/// the odd ones: the levels' numbering, and so the order Gauss–Seidel visits them in.
+/// Within a face an even cell's neighbours are all odd, so a sweep's consecutive updates
+/// do not wait on one another (the core overlaps them, where the lexicographic order
+/// chained every cell on the one before); only the cells along the cube's seams see a
+/// same-coloured neighbour, which Gauss–Seidel in any fixed order allows.
 fn chequered_order(n: usize) -> Vec<u32> {
     let cells = (0..6 * n * n).map(|c| c as u32);
     let colour = |&c: &u32| (c as usize % n + (c as usize / n) % n) % 2;
@@ -393,7 +428,8 @@ fn apply(level: &Level, alpha: &[f64], stencil: &[[f64; SIDES]], x: &[f64], out:
     }
 }
 
-/// One Gauss–Seidel sweep of `M z = r`, forwards or backwards.
+/// One Gauss–Seidel sweep of `M z = r`, forwards or backwards through the level's
+/// (chequered) numbering.
 fn gauss_seidel(
     level: &Level,
     inv_diag: &[f64],
@@ -402,23 +438,62 @@ fn gauss_seidel(
     z: &mut [f64],
     back: bool,
 ) {
-    let relax = |i: usize, z: &mut [f64]| {
-        let (nb, w) = (&level.neighbours[i], &stencil[i]);
-        let mut sum = r[i];
-        for k in 0..SIDES {
-            sum += w[k] * z[nb[k] as usize];
-        }
-        z[i] = sum * inv_diag[i];
-    };
+    let nb = &level.neighbours;
     if back {
-        level
-            .sweep_order
-            .iter()
-            .rev()
-            .for_each(|&i| relax(i as usize, z));
+        for i in (0..level.cells).rev() {
+            relax(i, &nb[i], &stencil[i], inv_diag[i], r[i], z);
+        }
     } else {
-        level.sweep_order.iter().for_each(|&i| relax(i as usize, z));
+        for i in 0..level.cells {
+            relax(i, &nb[i], &stencil[i], inv_diag[i], r[i], z);
+        }
     }
+}
+
+/// Gauss–Seidel's update of cell `i`, inlined into both sweeps.
+#[inline(always)]
+fn relax(i: usize, nb: &[u32; SIDES], w: &[f64; SIDES], inv_diag: f64, r: f64, z: &mut [f64]) {
+    let near = w[0] * z[nb[0] as usize] + w[1] * z[nb[1] as usize];
+    let far = w[2] * z[nb[2] as usize] + w[3] * z[nb[3] as usize];
+    z[i] = (r + near + far) * inv_diag;
+}
+
+/// `out[i] = values[order[i]]`.
+fn gather(order: &[u32], values: &[f64], out: &mut Vec<f64>) {
+    out.clear();
+    out.extend(order.iter().map(|&c| values[c as usize]));
+}
+
+/// The levels in the numbering `orders` gives each (`orders[k][new] = old`): cells,
+/// edges' ends and the fine-to-coarse parents renumbered, edges kept in their order.
+fn renumber(levels: &[Level], orders: &[Vec<u32>]) -> Vec<Level> {
+    let inverse = |order: &[u32]| {
+        let mut inv = vec![0u32; order.len()];
+        for (new, &old) in order.iter().enumerate() {
+            inv[old as usize] = new as u32;
+        }
+        inv
+    };
+    let inverses: Vec<Vec<u32>> = orders.iter().map(|o| inverse(o)).collect();
+    let mut out: Vec<Level> = Vec::with_capacity(levels.len());
+    for (k, level) in levels.iter().enumerate() {
+        let inv = &inverses[k];
+        let edges = level
+            .edges
+            .iter()
+            .map(|&(a, b)| (inv[a as usize], inv[b as usize]));
+        let mut renumbered = Level::new(level.cells, edges.collect());
+        renumbered.coarse_edge_of_fine = level.coarse_edge_of_fine.clone();
+        if k > 0 {
+            let fine_inv = &inverses[k - 1];
+            renumbered.parent_of_fine = vec![0; level.parent_of_fine.len()];
+            for (fine, &parent) in level.parent_of_fine.iter().enumerate() {
+                renumbered.parent_of_fine[fine_inv[fine] as usize] = inv[parent as usize];
+            }
+        }
+        out.push(renumbered);
+    }
+    out
 }
 
 /// Lanes of the dot products' partial sums: independent adds the core can overlap (one
@@ -533,6 +608,17 @@ fn dense_solve(l: &[f64], n: usize, b: &[f64], x: &mut [f64]) {
 mod tests {
     use super::*;
 
+    /// `(diag(alpha) + L_w) x` in the grid's own numbering, straight from its edges.
+    fn grid_apply(grid: &CubeSphere, alpha: &[f64], weight: &[f64], x: &[f64]) -> Vec<f64> {
+        let mut out: Vec<f64> = alpha.iter().zip(x).map(|(a, v)| a * v).collect();
+        for (e, w) in grid.edges().iter().zip(weight) {
+            let (a, b) = (e.a as usize, e.b as usize);
+            out[a] += w * (x[a] - x[b]);
+            out[b] -= w * (x[a] - x[b]);
+        }
+        out
+    }
+
     /// A stiff system (weights 10⁴× the mass term, as a frame's Marangoni step gives)
     /// converges to 1e-12 from zero in at most 20 iterations at n = 16 and 64 alike (the
     /// multigrid preconditioner keeps the count from growing with the grid), and the
@@ -562,9 +648,7 @@ mod tests {
             };
             let report = h.solve(&mut work, &alpha, &weight, &b, &mut x, limits);
             assert!(report.iterations <= 20, "n {n}: {report:?}");
-            let level = &h.levels[0];
-            let mut ax = vec![0.0; grid.cells()];
-            apply(level, &alpha, &work.stencil[0], &x, &mut ax);
+            let ax = grid_apply(&grid, &alpha, &weight, &x);
             let err = ax
                 .iter()
                 .zip(&b)
@@ -593,10 +677,8 @@ mod tests {
             .iter()
             .map(|c| 1.0 + 0.01 * c.x * c.y)
             .collect();
-        let mut b = vec![0.0; grid.cells()];
+        let b = grid_apply(&grid, &alpha, &weight, &answer);
         let mut work = Work::default();
-        h.prepare(&mut work, &alpha, &weight);
-        apply(&h.levels[0], &alpha, &work.stencil[0], &answer, &mut b);
         let limits = SolveLimits {
             tolerance: 1e-6,
             max_iterations: 50,
