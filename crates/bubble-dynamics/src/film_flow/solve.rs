@@ -537,7 +537,7 @@ fn restrict_residual(
     stencil: &[[f64; SIDES]],
     r: &[f64],
     z: &[f64],
-    rc: &mut Vec<f64>,
+    rc: &mut [f64],
 ) {
     rc.iter_mut().for_each(|v| *v = 0.0);
     let rows = alpha
