@@ -115,24 +115,32 @@ fn frame_cost(root: &Path, bubbles: &Path) -> Option<Frame> {
         |frames: &str| ["bench", "paper", "--size", SIZE, "--frames", frames].map(String::from);
     let (long_s, _) = timed(root, bubbles, &bench("210"))?;
     let (short_s, _) = timed(root, bubbles, &bench("10"))?;
-    // The bench's table: `size sim cube opaque bubbles other frame fps`.
+    // The bench's table, read by its header's names (`size sim_ms … frame_ms fps`):
+    // builds before the film column had one column fewer.
     let out = Command::new(bubbles)
         .args(bench("100"))
         .current_dir(root)
         .output()
         .ok()?;
     let text = String::from_utf8_lossy(&out.stdout);
-    let cols: Vec<f64> = text
+    let header: Vec<&str> = text
+        .lines()
+        .find(|l| l.starts_with("size"))?
+        .split_whitespace()
+        .collect();
+    let row: Vec<&str> = text
         .lines()
         .find(|l| l.starts_with(SIZE))?
         .split_whitespace()
-        .skip(1)
-        .filter_map(|c| c.parse().ok())
         .collect();
+    let column = |name: &str| -> Option<f64> {
+        let at = header.iter().position(|h| *h == name)?;
+        row.get(at)?.parse().ok()
+    };
     Some(Frame {
         cpu_ms: (long_s - short_s) / 200.0 * 1e3,
-        wall_ms: *cols.get(5)?,
-        sim_ms: *cols.first()?,
+        wall_ms: column("frame_ms")?,
+        sim_ms: column("sim_ms")?,
     })
 }
 

@@ -194,6 +194,55 @@ fn bench_prints_a_breakdown_per_size() {
     assert!(text.contains("fps") && text.contains("64x48"), "{text}");
 }
 
+/// The film flow's step cost is its own column, part of the simulation's: zero for a
+/// scene without film flow, above zero and at most the simulation's for `swirl`.
+#[test]
+fn bench_shows_the_film_steps_as_their_own_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let column = |scene: &str| {
+        let args = [
+            "bench",
+            scene,
+            "--frames",
+            "4",
+            "--size",
+            "32x24",
+            "--samples",
+            "1",
+        ];
+        let out = bubbles(&args, dir.path());
+        assert!(out.status.success(), "{}", stderr(&out));
+        let text = String::from_utf8(out.stdout).unwrap();
+        let header: Vec<&str> = text
+            .lines()
+            .find(|l| l.starts_with("size"))
+            .unwrap()
+            .split_whitespace()
+            .collect();
+        let row: Vec<&str> = text
+            .lines()
+            .find(|l| l.starts_with("32x24"))
+            .unwrap()
+            .split_whitespace()
+            .collect();
+        let at = |name: &str| -> f64 {
+            let k = header
+                .iter()
+                .position(|h| *h == name)
+                .unwrap_or_else(|| panic!("{text}"));
+            row[k].parse().unwrap()
+        };
+        (at("sim_ms"), at("film_ms"))
+    };
+    let (_, film_free) = column("paper");
+    assert_eq!(film_free, 0.0);
+    let (sim, film) = column("swirl");
+    assert!(
+        film > 0.0 && film <= sim,
+        "film {film} ms, simulation {sim} ms"
+    );
+}
+
 #[cfg(not(feature = "wgpu"))]
 #[test]
 fn backend_wgpu_without_the_feature_says_how_to_rebuild() {

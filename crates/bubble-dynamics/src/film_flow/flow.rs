@@ -104,6 +104,9 @@ pub struct FilmFlow {
     pub(crate) h_m: Vec<f64>,
     pub(crate) gamma: Vec<f64>,
     pub(crate) u_m_per_s: Vec<f64>,
+    /// The last Marangoni solve's change of Γ (empty before the first): the next solve's
+    /// first guess.
+    surfactant_change: Vec<f64>,
     scratch: Scratch,
 }
 
@@ -117,6 +120,8 @@ struct Scratch {
     vertex: Vec<f64>,
     weight: Vec<f64>,
     u_start: Vec<f64>,
+    stiffness: Vec<f64>,
+    guess: Vec<f64>,
     gradient: Vec<DVec3>,
     drag: Vec<f64>,
 }
@@ -142,6 +147,7 @@ impl FilmFlow {
             h_m: h,
             gamma: vec![1.0; cells],
             u_m_per_s: vec![0.0; edges],
+            surfactant_change: Vec::new(),
             hierarchy,
             grid,
             scratch: Scratch::default(),
@@ -280,15 +286,15 @@ impl FilmFlow {
     }
 
     /// `u ← u + dt (g_t + viscous)`.
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn momentum_explicit(&mut self, s: &mut Scratch, dt_s: f64, forcing: &Forcing) {
         // Gravity as the discrete gradient of the potential g·x between cell centres, so
         // a discrete Marangoni gradient can balance it exactly (the edge projection g·n
         // carries an O(Δx) curl that no tension gradient can hold).
-        let centres = self.grid.centres();
         let g = forcing.g_eff_m_per_s2;
-        for (u, e) in self.u_m_per_s.iter_mut().zip(self.grid.edges()) {
-            let rise = g.dot(centres[e.b as usize] - centres[e.a as usize]);
-            *u += dt_s * rise / e.dual_length;
+        let slope = &self.grid.edge_arrays().centre_gradient;
+        for (u, c) in self.u_m_per_s.iter_mut().zip(slope) {
+            *u += dt_s * g.dot(*c);
         }
         let nu = self.params.viscosity_pa_s / self.params.density_kg_per_m3;
         if nu > 0.0 {
@@ -306,6 +312,7 @@ impl FilmFlow {
     }
 
     /// One explicit step of the sheet's viscous stress over `dt_s`.
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn viscous_substep(&mut self, s: &mut Scratch, nu: f64, dt_s: f64) {
         let r = self.params.radius_m;
         let g = &self.grid;
@@ -315,11 +322,14 @@ impl FilmFlow {
         let divergence = &mut s.cell;
         divergence.clear();
         divergence.resize(g.cells(), 0.0);
-        for (e, &u) in g.edges().iter().zip(&self.u_m_per_s) {
-            vorticity[e.v1 as usize] += u * e.dual_length;
-            vorticity[e.v0 as usize] -= u * e.dual_length;
-            divergence[e.a as usize] += u * e.length;
-            divergence[e.b as usize] -= u * e.length;
+        let ea = g.edge_arrays();
+        let lengths = ea.length.iter().zip(&ea.dual_length);
+        let ends = ea.cells.iter().zip(&ea.vertices);
+        for ((&u, (l, d)), ([a, b], [v0, v1])) in self.u_m_per_s.iter().zip(lengths).zip(ends) {
+            vorticity[*v1 as usize] += u * d;
+            vorticity[*v0 as usize] -= u * d;
+            divergence[*a as usize] += u * l;
+            divergence[*b as usize] -= u * l;
         }
         for (z, a) in vorticity.iter_mut().zip(g.vertex_areas_sr()) {
             *z /= a * r;
@@ -328,10 +338,11 @@ impl FilmFlow {
             *d /= a * r;
         }
         let k = 1.0 / (r * r);
-        for (u, e) in self.u_m_per_s.iter_mut().zip(g.edges()) {
-            let curl_curl = (vorticity[e.v1 as usize] - vorticity[e.v0 as usize]) / (e.length * r);
-            let grad_div =
-                (divergence[e.b as usize] - divergence[e.a as usize]) / (e.dual_length * r);
+        let lengths = ea.length.iter().zip(&ea.dual_length);
+        let ends = ea.cells.iter().zip(&ea.vertices);
+        for ((u, (l, d)), ([a, b], [v0, v1])) in self.u_m_per_s.iter_mut().zip(lengths).zip(ends) {
+            let curl_curl = (vorticity[*v1 as usize] - vorticity[*v0 as usize]) / (l * r);
+            let grad_div = (divergence[*b as usize] - divergence[*a as usize]) / (d * r);
             *u += dt_s * nu * (-curl_curl + 2.0 * k * *u + 4.0 * grad_div);
         }
     }
@@ -344,6 +355,7 @@ impl FilmFlow {
     /// each edge's implicit factor `1/(1 + dt k)`, by which the Marangoni step's own
     /// velocity change is damped too: drag and Marangoni stress are then one backward-Euler
     /// step, and a film they hold together stays at rest.
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn air_shear(&mut self, s: &mut Scratch, dt_s: f64, air_m_per_s: DVec3) {
         let p = &self.params;
         s.drag.clear();
@@ -353,28 +365,22 @@ impl FilmFlow {
         }
         let nu_air = p.air_viscosity_pa_s / p.air_density_kg_per_m3.max(f64::MIN_POSITIVE);
         let (r, eddy) = (p.radius_m, 0.25 * p.radius_m);
-        let layer = |slip: f64| {
-            if slip > 0.0 {
-                (nu_air * eddy / slip).sqrt().min(r)
-            } else {
-                r
-            }
+        // 1/δ = max(√(|Δu|/(ν_air ℓ)), 1/R): a multiply where 1/δ was a division.
+        let per_layer_depth = {
+            let per_slip = 1.0 / (nu_air * eddy);
+            move |slip: f64| (slip * per_slip).sqrt().max(1.0 / r)
         };
-        let centres = self.grid.centres();
-        for ((u, e), factor) in self
-            .u_m_per_s
-            .iter_mut()
-            .zip(self.grid.edges())
-            .zip(&mut s.drag)
+        let ea = self.grid.edge_arrays();
+        let edges = ea.cells.iter().zip(&ea.centre_gradient);
+        for ((u, ([a, b], slope)), factor) in self.u_m_per_s.iter_mut().zip(edges).zip(&mut s.drag)
         {
-            let h = (0.5 * (self.h_m[e.a as usize] + self.h_m[e.b as usize])).max(H_FLOOR_M);
+            let h = (0.5 * (self.h_m[*a as usize] + self.h_m[*b as usize])).max(H_FLOOR_M);
             let per_layer = p.air_viscosity_pa_s / (p.density_kg_per_m3 * h);
             // The potential flow's surface velocity is the gradient of 1.5 U·x: taken as
             // the discrete gradient between cell centres, curl-free like the real one.
-            let rise = air_m_per_s.dot(centres[e.b as usize] - centres[e.a as usize]);
-            let outside = 1.5 * rise / e.dual_length;
-            let k_out = per_layer / layer((*u - outside).abs());
-            let k_in = per_layer / layer(u.abs());
+            let outside = 1.5 * air_m_per_s.dot(*slope);
+            let k_out = per_layer * per_layer_depth((*u - outside).abs());
+            let k_in = per_layer * per_layer_depth(u.abs());
             *factor = 1.0 / (1.0 + dt_s * (k_out + k_in));
             *u = (*u + dt_s * k_out * outside) * *factor;
         }
@@ -383,6 +389,7 @@ impl FilmFlow {
     /// Backward-Euler Marangoni step: solves for the surfactant the step ends with, sets
     /// the velocities from its gradient, and moves the surfactant with fluxes that sum to
     /// zero (so it is conserved to rounding whatever the solver's residual).
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn marangoni_implicit(&mut self, s: &mut Scratch, dt_s: f64) -> SolveReport {
         let p = self.params;
         let r = p.radius_m;
@@ -391,13 +398,15 @@ impl FilmFlow {
         // started with (transport), central with the step's change of velocity (the
         // forces' part, which the implicit solve treats centrally: an upwind flux there
         // would diffuse Γ at |g dt| and no gradient could hold a film at rest).
+        let ea = g.edge_arrays();
         let advective = &mut s.edge;
         advective.clear();
-        advective.extend(g.edges().iter().zip(&self.u_m_per_s).zip(&s.u_start).map(
-            |((e, &u), &u0)| {
-                let (ga, gb) = (self.gamma[e.a as usize], self.gamma[e.b as usize]);
+        let edges = ea.cells.iter().zip(&ea.length);
+        advective.extend(self.u_m_per_s.iter().zip(&s.u_start).zip(edges).map(
+            |((&u, &u0), ([a, b], l))| {
+                let (ga, gb) = (self.gamma[*a as usize], self.gamma[*b as usize]);
                 let up = if u0 >= 0.0 { ga } else { gb };
-                (up * u0 + 0.5 * (ga + gb) * (u - u0)) * e.length
+                (up * u0 + 0.5 * (ga + gb) * (u - u0)) * l
             },
         ));
         // The transport part may not take more than half a cell's surfactant in one step
@@ -406,68 +415,82 @@ impl FilmFlow {
         let outflow = &mut s.cell;
         outflow.clear();
         outflow.resize(g.cells(), 0.0);
-        for (e, &u0) in g.edges().iter().zip(&s.u_start) {
-            let up = if u0 >= 0.0 { e.a } else { e.b } as usize;
-            outflow[up] += dt_s * (self.gamma[up] * u0 * e.length).abs() / r;
+        for ((&u0, [a, b]), l) in s.u_start.iter().zip(&ea.cells).zip(&ea.length) {
+            let up = if u0 >= 0.0 { *a } else { *b } as usize;
+            outflow[up] += dt_s * (self.gamma[up] * u0 * l).abs() / r;
         }
-        for ((f, e), &u0) in advective.iter_mut().zip(g.edges()).zip(&s.u_start) {
-            let up = if u0 >= 0.0 { e.a } else { e.b } as usize;
+        let edges = ea.cells.iter().zip(&ea.length);
+        for ((f, &u0), ([a, b], l)) in advective.iter_mut().zip(&s.u_start).zip(edges) {
+            let up = if u0 >= 0.0 { *a } else { *b } as usize;
             let budget = MAX_OUTFLOW_FRACTION * g.areas_sr()[up] * self.gamma[up];
             if outflow[up] > budget {
-                *f -= (1.0 - budget / outflow[up]) * self.gamma[up] * u0 * e.length;
+                *f -= (1.0 - budget / outflow[up]) * self.gamma[up] * u0 * l;
             }
         }
         // Rows divided by R²: α = A (sr), w = dt² E l/(ρ h d R²)/(1 + dt k),
         // b = A Γ − dt Σ F/R.
-        let drag = std::mem::take(&mut s.drag);
-        let stiffness = |k: usize, e: &super::grid::GridEdge| {
-            let h = (0.5 * (self.h_m[e.a as usize] + self.h_m[e.b as usize])).max(H_FLOOR_M);
-            dt_s * p.elasticity_n_per_m / (p.density_kg_per_m3 * h) * drag[k]
-        };
+        // Each edge's dt·E/(ρh)/(1 + dt k), once: the weights and the velocity correction
+        // both use it.
+        let stiffness = &mut s.stiffness;
+        stiffness.clear();
+        stiffness.extend(ea.cells.iter().zip(&s.drag).map(|([a, b], drag)| {
+            let h = (0.5 * (self.h_m[*a as usize] + self.h_m[*b as usize])).max(H_FLOOR_M);
+            dt_s * p.elasticity_n_per_m / (p.density_kg_per_m3 * h) * drag
+        }));
         s.weight.clear();
+        let lengths = ea.length.iter().zip(&ea.dual_length);
         s.weight.extend(
-            g.edges()
+            stiffness
                 .iter()
-                .enumerate()
-                .map(|(k, e)| dt_s * stiffness(k, e) * e.length / (e.dual_length * r * r)),
+                .zip(lengths)
+                .map(|(k, (l, d))| dt_s * k * l / (d * r * r)),
         );
         let rhs = &mut s.cell;
         rhs.clear();
         rhs.extend(g.areas_sr().iter().zip(&self.gamma).map(|(a, gm)| a * gm));
-        for (e, f) in g.edges().iter().zip(advective.iter()) {
-            rhs[e.a as usize] -= dt_s * f / r;
-            rhs[e.b as usize] += dt_s * f / r;
+        for ([a, b], f) in ea.cells.iter().zip(advective.iter()) {
+            rhs[*a as usize] -= dt_s * f / r;
+            rhs[*b as usize] += dt_s * f / r;
         }
         let solution = &mut s.cell2;
         solution.clear();
         solution.extend_from_slice(&self.gamma);
-        let report = self.hierarchy.solve(
+        // The last step's change again as the first guess: a film in steady motion
+        // changes alike from step to step. The tolerance stays relative to Γⁿ's residual.
+        let guess = &mut s.guess;
+        guess.clear();
+        let change = &self.surfactant_change;
+        guess.extend(self.gamma.iter().zip(change).map(|(gm, d)| gm + d));
+        let report = self.hierarchy.solve_with_guess(
             &mut s.work,
             g.areas_sr(),
             &s.weight,
             rhs,
             solution,
+            Some(guess.as_slice()),
             SolveLimits {
                 tolerance: SOLVE_TOLERANCE,
                 max_iterations: SOLVE_MAX_ITERATIONS,
             },
         );
+        self.surfactant_change.clear();
+        let changes = solution.iter().zip(&self.gamma).map(|(x, gm)| x - gm);
+        self.surfactant_change.extend(changes);
         // Velocity correction and the conservative surfactant update.
         let flux = &mut s.edge2;
         flux.clear();
-        for (k, ((e, u), f_adv)) in g
-            .edges()
-            .iter()
-            .zip(self.u_m_per_s.iter_mut())
+        let edges = ea.cells.iter().zip(ea.length.iter().zip(&ea.dual_length));
+        let per_edge = self
+            .u_m_per_s
+            .iter_mut()
             .zip(advective.iter())
-            .enumerate()
-        {
-            let (a, b) = (e.a as usize, e.b as usize);
+            .zip(stiffness.iter());
+        for (((u, f_adv), k), ([a, b], (l, d))) in per_edge.zip(edges) {
+            let (a, b) = (*a as usize, *b as usize);
             let gamma_c = 0.5 * (self.gamma[a] + self.gamma[b]);
-            let du = -stiffness(k, e) * (solution[b] - solution[a])
-                / (gamma_c.max(f64::MIN_POSITIVE) * e.dual_length * r);
+            let du = -k * (solution[b] - solution[a]) / (gamma_c.max(f64::MIN_POSITIVE) * d * r);
             *u += du;
-            flux.push(f_adv + gamma_c * du * e.length);
+            flux.push(f_adv + gamma_c * du * l);
         }
         let before = &mut s.cell2;
         before.clear();
@@ -478,19 +501,20 @@ impl FilmFlow {
             // hundreds of m/s) overshot: redo it with every flux upwind and each donor
             // limited, which keeps Γ positive and still conserves it.
             self.gamma.copy_from_slice(before);
-            for ((f, e), &u) in flux.iter_mut().zip(g.edges()).zip(&self.u_m_per_s) {
-                let up = if u >= 0.0 { e.a } else { e.b } as usize;
-                *f = self.gamma[up] * u * e.length;
+            let edges = ea.cells.iter().zip(&ea.length);
+            for ((f, &u), ([a, b], l)) in flux.iter_mut().zip(&self.u_m_per_s).zip(edges) {
+                let up = if u >= 0.0 { *a } else { *b } as usize;
+                *f = self.gamma[up] * u * l;
             }
             limit_outflow(&g, flux, dt_s / r, &self.gamma, &mut s.cell);
             apply_fluxes(&g, flux, dt_s / r, &mut self.gamma);
         }
-        s.drag = drag;
         report
     }
 
     /// Moves liquid with the surfaces (upwind) and by the drainage flux relative to them,
     /// in sub-steps that keep each cell's outflow below half its content.
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn transport_thickness(&mut self, s: &mut Scratch, dt_s: f64, g_eff: DVec3) {
         let p = self.params;
         let r = p.radius_m;
@@ -501,20 +525,17 @@ impl FilmFlow {
             0.0
         };
         // Speed of every edge: the surfaces' plus the drainage's (ρ g_t h²/(3μ)).
-        s.edge.clear();
-        s.edge.extend(
-            g.edges()
-                .iter()
-                .zip(&self.u_m_per_s)
-                .map(|(e, &u)| edge_speed(e, u, drain * g_eff.dot(e.normal), &self.h_m)),
-        );
-        let courant = g
-            .edges()
+        let ea = g.edge_arrays();
+        s.edge.resize(ea.cells.len(), 0.0);
+        self.edge_speeds(&mut s.edge, drain, g_eff);
+        let courant = ea
+            .cells
             .iter()
+            .zip(&ea.length)
             .zip(s.edge.iter())
-            .map(|(e, v)| {
-                let a = g.areas_sr()[e.a as usize].min(g.areas_sr()[e.b as usize]);
-                v.abs() * dt_s * e.length / (a * r)
+            .map(|(([a, b], l), v)| {
+                let a = g.areas_sr()[*a as usize].min(g.areas_sr()[*b as usize]);
+                v.abs() * dt_s * l / (a * r)
             })
             .fold(0.0, f64::max);
         // A cell drains through at most two edges of a smooth flow: 2·courant per step, kept
@@ -523,17 +544,31 @@ impl FilmFlow {
         let h_dt = dt_s / f64::from(substeps);
         for k in 0..substeps {
             if k > 0 {
-                for ((v, e), &u) in s.edge.iter_mut().zip(g.edges()).zip(&self.u_m_per_s) {
-                    *v = edge_speed(e, u, drain * g_eff.dot(e.normal), &self.h_m);
-                }
+                self.edge_speeds(&mut s.edge, drain, g_eff);
             }
             self.upwind_substep(s, h_dt);
+        }
+    }
+
+    /// Each edge's transport speed: the surfaces' `u` plus the drainage `c·h_up²` with
+    /// `c = drain·g_eff·n`, the upwind cell chosen by the sign of the speed at the mean
+    /// thickness.
+    fn edge_speeds(&self, speed: &mut [f64], drain: f64, g_eff: DVec3) {
+        let ea = self.grid.edge_arrays();
+        let edges = ea.cells.iter().zip(&ea.normal);
+        for ((v, &u), ([a, b], normal)) in speed.iter_mut().zip(&self.u_m_per_s).zip(edges) {
+            let c = drain * g_eff.dot(*normal);
+            let (ha, hb) = (self.h_m[*a as usize], self.h_m[*b as usize]);
+            let mean = 0.5 * (ha + hb);
+            let h = if u + c * mean * mean >= 0.0 { ha } else { hb };
+            *v = u + c * h * h;
         }
     }
 
     /// One transport of `h` with the edge speeds in `s.edge`: second-order upwind (the
     /// upwind cell's Green–Gauss gradient carried to the edge midpoint, clamped between
     /// the two cells' values so no new extremum appears), outflow-limited.
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn upwind_substep(&mut self, s: &mut Scratch, dt_s: f64) {
         let r = self.params.radius_m;
         let g = &self.grid;
@@ -541,9 +576,10 @@ impl FilmFlow {
         // Cell gradients of h on the unit sphere, per radian.
         s.gradient.clear();
         s.gradient.resize(g.cells(), DVec3::ZERO);
-        for e in g.edges() {
-            let (a, b) = (e.a as usize, e.b as usize);
-            let flux = e.normal * (0.5 * (self.h_m[a] + self.h_m[b]) * e.length);
+        let ea = g.edge_arrays();
+        for (([a, b], normal), l) in ea.cells.iter().zip(&ea.normal).zip(&ea.length) {
+            let (a, b) = (*a as usize, *b as usize);
+            let flux = *normal * (0.5 * (self.h_m[a] + self.h_m[b]) * l);
             s.gradient[a] += flux;
             s.gradient[b] -= flux;
         }
@@ -554,13 +590,18 @@ impl FilmFlow {
         let (speed, volume) = (&s.edge, &mut s.edge2);
         volume.clear();
         // Volume across each edge over the step, per R² (m × sr).
-        for (e, &v) in g.edges().iter().zip(speed.iter()) {
-            let (up, down) = if v >= 0.0 { (e.a, e.b) } else { (e.b, e.a) };
+        let edges = ea.cells.iter().zip(&ea.reach).zip(&ea.length);
+        for (&v, (([a, b], reach), l)) in speed.iter().zip(edges) {
+            let (up, down, to_edge) = if v >= 0.0 {
+                (*a, *b, reach[0])
+            } else {
+                (*b, *a, reach[1])
+            };
             let (up, down) = (up as usize, down as usize);
             let (h_up, h_down) = (self.h_m[up], self.h_m[down]);
-            let reach = s.gradient[up].dot(e.midpoint - g.centres()[up]);
+            let reach = s.gradient[up].dot(to_edge);
             let h_face = (h_up + reach).clamp(h_up.min(h_down), h_up.max(h_down));
-            volume.push(h_face * v * e.length * dt_s / r);
+            volume.push(h_face * v * l * dt_s / r);
         }
         limit_outflow(g, volume, 1.0, &self.h_m, &mut s.cell);
         apply_fluxes(g, volume, 1.0, &mut self.h_m);
@@ -585,8 +626,8 @@ fn viscous_bound(g: &CubeSphere) -> f64 {
 
 /// Moves `scale·flux_e` (per unit sphere area) from cell `a` to `b` of every edge.
 fn apply_fluxes(g: &CubeSphere, flux: &[f64], scale: f64, values: &mut [f64]) {
-    for (e, f) in g.edges().iter().zip(flux) {
-        let (a, b) = (e.a as usize, e.b as usize);
+    for ([a, b], f) in g.edge_arrays().cells.iter().zip(flux) {
+        let (a, b) = (*a as usize, *b as usize);
         let moved = scale * f;
         values[a] -= moved / g.areas_sr()[a];
         values[b] += moved / g.areas_sr()[b];
@@ -604,24 +645,16 @@ fn limit_outflow(
 ) {
     outflow.clear();
     outflow.resize(g.cells(), 0.0);
-    for (e, f) in g.edges().iter().zip(flux.iter()) {
-        let donor = if *f >= 0.0 { e.a } else { e.b } as usize;
+    let cells = &g.edge_arrays().cells;
+    for ([a, b], f) in cells.iter().zip(flux.iter()) {
+        let donor = if *f >= 0.0 { *a } else { *b } as usize;
         outflow[donor] += (scale * f).abs();
     }
-    for (e, f) in g.edges().iter().zip(flux.iter_mut()) {
-        let donor = if *f >= 0.0 { e.a } else { e.b } as usize;
+    for ([a, b], f) in cells.iter().zip(flux.iter_mut()) {
+        let donor = if *f >= 0.0 { *a } else { *b } as usize;
         let budget = MAX_OUTFLOW_FRACTION * g.areas_sr()[donor] * values[donor];
         if outflow[donor] > budget {
             *f *= budget / outflow[donor];
         }
     }
-}
-
-/// Transport speed across edge `e`: the surfaces' `u` plus the drainage `c·h_up²`, with
-/// the upwind cell chosen by the sign of the speed at the mean thickness.
-fn edge_speed(e: &super::grid::GridEdge, u: f64, c: f64, h_m: &[f64]) -> f64 {
-    let (ha, hb) = (h_m[e.a as usize], h_m[e.b as usize]);
-    let mean = 0.5 * (ha + hb);
-    let h = if u + c * mean * mean >= 0.0 { ha } else { hb };
-    u + c * h * h
 }
