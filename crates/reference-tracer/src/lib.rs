@@ -5,8 +5,9 @@
 //! functions) and `thinfilm` (the exact film), never the rasterizer.
 //!
 //! Per pixel, at least `samples_per_side²` camera rays on an Owen-scrambled Sobol net
-//! ([`sampling`]), then twice as many, and so on, until two halves of the pixel's rays agree
-//! within `tolerance_de` (ΔE2000, as displayed) or `max_samples` is reached: rays go
+//! ([`sampling`]), then twice as many, and so on, until the standard error of the pixel's
+//! mean, from the spread of four blocks of its rays, is within `tolerance_de` (ΔE2000, as
+//! displayed) or `max_samples` is reached: rays go
 //! where the image is not yet converged. Each ray carries its differentials, so textures
 //! are box-filtered over the patch its sample stands for. Every choice is per pixel and
 //! from the seed, so the image is the same at any thread count. A ray meets
@@ -52,10 +53,10 @@ pub struct ReferenceSettings {
     /// Camera rays per pixel along each axis at the start (the pixel gets its square);
     /// also the texture filter's cell: a ray stands for `1/samples_per_side` of a pixel.
     pub samples_per_side: u32,
-    /// Most camera rays per pixel: the count doubles until the halves agree or this is hit.
+    /// Most camera rays per pixel: the count doubles until the pixel converges or this is hit.
     pub max_samples: u32,
-    /// A pixel is done when the means of its first and second half of rays differ by at
-    /// most this ΔE2000, as displayed (`exposure_ev`, `tonemap`).
+    /// A pixel is done when the standard error of its mean, estimated from four blocks of
+    /// its rays, is at most this ΔE2000, as displayed (`exposure_ev`, `tonemap`).
     pub tolerance_de: f64,
     /// Box-filter checkers over each ray's footprint (true), or point-sample them.
     pub filter_textures: bool,
@@ -93,15 +94,15 @@ pub enum Reflections {
 }
 
 impl Default for ReferenceSettings {
-    /// 400 × 400, 16 to 1024 rays per pixel to ΔE 0.3 (ACES, 0 EV), filtered textures,
-    /// depth 8, cut-off 1e-4, 10 nm, polarised, spectral.
+    /// 400 × 400, 16 to 1024 rays per pixel to a standard error of ΔE 0.15 (ACES, 0 EV),
+    /// filtered textures, depth 8, cut-off 1e-4, 10 nm, polarised, spectral.
     fn default() -> Self {
         Self {
             width: 400,
             height: 400,
             samples_per_side: 4,
             max_samples: 1024,
-            tolerance_de: 0.3,
+            tolerance_de: 0.15,
             filter_textures: true,
             exposure_ev: 0.0,
             tonemap: ToneMap::AcesFitted,
@@ -185,7 +186,7 @@ pub struct RayCount {
     pub mean: f64,
     /// The most any pixel got.
     pub max: u32,
-    /// Pixels that reached `max_samples` with halves still further apart than the tolerance.
+    /// Pixels that reached `max_samples` with a standard error still above the tolerance.
     pub unconverged: usize,
 }
 
@@ -235,7 +236,7 @@ pub fn render_reference_counted(
     Ok((frame, count))
 }
 
-/// A finished pixel: its colour, the rays it took and whether its halves agreed.
+/// A finished pixel: its colour, the rays it took and whether it met the tolerance.
 struct Pixel {
     rgb: [f32; 3],
     rays: u32,
@@ -243,30 +244,85 @@ struct Pixel {
 }
 
 /// The pixel's mean over rays `0..n`, doubling `n` from `samples_per_side²` until the
-/// mean of its first half and that of its second agree within the tolerance, or
-/// `max_samples`. Each half is itself a stratified net (see [`sampling`]).
+/// standard error of the mean, estimated from four consecutive blocks of its rays, is
+/// within the tolerance, or `max_samples`. Each block is itself a scrambled net (see
+/// [`sampling`]), so their spread is that of independent stratified estimates.
 fn pixel(tracer: &Tracer<'_>, view: &View, x: usize, y: usize) -> Pixel {
     let s = tracer.settings;
-    let base = s.samples_per_side * s.samples_per_side;
-    let sample = |range: std::ops::Range<u32>| sum_rays(tracer, view, (x, y), range);
-    // Rays [0, m) summed in `first`, [m, n) in `second`.
-    let (mut m, mut n) = (base / 2, base);
-    let (mut first, mut second) = (sample(0..m), sample(m..n));
+    let sample = |range: std::ops::Range<u32>| Block {
+        sum: sum_rays(tracer, view, (x, y), range.clone()),
+        rays: range.len() as u32,
+    };
+    let split = |from: u32, to: u32| {
+        [
+            sample(from..from + (to - from) / 2),
+            sample(from + (to - from) / 2..to),
+        ]
+    };
+    let mut n = s.samples_per_side * s.samples_per_side;
+    let [q0, q1] = split(0, n / 2);
+    let [q2, q3] = split(n / 2, n);
+    let mut blocks = [q0, q1, q2, q3];
     loop {
-        let total = [0, 1, 2].map(|c| first[c] + second[c]);
-        let converged = m > 0 && agree(s, mean(first, m), mean(second, n - m));
+        let total = blocks.iter().fold(Block::EMPTY, |a, b| a.plus(b));
+        let converged = standard_error(s, &blocks, &total).is_some_and(|e| e <= s.tolerance_de);
         if converged || n >= s.max_samples {
             // Out-of-gamut colours stay negative, as in the LUT path; the tone curve clamps them.
             return Pixel {
-                rgb: mean(total, n).map(|c| c as f32),
+                rgb: total.mean().map(|c| c as f32),
                 rays: n,
-                converged: converged || m == 0,
+                converged: converged || n < 4,
             };
         }
         let next = n.saturating_mul(2).min(s.max_samples);
-        (first, second, m) = (total, sample(n..next), n);
+        let [q2, q3] = split(n, next);
+        blocks = [
+            blocks[0].plus(&blocks[1]),
+            blocks[2].plus(&blocks[3]),
+            q2,
+            q3,
+        ];
         n = next;
     }
+}
+
+/// The summed radiance of some of a pixel's rays.
+#[derive(Debug, Clone, Copy)]
+struct Block {
+    sum: [f64; 3],
+    rays: u32,
+}
+
+impl Block {
+    const EMPTY: Block = Block {
+        sum: [0.0; 3],
+        rays: 0,
+    };
+
+    fn plus(&self, other: &Block) -> Block {
+        Block {
+            sum: [0, 1, 2].map(|c| self.sum[c] + other.sum[c]),
+            rays: self.rays + other.rays,
+        }
+    }
+
+    fn mean(&self) -> [f64; 3] {
+        self.sum.map(|c| c / f64::from(self.rays.max(1)))
+    }
+}
+
+/// The standard error of the pixel's mean in displayed ΔE2000, from the spread of four
+/// block means about it: `sqrt(Σ ΔE² / (4 · 3))`; `None` while a block is empty.
+fn standard_error(s: &ReferenceSettings, blocks: &[Block; 4], total: &Block) -> Option<f64> {
+    if blocks.iter().any(|b| b.rays == 0) {
+        return None;
+    }
+    let centre = displayed(s, total.mean());
+    let spread: f64 = blocks
+        .iter()
+        .map(|b| ciede2000(displayed(s, b.mean()), centre).powi(2))
+        .sum();
+    Some((spread / 12.0).sqrt())
 }
 
 /// The sum of the radiance along the pixel's rays `range` (indices into its sequence).
@@ -301,15 +357,6 @@ fn sum_rays(
         }
     }
     sum
-}
-
-fn mean(sum: [f64; 3], n: u32) -> [f64; 3] {
-    sum.map(|c| c / f64::from(n.max(1)))
-}
-
-/// Whether two estimates of a pixel look alike once displayed: ΔE2000 within tolerance.
-fn agree(s: &ReferenceSettings, a: [f64; 3], b: [f64; 3]) -> bool {
-    ciede2000(displayed(s, a), displayed(s, b)) <= s.tolerance_de
 }
 
 /// CIELAB of a linear colour after the exposure and tone curve (white = sRGB white).

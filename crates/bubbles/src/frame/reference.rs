@@ -11,15 +11,16 @@ use reference_tracer::{FilmSpec, ReferenceSettings, Reflections, render_referenc
 #[derive(Debug, Clone, clap::Args)]
 pub struct ReferenceOptions {
     /// Reference: camera rays per pixel along each axis to start with (the pixel gets the
-    /// square); pixels whose two halves of rays disagree get twice as many, and so on.
+    /// square); pixels whose estimate is not yet within --ref-tolerance get twice as many,
+    /// and so on.
     #[arg(long, default_value_t = 4)]
     pub ref_samples: u32,
     /// Reference: most camera rays one pixel may get (--ref-samples² disables refinement).
     #[arg(long, default_value_t = 1024)]
     pub ref_max_samples: u32,
-    /// Reference: a pixel is done when its two halves of rays differ by at most this
-    /// ΔE2000 as displayed.
-    #[arg(long, default_value_t = 0.3)]
+    /// Reference: a pixel is done when the standard error of its mean, estimated from four
+    /// blocks of its rays, is at most this ΔE2000 as displayed.
+    #[arg(long, default_value_t = 0.15)]
     pub ref_tolerance: f64,
     /// Reference: point-sample the checkers instead of box-filtering them over each ray's
     /// footprint (the reference before 2026-11-25).
