@@ -300,9 +300,10 @@ fn decode_srgb(v: f64) -> f64 {
     }
 }
 
-/// The bounds two seeds of the converged test image must meet (ΔE2000 mean and p95).
-const MEAN_BOUND: f64 = 0.4;
-const P95_BOUND: f64 = 2.0;
+/// Mean ΔE2000 two seeds of the converged test image may differ by.
+const MEAN_BOUND: f64 = 0.25;
+/// 95th-percentile ΔE2000 two seeds of the converged test image may differ by.
+const P95_BOUND: f64 = 1.2;
 
 /// Two sampling seeds of the paper scene with `settings` otherwise.
 fn two_seeds(settings: &ReferenceSettings) -> (f64, f64) {
@@ -319,11 +320,12 @@ fn two_seeds(settings: &ReferenceSettings) -> (f64, f64) {
     displayed_delta_e(&seed(0), &seed(1))
 }
 
-/// The converged reference: two seeds agree as issue 25 asks of the 400 × 400 image (mean
-/// ΔE2000 ≤ 0.05, p95 ≤ 0.5), here at 24 × 24 (25 nm wavelengths and 2 films a path, for
-/// CI's time: the sampling is what is tested), while
-/// the old sampling (16 point-sampled rays, no refinement) misses the bound by far: the
-/// bound tells converged from not.
+/// The converged reference: two seeds agree (0.196 / 0.907 here) where the old sampling
+/// (16 point-sampled rays, no refinement) misses the bound by far (1.683 / 6.836), so the
+/// bound tells converged from not; a tolerance of 0.3, at most 64 rays or no texture
+/// filtering each miss it too. 24 × 24, 25 nm wavelengths and 2 films a path, for CI's
+/// time: the sampling is what is tested. (Issue 25 asks mean ≤ 0.05 and p95 ≤ 0.5 of the
+/// 400 × 400 image, whose pixels each hold far less detail.)
 #[test]
 fn two_seeds_agree_as_a_converged_reference_must() {
     let converged = ReferenceSettings {
