@@ -140,7 +140,7 @@ impl ReferenceSettings {
                 "samples_per_side² ..= 65536",
             ));
         }
-        if !(self.tolerance_de >= 0.0) {
+        if self.tolerance_de.is_nan() || self.tolerance_de < 0.0 {
             return Err(RenderError::setting(
                 "tolerance_de",
                 self.tolerance_de,
