@@ -20,11 +20,11 @@ struct Variant {
 /// Pairs compared besides "every variant against the reference": (image, against).
 const PAIRS: [(&str, &str); 1] = [("ref-centre", "ref-no-films")];
 
-const VARIANTS: [Variant; 14] = [
+const VARIANTS: [Variant; 15] = [
     Variant {
         name: "reference",
         flags: &["--backend", "reference"],
-        what: "the reference: depth 8, polarised, spectral, 16 rays per pixel",
+        what: "the reference: depth 8, polarised, spectral, 16 to 1024 rays per pixel to a standard error of ΔE 0.15",
     },
     Variant {
         name: "cpu",
@@ -89,7 +89,18 @@ const VARIANTS: [Variant; 14] = [
     Variant {
         name: "ref-seed1",
         flags: &["--backend", "reference", "--ref-seed", "1"],
-        what: "reference with another jitter seed: its noise",
+        what: "reference with another sampling seed: its noise",
+    },
+    Variant {
+        name: "ref-16-point",
+        flags: &[
+            "--backend",
+            "reference",
+            "--ref-max-samples",
+            "16",
+            "--ref-point-textures",
+        ],
+        what: "reference as it was: 16 rays per pixel, point-sampled checkers, no refinement",
     },
     Variant {
         name: "ref-no-films",
@@ -115,22 +126,27 @@ pub fn run(root: &Path, bubbles: &Path) -> bool {
         args.extend(SIZE);
         args.extend(v.flags);
         let start = Instant::now();
-        if !run_bubbles(root, bubbles, &args).0 {
+        let (ok, _, log) = run_bubbles(root, bubbles, &args);
+        if !ok {
             return false;
         }
-        let secs = start.elapsed().as_secs_f64();
+        let secs = format!(
+            "{:.1}{}",
+            start.elapsed().as_secs_f64(),
+            rays_per_pixel(&log)
+        );
         let heat = (v.name == "cpu").then(|| format!("{DIR}/heatmap-cpu.png"));
         let reference = format!("{DIR}/reference.png");
         let mut cmp = vec!["compare", "--json", reference.as_str(), out.as_str()];
         if let Some(h) = &heat {
             cmp.extend(["--heatmap", h.as_str()]);
         }
-        let (ok, json) = run_bubbles(root, bubbles, &cmp);
+        let (ok, json, _) = run_bubbles(root, bubbles, &cmp);
         if !ok {
             return false;
         }
         rows.push(format!(
-            "| {} | {} | {:.1} | {} |",
+            "| {} | {} | {} | {} |",
             v.name,
             v.what,
             secs,
@@ -139,7 +155,7 @@ pub fn run(root: &Path, bubbles: &Path) -> bool {
     }
     for (image, against) in PAIRS {
         let (a, b) = (format!("{DIR}/{against}.png"), format!("{DIR}/{image}.png"));
-        let (ok, json) = run_bubbles(root, bubbles, &["compare", "--json", &a, &b]);
+        let (ok, json, _) = run_bubbles(root, bubbles, &["compare", "--json", &a, &b]);
         if !ok {
             return false;
         }
@@ -158,6 +174,15 @@ pub fn run(root: &Path, bubbles: &Path) -> bool {
     std::fs::write(root.join(DIR).join("measured.md"), table).is_ok()
 }
 
+/// `" (N rays/px)"` from the reference's closing line on stderr, or nothing.
+fn rays_per_pixel(log: &str) -> String {
+    log.split(" rays per pixel on average")
+        .next()
+        .filter(|head| head.len() < log.len())
+        .and_then(|head| head.rsplit(' ').next())
+        .map_or(String::new(), |n| format!(" ({n} rays/px)"))
+}
+
 /// `mean / p95 / max` from compare's JSON.
 fn summary(json: &str) -> String {
     let field = |k: &str| -> String {
@@ -170,19 +195,19 @@ fn summary(json: &str) -> String {
     format!("{} / {} / {}", field("mean"), field("p95"), field("max"))
 }
 
-fn run_bubbles(root: &Path, bubbles: &Path, args: &[&str]) -> (bool, String) {
+/// Runs `bubbles args`: success, stdout and stderr (also echoed).
+fn run_bubbles(root: &Path, bubbles: &Path, args: &[&str]) -> (bool, String, String) {
     eprintln!("$ bubbles {}", args.join(" "));
     match Command::new(bubbles).args(args).current_dir(root).output() {
         Ok(out) => {
-            eprint!("{}", String::from_utf8_lossy(&out.stderr));
-            (
-                out.status.success(),
-                String::from_utf8_lossy(&out.stdout).into_owned(),
-            )
+            let log = String::from_utf8_lossy(&out.stderr).into_owned();
+            eprint!("{log}");
+            let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+            (out.status.success(), stdout, log)
         }
         Err(e) => {
             eprintln!("cannot run {}: {e}", bubbles.display());
-            (false, String::new())
+            (false, String::new(), String::new())
         }
     }
 }

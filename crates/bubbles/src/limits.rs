@@ -86,11 +86,11 @@ pub const MAX_LAYER_THICKNESS_NM: f64 = thinfilm::fresnel::MAX_THICKNESS_NM;
 pub const MAX_REFERENCE_FILM_HITS: f64 = (1u64 << 42) as f64;
 
 /// The most film interactions `--backend reference` can trace for a frame: every camera
-/// ray (`samples_per_side²` per pixel) may split at each film into a reflected and a
+/// ray (at most `max_samples` per pixel) may split at each film into a reflected and a
 /// transmitted beam until `depth` films, `2^(depth+1) − 1` interactions (the weight
 /// cut-off prunes many, but grazing films reflect almost everything, so it bounds none).
-pub fn reference_film_hits(width: usize, height: usize, samples_per_side: u32, depth: u32) -> f64 {
-    let rays = width as f64 * height as f64 * f64::from(samples_per_side).powi(2);
+pub fn reference_film_hits(width: usize, height: usize, max_samples: u32, depth: u32) -> f64 {
+    let rays = width as f64 * height as f64 * f64::from(max_samples);
     rays * (2f64.powf(f64::from(depth) + 1.0) - 1.0)
 }
 
@@ -116,7 +116,7 @@ pub const HELP: &str = "Limits (a larger request is refused with exit code 2):
   refractive index (real part)                0.001..=1e6
   layer thickness (reflectance, fit, color)   0..=1e9 nm
   reference film hits per frame               4398046511104
-    (pixels × ref-samples² × (2^(ref-depth+1) − 1))
+    (pixels × ref-max-samples × (2^(ref-depth+1) − 1))
   planned memory of one run                   3 GiB";
 
 /// Bytes of one dynamic cube map of `face_size` (six bordered faces of RGB f32 and their
@@ -226,13 +226,15 @@ mod tests {
 
     #[test]
     fn reference_work_counts_every_split_up_to_the_depth() {
-        // 4 × 4 pixels, 4 × 4 rays each, depth 1: the film, then its two beams' films.
-        assert_eq!(reference_film_hits(4, 4, 4, 1), 256.0 * 3.0);
-        // Issue 28: depth 64 on 4 × 4 pixels is far past the bound, the default
-        // 400 × 400 frame at depth 8 and the largest frame at depth 8 are within it.
-        assert!(reference_film_hits(4, 4, 4, 64) > MAX_REFERENCE_FILM_HITS);
-        assert!(reference_film_hits(400, 400, 4, 8) < MAX_REFERENCE_FILM_HITS);
-        assert!(reference_film_hits(16384, 16384, 4, 8) < MAX_REFERENCE_FILM_HITS);
+        // 4 × 4 pixels, at most 16 rays each, depth 1: the film, then its two beams' films.
+        assert_eq!(reference_film_hits(4, 4, 16, 1), 256.0 * 3.0);
+        // Issue 28: depth 64 on 4 × 4 pixels is far past the bound, the default 400 × 400
+        // frame (up to 1024 rays a pixel) at depth 8 is within it, and so is the largest
+        // frame at depth 8 with 16 rays a pixel; with up to 1024 it must be refused.
+        assert!(reference_film_hits(4, 4, 16, 64) > MAX_REFERENCE_FILM_HITS);
+        assert!(reference_film_hits(400, 400, 1024, 8) < MAX_REFERENCE_FILM_HITS);
+        assert!(reference_film_hits(16384, 16384, 16, 8) < MAX_REFERENCE_FILM_HITS);
+        assert!(reference_film_hits(16384, 16384, 1024, 8) > MAX_REFERENCE_FILM_HITS);
     }
 
     #[test]

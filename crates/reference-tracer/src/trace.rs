@@ -6,6 +6,11 @@
 //! in that film's s/p axes as intensities (`cos²φ` of the old s goes to the new s), which
 //! is exact when the axes agree, as they do along any chord through a sphere, and drops
 //! only the s–p coherence elsewhere.
+//!
+//! A ray also carries its differentials across the sample's footprint (Igehy 1999), so
+//! the checkered ground and objects are box-filtered over the patch the sample stands
+//! for, seen directly, through films or in a film's curved mirror, instead of being
+//! point-sampled: most of the 16-ray reference's noise was the distant checker aliasing.
 
 use glam::Vec3;
 use thinfilm::{Response, ThinFilm};
@@ -55,6 +60,65 @@ impl Beam {
     }
 }
 
+/// A ray and how its origin and direction change across the sample's footprint, one
+/// differential per image axis (Igehy 1999).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Ray {
+    pub origin: Vec3,
+    pub dir: Vec3,
+    pub d_origin: [Vec3; 2],
+    pub d_dir: [Vec3; 2],
+}
+
+impl Ray {
+    /// How the hit point at distance `t` on a plane of normal `n` moves (transfer).
+    fn hit_differentials(&self, t: f32, n: Vec3) -> [Vec3; 2] {
+        let cos = self.dir.dot(n);
+        [0, 1].map(|k| {
+            let q = self.d_origin[k] + self.d_dir[k] * t;
+            let moved = q - self.dir * (q.dot(n) / cos);
+            // A grazing plane: the footprint is unbounded; the filter then gives the mean.
+            if moved.is_finite() {
+                moved
+            } else {
+                Vec3::splat(1e9)
+            }
+        })
+    }
+
+    /// The ray continuing from `origin` along `dir` with differentials `d_origin`, `d_dir`.
+    fn next(origin: Vec3, dir: Vec3, d_origin: [Vec3; 2], d_dir: [Vec3; 2]) -> Ray {
+        Ray {
+            origin,
+            dir,
+            d_origin,
+            d_dir,
+        }
+    }
+}
+
+/// Per axis, the extent of the box bounding the parallelogram the two differentials span.
+fn extent(d: [Vec3; 2]) -> Vec3 {
+    (d[0].abs() + d[1].abs()).min(Vec3::splat(1e9))
+}
+
+/// The normal of triangle `[a, b, c]` (unit; any sign).
+fn plane_normal([a, b, c]: [Vec3; 3]) -> Vec3 {
+    (b - a).cross(c - a).normalize_or(Vec3::Y)
+}
+
+/// Barycentric `(du, dv)` of a move `dp` within triangle `[a, b, c]` (least squares).
+fn barycentric_move([a, b, c]: [Vec3; 3], dp: Vec3) -> (f32, f32) {
+    let (e1, e2) = (b - a, c - a);
+    let (a11, a12, a22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let (b1, b2) = (e1.dot(dp), e2.dot(dp));
+    let det = a11 * a22 - a12 * a12;
+    if det.abs() <= f32::MIN_POSITIVE {
+        return (0.0, 0.0);
+    }
+    ((a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det)
+}
+
 /// A film's response per channel.
 struct FilmFactors {
     r_s: [f64; MAX_WAVELENGTHS],
@@ -89,37 +153,73 @@ impl Tracer<'_> {
     /// Adds the linear RGB radiance arriving along the ray to `out`, weighted by `beam`.
     pub fn trace(
         &self,
-        origin: Vec3,
-        dir: Vec3,
+        ray: &Ray,
         beam: &Beam,
         films_left: u32,
         skip: Option<u32>,
         out: &mut [f64; 3],
     ) {
         let scene = self.geo.scene;
+        let (origin, dir) = (ray.origin, ray.dir);
         match self.geo.closest(origin, dir, films_left > 0, skip) {
             None => self.add_rgb(scene.environment.radiance(dir), beam, out),
             Some(Hit::Light { light }) => self.add_light(light, beam, out),
             Some(Hit::Ground { t }) => {
-                let rgb = self.shade_ground(origin + dir * t, dir);
+                let d = extent(ray.hit_differentials(t, Vec3::Y));
+                let rgb = self.shade_ground(origin + dir * t, dir, [d.x, d.z]);
                 self.add_rgb(rgb, beam, out);
             }
             Some(Hit::Opaque { tri, t, u, v }) => {
-                let rgb = self.shade_object(tri, origin + dir * t, dir, (u, v));
+                let n = plane_normal(self.geo.opaque_tris[tri as usize]);
+                let d = extent(ray.hit_differentials(t, n));
+                let rgb = self.shade_object(tri, origin + dir * t, dir, (u, v), d);
                 self.add_rgb(rgb, beam, out);
             }
             Some(Hit::Film { tri, t, u, v }) => {
-                self.film(tri, origin + dir * t, dir, (u, v), beam, films_left, out);
+                self.film(tri, ray, t, (u, v), beam, films_left, out);
             }
         }
+    }
+
+    /// The film's shading normal at `(u, v)` facing the ray, and how it turns across the
+    /// footprint when the hit point moves by `dp` (the blended vertex normals' derivative).
+    fn film_normal(
+        &self,
+        tri: u32,
+        (u, v): (f32, f32),
+        dir: Vec3,
+        dp: [Vec3; 2],
+    ) -> (Vec3, [Vec3; 2]) {
+        let (b, idx) = self.geo.bubble_owner[tri as usize];
+        let normals = idx.map(|i| self.geo.scene.bubbles[b as usize].normals[i as usize]);
+        let raw = blend(normals, u, v);
+        let len = raw.length();
+        let n = if len > 0.0 && len.is_finite() {
+            raw / len
+        } else {
+            -dir
+        };
+        let sign = if dir.dot(n) > 0.0 { -1.0 } else { 1.0 };
+        let corners = self.geo.bubble_tris[tri as usize];
+        let dn = dp.map(|d| {
+            let (du, dv) = barycentric_move(corners, d);
+            let d_raw = (normals[1] - normals[0]) * du + (normals[2] - normals[0]) * dv;
+            let turn = (d_raw - n * d_raw.dot(n)) / len.max(f32::MIN_POSITIVE);
+            if turn.is_finite() {
+                turn * sign
+            } else {
+                Vec3::ZERO
+            }
+        });
+        (n * sign, dn)
     }
 
     #[allow(clippy::too_many_arguments)]
     fn film(
         &self,
         tri: u32,
-        p: Vec3,
-        dir: Vec3,
+        ray: &Ray,
+        t: f32,
         (u, v): (f32, f32),
         beam: &Beam,
         films_left: u32,
@@ -127,10 +227,11 @@ impl Tracer<'_> {
     ) {
         let (b, idx) = self.geo.bubble_owner[tri as usize];
         let mesh = &self.geo.scene.bubbles[b as usize];
-        let mut n = blend(idx.map(|i| mesh.normals[i as usize]), u, v).normalize_or(-dir);
-        if dir.dot(n) > 0.0 {
-            n = -n;
-        }
+        let dir = ray.dir;
+        let p = ray.origin + dir * t;
+        let dp = ray.hit_differentials(t, plane_normal(self.geo.bubble_tris[tri as usize]));
+        let (n, dn) = self.film_normal(tri, (u, v), dir, dp);
+        let through = Ray::next(p, dir, dp, ray.d_dir);
         let cos_theta = f64::from(-dir.dot(n)).clamp(0.0, 1.0);
         // A film field gives thickness and coverage at the hit's material direction, read
         // through the same `FilmField::sample` as the real-time backends.
@@ -144,7 +245,7 @@ impl Tracer<'_> {
         };
         if coverage <= 0.0 {
             // A hole: the ray goes on as if this film were not there.
-            self.trace(p, dir, beam, films_left, Some(tri), out);
+            self.trace(&through, beam, films_left, Some(tri), out);
             return;
         }
         let thickness_nm = f64::from(thickness_nm).max(0.0);
@@ -175,16 +276,17 @@ impl Tracer<'_> {
         }
         let min = self.settings.min_weight;
         if reflected.weight(ch) >= min {
-            let r_dir = (dir - n * (2.0 * dir.dot(n))).normalize_or(-dir);
-            let (origin, films) = match self.settings.reflections {
-                Reflections::Traced => (p, films_left - 1),
-                Reflections::NoFilms => (p, 0),
-                Reflections::FromCentre => (self.geo.centres[b as usize], 0),
+            let (origin, films, d_origin) = match self.settings.reflections {
+                Reflections::Traced => (p, films_left - 1, dp),
+                Reflections::NoFilms => (p, 0, dp),
+                Reflections::FromCentre => (self.geo.centres[b as usize], 0, [Vec3::ZERO; 2]),
             };
-            self.trace(origin, r_dir, &reflected, films, Some(tri), out);
+            let mirror = reflect(ray, n, dn);
+            let r = Ray::next(origin, mirror.dir, d_origin, mirror.d_dir);
+            self.trace(&r, &reflected, films, Some(tri), out);
         }
         if transmitted.weight(ch) >= min {
-            self.trace(p, dir, &transmitted, films_left - 1, Some(tri), out);
+            self.trace(&through, &transmitted, films_left - 1, Some(tri), out);
         }
     }
 
@@ -275,13 +377,18 @@ impl Tracer<'_> {
         }
     }
 
-    fn shade_ground(&self, p: Vec3, dir: Vec3) -> [f32; 3] {
+    /// The ground at `p`, its checker box-filtered over `footprint` (metres along x, z).
+    fn shade_ground(&self, p: Vec3, dir: Vec3, footprint: [f32; 2]) -> [f32; 3] {
         let scene = self.geo.scene;
         let Some(g) = &scene.ground else {
             return [0.0; 3];
         };
-        // A point sample: the reference's pixel samples do the filtering.
-        let albedo = ground_albedo(&g.material, p.x, p.z, [0.0, 0.0]);
+        let footprint = if self.settings.filter_textures {
+            footprint
+        } else {
+            [0.0; 2]
+        };
+        let albedo = ground_albedo(&g.material, p.x, p.z, footprint);
         lit(
             &g.material,
             albedo,
@@ -293,7 +400,15 @@ impl Tracer<'_> {
         )
     }
 
-    fn shade_object(&self, tri: u32, p: Vec3, dir: Vec3, (u, v): (f32, f32)) -> [f32; 3] {
+    /// Opaque triangle `tri` at `p`, a checker box-filtered over `footprint` (metres per axis).
+    fn shade_object(
+        &self,
+        tri: u32,
+        p: Vec3,
+        dir: Vec3,
+        (u, v): (f32, f32),
+        footprint: Vec3,
+    ) -> [f32; 3] {
         let scene = self.geo.scene;
         let (o, idx) = self.geo.opaque_owner[tri as usize];
         let mesh = &self.geo.meshes[o as usize];
@@ -305,9 +420,27 @@ impl Tracer<'_> {
             [0.0; 2]
         };
         let material = scene.objects[o as usize].material();
-        let albedo = object_albedo(material, p, uv, [0.0; 3]);
+        let footprint = if self.settings.filter_textures {
+            footprint.to_array()
+        } else {
+            [0.0; 3]
+        };
+        let albedo = object_albedo(material, p, uv, footprint);
         lit(material, albedo, p, n, dir, &self.ambient, &scene.lights)
     }
+}
+
+/// The mirror direction of `ray` about unit normal `n` and its differentials, the normal
+/// turning by `dn` across the footprint (Igehy 1999, eq. 14).
+fn reflect(ray: &Ray, n: Vec3, dn: [Vec3; 2]) -> Ray {
+    let d = ray.dir;
+    let cos = d.dot(n);
+    let dir = (d - n * (2.0 * cos)).normalize_or(-d);
+    let d_dir = [0, 1].map(|k| {
+        let dd = ray.d_dir[k];
+        dd - (dn[k] * cos + n * (dd.dot(n) + d.dot(dn[k]))) * 2.0
+    });
+    Ray::next(ray.origin, dir, [Vec3::ZERO; 2], d_dir)
 }
 
 /// A lossless film conserves energy at every hit: `R + T = 1` for s and p (debug builds).

@@ -5,14 +5,27 @@ use crate::error::CliError;
 use crate::limits;
 use crate::scene::values::plain;
 use raster::{Frame, RenderScene, RenderSettings};
-use reference_tracer::{FilmSpec, ReferenceSettings, Reflections, render_reference};
+use reference_tracer::{FilmSpec, ReferenceSettings, Reflections, render_reference_counted};
 
 /// Options of the reference backend (ignored by the CPU backend).
 #[derive(Debug, Clone, clap::Args)]
 pub struct ReferenceOptions {
-    /// Reference: camera rays per pixel along each axis (the pixel gets the square).
+    /// Reference: camera rays per pixel along each axis to start with (the pixel gets the
+    /// square); pixels whose estimate is not yet within --ref-tolerance get twice as many,
+    /// and so on.
     #[arg(long, default_value_t = 4)]
     pub ref_samples: u32,
+    /// Reference: most camera rays one pixel may get (--ref-samples² disables refinement).
+    #[arg(long, default_value_t = 1024)]
+    pub ref_max_samples: u32,
+    /// Reference: a pixel is done when the standard error of its mean, estimated from four
+    /// blocks of its rays, is at most this ΔE2000 as displayed.
+    #[arg(long, default_value_t = 0.15)]
+    pub ref_tolerance: f64,
+    /// Reference: point-sample the checkers instead of box-filtering them over each ray's
+    /// footprint (the reference before 2026-11-25).
+    #[arg(long)]
+    pub ref_point_textures: bool,
     /// Reference: films a path may meet before further films are passed straight through.
     #[arg(long, default_value_t = 8)]
     pub ref_depth: u32,
@@ -53,6 +66,9 @@ impl Default for ReferenceOptions {
         let d = ReferenceSettings::default();
         Self {
             ref_samples: d.samples_per_side,
+            ref_max_samples: d.max_samples,
+            ref_tolerance: d.tolerance_de,
+            ref_point_textures: !d.filter_textures,
             ref_depth: d.max_depth,
             ref_min_weight: d.min_weight,
             ref_step_nm: d.step_nm,
@@ -71,6 +87,11 @@ impl ReferenceOptions {
             width: frame.width,
             height: frame.height,
             samples_per_side: self.ref_samples,
+            max_samples: self.ref_max_samples,
+            tolerance_de: self.ref_tolerance,
+            filter_textures: !self.ref_point_textures,
+            exposure_ev: frame.exposure_ev,
+            tonemap: frame.tonemap,
             max_depth: self.ref_depth,
             min_weight: self.ref_min_weight,
             step_nm: self.ref_step_nm,
@@ -92,19 +113,19 @@ pub fn check_work(settings: &ReferenceSettings) -> Result<(), CliError> {
     let hits = limits::reference_film_hits(
         settings.width,
         settings.height,
-        settings.samples_per_side,
+        settings.max_samples,
         settings.max_depth,
     );
     if hits <= limits::MAX_REFERENCE_FILM_HITS {
         return Ok(());
     }
     Err(CliError::input(format!(
-        "--backend reference at {}x{} with --ref-samples {} and --ref-depth {} may trace up \
-         to {} film hits (pixels × samples² × (2^(depth+1) − 1)), over the limit of {}: lower \
-         --ref-depth, --ref-samples or the size",
+        "--backend reference at {}x{} with --ref-max-samples {} and --ref-depth {} may trace \
+         up to {} film hits (pixels × max samples × (2^(depth+1) − 1)), over the limit of {}: \
+         lower --ref-depth, --ref-max-samples or the size",
         settings.width,
         settings.height,
-        settings.samples_per_side,
+        settings.max_samples,
         settings.max_depth,
         plain(hits),
         plain(limits::MAX_REFERENCE_FILM_HITS)
@@ -129,16 +150,20 @@ pub fn render(
         bar.set_style(style);
     }
     let start = std::time::Instant::now();
-    let frame = render_reference(scene, spec, settings, &|| bar.inc(1))
+    let (frame, rays) = render_reference_counted(scene, spec, settings, &|| bar.inc(1))
         .map_err(|e| CliError::input(format!("reference: {e}")))?;
     bar.finish_and_clear();
     if progress {
         eprintln!(
-            "reference: traced {}x{} in {:.2} s on {} threads",
+            "reference: traced {}x{} in {:.2} s on {} threads, {:.1} rays per pixel on \
+             average (at most {}; {} pixels stopped at the cap unconverged)",
             settings.width,
             settings.height,
             start.elapsed().as_secs_f64(),
-            rayon::current_num_threads()
+            rayon::current_num_threads(),
+            rays.mean,
+            rays.max,
+            rays.unconverged
         );
     }
     Ok(frame)
