@@ -19,8 +19,8 @@ use thinfilm::{Complex64, Incidence, Layer, Observer, OpticsError, SpectralInteg
 
 /// Points per rayon task: small enough to balance, large enough to amortise.
 const CHUNK: usize = 1024;
-/// Wavelengths per task of a stack grid's row (each task folds its own span).
-const SPAN: usize = 128;
+/// The fewest wavelengths a task of a stack grid's row takes (each folds its own span).
+const SPAN: usize = 64;
 
 type Pair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
 type Triple<'py> = (
@@ -168,16 +168,19 @@ fn rt_grid<'py>(
             let grid = StackGrid::try_new(&stack, &angle, &wl)?;
             let (mut r, mut t) = (zeroed(grid.len()), zeroed(grid.len()));
             if !grid.is_empty() {
-                // Spans of a row, so that a grid of one or a few angles still fills both cores.
+                // Spans of a row, so that a grid of one or a few angles still fills the
+                // threads (about four tasks each), whole rows where there are enough.
                 let width = grid.wavelengths();
+                let tasks = 4 * rayon::current_num_threads();
+                let span = (grid.len() / tasks).clamp(SPAN, width.max(SPAN));
                 r.par_chunks_mut(width)
                     .zip(t.par_chunks_mut(width))
                     .enumerate()
                     .try_for_each(|(a, (r, t))| {
-                        r.par_chunks_mut(SPAN)
-                            .zip(t.par_chunks_mut(SPAN))
+                        r.par_chunks_mut(span)
+                            .zip(t.par_chunks_mut(span))
                             .enumerate()
-                            .try_for_each(|(k, (r, t))| grid.try_fill_span(a, k * SPAN, pol, r, t))
+                            .try_for_each(|(k, (r, t))| grid.try_fill_span(a, k * span, pol, r, t))
                     })?;
             }
             Ok::<_, OpticsError>((r, t))

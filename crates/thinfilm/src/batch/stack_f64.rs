@@ -62,8 +62,10 @@ impl Amplitudes {
 /// Scratch for one row: the layer phase factor and both polarisations' amplitudes.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Row {
-    phi_re: Vec<f64>,
-    phi_im: Vec<f64>,
+    /// `φ² = e^{2iδ}` over the row, and `|φ|²`.
+    sq_re: Vec<f64>,
+    sq_im: Vec<f64>,
+    phi_norm: Vec<f64>,
     /// The amplitudes of the polarisations solved, after [`Row::fold`].
     pub amps: [Amplitudes; 2],
 }
@@ -83,13 +85,14 @@ impl Row {
         for (amps, &exit) in self.amps.iter_mut().zip(&exit).take(pols) {
             amps.start(n, exit);
         }
-        self.phi_re.resize(n, 0.0);
-        self.phi_im.resize(n, 0.0);
+        for v in [&mut self.sq_re, &mut self.sq_im, &mut self.phi_norm] {
+            v.resize(n, 0.0);
+        }
         let largest = inv_wavelength_nm.iter().fold(0.0f64, |m, &x| m.max(x));
         for layer in layers {
             self.phase(inv_wavelength_nm, largest, layer.beta_nm);
             let front = layer.front.map(Front::new);
-            let phi = (&self.phi_re[..], &self.phi_im[..]);
+            let phi = (&self.sq_re[..], &self.sq_im[..], &self.phi_norm[..]);
             if pols == 2 {
                 let [s, p] = &mut self.amps;
                 through_layer_both(phi, front, s, p);
@@ -99,24 +102,27 @@ impl Row {
         }
     }
 
-    /// `φ = e^{iβ/λ}` over the row: the vector sine and cosine for a lossless layer within
-    /// their range, libm's (with the decay `e^{−Im δ}`) otherwise.
+    /// `φ² = e^{2iβ/λ}` and `|φ|²` over the row (only these enter the recursion): the
+    /// vector sine and cosine for a lossless layer within their range (`|φ|² = 1`), libm's
+    /// with the decay `e^{−2 Im δ}` otherwise.
     fn phase(&mut self, inv_wavelength_nm: &[f64], largest: f64, beta_nm: Complex64) {
-        if beta_nm.im == 0.0 && beta_nm.re.abs() * largest <= MAX_ARG {
+        let twice = 2.0 * beta_nm;
+        if twice.im == 0.0 && twice.re.abs() * largest <= MAX_ARG {
             phase_lossless(
                 inv_wavelength_nm,
-                beta_nm.re,
-                &mut self.phi_re,
-                &mut self.phi_im,
+                twice.re,
+                &mut self.sq_re,
+                &mut self.sq_im,
             );
+            self.phi_norm.fill(1.0);
             return;
         }
-        let phi = self.phi_re.iter_mut().zip(self.phi_im.iter_mut());
-        for ((re, im), &inv) in phi.zip(inv_wavelength_nm) {
-            let delta = beta_nm * inv;
-            let (sin, cos) = delta.re.sin_cos();
-            let decay = (-delta.im).exp();
-            (*re, *im) = (decay * cos, decay * sin);
+        let sq = self.sq_re.iter_mut().zip(self.sq_im.iter_mut());
+        for (((re, im), norm), &inv) in sq.zip(self.phi_norm.iter_mut()).zip(inv_wavelength_nm) {
+            let delta2 = twice * inv;
+            let (sin, cos) = delta2.re.sin_cos();
+            let decay2 = (-delta2.im).exp();
+            (*re, *im, *norm) = (decay2 * cos, decay2 * sin, decay2);
         }
     }
 }
@@ -166,7 +172,7 @@ fn phase_lossless_body(inv: &[f64], beta_nm: f64, re: &mut [f64], im: &mut [f64]
     }
 }
 
-fn through_layer(phi: (&[f64], &[f64]), front: Front, amps: &mut Amplitudes) {
+fn through_layer(phi: (&[f64], &[f64], &[f64]), front: Front, amps: &mut Amplitudes) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU supports AVX2, checked just above.
@@ -178,25 +184,25 @@ fn through_layer(phi: (&[f64], &[f64]), front: Front, amps: &mut Amplitudes) {
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn through_layer_avx2(phi: (&[f64], &[f64]), front: Front, amps: &mut Amplitudes) {
+fn through_layer_avx2(phi: (&[f64], &[f64], &[f64]), front: Front, amps: &mut Amplitudes) {
     through_layer_body(phi, front, amps);
 }
 
 #[inline(always)]
-fn through_layer_body(phi: (&[f64], &[f64]), front: Front, amps: &mut Amplitudes) {
+fn through_layer_body(phi: (&[f64], &[f64], &[f64]), front: Front, amps: &mut Amplitudes) {
     let n = phi.0.len();
-    let (pr, pi) = (&phi.0[..n], &phi.1[..n]);
+    let (sq_re, sq_im, phi_norm) = (&phi.0[..n], &phi.1[..n], &phi.2[..n]);
     let (g_re, g_im) = (&mut amps.g_re[..n], &mut amps.g_im[..n]);
     let t_norm = &mut amps.t_norm[..n];
     for i in 0..n {
-        let sq = phase_terms(pr[i], pi[i]);
+        let sq = (sq_re[i], sq_im[i], phi_norm[i]);
         (g_re[i], g_im[i], t_norm[i]) = step(front, sq, g_re[i], g_im[i], t_norm[i]);
     }
 }
 
 /// Both polarisations in one pass: they share the phase's loads and `φ²`.
 fn through_layer_both(
-    phi: (&[f64], &[f64]),
+    phi: (&[f64], &[f64], &[f64]),
     front: [Front; 2],
     s: &mut Amplitudes,
     p: &mut Amplitudes,
@@ -213,7 +219,7 @@ fn through_layer_both(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn through_layer_both_avx2(
-    phi: (&[f64], &[f64]),
+    phi: (&[f64], &[f64], &[f64]),
     front: [Front; 2],
     s: &mut Amplitudes,
     p: &mut Amplitudes,
@@ -223,30 +229,24 @@ fn through_layer_both_avx2(
 
 #[inline(always)]
 fn through_layer_both_body(
-    phi: (&[f64], &[f64]),
+    phi: (&[f64], &[f64], &[f64]),
     front: [Front; 2],
     s: &mut Amplitudes,
     p: &mut Amplitudes,
 ) {
     let n = phi.0.len();
-    let (pr, pi) = (&phi.0[..n], &phi.1[..n]);
+    let (sq_re, sq_im, phi_norm) = (&phi.0[..n], &phi.1[..n], &phi.2[..n]);
     let (sg_re, sg_im, st) = (&mut s.g_re[..n], &mut s.g_im[..n], &mut s.t_norm[..n]);
     let (pg_re, pg_im, pt) = (&mut p.g_re[..n], &mut p.g_im[..n], &mut p.t_norm[..n]);
     for i in 0..n {
-        let sq = phase_terms(pr[i], pi[i]);
+        let sq = (sq_re[i], sq_im[i], phi_norm[i]);
         (sg_re[i], sg_im[i], st[i]) = step(front[0], sq, sg_re[i], sg_im[i], st[i]);
         (pg_re[i], pg_im[i], pt[i]) = step(front[1], sq, pg_re[i], pg_im[i], pt[i]);
     }
 }
 
-/// `(Re φ², Im φ², |φ|²)`.
-#[inline(always)]
-fn phase_terms(re: f64, im: f64) -> (f64, f64, f64) {
-    (re * re - im * im, 2.0 * re * im, re * re + im * im)
-}
-
-/// The smallest `|1 + rΓφ²|²` the recursion trusts: `|den| ≥ 0.01` bounds the error it
-/// adds to `100 ε` relative.
+/// The smallest `|1 + rΓφ²|²` the recursion trusts: a layer amplifies the rounding of what
+/// is behind it by up to `1 / |1 + rΓφ²|²`, here 100.
 const MIN_DEN_NORM: f64 = 1e-2;
 
 /// `r + Γφ²` and `1 + rΓφ²` with `|1 + rΓφ²|²`: one layer's numerator and denominator.
