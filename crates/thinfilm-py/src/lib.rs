@@ -5,6 +5,7 @@
 //! other Python threads run meanwhile; every bad value raises `ValueError` naming it.
 
 mod inverse;
+mod outer;
 
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
@@ -14,13 +15,10 @@ use thinfilm::airy::ThinFilm;
 use thinfilm::colorspace::{SRGB_FROM_XYZ, apply, srgb_encode};
 use thinfilm::dispersion::RefractiveIndex;
 use thinfilm::grid::{FilmGrid, Polarisation as GridPol};
-use thinfilm::stack_grid::StackGrid;
 use thinfilm::{Complex64, Incidence, Layer, Observer, OpticsError, SpectralIntegrator, Stack};
 
 /// Points per rayon task: small enough to balance, large enough to amortise.
 const CHUNK: usize = 1024;
-/// The fewest wavelengths a task of a stack grid's row takes (each folds its own span).
-const SPAN: usize = 64;
 
 type Pair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
 type Triple<'py> = (
@@ -29,7 +27,7 @@ type Triple<'py> = (
     Bound<'py, PyArray1<f64>>,
 );
 
-fn value_error(err: OpticsError) -> PyErr {
+pub(crate) fn value_error(err: OpticsError) -> PyErr {
     PyValueError::new_err(err.to_string())
 }
 
@@ -44,7 +42,7 @@ enum Pol {
     Mean,
 }
 
-fn pol_from(name: &str) -> PyResult<Pol> {
+pub(crate) fn pol_from(name: &str) -> PyResult<Pol> {
     match name {
         "s" => Ok(Pol::S),
         "p" => Ok(Pol::P),
@@ -55,7 +53,7 @@ fn pol_from(name: &str) -> PyResult<Pol> {
     }
 }
 
-fn grid_pol(pol: Pol) -> GridPol {
+pub(crate) fn grid_pol(pol: Pol) -> GridPol {
     match pol {
         Pol::S => GridPol::S,
         Pol::P => GridPol::P,
@@ -113,7 +111,11 @@ fn rt<'py>(
 }
 
 /// The stack of `rt`'s arguments, with errors naming the bad argument.
-fn stack_from(n: Vec<Complex64>, d_nm: Vec<f64>, coherent: Vec<bool>) -> PyResult<Stack> {
+pub(crate) fn stack_from(
+    n: Vec<Complex64>,
+    d_nm: Vec<f64>,
+    coherent: Vec<bool>,
+) -> PyResult<Stack> {
     if n.len() != d_nm.len() + 2 {
         return Err(PyValueError::new_err(format!(
             "n has {} media and d_nm {} thicknesses: n needs len(d_nm) + 2 (both semi-infinite ends)",
@@ -144,49 +146,6 @@ fn stack_from(n: Vec<Complex64>, d_nm: Vec<f64>, coherent: Vec<bool>) -> PyResul
         })
         .collect();
     Stack::new(n0.re, layers, n[n.len() - 1]).map_err(value_error)
-}
-
-/// `(R, T)` of a stack (as `rt`) on the grid `angle_deg × wavelength_nm`, flattened
-/// angle-major: [`thinfilm::stack_grid::StackGrid`] computes each interface once per
-/// angle, then the angles' rows in parallel.
-#[pyfunction]
-#[pyo3(signature = (n, d_nm, wavelength_nm, angle_deg, pol, coherent))]
-fn rt_grid<'py>(
-    py: Python<'py>,
-    n: Vec<Complex64>,
-    d_nm: Vec<f64>,
-    wavelength_nm: PyReadonlyArray1<'py, f64>,
-    angle_deg: PyReadonlyArray1<'py, f64>,
-    pol: &str,
-    coherent: Vec<bool>,
-) -> PyResult<Pair<'py>> {
-    let pol = grid_pol(pol_from(pol)?);
-    let stack = stack_from(n, d_nm, coherent)?;
-    let (wl, angle) = (copy(&wavelength_nm), copy(&angle_deg));
-    let (r, t) = py
-        .allow_threads(|| {
-            let grid = StackGrid::try_new(&stack, &angle, &wl)?;
-            let (mut r, mut t) = (zeroed(grid.len()), zeroed(grid.len()));
-            if !grid.is_empty() {
-                // Spans of a row, so that a grid of one or a few angles still fills the
-                // threads (about four tasks each), whole rows where there are enough.
-                let width = grid.wavelengths();
-                let tasks = 4 * rayon::current_num_threads();
-                let span = (grid.len() / tasks).clamp(SPAN, width.max(SPAN));
-                r.par_chunks_mut(width)
-                    .zip(t.par_chunks_mut(width))
-                    .enumerate()
-                    .try_for_each(|(a, (r, t))| {
-                        r.par_chunks_mut(span)
-                            .zip(t.par_chunks_mut(span))
-                            .enumerate()
-                            .try_for_each(|(k, (r, t))| grid.try_fill_span(a, k * span, pol, r, t))
-                    })?;
-            }
-            Ok::<_, OpticsError>((r, t))
-        })
-        .map_err(value_error)?;
-    Ok((r.into_pyarray(py), t.into_pyarray(py)))
 }
 
 /// The film's index (checked with the outside medium) and copies of the three arrays.
@@ -618,7 +577,7 @@ fn graded_rt<'py>(
 /// A zeroed output buffer; on Linux a large one asks for transparent huge pages before it
 /// is first touched, so that filling it costs a few page faults rather than one per 4 KiB
 /// (measured: touching 16 MB of fresh pages took longer than computing the 1 M-point grid).
-fn zeroed(len: usize) -> Vec<f64> {
+pub(crate) fn zeroed(len: usize) -> Vec<f64> {
     let v = vec![0.0; len];
     #[cfg(target_os = "linux")]
     {
@@ -713,7 +672,7 @@ fn xyz_to_srgb<'py>(
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rt, m)?)?;
-    m.add_function(wrap_pyfunction!(rt_grid, m)?)?;
+    m.add_function(wrap_pyfunction!(outer::rt_outer, m)?)?;
     m.add_function(wrap_pyfunction!(film_rt, m)?)?;
     m.add_function(wrap_pyfunction!(film_rt_fast, m)?)?;
     m.add_function(wrap_pyfunction!(film_rt_grid, m)?)?;

@@ -69,3 +69,30 @@ def test_grid_errors_name_the_bad_value():
         thinfilm.rt([1.0, 1.5, 1.0], [100.0], np.array([550.0, -5.0])[None, :], np.array([0.0])[:, None])
     with pytest.raises(ValueError, match="95"):
         thinfilm.rt([1.0, 1.5, 1.0], [100.0], np.array([550.0])[None, :], np.array([0.0, 95.0])[:, None])
+
+
+def test_outer_products_of_any_rank_take_the_grid_and_points_do_not():
+    rng = np.random.default_rng(11)
+    n, d = random_stack(rng, layers=3, absorbing=False)
+    wl = rng.uniform(380, 800, 5)
+    angle = rng.uniform(0, 80, 3)
+    for wl_arg, angle_arg in [
+        (wl[:, None, None], angle[None, :, None]),  # rank 3, trailing axis of 1
+        (wl[None, :], angle[:, None, None]),  # ranks differ
+        (550.0, angle),  # a scalar wavelength
+        (wl, 30.0),  # a scalar angle
+        (wl, angle[:, None]),
+    ]:
+        r, t = thinfilm.rt(n, d, wl_arg, angle_arg)
+        full = [np.ascontiguousarray(x) for x in np.broadcast_arrays(wl_arg, angle_arg)]
+        assert r.shape == full[0].shape
+        r_ref, t_ref = thinfilm.rt(n, d, *full)  # full arrays: no outer product
+        np.testing.assert_allclose(r, r_ref, rtol=0, atol=1e-13)
+        np.testing.assert_allclose(t, t_ref, rtol=0, atol=1e-13)
+    # Points on one shared axis, an empty axis and mismatched shapes stay on the point path.
+    r, _ = thinfilm.rt(n, d, wl, wl * 0.0 + 10.0)
+    assert r.shape == (5,)
+    r, _ = thinfilm.rt(n, d, np.zeros((0, 1)) + 500.0, angle)
+    assert r.shape == (0, 3)
+    with pytest.raises(ValueError, match="broadcast"):
+        thinfilm.rt(n, d, wl, angle)

@@ -52,31 +52,17 @@ def rt(n, d_nm, wavelength_nm, angle_deg, pol="u", coherent=None):
             if not isinstance(flag, (bool, int)) or flag not in (0, 1):
                 raise ValueError(f"coherent[{k}] = {flag!r} is not True or False")
             flags.append(bool(flag))
-    grid = _grid_axes(wavelength_nm, angle_deg)
+    try:
+        wl_array = np.asarray(wavelength_nm, dtype=np.float64)
+        angle_array = np.asarray(angle_deg, dtype=np.float64)
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"wavelength_nm or angle_deg is not numeric: {err}") from None
+    grid = _native.rt_outer(n, d_nm, wl_array, angle_array, pol, flags)
     if grid is not None:
-        shape, (wl, angle), wavelength_first = grid
-        r, t = _native.rt_grid(n, d_nm, wl, angle, pol, flags)
-        r, t = r.reshape(angle.size, wl.size), t.reshape(angle.size, wl.size)
-        if wavelength_first:
-            r, t = r.T, t.T
-        return r.reshape(shape), t.reshape(shape)
+        return grid
     shape, (wl, angle) = _flat(wavelength_nm, angle_deg)
     r, t = _native.rt(n, d_nm, wl, angle, pol, flags)
     return r.reshape(shape), t.reshape(shape)
-
-
-def _grid_axes(wavelength_nm, angle_deg):
-    """When wavelength and angle form an outer product: the broadcast shape, their 1-d
-    values, and whether the wavelength axis comes first; otherwise None."""
-    axes = _axes(wavelength_nm, angle_deg)
-    if axes is None:
-        return None
-    try:
-        shape = np.broadcast_shapes(np.shape(wavelength_nm), np.shape(angle_deg))
-    except ValueError as err:
-        raise ValueError(f"arguments do not broadcast together: {err}") from None
-    (wl, angle), (at_wl, at_angle) = axes
-    return shape, (wl, angle), at_wl >= 0 and at_wl < at_angle
 
 
 def _axes(*arrays):
