@@ -19,8 +19,9 @@ pub use to_dynamics::sim_error;
 pub use to_raster::bubble_meshes;
 
 /// Built-in scenes, by name, with their TOML source.
-pub const BUILTINS: [(&str, &str); 9] = [
+pub const BUILTINS: [(&str, &str); 10] = [
     ("paper", include_str!("../../scenes/paper.toml")),
+    ("crowd", include_str!("../../scenes/crowd.toml")),
     (
         "white-furnace",
         include_str!("../../scenes/white-furnace.toml"),
