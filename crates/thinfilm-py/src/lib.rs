@@ -398,7 +398,7 @@ fn fit_thickness_cauchy<'py>(
     a_range: (f64, f64),
     b_range_nm2: (f64, f64),
     wavelength_uncertainty_nm: f64,
-) -> PyResult<Vec<f64>> {
+) -> PyResult<[f64; 17]> {
     check_fit_stack(&n, &d_nm, layer)?;
     let incidence = Incidence::try_from_angle_deg(angle_deg).map_err(value_error)?;
     let (wl, r) = (copy(&wavelength_nm), copy(&reflectance));
@@ -423,12 +423,7 @@ fn fit_thickness_cauchy<'py>(
             )
         })
         .map_err(value_error)?;
-    let mut out = Vec::with_capacity(17);
-    for e in [fit.thickness_nm, fit.a, fit.b_nm2] {
-        out.extend([e.value, e.low, e.high, e.sigma, e.systematic]);
-    }
-    out.extend([fit.offset, fit.rms_residual]);
-    Ok(out)
+    Ok(fit.values())
 }
 
 /// The thickness of inner layer `layer` of the stack `n`, `d_nm` fitted to a measured

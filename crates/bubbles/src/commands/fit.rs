@@ -14,7 +14,7 @@ use std::io::{Read as _, Write as _};
 
 use thinfilm::dispersion::RefractiveIndex;
 use thinfilm::fit::{
-    CauchyRange, Fit, Measurement, Search, fit_thickness, fit_thickness_and_index,
+    CauchyRange, Fit, IndexFit, Measurement, Search, fit_thickness, fit_thickness_and_index,
 };
 use thinfilm::{Incidence, Layer, Stack};
 
@@ -96,27 +96,6 @@ pub struct Args {
     )]
     cauchy_b_nm2: Option<Vec<f64>>,
 }
-
-/// The names of the row `--cauchy-a` writes.
-const INDEX_FIELDS: [&str; 17] = [
-    "thickness_nm",
-    "low_nm",
-    "high_nm",
-    "sigma_nm",
-    "systematic_nm",
-    "a",
-    "a_low",
-    "a_high",
-    "a_sigma",
-    "a_systematic",
-    "b_nm2",
-    "b_low",
-    "b_high",
-    "b_sigma",
-    "b_systematic",
-    "offset",
-    "rms_residual",
-];
 
 /// A `LO,HI` flag's pair, or an error naming the flag.
 fn pair(flag: &str, values: &[f64]) -> Result<[f64; 2], CliError> {
@@ -207,12 +186,7 @@ pub fn run(args: Args) -> CliResult {
         };
         let fit = fit_thickness_and_index(model, &measurement, args.min_nm, args.max_nm, range)
             .map_err(|e| CliError::input(e.to_string()))?;
-        let mut values = Vec::new();
-        for e in [fit.thickness_nm, fit.a, fit.b_nm2] {
-            values.extend([e.value, e.low, e.high, e.sigma, e.systematic]);
-        }
-        values.extend([fit.offset, fit.rms_residual]);
-        csv_row(&INDEX_FIELDS, &values)
+        csv_row(&IndexFit::FIELDS, &fit.values())
     } else {
         let model = |d: f64| {
             let mut stack = base.clone();

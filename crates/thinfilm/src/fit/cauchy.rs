@@ -78,6 +78,40 @@ pub struct IndexFit {
     pub rms_residual: f64,
 }
 
+impl IndexFit {
+    /// The names of [`IndexFit::values`], in order.
+    pub const FIELDS: [&'static str; 17] = [
+        "thickness_nm",
+        "low_nm",
+        "high_nm",
+        "sigma_nm",
+        "systematic_nm",
+        "a",
+        "a_low",
+        "a_high",
+        "a_sigma",
+        "a_systematic",
+        "b_nm2",
+        "b_low",
+        "b_high",
+        "b_sigma",
+        "b_systematic",
+        "offset",
+        "rms_residual",
+    ];
+
+    /// Every number of the fit, in the order of [`IndexFit::FIELDS`]: each estimate's
+    /// value, low, high, sigma and systematic, then the offset and the residual.
+    pub fn values(&self) -> [f64; 17] {
+        let mut out = [0.0; 17];
+        for (k, e) in [self.thickness_nm, self.a, self.b_nm2].iter().enumerate() {
+            out[5 * k..5 * k + 5].copy_from_slice(&[e.value, e.low, e.high, e.sigma, e.systematic]);
+        }
+        (out[15], out[16]) = (self.offset, self.rms_residual);
+        out
+    }
+}
+
 /// Fits the thickness `d` and the Cauchy index of the layer that `model(d, index)` builds
 /// to `measured`, with `d` in `[min_nm, max_nm]` and the index within `range`.
 ///
