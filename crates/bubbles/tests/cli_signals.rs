@@ -77,22 +77,7 @@ fn sigint_during_a_long_render_stops_it_with_130_and_no_output() {
 #[test]
 fn sigterm_during_animate_frames_stops_with_143_and_leaves_whole_frames_only() {
     let dir = tempfile::tempdir().unwrap();
-    let args = [
-        "animate",
-        "s.toml",
-        "--seconds",
-        "100",
-        "--fps",
-        "10",
-        "--out",
-        "f",
-        "--width",
-        "8",
-        "--height",
-        "8",
-        "--samples",
-        "1",
-    ];
+    let args = long_animation("f");
     let child = spawn(&args, dir.path());
     let frames = dir.path().join("f");
     signal_when(&child, "TERM", || frames.join("frame_00002.png").exists());
@@ -106,7 +91,17 @@ fn sigterm_during_animate_frames_stops_with_143_and_leaves_whole_frames_only() {
 #[test]
 fn sigint_during_an_apng_removes_its_temporary_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let args = [
+    let args = long_animation("a.apng");
+    let child = spawn(&args, dir.path());
+    signal_when(&child, "INT", || !no_temporaries(dir.path()));
+    assert_stopped(child, 130, "SIGINT");
+    assert_eq!(files_in(dir.path()), ["s.toml"]);
+}
+
+/// `bubbles animate` of `s.toml` for 100 s at 10 fps into `out`, 8×8 with one sample: long
+/// enough that a signal always lands while frames are being written.
+fn long_animation(out: &str) -> [&str; 14] {
+    [
         "animate",
         "s.toml",
         "--seconds",
@@ -114,16 +109,12 @@ fn sigint_during_an_apng_removes_its_temporary_and_writes_nothing() {
         "--fps",
         "10",
         "--out",
-        "a.apng",
+        out,
         "--width",
         "8",
         "--height",
         "8",
         "--samples",
         "1",
-    ];
-    let child = spawn(&args, dir.path());
-    signal_when(&child, "INT", || !no_temporaries(dir.path()));
-    assert_stopped(child, 130, "SIGINT");
-    assert_eq!(files_in(dir.path()), ["s.toml"]);
+    ]
 }

@@ -30,15 +30,24 @@ fn render_with(scene: &str, backend: &str, out: &str, dir: &Path, extra: &[&str]
         out,
     ];
     args.extend(extra);
-    let run = bubbles(&args, dir);
+    let Some((run, err)) = run_unless_no_adapter(&args, dir) else {
+        return false;
+    };
+    assert!(run.status.success(), "{backend}: {err}");
+    true
+}
+
+/// Runs `bubbles args` in `dir`: its output and stderr, or `None` (said on stderr) when
+/// no wgpu adapter is found outside CI, where the wgpu tests are skipped.
+fn run_unless_no_adapter(args: &[&str], dir: &Path) -> Option<(std::process::Output, String)> {
+    let run = bubbles(args, dir);
     let err = stderr(&run);
     if !run.status.success() && err.contains("no wgpu adapter") && std::env::var_os("CI").is_none()
     {
         eprintln!("skipped: {err}");
-        return false;
+        return None;
     }
-    assert!(run.status.success(), "{backend}: {err}");
-    true
+    Some((run, err))
 }
 
 /// Renders `scene` through wgpu and through the CPU with per-triangle partial shading
@@ -173,12 +182,9 @@ fn pond_through_wgpu_is_refused_naming_the_water() {
         "--out",
         "x.png",
     ];
-    let out = bubbles(&args, dir.path());
-    let err = stderr(&out);
-    if err.contains("no wgpu adapter") && std::env::var_os("CI").is_none() {
-        eprintln!("skipped: {err}");
+    let Some((out, err)) = run_unless_no_adapter(&args, dir.path()) else {
         return;
-    }
+    };
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
         err.contains("water") && err.contains("--backend cpu"),
@@ -206,12 +212,9 @@ fn a_sample_count_the_device_lacks_is_replaced_by_the_nearest_and_said() {
         "--out",
         "x.png",
     ];
-    let out = bubbles(&args, dir.path());
-    let err = stderr(&out);
-    if err.contains("no wgpu adapter") && std::env::var_os("CI").is_none() {
-        eprintln!("skipped: {err}");
+    let Some((out, err)) = run_unless_no_adapter(&args, dir.path()) else {
         return;
-    }
+    };
     assert!(out.status.success(), "{err}");
     assert!(dir.path().join("x.png").exists());
     assert_eq!(
