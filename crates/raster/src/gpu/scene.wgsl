@@ -43,6 +43,8 @@ struct Scene {
     ground_height_m: f32,
     cube_face_size: u32,
     reflectivity_table: u32,
+    // 1 when dynamic cube maps are read corrected for the ground's parallax (parallax.rs)
+    ground_parallax: u32,
 }
 
 struct Material {
@@ -290,13 +292,23 @@ fn fs_ground(in: FullScreen) -> @location(0) vec4<f32> {
     let ddy = view.ground_ddy.xyz;
     let dpx = (ddx - d * (ddx.y * inv_dy)) * t;
     let dpy = (ddy - d * (ddy.y * inv_dy)) * t;
-    let footprint = min(vec2<f32>(abs(dpx.x) + abs(dpy.x), abs(dpx.z) + abs(dpy.z)), vec2<f32>(1e9));
+    // Edge-on the footprint is unbounded: the filter then returns the mean.
+    let ax = clamp(vec2<f32>(dpx.x, dpx.z), vec2<f32>(-1e9), vec2<f32>(1e9));
+    let ay = clamp(vec2<f32>(dpy.x, dpy.z), vec2<f32>(-1e9), vec2<f32>(1e9));
     let m = materials[scene.ground_material];
     var albedo = m.a.xyz;
     if (m.specular.w == PATTERN_CHECKER) {
+        // shading.rs `ground_albedo_over_pixel`: four quarter-pixel boxes.
         let inv = 1.0 / m.a.w;
-        let w = filtered_checker(vec2<f32>(p.x * inv, p.z * inv), footprint * inv);
-        albedo = lerp3(m.a.xyz, m.b.xyz, w);
+        let f = 0.5 * (abs(ax) + abs(ay)) * inv;
+        let o = GROUND_QUARTER_OFFSET_PX;
+        var sum = 0.0;
+        for (var k = 0; k < 4; k++) {
+            let s = vec2<f32>(select(-o, o, (k & 1) != 0), select(-o, o, k >= 2));
+            let q = vec2<f32>(p.x, p.z) + ax * s.x + ay * s.y;
+            sum += filtered_checker(q * inv, f);
+        }
+        albedo = lerp3(m.a.xyz, m.b.xyz, 0.25 * sum);
     }
     let normal = vec3<f32>(0.0, view.ground_ddx.w, 0.0);
     return vec4<f32>(lit(m, albedo, p, normal, d), 1.0);
@@ -350,6 +362,8 @@ struct BubbleIn {
     @location(5) material_dir: vec3<f32>,
     // the bubble's film field: first texel in `film_texels`, face size (0: no field)
     @location(6) film: vec2<u32>,
+    // the bubble's centre, where its cube map is rendered from
+    @location(7) centre: vec3<f32>,
 }
 
 struct BubbleOut {
@@ -367,13 +381,14 @@ struct BubbleOut {
     // raster.rs attributes 3..6 of a bubble with a film field: perspective-correct
     @location(7) @interpolate(perspective, centroid) material_dir: vec3<f32>,
     @location(8) @interpolate(flat) film: vec2<u32>,
+    @location(9) @interpolate(flat) centre: vec3<f32>,
 }
 
 @vertex
 fn vs_bubble(in: BubbleIn) -> BubbleOut {
     let clip = clip_of(in.position);
     return BubbleOut(clip, in.position, in.normal, in.thickness_nm, in.pixel_angle_rad,
-        in.bubble, in.normal / clip.w, 1.0 / clip.w, in.material_dir, in.film);
+        in.bubble, in.normal / clip.w, 1.0 / clip.w, in.material_dir, in.film, in.centre);
 }
 
 // lut_sampler.rs `split`: lower sample index and the upper one's weight on an axis of n.
@@ -588,6 +603,40 @@ fn reflection(bubble: u32, dir: vec3<f32>, derivatives: array<vec3<f32>, 2>) -> 
     return env_radiance(dir);
 }
 
+// parallax.rs `ParallaxRead`: `hit` false when the ray keeps its own direction.
+struct ParallaxRead {
+    hit: bool,
+    dir: vec3<f32>,
+    derivatives: array<vec3<f32>, 2>,
+}
+
+// parallax.rs `ground_parallax`: the cube-map read of a ray from film point `p` along unit
+// `dir` turned towards where it meets the ground `y = height_m`, seen from `centre`.
+fn ground_parallax(centre: vec3<f32>, p: vec3<f32>, dir: vec3<f32>, d_p: array<vec3<f32>, 2>,
+    d_dir: array<vec3<f32>, 2>, height_m: f32) -> ParallaxRead {
+    var out = ParallaxRead(false, dir, d_dir);
+    let above = p.y - height_m;
+    if (!(dir.y * above < 0.0 && (centre.y - height_m) * above > 0.0)) {
+        return out;
+    }
+    let t = -above / dir.y;
+    let to_hit = p + dir * t - centre;
+    let len = length(to_hit);
+    if (!(len > 0.0 && len < 3.0e38)) {
+        return out;
+    }
+    let u = to_hit / len;
+    out.hit = true;
+    out.dir = u;
+    for (var k = 0; k < 2; k++) {
+        let dt = -(d_p[k].y + t * d_dir[k].y) / dir.y;
+        let dq = d_p[k] + d_dir[k] * t + dir * dt;
+        let du = (dq - u * dot(u, dq)) / len;
+        out.derivatives[k] = select(vec3<f32>(0.0), du, all(abs(du) < vec3<f32>(3.0e38)));
+    }
+    return out;
+}
+
 // passes.rs `LightSight::visibility`: the highlight filter (see its documentation).
 fn light_visibility(light: Light, p: vec3<f32>, reflected: vec3<f32>, pixel_angle_rad: f32) -> f32 {
     let to_light = light.position.xyz - p;
@@ -712,9 +761,10 @@ fn fs_bubble_add(in: BubbleOut) -> @location(0) vec4<f32> {
     // need uniform control flow, so they come first.
     let w = 1.0 / in.inv_w;
     let n_centre = in.normal_over_w * w;
+    let d_inv_w = vec2<f32>(dpdxFine(in.inv_w), dpdyFine(in.inv_w));
     let dn_raw = array<vec3<f32>, 2>(
-        (dpdxFine(in.normal_over_w) - n_centre * dpdxFine(in.inv_w)) * w,
-        (dpdyFine(in.normal_over_w) - n_centre * dpdyFine(in.inv_w)) * w);
+        (dpdxFine(in.normal_over_w) - n_centre * d_inv_w.x) * w,
+        (dpdyFine(in.normal_over_w) - n_centre * d_inv_w.y) * w);
     let f = film_of(in);
     if (f.coverage <= 0.0) {
         // A hole adds nothing.
@@ -727,7 +777,17 @@ fn fs_bubble_add(in: BubbleOut) -> @location(0) vec4<f32> {
         -view.up.xyz * view.tan_half_per_px.w);
     let derivatives = reflection_derivatives(rel / dot(rel, view.forward.xyz), dd, in.normal,
         dn_raw);
-    var add = r * reflection(in.bubble, reflected, derivatives);
+    var read = ParallaxRead(false, reflected, derivatives);
+    if (scene.ground_parallax != 0u) {
+        // renderer.rs `BubbleCtx::parallax_read`: p = eye + d·w, ∂p = ∂d·w − d·w²·∂(1/w).
+        let depth = dot(rel, view.forward.xyz);
+        let d = rel / depth;
+        let d_p = array<vec3<f32>, 2>(dd[0] * depth - d * (depth * depth * d_inv_w.x),
+            dd[1] * depth - d * (depth * depth * d_inv_w.y));
+        read = ground_parallax(in.centre, in.world, reflected, d_p, derivatives,
+            scene.ground_height_m);
+    }
+    var add = r * reflection(in.bubble, read.dir, read.derivatives);
     for (var i = 0u; i < scene.light_count; i++) {
         let light = lights[i];
         let vis = light_visibility(light, in.world, reflected, in.pixel_angle_rad);

@@ -13,7 +13,7 @@ use render_scene::ground_view::GroundView;
 use render_scene::tessellate::{Geometry, tessellate};
 use render_scene::{
     Environment, FilmTables, Light, Material, Pattern, ReflectionFilter, ReflectionMode,
-    RenderScene, RenderSettings, Sky,
+    ReflectionParallax, RenderScene, RenderSettings, Sky,
 };
 
 /// `Material.specular.w` of a solid albedo.
@@ -39,9 +39,19 @@ pub(super) const VIEW_BYTES: u64 = 9 * 16;
 /// Bytes of one object vertex: position, normal, tag.
 pub(super) const OBJECT_VERTEX_BYTES: u64 = 28;
 /// Bytes of one bubble vertex: position, normal, thickness, pixel angle, bubble index,
-/// material direction (zero without a film field), and the bubble's film field as
-/// (first texel in the film texture, face size; face size 0: no field).
-pub(super) const BUBBLE_VERTEX_BYTES: u64 = 56;
+/// material direction (zero without a film field), the bubble's film field as (first
+/// texel in the film texture, face size; face size 0: no field), and the bubble's centre
+/// (where its cube map is rendered from).
+pub(super) const BUBBLE_VERTEX_BYTES: u64 = 68;
+
+/// How bubbles read their dynamic cube maps: the renderer's choices.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(super) struct CubeReads {
+    /// Footprint-filtered or one bilinear tap.
+    pub filter: ReflectionFilter,
+    /// Corrected for the ground's parallax, or from the centre.
+    pub parallax: ReflectionParallax,
+}
 
 /// Little-endian bytes for a GPU buffer.
 #[derive(Debug, Default)]
@@ -200,7 +210,7 @@ impl SceneData {
         settings: &RenderSettings,
         view: &View,
         max_texture_side: u32,
-        filter: ReflectionFilter,
+        reads: CubeReads,
     ) -> Result<SceneData, GpuError> {
         let mut objects = Geometry::default();
         let mut light_spheres = Geometry::default();
@@ -233,7 +243,7 @@ impl SceneData {
             scene: scene_bytes(
                 scene,
                 &settings.reflection,
-                filter,
+                reads,
                 face_size,
                 ground_material,
                 tables,
@@ -255,7 +265,7 @@ impl SceneData {
 fn scene_bytes(
     scene: &RenderScene,
     reflection: &ReflectionMode,
-    filter: ReflectionFilter,
+    reads: CubeReads,
     face_size: u32,
     ground_material: u32,
     tables: &FilmTables,
@@ -272,7 +282,7 @@ fn scene_bytes(
         _ => (ENV_UNIFORM, Sky::default(), [0.0; 3]),
     };
     b.u32(env_kind).u32(scene.lights.len() as u32);
-    b.u32(match (reflection, filter) {
+    b.u32(match (reflection, reads.filter) {
         (ReflectionMode::DynamicCubeMap { .. }, ReflectionFilter::Footprint) => REFLECTION_CUBE,
         (ReflectionMode::DynamicCubeMap { .. }, ReflectionFilter::Bilinear) => {
             REFLECTION_CUBE_BILINEAR
@@ -296,6 +306,11 @@ fn scene_bytes(
     b.vec4(uniform, 0.0);
     let height = scene.ground.as_ref().map_or(0.0, |g| g.height_m);
     b.u32(ground_material).f32(height).u32(face_size).u32(0);
+    // parallax.rs: on for dynamic cube maps over a ground (renderer.rs `ground_height_m`).
+    let parallax = reads.parallax == ReflectionParallax::Ground
+        && scene.ground.is_some()
+        && matches!(reflection, ReflectionMode::DynamicCubeMap { .. });
+    b.u32(u32::from(parallax)).u32(0).u32(0).u32(0);
     b.0
 }
 
@@ -360,6 +375,7 @@ fn bubble_vertices(
     let mut b = Bytes::default();
     let mut draws = Vec::new();
     let mut start = 0u32;
+    let centres: Vec<Vec3> = scene.bubbles.iter().map(|b| b.center()).collect();
     for k in far_to_near(&scene.bubbles, view.eye) {
         let bubble = &scene.bubbles[k];
         for front in [false, true] {
@@ -380,6 +396,8 @@ fn bubble_vertices(
                         .map_or(Vec3::ZERO, |f| f.material_dirs[i]);
                     b.f32(m.x).f32(m.y).f32(m.z);
                     b.u32(films[k][0]).u32(films[k][1]);
+                    let c = centres[k];
+                    b.f32(c.x).f32(c.y).f32(c.z);
                 }
             }
             let end = (b.0.len() as u64 / BUBBLE_VERTEX_BYTES) as u32;
@@ -552,7 +570,7 @@ mod tests {
             &settings,
             &view,
             50,
-            ReflectionFilter::Footprint,
+            CubeReads::default(),
         )
         .unwrap();
         let (width, height, bytes) = &data.films;
@@ -596,7 +614,7 @@ mod tests {
             &settings,
             &view,
             10,
-            ReflectionFilter::Footprint,
+            CubeReads::default(),
         )
         .unwrap_err();
         assert!(matches!(err, GpuError::Unsupported(_)), "{err:?}");
