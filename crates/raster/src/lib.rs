@@ -33,7 +33,6 @@ pub use render_scene::{
     FilmTables, Frame, FrameTimings, Ground, Irradiance, Light, Lut, MAX_FACE_SIZE,
     MAX_FILM_THICKNESS_NM, MAX_IMAGE_SIDE, Mat3, Material, Object, PartialShading, Pattern,
     ReflectionFilter, ReflectionMode, ReflectionParallax, RenderError, RenderScene, RenderSettings,
-    SAMPLE_COUNTS, Sky,
-    SphereMap, Texture, ToneMap, TriMesh, Vec3, WATER_IOR, WaterSurface, linear_to_srgb, refract,
-    sphere_map_direction, sphere_map_uv, tone_map,
+    SAMPLE_COUNTS, Sky, SphereMap, Texture, ToneMap, TriMesh, Vec3, WATER_IOR, WaterSurface,
+    linear_to_srgb, refract, sphere_map_direction, sphere_map_uv, tone_map,
 };

@@ -13,7 +13,8 @@ use render_scene::reflection::Reflection;
 use render_scene::tessellate::{Geometry, tessellate};
 use render_scene::{
     BubbleMesh, CubeMap, Environment, FilmField, FilmTables, Frame, FrameTimings, Material,
-    PartialShading, ReflectionFilter, ReflectionMode, ReflectionParallax, RenderError, RenderScene, RenderSettings,
+    PartialShading, ReflectionFilter, ReflectionMode, ReflectionParallax, RenderError, RenderScene,
+    RenderSettings,
 };
 
 use crate::passes::bubble::{BubbleCtx, setup_bubble_tris};
@@ -128,7 +129,8 @@ impl Renderer {
         let setup_s = start.elapsed().as_secs_f64();
 
         self.centres.clear();
-        self.centres.extend(scene.bubbles.iter().map(BubbleMesh::center));
+        self.centres
+            .extend(scene.bubbles.iter().map(BubbleMesh::center));
         let t = Instant::now();
         if let ReflectionMode::DynamicCubeMap { face_size } = settings.reflection {
             self.render_cube_maps(scene, &materials, face_size);

@@ -64,8 +64,7 @@ pub use mesh::TriMesh;
 pub use scene::{BubbleMesh, FilmTables, Ground, Light, Object, RenderScene};
 pub use settings::{
     MAX_IMAGE_SIDE, PartialShading, ReflectionFilter, ReflectionMode, ReflectionParallax,
-    RenderSettings,
-    SAMPLE_COUNTS, ToneMap,
+    RenderSettings, SAMPLE_COUNTS, ToneMap,
 };
 pub use spheremap::SphereMap;
 pub use texture::Texture;

@@ -6,8 +6,8 @@ use glam::Vec3;
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use naga::{Module, TypeInner};
 use render_scene::{
-    Camera, Environment, FilmTables, Ground, Light, Lut, Material, Object,
-    RenderScene, RenderSettings,
+    Camera, Environment, FilmTables, Ground, Light, Lut, Material, Object, RenderScene,
+    RenderSettings,
 };
 
 use super::scene_data::{

@@ -14,8 +14,7 @@ use render_scene::cubemap::FACE_BASES;
 use render_scene::ground_view::GroundView;
 use render_scene::{
     BubbleMesh, CubeMap, FilmTables, Frame, FrameTimings, ReflectionFilter, ReflectionMode,
-    ReflectionParallax,
-    RenderScene, RenderSettings,
+    ReflectionParallax, RenderScene, RenderSettings,
 };
 
 /// Size `(width, height, layers)` and sample count of a cached texture.

@@ -603,38 +603,20 @@ fn reflection(bubble: u32, dir: vec3<f32>, derivatives: array<vec3<f32>, 2>) -> 
     return env_radiance(dir);
 }
 
-// parallax.rs `ParallaxRead`: `hit` false when the ray keeps its own direction.
-struct ParallaxRead {
-    hit: bool,
-    dir: vec3<f32>,
-    derivatives: array<vec3<f32>, 2>,
-}
-
-// parallax.rs `ground_parallax`: the cube-map read of a ray from film point `p` along unit
-// `dir` turned towards where it meets the ground `y = height_m`, seen from `centre`.
-fn ground_parallax(centre: vec3<f32>, p: vec3<f32>, dir: vec3<f32>, d_p: array<vec3<f32>, 2>,
-    d_dir: array<vec3<f32>, 2>, height_m: f32) -> ParallaxRead {
-    var out = ParallaxRead(false, dir, d_dir);
+// parallax.rs `ground_parallax`: the direction from `centre` to where the ray from film
+// point `p` along unit `dir` meets the ground `y = height_m`; `dir` itself when it does
+// not, or when `p` and `centre` are on opposite sides of the plane.
+fn ground_parallax(centre: vec3<f32>, p: vec3<f32>, dir: vec3<f32>, height_m: f32) -> vec3<f32> {
     let above = p.y - height_m;
     if (!(dir.y * above < 0.0 && (centre.y - height_m) * above > 0.0)) {
-        return out;
+        return dir;
     }
-    let t = -above / dir.y;
-    let to_hit = p + dir * t - centre;
+    let to_hit = p - dir * (above / dir.y) - centre;
     let len = length(to_hit);
     if (!(len > 0.0 && len < 3.0e38)) {
-        return out;
+        return dir;
     }
-    let u = to_hit / len;
-    out.hit = true;
-    out.dir = u;
-    for (var k = 0; k < 2; k++) {
-        let dt = -(d_p[k].y + t * d_dir[k].y) / dir.y;
-        let dq = d_p[k] + d_dir[k] * t + dir * dt;
-        let du = (dq - u * dot(u, dq)) / len;
-        out.derivatives[k] = select(vec3<f32>(0.0), du, all(abs(du) < vec3<f32>(3.0e38)));
-    }
-    return out;
+    return to_hit / len;
 }
 
 // passes.rs `LightSight::visibility`: the highlight filter (see its documentation).
@@ -761,10 +743,9 @@ fn fs_bubble_add(in: BubbleOut) -> @location(0) vec4<f32> {
     // need uniform control flow, so they come first.
     let w = 1.0 / in.inv_w;
     let n_centre = in.normal_over_w * w;
-    let d_inv_w = vec2<f32>(dpdxFine(in.inv_w), dpdyFine(in.inv_w));
     let dn_raw = array<vec3<f32>, 2>(
-        (dpdxFine(in.normal_over_w) - n_centre * d_inv_w.x) * w,
-        (dpdyFine(in.normal_over_w) - n_centre * d_inv_w.y) * w);
+        (dpdxFine(in.normal_over_w) - n_centre * dpdxFine(in.inv_w)) * w,
+        (dpdyFine(in.normal_over_w) - n_centre * dpdyFine(in.inv_w)) * w);
     let f = film_of(in);
     if (f.coverage <= 0.0) {
         // A hole adds nothing.
@@ -777,17 +758,11 @@ fn fs_bubble_add(in: BubbleOut) -> @location(0) vec4<f32> {
         -view.up.xyz * view.tan_half_per_px.w);
     let derivatives = reflection_derivatives(rel / dot(rel, view.forward.xyz), dd, in.normal,
         dn_raw);
-    var read = ParallaxRead(false, reflected, derivatives);
+    var dir = reflected;
     if (scene.ground_parallax != 0u) {
-        // renderer.rs `BubbleCtx::parallax_read`: p = eye + d·w, ∂p = ∂d·w − d·w²·∂(1/w).
-        let depth = dot(rel, view.forward.xyz);
-        let d = rel / depth;
-        let d_p = array<vec3<f32>, 2>(dd[0] * depth - d * (depth * depth * d_inv_w.x),
-            dd[1] * depth - d * (depth * depth * d_inv_w.y));
-        read = ground_parallax(in.centre, in.world, reflected, d_p, derivatives,
-            scene.ground_height_m);
+        dir = ground_parallax(in.centre, in.world, reflected, scene.ground_height_m);
     }
-    var add = r * reflection(in.bubble, read.dir, read.derivatives);
+    var add = r * reflection(in.bubble, dir, derivatives);
     for (var i = 0u; i < scene.light_count; i++) {
         let light = lights[i];
         let vis = light_visibility(light, in.world, reflected, in.pixel_angle_rad);

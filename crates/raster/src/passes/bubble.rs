@@ -260,10 +260,8 @@ impl BubbleCtx<'_> {
         };
         let reflected = Vec3::from(reflected);
         let p = self.view.eye + Vec3::from(d / inv_w);
-        let env = match self.parallax_read(tri, p, d, inv_w, reflected, derivatives) {
-            Some(read) => reflection.sample(read.dir, read.derivatives, self.filter),
-            None => reflection.sample(reflected, derivatives, self.filter),
-        };
+        let dir = self.parallax_dir(tri, p, reflected).unwrap_or(reflected);
+        let env = reflection.sample(dir, derivatives, self.filter);
         let mut add = [r_rgb[0] * env[0], r_rgb[1] * env[1], r_rgb[2] * env[2]];
         let mut shareable = true;
         if !self.lights.is_empty() {
@@ -294,30 +292,13 @@ impl BubbleCtx<'_> {
         (t_rgb, add, shareable)
     }
 
-    /// The cube-map read of bubble `tri.tag` turned towards where the ray from film point
-    /// `p` (view ray `d`, inverse depth `inv_w`) along `reflected` meets the ground, when
-    /// the bubble reads a dynamic cube map with the parallax correction on.
+    /// The direction bubble `tri.tag` reads its dynamic cube map in for the ray from film
+    /// point `p` along `reflected`, when the parallax correction is on and the ray meets
+    /// the ground (`parallax::ground_parallax`).
     #[inline]
-    fn parallax_read(
-        &self,
-        tri: &SetupTri,
-        p: Vec3,
-        d: Vec3A,
-        inv_w: f32,
-        reflected: Vec3,
-        derivatives: [Vec3; 2],
-    ) -> Option<render_scene::parallax::ParallaxRead> {
-        let height_m = self.ground_height_m?;
+    fn parallax_dir(&self, tri: &SetupTri, p: Vec3, reflected: Vec3) -> Option<Vec3> {
         let centre = *self.parallax_centres.get(tri.tag as usize)?;
-        // p = eye + d·w with w = 1/(1/w): ∂p = ∂d·w − d·w²·∂(1/w).
-        let w = 1.0 / inv_w;
-        let d = Vec3::from(d);
-        let d_p = [
-            (self.view.right * self.view.x_per_px, tri.inv_w.dx),
-            (-self.view.up * self.view.y_per_px, tri.inv_w.dy),
-        ]
-        .map(|(dd, di)| dd * w - d * (w * w * di));
-        ground_parallax(centre, p, reflected, d_p, derivatives, height_m)
+        ground_parallax(centre, p, reflected, self.ground_height_m?)
     }
 
     /// Change of the unit reflected direction per pixel along x and y at the point with

@@ -84,8 +84,14 @@ pub(crate) fn ground_span(
         let inv_dy = t * g.inv_height;
         let (kx, ky) = (ddx.y * inv_dy, ddy.y * inv_dy);
         // ∂P/∂px and ∂P/∂py in x and z, in checker cells.
-        let (xx, xy) = ((ddx.x - dx * kx) * t * inv_scale, (ddy.x - dx * ky) * t * inv_scale);
-        let (zx, zy) = ((ddx.z - dz * kx) * t * inv_scale, (ddy.z - dz * ky) * t * inv_scale);
+        let (xx, xy) = (
+            (ddx.x - dx * kx) * t * inv_scale,
+            (ddy.x - dx * ky) * t * inv_scale,
+        );
+        let (zx, zy) = (
+            (ddx.z - dz * kx) * t * inv_scale,
+            (ddy.z - dz * ky) * t * inv_scale,
+        );
         let f = [0.5 * (xx.abs() + xy.abs()), 0.5 * (zx.abs() + zy.abs())];
         let (cx, cz) = (px[i] * inv_scale, pz[i] * inv_scale);
         let o = GROUND_QUARTER_OFFSET_PX;
