@@ -126,6 +126,17 @@ def test_large_outputs_reuse_pooled_buffers_without_showing_old_values():
         assert not np.isnan(again[0]).any() and not np.isnan(again[1]).any()
         if not fast:
             assert np.array_equal(again[0], expected[0]) and np.array_equal(again[1], expected[1])
+        # Every task's runs land where they belong: random points against the point path.
+        rng = np.random.default_rng(5)
+        i, j, k = (rng.integers(0, n, 300) for n in (d.size, a.size, wl.size))
+        r_point, t_point = thinfilm.film_rt(d[i], a[j], wl[k])  # exact, point by point
+        tol = 5e-7 if fast else 1e-13
+        np.testing.assert_allclose(again[0][i, j, k], r_point, rtol=0, atol=tol)
+        np.testing.assert_allclose(again[1][i, j, k], t_point, rtol=0, atol=tol)
+        # The angle-major order that film_rt writes directly, too.
+        r_am, _ = thinfilm.film_rt(d[None, :, None], a[:, None, None], wl, fast=fast)
+        np.testing.assert_array_equal(r_am[j, i, k], again[0][i, j, k])
+        del r_am
         # A result stays valid (and unshared) while it lives.
         other = thinfilm.film_rt_grid(d, a, wl, n_film=1.5)
         assert not np.shares_memory(again[0], other[0]) and not np.shares_memory(again[1], other[1])
