@@ -2,7 +2,8 @@
 //! arrays out. Broadcasting and shapes are done in `python/thinfilm/__init__.py`.
 //!
 //! Every call copies its inputs, releases the GIL and computes in parallel (rayon), so
-//! other Python threads run meanwhile; every bad value raises `ValueError` naming it.
+//! other Python threads run meanwhile; every bad value raises `ValueError` naming it. The
+//! film grid's large outputs are written into buffers kept between calls (`pool.rs`).
 
 mod inverse;
 mod outer;
