@@ -20,7 +20,7 @@ struct Variant {
 /// Pairs compared besides "every variant against the reference": (image, against).
 const PAIRS: [(&str, &str); 1] = [("ref-centre", "ref-no-films")];
 
-const VARIANTS: [Variant; 15] = [
+const VARIANTS: [Variant; 16] = [
     Variant {
         name: "reference",
         flags: &["--backend", "reference"],
