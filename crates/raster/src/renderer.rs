@@ -7,7 +7,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 use render_scene::camera::View;
 use render_scene::cubemap::FACE_BASES;
-use render_scene::ground_view::GroundView;
+use render_scene::ground_view::{GroundFilter, GroundView};
 use render_scene::lut_sampler::LutSampler;
 use render_scene::reflection::Reflection;
 use render_scene::tessellate::{Geometry, tessellate};
@@ -321,10 +321,12 @@ impl Renderer {
                 pattern: SamplePattern::new(1),
                 env: &scene.environment,
                 sky_texels: env_cube.map(|c| c.face(j % 6)),
+                // Reflection lookups filter the faces again: one box per texel.
                 ground: scene
                     .ground
                     .as_ref()
-                    .and_then(|g| GroundView::new(g, &view)),
+                    .and_then(|g| GroundView::new(g, &view))
+                    .map(|g| g.with_filter(GroundFilter::Pixel)),
                 ambient: &ambient,
                 lights: &scene.lights,
                 materials,

@@ -1,14 +1,28 @@
 //! [`GroundView`]: the ground plane's constants for one view, which the CPU opaque pass and
-//! the GPU's `fs_ground` (through `view_bytes`) both read.
+//! the GPU's `fs_ground` (through `view_bytes`) both read, and its [`GroundFilter`].
 
 use glam::Vec3;
 
 use crate::Ground;
 use crate::camera::View;
 
+/// How the ground's checker is box-filtered over a pixel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum GroundFilter {
+    /// Two half-pixel boxes along the pixel's longer side
+    /// (`shading::ground_albedo_over_pixel`): the main view.
+    #[default]
+    Halves,
+    /// One box over the pixel's axis-aligned footprint: cube-map faces, which the
+    /// reflection lookups filter again (half the checker's work).
+    Pixel,
+}
+
 /// The ground plane prepared for one view: its inverse depth is affine in pixel coordinates.
 #[derive(Debug, Clone, Copy)]
 pub struct GroundView<'a> {
+    /// How its checker is filtered over a pixel.
+    pub filter: GroundFilter,
     /// The plane.
     pub ground: &'a Ground,
     /// `1/t = c + gx·px + gy·py`; the plane is in front where positive.
@@ -37,6 +51,7 @@ impl<'a> GroundView<'a> {
         let (sx, sy) = (view.x_per_px, view.y_per_px);
         let inv_h = 1.0 / height;
         Some(Self {
+            filter: GroundFilter::default(),
             ground,
             c: (view.forward.y - view.tan_half_x * view.right.y + view.tan_half_y * view.up.y)
                 * inv_h,
@@ -47,6 +62,11 @@ impl<'a> GroundView<'a> {
             ddx: view.right * sx,
             ddy: -view.up * sy,
         })
+    }
+
+    /// This view with its checker filtered by `filter`.
+    pub fn with_filter(self, filter: GroundFilter) -> Self {
+        Self { filter, ..self }
     }
 
     /// Inverse depth `1/t` of the plane behind pixel-space point `(px, py)`.

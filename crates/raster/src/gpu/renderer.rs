@@ -11,7 +11,7 @@ use super::scene_data::{
 use super::{Gpu, GpuError, GpuOptions};
 use render_scene::camera::View;
 use render_scene::cubemap::FACE_BASES;
-use render_scene::ground_view::GroundView;
+use render_scene::ground_view::{GroundFilter, GroundView};
 use render_scene::{
     BubbleMesh, CubeMap, FilmTables, Frame, FrameTimings, ReflectionFilter, ReflectionMode,
     ReflectionParallax, RenderScene, RenderSettings,
@@ -455,8 +455,19 @@ impl GpuRenderer {
         let mut bytes = Vec::with_capacity(views.len() * VIEW_STRIDE as usize);
         let mut ground_bytes: Vec<u8> = Vec::new();
         let mut ranges = Vec::with_capacity(views.len());
-        for v in views {
-            let ground = scene.ground.as_ref().and_then(|g| GroundView::new(g, v));
+        for (k, v) in views.iter().enumerate() {
+            // The main view (first) filters the checker over half pixels, the cube faces
+            // over one box per texel, as the CPU's `render_cube_maps`.
+            let filter = if k == 0 {
+                GroundFilter::Halves
+            } else {
+                GroundFilter::Pixel
+            };
+            let ground = scene
+                .ground
+                .as_ref()
+                .and_then(|g| GroundView::new(g, v))
+                .map(|g| g.with_filter(filter));
             bytes.extend(view_bytes(v, ground.as_ref()));
             bytes.resize(bytes.len().next_multiple_of(VIEW_STRIDE as usize), 0);
             let start = (ground_bytes.len() / 12) as u32;

@@ -15,7 +15,7 @@ struct View {
     up: vec4<f32>,
     // tan_half_x, tan_half_y, x_per_px, y_per_px
     tan_half_per_px: vec4<f32>,
-    // width, height, near_m, 0
+    // width, height, near_m, 1 when the ground's checker is filtered over half pixels
     size_near: vec4<f32>,
     // c, gx, gy, inv_height: 1/t = c + gx·px + gy·py
     ground: vec4<f32>,
@@ -298,17 +298,20 @@ fn fs_ground(in: FullScreen) -> @location(0) vec4<f32> {
     let m = materials[scene.ground_material];
     var albedo = m.a.xyz;
     if (m.specular.w == PATTERN_CHECKER) {
-        // shading.rs `ground_albedo_over_pixel`: four quarter-pixel boxes.
+        // shading.rs `ground_albedo_over_pixel`: two half-pixel boxes (`ground_halves`)
+        // along the longer of the pixel's sides on the plane, or one box.
         let inv = 1.0 / m.a.w;
-        let f = 0.5 * (abs(ax) + abs(ay)) * inv;
-        let o = GROUND_QUARTER_OFFSET_PX;
-        var sum = 0.0;
-        for (var k = 0; k < 4; k++) {
-            let s = vec2<f32>(select(-o, o, (k & 1) != 0), select(-o, o, k >= 2));
-            let q = vec2<f32>(p.x, p.z) + ax * s.x + ay * s.y;
-            sum += filtered_checker(q * inv, f);
+        let c = vec2<f32>(p.x, p.z);
+        var w = filtered_checker(c * inv, (abs(ax) + abs(ay)) * inv);
+        if (view.size_near.w != 0.0) {
+            let long_x = dot(ax, ax) >= dot(ay, ay);
+            let major = select(ay, ax, long_x);
+            let minor = select(ax, ay, long_x);
+            let o = GROUND_HALF_OFFSET_PX * major;
+            let f = (0.5 * abs(major) + abs(minor)) * inv;
+            w = 0.5 * (filtered_checker((c - o) * inv, f) + filtered_checker((c + o) * inv, f));
         }
-        albedo = lerp3(m.a.xyz, m.b.xyz, 0.25 * sum);
+        albedo = lerp3(m.a.xyz, m.b.xyz, w);
     }
     let normal = vec3<f32>(0.0, view.ground_ddx.w, 0.0);
     return vec4<f32>(lit(m, albedo, p, normal, d), 1.0);

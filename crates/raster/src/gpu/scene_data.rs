@@ -9,7 +9,7 @@ use glam::Vec3;
 use super::GpuError;
 use render_scene::bubble_order::{far_to_near, is_front_facing, reflection_rate};
 use render_scene::camera::View;
-use render_scene::ground_view::GroundView;
+use render_scene::ground_view::{GroundFilter, GroundView};
 use render_scene::tessellate::{Geometry, tessellate};
 use render_scene::{
     Environment, FilmTables, Light, Material, Pattern, ReflectionFilter, ReflectionMode,
@@ -86,7 +86,12 @@ pub(super) fn view_bytes(view: &View, ground: Option<&GroundView<'_>>) -> Vec<u8
         [view.tan_half_x, view.tan_half_y, view.x_per_px],
         view.y_per_px,
     );
-    b.vec4([view.width as f32, view.height as f32, view.near_m], 0.0);
+    // Its last lane: 1 when the ground's checker is filtered over half pixels.
+    let halves = ground.is_some_and(|g| g.filter == GroundFilter::Halves);
+    b.vec4(
+        [view.width as f32, view.height as f32, view.near_m],
+        f32::from(u8::from(halves)),
+    );
     match ground {
         Some(g) => {
             b.vec4([g.c, g.gx, g.gy], g.inv_height);

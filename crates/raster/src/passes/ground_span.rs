@@ -3,9 +3,9 @@
 //! compiler can keep it in SIMD registers. Other ground materials use the scalar path.
 
 use render_scene::camera::View;
-use render_scene::ground_view::GroundView;
+use render_scene::ground_view::{GroundFilter, GroundView};
 use render_scene::index_f32::index_f32;
-use render_scene::shading::GROUND_QUARTER_OFFSET_PX;
+use render_scene::shading::ground_halves;
 use render_scene::{Irradiance, Light, Pattern};
 
 use super::SPAN;
@@ -28,7 +28,7 @@ fn floor_small(x: f32) -> f32 {
 }
 
 /// Box-filtered checker weight, as [`render_scene::shading`]'s scalar version, clamped for range
-/// (summed over a pixel's quarters as `ground_albedo_over_pixel` sums them).
+/// (summed over a pixel's halves as `ground_albedo_over_pixel` sums them).
 #[inline(always)]
 fn checker_weight(p: [f32; 2], footprint: [f32; 2]) -> f32 {
     let tri = |x: f32| (x - floor_small(x) - 0.5).abs();
@@ -70,9 +70,10 @@ pub(crate) fn ground_span(
     // Row constants: d(x) = d0 + x·ddx.
     let d0 = view.forward + view.up * ay + view.right * (0.5 * sx - view.tan_half_x);
     let (ddx, ddy, eye) = (g.ddx, g.ddy, view.eye);
-    let mut weight = [0.0f32; SPAN];
     let mut px = [0.0f32; SPAN];
     let mut pz = [0.0f32; SPAN];
+    // ∂P/∂px.x, ∂P/∂py.x, ∂P/∂px.z, ∂P/∂py.z per pixel, in checker cells.
+    let mut grad = [[0.0f32; SPAN]; 4];
     for i in 0..n {
         let x = index_f32(x0 + i);
         let (dx, dz) = (d0.x + ddx.x * x, d0.z + ddx.z * x);
@@ -83,23 +84,19 @@ pub(crate) fn ground_span(
         // ∂P/∂px = t·(∂d − d·∂d.y/d.y) with 1/d.y = t/(h − eye.y).
         let inv_dy = t * g.inv_height;
         let (kx, ky) = (ddx.y * inv_dy, ddy.y * inv_dy);
-        // ∂P/∂px and ∂P/∂py in x and z, in checker cells.
-        let (xx, xy) = (
-            (ddx.x - dx * kx) * t * inv_scale,
-            (ddy.x - dx * ky) * t * inv_scale,
-        );
-        let (zx, zy) = (
-            (ddx.z - dz * kx) * t * inv_scale,
-            (ddy.z - dz * ky) * t * inv_scale,
-        );
-        let f = [0.5 * (xx.abs() + xy.abs()), 0.5 * (zx.abs() + zy.abs())];
-        let (cx, cz) = (px[i] * inv_scale, pz[i] * inv_scale);
-        let o = GROUND_QUARTER_OFFSET_PX;
-        let mut sum = 0.0;
-        for (sx, sy) in [(-o, -o), (o, -o), (-o, o), (o, o)] {
-            sum += checker_weight([cx + sx * xx + sy * xy, cz + sx * zx + sy * zy], f);
-        }
-        weight[i] = 0.25 * sum;
+        let ts = t * inv_scale;
+        grad[0][i] = (ddx.x - dx * kx) * ts;
+        grad[1][i] = (ddy.x - dx * ky) * ts;
+        grad[2][i] = (ddx.z - dz * kx) * ts;
+        grad[3][i] = (ddy.z - dz * ky) * ts;
+    }
+    let cells = |p: &[f32; SPAN]| p.map(|v| v * inv_scale);
+    let (cx, cz) = (cells(&px), cells(&pz));
+    let mut weight = [0.0f32; SPAN];
+    // One loop per filter, each branch-free, so both vectorise.
+    match g.filter {
+        GroundFilter::Halves => half_weights(&cx, &cz, &grad, &mut weight[..n]),
+        GroundFilter::Pixel => pixel_weights(&cx, &cz, &grad, &mut weight[..n]),
     }
     let mut irradiance = [[0.0f32; SPAN]; 3];
     let ambient = ambient.diffuse(g.normal);
@@ -123,6 +120,31 @@ pub(crate) fn ground_span(
             // a + (b − a)·w is exact when a = b: a solid ground in a white furnace stays white.
             o[k] = (a[k] + (b[k] - a[k]) * w) * irradiance[k][i];
         }
+    }
+}
+
+/// Checker weights over each pixel's axis-aligned footprint (`GroundFilter::Pixel`) at
+/// pattern-space centres `cx`, `cz` with gradients `grad` (see `ground_span`).
+#[inline(always)]
+fn pixel_weights(cx: &[f32; SPAN], cz: &[f32; SPAN], grad: &[[f32; SPAN]; 4], out: &mut [f32]) {
+    for (i, w) in out.iter_mut().enumerate() {
+        let f = [
+            grad[0][i].abs() + grad[1][i].abs(),
+            grad[2][i].abs() + grad[3][i].abs(),
+        ];
+        *w = checker_weight([cx[i], cz[i]], f);
+    }
+}
+
+/// Checker weights averaged over each pixel's two halves along its longer side
+/// (`GroundFilter::Halves`, as `shading::ground_albedo_over_pixel`).
+#[inline(always)]
+fn half_weights(cx: &[f32; SPAN], cz: &[f32; SPAN], grad: &[[f32; SPAN]; 4], out: &mut [f32]) {
+    for (i, w) in out.iter_mut().enumerate() {
+        let (o, f) = ground_halves([grad[0][i], grad[2][i]], [grad[1][i], grad[3][i]]);
+        let lo = checker_weight([cx[i] - o[0], cz[i] - o[1]], f);
+        let hi = checker_weight([cx[i] + o[0], cz[i] + o[1]], f);
+        *w = 0.5 * (lo + hi);
     }
 }
 

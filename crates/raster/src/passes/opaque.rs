@@ -226,7 +226,8 @@ impl OpaqueCtx<'_> {
         let dpy = (g.ddy - d * (g.ddy.y * inv_dy)) * t;
         // Edge-on the footprint is unbounded: the filter then returns the mean.
         let bound = |v: Vec3| [v.x, v.z].map(|f| if f.abs() < 1e9 { f } else { 1e9 });
-        let albedo = ground_albedo_over_pixel(&g.ground.material, p.x, p.z, bound(dpx), bound(dpy));
+        let m = &g.ground.material;
+        let albedo = ground_albedo_over_pixel(m, p.x, p.z, bound(dpx), bound(dpy), g.filter);
         lit(
             &g.ground.material,
             albedo,
