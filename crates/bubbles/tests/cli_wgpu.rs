@@ -227,3 +227,157 @@ fn a_sample_count_the_device_lacks_is_replaced_by_the_nearest_and_said() {
         "{err}"
     );
 }
+
+/// Renders scene file `scene` (in `dir`) at `size`×`size` through wgpu and through the
+/// CPU with per-triangle partial shading, both with `extra` flags; returns their mean and
+/// 99th-percentile ΔE2000, or `None` when no adapter was found.
+fn scene_file_against_cpu(
+    scene: &str,
+    dir: &Path,
+    size: u32,
+    extra: &[&str],
+) -> Option<(f64, f64)> {
+    let size = size.to_string();
+    let render = |backend: &str, out: &str, more: &[&str]| {
+        let mut args = vec![
+            "render",
+            scene,
+            "--backend",
+            backend,
+            "--width",
+            &size,
+            "--height",
+            &size,
+            "--out",
+            out,
+        ];
+        args.extend(extra);
+        args.extend(more);
+        run_unless_no_adapter(&args, dir).map(|(run, err)| {
+            assert!(run.status.success(), "{backend} {extra:?}: {err}");
+        })
+    };
+    render("wgpu", "gpu.png", &[])?;
+    render("cpu", "cpu.png", &["--partial-shading", "per-triangle"])?;
+    eprint!("{scene} {extra:?}: ");
+    Some(compare(dir, "cpu.png", "gpu.png"))
+}
+
+/// A scene over `environment` (a TOML `[environment]` table): a checker ground the
+/// environment lights, a bubble that reflects it, the camera looking along −Z and up, so
+/// that most of the frame is the environment itself.
+fn environment_scene(environment: &str) -> String {
+    format!(
+        r#"[camera]
+eye_m = [0.0, 0.05, 0.3]
+target_m = [0.0, 0.1, 0.0]
+vfov_deg = 70.0
+
+{environment}
+
+[ground]
+height_m = 0.0
+material = {{ kind = "checker", a = [0.8, 0.8, 0.78], b = [0.1, 0.12, 0.2], scale_m = 0.04 }}
+
+[[bubbles]]
+center_m = [0.01, 0.09, 0.06]
+radius_m = 0.08
+mean_thickness_nm = 500.0
+subdivisions = 3
+seed = 1
+
+[film]
+n_film = 1.33
+illuminant = "d65"
+"#
+    )
+}
+
+/// Writes an sRGB PNG of `w`×`h` whose texel `(x, y)` is `rgb(x, y)`.
+fn write_png(path: &Path, (w, h): (u32, u32), rgb: impl Fn(u32, u32) -> [u8; 3]) {
+    image::RgbImage::from_fn(w, h, |x, y| image::Rgb(rgb(x, y)))
+        .save(path)
+        .unwrap();
+}
+
+/// An equirect environment (issue 24): the sky behind every pixel, the dynamic cube maps'
+/// sky and the static reflection all read the latitude-longitude image as the CPU does.
+/// The image varies along both axes and is asymmetric about every meridian, so a flipped
+/// or shifted mapping shows.
+#[test]
+fn equirect_environment_through_wgpu_matches_the_cpu_backend_in_ciede2000() {
+    let dir = tempfile::tempdir().unwrap();
+    write_png(&dir.path().join("env.png"), (48, 24), |x, y| {
+        let stripe = if (x / 6 + y / 4) % 2 == 0 { 40 } else { 0 };
+        [
+            (40 + 4 * x) as u8,
+            (30 + 8 * y) as u8,
+            (200 - 3 * x + stripe) as u8,
+        ]
+    });
+    let scene = environment_scene("[environment]\nkind = \"equirect\"\npath = \"env.png\"");
+    std::fs::write(dir.path().join("equirect.toml"), scene).unwrap();
+    let mut measured = Vec::new();
+    for reflection in ["dynamic", "static"] {
+        let flags = ["--reflection", reflection];
+        let Some(d) = scene_file_against_cpu("equirect.toml", dir.path(), 128, &flags) else {
+            return;
+        };
+        measured.push((reflection, d));
+    }
+    for (reflection, (mean, p99)) in measured {
+        assert!(mean <= 0.25, "{reflection}: mean ΔE2000 {mean} > 0.25");
+        assert!(
+            p99 <= 1.2,
+            "{reflection}: 99th percentile ΔE2000 {p99} > 1.2"
+        );
+    }
+}
+
+/// Cube-face environment (issue 24): the sky reads level 0 as `CubeMap::sample`, the
+/// static reflection the faces' mip chain through the footprint filter. Each face has its
+/// own colour and a gradient along both of its axes, so a swapped face or flipped axis
+/// shows.
+#[test]
+fn cube_face_environment_through_wgpu_matches_the_cpu_backend_in_ciede2000() {
+    let dir = tempfile::tempdir().unwrap();
+    let base: [[u32; 3]; 6] = [
+        [200, 60, 40],
+        [40, 160, 60],
+        [60, 90, 220],
+        [90, 70, 40],
+        [200, 180, 60],
+        [150, 60, 190],
+    ];
+    let names = ["px", "nx", "py", "ny", "pz", "nz"];
+    for (name, b) in names.iter().zip(base) {
+        write_png(&dir.path().join(format!("{name}.png")), (16, 16), |x, y| {
+            [
+                b[0] * (8 + x) / 24,
+                b[1] * (24 - y / 2) / 24,
+                b[2] * (10 + x + y) / 40,
+            ]
+            .map(|c| c as u8)
+        });
+    }
+    let faces = names.map(|n| format!("\"{n}.png\"")).join(", ");
+    let scene = environment_scene(&format!(
+        "[environment]\nkind = \"cube\"\nfaces = [{faces}]"
+    ));
+    std::fs::write(dir.path().join("cube.toml"), scene).unwrap();
+    let mut measured = Vec::new();
+    for reflection in ["dynamic", "static"] {
+        let flags = ["--reflection", reflection];
+        let Some(d) = scene_file_against_cpu("cube.toml", dir.path(), 128, &flags) else {
+            return;
+        };
+        measured.push((reflection, d));
+    }
+    for (reflection, (mean, p99)) in measured {
+        assert!(mean <= 0.25, "{reflection}: mean ΔE2000 {mean} > 0.25");
+        assert!(
+            p99 <= 1.2,
+            "{reflection}: 99th percentile ΔE2000 {p99} > 1.2"
+        );
+    }
+}

@@ -82,7 +82,13 @@ impl Layouts {
         };
         let scene = layout(
             "scene",
-            &[entry(0, uniform), entry(1, storage()), entry(2, storage())],
+            &[
+                entry(0, uniform),
+                entry(1, storage()),
+                entry(2, storage()),
+                // The image atlas (Rgba32Float, read with textureLoad).
+                entry(3, texture(wgpu::TextureViewDimension::D2)),
+            ],
         );
         let bubble = layout(
             "bubble tables",

@@ -43,6 +43,9 @@ struct Scene {
     ground_height_m: f32,
     cube_face_size: u32,
     reflectivity_table: u32,
+    // The environment image in `images`: first texel, width, height of an equirect; first
+    // texel, face size of cube faces (scene_data.rs `Atlas`).
+    env_image: vec4<u32>,
 }
 
 struct Material {
@@ -75,6 +78,9 @@ struct LutInfo {
 @group(1) @binding(0) var<uniform> scene: Scene;
 @group(1) @binding(1) var<storage, read> materials: array<Material>;
 @group(1) @binding(2) var<storage, read> lights: array<Light>;
+// The image atlas: every image the scene reads (the environment's), row-major one after
+// another, linear texel i at (i mod width, i div width), RGB (scene_data.rs `Atlas`).
+@group(1) @binding(3) var images: texture_2d<f32>;
 @group(2) @binding(0) var luts: texture_2d<f32>;
 @group(2) @binding(1) var<storage, read> lut_info: array<LutInfo>;
 @group(2) @binding(2) var cubes: texture_2d_array<f32>;
@@ -124,6 +130,12 @@ fn env_radiance(dir: vec3<f32>) -> vec3<f32> {
     if (scene.env_kind == ENV_UNIFORM) {
         return scene.uniform_rgb.xyz;
     }
+    if (scene.env_kind == ENV_EQUIRECT) {
+        return equirect_sample(scene.env_image, dir);
+    }
+    if (scene.env_kind == ENV_CUBE) {
+        return env_cube_sample(scene.env_image.x, scene.env_image.y, dir);
+    }
     let d = normalize_or(dir, vec3<f32>(0.0, 1.0, 0.0));
     var out: vec3<f32>;
     if (d.y >= 0.0) {
@@ -136,6 +148,112 @@ fn env_radiance(dir: vec3<f32>) -> vec3<f32> {
         out += scene.sun_rgb.xyz;
     }
     return out;
+}
+
+// ---- images: environment maps and textures ---------------------------------------------
+
+// Linear texel `i` of the image atlas.
+fn image_texel(i: u32) -> vec3<f32> {
+    let width = textureDimensions(images).x;
+    return textureLoad(images, vec2<u32>(i % width, i / width), 0).xyz;
+}
+
+// A texel pair on one axis and the second one's weight (texture.rs `split_repeat`,
+// `split_clamp`).
+struct Split {
+    i0: u32,
+    i1: u32,
+    t: f32,
+}
+
+// texture.rs `split_repeat`: the axis of `n` texels repeats (texel centres at (i + 0.5)/n).
+fn split_repeat(u: f32, n: u32) -> Split {
+    var x = u * f32(n) - 0.5;
+    // Not finite (NaN or infinite) reads as 0.
+    if (!(abs(x) < 3.0e38)) {
+        x = 0.0;
+    }
+    let f = floor(x);
+    var i0: u32;
+    if (abs(f) < 2147483520.0) {
+        let q = i32(f) % i32(n);
+        i0 = u32(select(q, q + i32(n), q < 0));
+    } else {
+        let nf = f32(n);
+        i0 = u32(clamp(f - nf * floor(f / nf), 0.0, nf - 1.0));
+    }
+    return Split(i0, select(i0 + 1u, 0u, i0 + 1u == n), x - f);
+}
+
+// texture.rs `split_clamp`: the axis of `n` texels is clamped to its edges.
+fn split_clamp(u: f32, n: u32) -> Split {
+    var x = clamp(u * f32(n) - 0.5, 0.0, f32(n - 1u));
+    if (x != x) {
+        x = 0.0;
+    }
+    let i0 = u32(x);
+    return Split(i0, min(i0 + 1u, n - 1u), x - f32(i0));
+}
+
+// texture.rs `Texture::bilinear` and `bilerp` of the image whose first texel is `first`
+// and which is `width` texels wide.
+fn image_bilinear(first: u32, width: u32, sx: Split, sy: Split) -> vec3<f32> {
+    let a = image_texel(first + sy.i0 * width + sx.i0);
+    let b = image_texel(first + sy.i0 * width + sx.i1);
+    let c = image_texel(first + sy.i1 * width + sx.i0);
+    let d = image_texel(first + sy.i1 * width + sx.i1);
+    let top = a + (b - a) * sx.t;
+    let bottom = c + (d - c) * sx.t;
+    return top + (bottom - top) * sy.t;
+}
+
+// texture.rs `Texture::sample_equirect` of the image `img` = (first texel, width, height):
+// u = 0.5 + atan2(x, −z)/2π, v = acos(y)/π.
+fn equirect_sample(img: vec4<u32>, dir: vec3<f32>) -> vec3<f32> {
+    let len = length(dir);
+    var y = 1.0;
+    if (len > 0.0) {
+        y = clamp(dir.y / len, -1.0, 1.0);
+    }
+    let u = 0.5 + atan2(dir.x, -dir.z) * (0.5 / PI);
+    let v = acos(y) * (1.0 / PI);
+    return image_bilinear(img.x, img.y, split_repeat(u, img.y), split_clamp(v, img.z));
+}
+
+// cubemap.rs `CubeMap::sample` of cube faces stored in the atlas: level 0's six bordered
+// (n + 2)² faces from texel `first`, n = `size`; `cube_level_bilinear`'s arithmetic.
+fn env_cube_sample(first: u32, size: u32, dir: vec3<f32>) -> vec3<f32> {
+    let fst = face_coordinates(dir);
+    let n = f32(size);
+    let m = n + 2.0;
+    let fx = clamp((fst.y + 1.0) * 0.5 * n + 0.5, 0.0, m - 1.0);
+    let fy = clamp((fst.z + 1.0) * 0.5 * n + 0.5, 0.0, m - 1.0);
+    let x0 = min(floor(fx), m - 2.0);
+    let y0 = min(floor(fy), m - 2.0);
+    let tx = fx - x0;
+    let ty = fy - y0;
+    let mu = size + 2u;
+    let i = first + (u32(fst.x) * mu + u32(y0)) * mu + u32(x0);
+    let a = image_texel(i);
+    let b = image_texel(i + 1u);
+    let c = image_texel(i + mu);
+    let d = image_texel(i + mu + 1u);
+    let top = a + (b - a) * tx;
+    let bottom = c + (d - c) * tx;
+    return top + (bottom - top) * ty;
+}
+
+// reflection.rs `Reflection::sample` of `Reflection::Env`: the environment's cube faces
+// through their mip chain (chain 0 of `cube_mips`), filtered as a dynamic cube map is, or
+// the environment itself.
+fn static_reflection(dir: vec3<f32>, derivatives: array<vec3<f32>, 2>) -> vec3<f32> {
+    if (scene.reflection == REFLECTION_ENV_CUBE) {
+        return cube_footprint(0u, dir, derivatives[0], derivatives[1]);
+    }
+    if (scene.reflection == REFLECTION_ENV_CUBE_BILINEAR) {
+        return cube_sample(0u, dir);
+    }
+    return env_radiance(dir);
 }
 
 // irradiance.rs `Irradiance::diffuse`.
@@ -585,7 +703,7 @@ fn reflection(bubble: u32, dir: vec3<f32>, derivatives: array<vec3<f32>, 2>) -> 
     if (scene.reflection == REFLECTION_CUBE_BILINEAR) {
         return cube_sample(bubble, dir);
     }
-    return env_radiance(dir);
+    return static_reflection(dir, derivatives);
 }
 
 // passes.rs `LightSight::visibility`: the highlight filter (see its documentation).

@@ -24,6 +24,10 @@ pub(super) const PATTERN_CHECKER: f32 = 1.0;
 pub(super) const ENV_SKY: u32 = 0;
 /// `Scene.env_kind` of a uniform environment.
 pub(super) const ENV_UNIFORM: u32 = 1;
+/// `Scene.env_kind` of an equirect (latitude-longitude) image in the image atlas.
+pub(super) const ENV_EQUIRECT: u32 = 2;
+/// `Scene.env_kind` of six cube faces (level 0, bordered) in the image atlas.
+pub(super) const ENV_CUBE: u32 = 3;
 /// `Scene.reflection` of dynamic cube maps.
 pub(super) const REFLECTION_CUBE: u32 = 0;
 /// `Scene.reflection` of the static environment.
@@ -31,6 +35,11 @@ pub(super) const REFLECTION_ENVIRONMENT: u32 = 1;
 /// `Scene.reflection` of dynamic cube maps read with one bilinear tap
 /// ([`ReflectionFilter::Bilinear`]).
 pub(super) const REFLECTION_CUBE_BILINEAR: u32 = 2;
+/// `Scene.reflection` of the static environment when it is cube faces: their mip chain is
+/// chain 0 of `cube_mips`, read with the footprint filter.
+pub(super) const REFLECTION_ENV_CUBE: u32 = 3;
+/// [`REFLECTION_ENV_CUBE`] read with one bilinear tap ([`ReflectionFilter::Bilinear`]).
+pub(super) const REFLECTION_ENV_CUBE_BILINEAR: u32 = 4;
 /// `Scene.transmittance_table` when `T = 1 − R`.
 pub(super) const NO_TABLE: u32 = u32::MAX;
 
@@ -160,6 +169,12 @@ pub(super) struct SceneData {
     /// (`FilmField::bordered`, `[thickness_nm, coverage]` as Rg32Float), one after
     /// another, texel `i` at `(i mod width, i div width)`.
     pub films: FilmTexture,
+    /// The image atlas (`Atlas`): the environment's image or cube faces, as Rgba32Float.
+    pub images: LutTexture,
+    /// The environment cube faces' whole mip chain as f32 RGB in `CubeMap`'s level layout
+    /// (what `cube_mips` holds per bubble) when the static environment reflects in the
+    /// bubbles; empty otherwise.
+    pub env_chain: Vec<u8>,
 }
 
 /// Why the wgpu backend cannot draw `what` (it draws the scenes the built-in scenes use).
@@ -177,11 +192,6 @@ pub(super) fn check_supported(
     }
     if scene.water.is_some() {
         return Err(unsupported("a water surface (the [water] section)"));
-    }
-    match scene.environment {
-        Environment::Sky(_) | Environment::Uniform(_) => {}
-        Environment::Equirect(_) => return Err(unsupported("an equirect environment image")),
-        Environment::CubeFaces(_) => return Err(unsupported("a cube-face environment")),
     }
     let ground = scene.ground.iter().map(|g| &g.material);
     for m in scene.objects.iter().map(|o| o.material()).chain(ground) {
@@ -225,17 +235,37 @@ impl SceneData {
             .iter()
             .map(|l| l.light_lut.map_or(0, |i| first_light + i as u32))
             .collect();
-        let face_size = match settings.reflection {
-            ReflectionMode::DynamicCubeMap { face_size } => face_size as u32,
+        let mut atlas = Atlas::default();
+        let env_image = match &scene.environment {
+            Environment::Equirect(t) => atlas.push(t.texels(), t.width(), t.height()),
+            Environment::CubeFaces(c) => atlas.push(c.level_texels(0), c.face_size(), 0),
+            Environment::Sky(_) | Environment::Uniform(_) => [0; 4],
+        };
+        // The static environment's cube faces are read as a bubble's cube map is, from
+        // `cube_mips` (chain 0): `face_size` is then theirs.
+        let env_cube = match (&settings.reflection, &scene.environment) {
+            (ReflectionMode::StaticEnvironment, Environment::CubeFaces(c)) => Some(c),
+            _ => None,
+        };
+        let face_size = match (&settings.reflection, env_cube) {
+            (ReflectionMode::DynamicCubeMap { face_size }, _) => *face_size as u32,
+            (_, Some(c)) => c.face_size() as u32,
             _ => 0,
         };
+        let env_chain: Vec<u8> = env_cube.map_or(Vec::new(), |c| {
+            (0..c.levels())
+                .flat_map(|level| c.level_texels(level))
+                .flatten()
+                .flat_map(|x| x.to_le_bytes())
+                .collect()
+        });
         Ok(SceneData {
             scene: scene_bytes(
                 scene,
                 &settings.reflection,
                 filter,
-                face_size,
-                ground_material,
+                [face_size, ground_material],
+                env_image,
                 tables,
             ),
             materials: material_bytes(&materials),
@@ -248,7 +278,48 @@ impl SceneData {
             luts,
             lut_info,
             films,
+            images: atlas.finish(max_texture_side)?,
+            env_chain,
         })
+    }
+}
+
+/// Images as `scene.wgsl` reads them (`images`): each image's texels row-major, one image
+/// after another, linear texel `i` at `(i mod width, i div width)` of one Rgba32Float
+/// texture (rows of at most the device's side, the last row padded).
+#[derive(Debug, Default)]
+struct Atlas {
+    texels: Bytes,
+}
+
+impl Atlas {
+    /// Appends `texels`; returns the WGSL descriptor `(first texel, a, b, 0)`.
+    fn push(&mut self, texels: &[[f32; 3]], a: usize, b: usize) -> [u32; 4] {
+        let first = self.texels.0.len() / 16;
+        for t in texels {
+            self.texels.vec4(*t, 1.0);
+        }
+        // `finish` refuses an atlas past the device's side² (< 2³²) texels.
+        [first as u32, a as u32, b as u32, 0]
+    }
+
+    /// The texture `(width, height, texels)`.
+    ///
+    /// # Errors
+    /// [`GpuError::Unsupported`], naming the texel count and the limit, when the atlas
+    /// would be taller than `max_side`.
+    fn finish(mut self, max_side: u32) -> Result<LutTexture, GpuError> {
+        let count = (self.texels.0.len() / 16).max(1);
+        let width = count.min(max_side as usize);
+        let height = count.div_ceil(width);
+        if height > max_side as usize {
+            return Err(unsupported(format!(
+                "images of {count} texels (the environment's and the textures': their \
+                 texture holds at most {max_side} × {max_side} texels on this device)"
+            )));
+        }
+        self.texels.0.resize(16 * width * height, 0);
+        Ok((width as u32, height as u32, self.texels.0))
     }
 }
 
@@ -256,8 +327,8 @@ fn scene_bytes(
     scene: &RenderScene,
     reflection: &ReflectionMode,
     filter: ReflectionFilter,
-    face_size: u32,
-    ground_material: u32,
+    [face_size, ground_material]: [u32; 2],
+    env_image: [u32; 4],
     tables: &FilmTables,
 ) -> Vec<u8> {
     let mut b = Bytes::default();
@@ -268,14 +339,21 @@ fn scene_bytes(
     let (env_kind, sky, uniform) = match &scene.environment {
         Environment::Uniform(rgb) => (ENV_UNIFORM, Sky::default(), *rgb),
         Environment::Sky(sky) => (ENV_SKY, *sky, [0.0; 3]),
-        // check_supported refused the others.
-        _ => (ENV_UNIFORM, Sky::default(), [0.0; 3]),
+        Environment::Equirect(_) => (ENV_EQUIRECT, Sky::default(), [0.0; 3]),
+        Environment::CubeFaces(_) => (ENV_CUBE, Sky::default(), [0.0; 3]),
     };
+    let env_cube = matches!(scene.environment, Environment::CubeFaces(_));
     b.u32(env_kind).u32(scene.lights.len() as u32);
     b.u32(match (reflection, filter) {
         (ReflectionMode::DynamicCubeMap { .. }, ReflectionFilter::Footprint) => REFLECTION_CUBE,
         (ReflectionMode::DynamicCubeMap { .. }, ReflectionFilter::Bilinear) => {
             REFLECTION_CUBE_BILINEAR
+        }
+        (ReflectionMode::StaticEnvironment, ReflectionFilter::Footprint) if env_cube => {
+            REFLECTION_ENV_CUBE
+        }
+        (ReflectionMode::StaticEnvironment, ReflectionFilter::Bilinear) if env_cube => {
+            REFLECTION_ENV_CUBE_BILINEAR
         }
         _ => REFLECTION_ENVIRONMENT,
     });
@@ -296,6 +374,11 @@ fn scene_bytes(
     b.vec4(uniform, 0.0);
     let height = scene.ground.as_ref().map_or(0.0, |g| g.height_m);
     b.u32(ground_material).f32(height).u32(face_size).u32(0);
+    // The environment image: (first texel, width, height) of an equirect, (first texel,
+    // face size) of cube faces.
+    for w in env_image {
+        b.u32(w);
+    }
     b.0
 }
 
