@@ -307,16 +307,7 @@ fn write_png(path: &Path, (w, h): (u32, u32), rgb: impl Fn(u32, u32) -> [u8; 3])
 #[test]
 fn equirect_environment_through_wgpu_matches_the_cpu_backend_in_ciede2000() {
     let dir = tempfile::tempdir().unwrap();
-    write_png(&dir.path().join("env.png"), (48, 24), |x, y| {
-        let stripe = if (x / 6 + y / 4) % 2 == 0 { 40 } else { 0 };
-        [
-            (40 + 4 * x) as u8,
-            (30 + 8 * y) as u8,
-            (200 - 3 * x + stripe) as u8,
-        ]
-    });
-    let scene = environment_scene("[environment]\nkind = \"equirect\"\npath = \"env.png\"");
-    std::fs::write(dir.path().join("equirect.toml"), scene).unwrap();
+    write_equirect_scene(dir.path());
     let mut measured = Vec::new();
     for reflection in ["dynamic", "static"] {
         let flags = ["--reflection", reflection];
@@ -332,6 +323,37 @@ fn equirect_environment_through_wgpu_matches_the_cpu_backend_in_ciede2000() {
             "{reflection}: 99th percentile ΔE2000 {p99} > 1.2"
         );
     }
+}
+
+/// Writes `equirect.toml`, [`environment_scene`] under a generated 48×24 equirect
+/// `env.png` that varies along both axes and is asymmetric about every meridian.
+fn write_equirect_scene(dir: &Path) {
+    write_png(&dir.join("env.png"), (48, 24), |x, y| {
+        let stripe = if (x / 6 + y / 4) % 2 == 0 { 40 } else { 0 };
+        [
+            (40 + 4 * x) as u8,
+            (30 + 8 * y) as u8,
+            (200 - 3 * x + stripe) as u8,
+        ]
+    });
+    let scene = environment_scene("[environment]\nkind = \"equirect\"\npath = \"env.png\"");
+    std::fs::write(dir.join("equirect.toml"), scene).unwrap();
+}
+
+/// Sphere-map reflections (issue 24): the bubble reads the mirror-ball image the CLI
+/// makes from the environment (`SphereMap::from_environment`) as `SphereMap::sample`
+/// does; the equirect environment makes every direction's colour its own, so a flipped
+/// axis of the map shows on the bubble.
+#[test]
+fn sphere_map_reflection_through_wgpu_matches_the_cpu_backend_in_ciede2000() {
+    let dir = tempfile::tempdir().unwrap();
+    write_equirect_scene(dir.path());
+    let flags = ["--reflection", "sphere-map"];
+    let Some((mean, p99)) = scene_file_against_cpu("equirect.toml", dir.path(), 128, &flags) else {
+        return;
+    };
+    assert!(mean <= 0.25, "mean ΔE2000 {mean} > 0.25");
+    assert!(p99 <= 1.2, "99th percentile ΔE2000 {p99} > 1.2");
 }
 
 /// Cube-face environment (issue 24): the sky reads level 0 as `CubeMap::sample`, the

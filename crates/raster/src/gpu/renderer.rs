@@ -142,7 +142,7 @@ impl GpuRenderer {
         settings.validate()?;
         scene.validate()?;
         tables.validate_for(scene)?;
-        check_supported(scene, settings)?;
+        check_supported(scene)?;
         let (w, h) = (settings.width as u32, settings.height as u32);
         self.gpu.check_size(w, h)?;
         let view = scene.camera.view(settings.width, settings.height);

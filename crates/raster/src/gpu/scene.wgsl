@@ -46,6 +46,10 @@ struct Scene {
     // The environment image in `images`: first texel, width, height of an equirect; first
     // texel, face size of cube faces (scene_data.rs `Atlas`).
     env_image: vec4<u32>,
+    // The sphere map in `images`: first texel, width, height; then its map_from_world by
+    // rows (spheremap.rs `SphereMap`).
+    sphere_image: vec4<u32>,
+    sphere_from_world: array<vec4<f32>, 3>,
 }
 
 struct Material {
@@ -220,6 +224,27 @@ fn equirect_sample(img: vec4<u32>, dir: vec3<f32>) -> vec3<f32> {
     return image_bilinear(img.x, img.y, split_repeat(u, img.y), split_clamp(v, img.z));
 }
 
+// texture.rs `Texture::sample_clamp` of the image `img` = (first texel, width, height).
+fn image_clamp(img: vec4<u32>, u: f32, v: f32) -> vec3<f32> {
+    return image_bilinear(img.x, img.y, split_clamp(u, img.y), split_clamp(v, img.z));
+}
+
+// spheremap.rs `SphereMap::sample`: the mirror ball's image at the reflected direction
+// `dir` (any length) turned into map space: u = r.x/m + ½, v = ½ − r.y/m,
+// m = 2·√(r.x² + r.y² + (r.z + 1)²).
+fn sphere_map_sample(dir: vec3<f32>) -> vec3<f32> {
+    let rows = scene.sphere_from_world;
+    let q = vec3<f32>(dot(rows[0].xyz, dir), dot(rows[1].xyz, dir), dot(rows[2].xyz, dir));
+    let r = normalize_or(q, vec3<f32>(0.0, 0.0, 1.0));
+    let m = 2.0 * sqrt(r.x * r.x + r.y * r.y + (r.z + 1.0) * (r.z + 1.0));
+    // At r = −Z every rim point is the answer: the rim's right-hand side, as the CPU.
+    var uv = vec2<f32>(1.0, 0.5);
+    if (m > 1e-6) {
+        uv = vec2<f32>(r.x / m + 0.5, 0.5 - r.y / m);
+    }
+    return image_clamp(scene.sphere_image, uv.x, uv.y);
+}
+
 // cubemap.rs `CubeMap::sample` of cube faces stored in the atlas: level 0's six bordered
 // (n + 2)² faces from texel `first`, n = `size`; `cube_level_bilinear`'s arithmetic.
 fn env_cube_sample(first: u32, size: u32, dir: vec3<f32>) -> vec3<f32> {
@@ -243,15 +268,18 @@ fn env_cube_sample(first: u32, size: u32, dir: vec3<f32>) -> vec3<f32> {
     return top + (bottom - top) * ty;
 }
 
-// reflection.rs `Reflection::sample` of `Reflection::Env`: the environment's cube faces
-// through their mip chain (chain 0 of `cube_mips`), filtered as a dynamic cube map is, or
-// the environment itself.
+// reflection.rs `Reflection::sample` of `Reflection::Env` and `Reflection::Sphere`: the
+// environment's cube faces through their mip chain (chain 0 of `cube_mips`), filtered as
+// a dynamic cube map is, the sphere map, or the environment itself.
 fn static_reflection(dir: vec3<f32>, derivatives: array<vec3<f32>, 2>) -> vec3<f32> {
     if (scene.reflection == REFLECTION_ENV_CUBE) {
         return cube_footprint(0u, dir, derivatives[0], derivatives[1]);
     }
     if (scene.reflection == REFLECTION_ENV_CUBE_BILINEAR) {
         return cube_sample(0u, dir);
+    }
+    if (scene.reflection == REFLECTION_SPHERE_MAP) {
+        return sphere_map_sample(dir);
     }
     return env_radiance(dir);
 }

@@ -4,7 +4,7 @@
 // Without the `wgpu` feature only the naga layout test uses this module.
 #![cfg_attr(not(feature = "wgpu"), allow(dead_code))]
 
-use glam::Vec3;
+use glam::{Mat3, Vec3};
 
 use super::GpuError;
 use render_scene::bubble_order::{far_to_near, is_front_facing, reflection_rate};
@@ -40,6 +40,8 @@ pub(super) const REFLECTION_CUBE_BILINEAR: u32 = 2;
 pub(super) const REFLECTION_ENV_CUBE: u32 = 3;
 /// [`REFLECTION_ENV_CUBE`] read with one bilinear tap ([`ReflectionFilter::Bilinear`]).
 pub(super) const REFLECTION_ENV_CUBE_BILINEAR: u32 = 4;
+/// `Scene.reflection` of a sphere map (`Scene.sphere_image` in the image atlas).
+pub(super) const REFLECTION_SPHERE_MAP: u32 = 5;
 /// `Scene.transmittance_table` when `T = 1 − R`.
 pub(super) const NO_TABLE: u32 = u32::MAX;
 
@@ -183,13 +185,7 @@ fn unsupported(what: impl Into<String>) -> GpuError {
 }
 
 /// Refuses what the wgpu backend does not draw yet, naming it.
-pub(super) fn check_supported(
-    scene: &RenderScene,
-    settings: &RenderSettings,
-) -> Result<(), GpuError> {
-    if let ReflectionMode::SphereMap(_) = settings.reflection {
-        return Err(unsupported("reflection mode sphere-map"));
-    }
+pub(super) fn check_supported(scene: &RenderScene) -> Result<(), GpuError> {
     if scene.water.is_some() {
         return Err(unsupported("a water surface (the [water] section)"));
     }
@@ -241,6 +237,14 @@ impl SceneData {
             Environment::CubeFaces(c) => atlas.push(c.level_texels(0), c.face_size(), 0),
             Environment::Sky(_) | Environment::Uniform(_) => [0; 4],
         };
+        let sphere = match &settings.reflection {
+            ReflectionMode::SphereMap(map) => {
+                let t = map.texture();
+                let image = atlas.push(t.texels(), t.width(), t.height());
+                Some((image, map.map_from_world()))
+            }
+            _ => None,
+        };
         // The static environment's cube faces are read as a bubble's cube map is, from
         // `cube_mips` (chain 0): `face_size` is then theirs.
         let env_cube = match (&settings.reflection, &scene.environment) {
@@ -266,6 +270,7 @@ impl SceneData {
                 filter,
                 [face_size, ground_material],
                 env_image,
+                sphere,
                 tables,
             ),
             materials: material_bytes(&materials),
@@ -329,6 +334,7 @@ fn scene_bytes(
     filter: ReflectionFilter,
     [face_size, ground_material]: [u32; 2],
     env_image: [u32; 4],
+    sphere: Option<([u32; 4], Mat3)>,
     tables: &FilmTables,
 ) -> Vec<u8> {
     let mut b = Bytes::default();
@@ -355,6 +361,7 @@ fn scene_bytes(
         (ReflectionMode::StaticEnvironment, ReflectionFilter::Bilinear) if env_cube => {
             REFLECTION_ENV_CUBE_BILINEAR
         }
+        (ReflectionMode::SphereMap(_), _) => REFLECTION_SPHERE_MAP,
         _ => REFLECTION_ENVIRONMENT,
     });
     // Table 0 is the reflectivity, 1 the transmittance when there is one.
@@ -378,6 +385,15 @@ fn scene_bytes(
     // face size) of cube faces.
     for w in env_image {
         b.u32(w);
+    }
+    // The sphere map: its image (first texel, width, height), then the rows of its
+    // `map_from_world`.
+    let (image, map_from_world) = sphere.unwrap_or(([0; 4], Mat3::IDENTITY));
+    for w in image {
+        b.u32(w);
+    }
+    for row in 0..3 {
+        b.vec4(map_from_world.row(row).to_array(), 0.0);
     }
     b.0
 }
@@ -623,7 +639,7 @@ mod tests {
         scene.bubbles[2].film = film(&other);
         scene.bubbles[3].film = film(&shared);
         // The wgpu backend draws film fields: nothing refuses them.
-        check_supported(&scene, &settings).unwrap();
+        check_supported(&scene).unwrap();
         let tables = FilmTables::from_reflectivity(
             render_scene::Lut::try_from_fn(4, 4, 1000.0, |_, _| [0.1; 3]).unwrap(),
         );
