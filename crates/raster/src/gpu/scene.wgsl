@@ -426,9 +426,20 @@ fn vs_ground(@location(0) ndc_depth: vec3<f32>) -> FullScreen {
 
 @fragment
 fn fs_ground(in: FullScreen) -> @location(0) vec4<f32> {
-    let inv_t = max(ground_inv_depth(in.pix), 1e-30);
+    // The CPU shades the ground once per pixel (`background_pixel`), at the centre where
+    // the plane covers every sample: so does this where the plane covers the whole pixel
+    // (its inverse depth, affine in pixel space, positive at all four corners), also
+    // along the internal edges of the clipped polygon, where each triangle's centroid
+    // would fall elsewhere (visible where an image is minified). Elsewhere (the horizon)
+    // at the covered samples' centroid.
+    var pix = in.pix;
+    let corner_margin = 0.5 * (abs(view.ground.y) + abs(view.ground.z));
+    if (ground_inv_depth(in.position.xy) - corner_margin > 0.0) {
+        pix = in.position.xy;
+    }
+    let inv_t = max(ground_inv_depth(pix), 1e-30);
     let t = 1.0 / inv_t;
-    let d = view_ray(in.pix);
+    let d = view_ray(pix);
     let p = view.eye.xyz + d * t;
     // passes.rs `shade_ground`: footprint of one pixel on the plane.
     let inv_dy = t * view.ground.w;
