@@ -213,7 +213,9 @@ pub(super) fn add_blend() -> wgpu::BlendState {
 
 impl Pipelines {
     pub(super) fn new(device: &wgpu::Device, layouts: &Layouts, samples: u32) -> Pipelines {
-        let object_attrs = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Uint32];
+        let object_attrs = wgpu::vertex_attr_array![
+            0 => Float32x3, 1 => Float32x3, 2 => Uint32, 3 => Float32x2
+        ];
         let objects = [Some(wgpu::VertexBufferLayout {
             array_stride: OBJECT_VERTEX_BYTES,
             step_mode: wgpu::VertexStepMode::Vertex,

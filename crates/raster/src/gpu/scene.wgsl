@@ -59,6 +59,9 @@ struct Material {
     b: vec4<f32>,
     // specular rgb, pattern kind
     specular: vec4<f32>,
+    // a textured material's image in `images`: first texel, width, height (its repeat on
+    // the ground is `a.w` metres)
+    image: vec4<u32>,
 }
 
 struct Light {
@@ -224,6 +227,11 @@ fn equirect_sample(img: vec4<u32>, dir: vec3<f32>) -> vec3<f32> {
     return image_bilinear(img.x, img.y, split_repeat(u, img.y), split_clamp(v, img.z));
 }
 
+// texture.rs `Texture::sample_repeat` of the image `img` = (first texel, width, height).
+fn image_repeat(img: vec4<u32>, u: f32, v: f32) -> vec3<f32> {
+    return image_bilinear(img.x, img.y, split_repeat(u, img.y), split_repeat(v, img.z));
+}
+
 // texture.rs `Texture::sample_clamp` of the image `img` = (first texel, width, height).
 fn image_clamp(img: vec4<u32>, u: f32, v: f32) -> vec3<f32> {
     return image_bilinear(img.x, img.y, split_clamp(u, img.y), split_clamp(v, img.z));
@@ -362,8 +370,12 @@ fn surface_footprint(d: vec3<f32>, t: f32, n: vec3<f32>) -> vec3<f32> {
     return select(vec3<f32>(1e6), f, f < vec3<f32>(1e6));
 }
 
-// shading.rs `object_albedo` (solid, and the 3-D checker box-filtered over `footprint`).
-fn object_albedo(m: Material, p: vec3<f32>, footprint: vec3<f32>) -> vec3<f32> {
+// shading.rs `object_albedo` (solid, the 3-D checker box-filtered over `footprint`, an
+// image at the mesh's `uv`).
+fn object_albedo(m: Material, p: vec3<f32>, uv: vec2<f32>, footprint: vec3<f32>) -> vec3<f32> {
+    if (m.specular.w == PATTERN_TEXTURED) {
+        return image_repeat(m.image, uv.x, uv.y);
+    }
     if (m.specular.w != PATTERN_CHECKER) {
         return m.a.xyz;
     }
@@ -455,6 +467,10 @@ fn fs_ground(in: FullScreen) -> @location(0) vec4<f32> {
         let w = filtered_checker(vec2<f32>(p.x * inv, p.z * inv), footprint * inv);
         albedo = lerp3(m.a.xyz, m.b.xyz, w);
     }
+    // shading.rs `ground_albedo` of an image: one repeat per `scale_m` along x and z.
+    if (m.specular.w == PATTERN_TEXTURED) {
+        albedo = image_repeat(m.image, p.x / m.a.w, p.z / m.a.w);
+    }
     let normal = vec3<f32>(0.0, view.ground_ddx.w, 0.0);
     return vec4<f32>(lit(m, albedo, p, normal, d), 1.0);
 }
@@ -465,6 +481,7 @@ struct ObjectIn {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) tag: u32,
+    @location(3) uv: vec2<f32>,
 }
 
 struct ObjectOut {
@@ -472,11 +489,12 @@ struct ObjectOut {
     @location(0) @interpolate(perspective, centroid) world: vec3<f32>,
     @location(1) @interpolate(perspective, centroid) normal: vec3<f32>,
     @location(2) @interpolate(flat) tag: u32,
+    @location(3) @interpolate(perspective, centroid) uv: vec2<f32>,
 }
 
 @vertex
 fn vs_object(in: ObjectIn) -> ObjectOut {
-    return ObjectOut(clip_of(in.position), in.position, in.normal, in.tag);
+    return ObjectOut(clip_of(in.position), in.position, in.normal, in.tag, in.uv);
 }
 
 @fragment
@@ -491,7 +509,8 @@ fn fs_object(in: ObjectOut) -> @location(0) vec4<f32> {
     let rel = in.world - view.eye.xyz;
     let t = dot(rel, view.forward.xyz);
     let footprint = surface_footprint(rel / t, t, n);
-    return vec4<f32>(lit(m, object_albedo(m, in.world, footprint), in.world, n, v), 1.0);
+    let albedo = object_albedo(m, in.world, in.uv, footprint);
+    return vec4<f32>(lit(m, albedo, in.world, n, v), 1.0);
 }
 
 // ---- bubbles -----------------------------------------------------------------------------

@@ -20,6 +20,8 @@ use render_scene::{
 pub(super) const PATTERN_SOLID: f32 = 0.0;
 /// `Material.specular.w` of a checkerboard.
 pub(super) const PATTERN_CHECKER: f32 = 1.0;
+/// `Material.specular.w` of an image (`Material.image` in the image atlas).
+pub(super) const PATTERN_TEXTURED: f32 = 2.0;
 /// `Scene.env_kind` of a procedural sky.
 pub(super) const ENV_SKY: u32 = 0;
 /// `Scene.env_kind` of a uniform environment.
@@ -47,8 +49,8 @@ pub(super) const NO_TABLE: u32 = u32::MAX;
 
 /// Bytes of the WGSL `View` struct.
 pub(super) const VIEW_BYTES: u64 = 9 * 16;
-/// Bytes of one object vertex: position, normal, tag.
-pub(super) const OBJECT_VERTEX_BYTES: u64 = 28;
+/// Bytes of one object vertex: position, normal, tag, texture uv.
+pub(super) const OBJECT_VERTEX_BYTES: u64 = 36;
 /// Bytes of one bubble vertex: position, normal, thickness, pixel angle, bubble index,
 /// material direction (zero without a film field), and the bubble's film field as
 /// (first texel in the film texture, face size; face size 0: no field).
@@ -171,7 +173,8 @@ pub(super) struct SceneData {
     /// (`FilmField::bordered`, `[thickness_nm, coverage]` as Rg32Float), one after
     /// another, texel `i` at `(i mod width, i div width)`.
     pub films: FilmTexture,
-    /// The image atlas (`Atlas`): the environment's image or cube faces, as Rgba32Float.
+    /// The image atlas (`Atlas`): the environment's image or cube faces, the sphere map,
+    /// the materials' images, as Rgba32Float.
     pub images: LutTexture,
     /// The environment cube faces' whole mip chain as f32 RGB in `CubeMap`'s level layout
     /// (what `cube_mips` holds per bubble) when the static environment reflects in the
@@ -188,12 +191,6 @@ fn unsupported(what: impl Into<String>) -> GpuError {
 pub(super) fn check_supported(scene: &RenderScene) -> Result<(), GpuError> {
     if scene.water.is_some() {
         return Err(unsupported("a water surface (the [water] section)"));
-    }
-    let ground = scene.ground.iter().map(|g| &g.material);
-    for m in scene.objects.iter().map(|o| o.material()).chain(ground) {
-        if let Pattern::Textured { .. } = m.pattern {
-            return Err(unsupported("a textured material"));
-        }
     }
     Ok(())
 }
@@ -256,6 +253,7 @@ impl SceneData {
             (_, Some(c)) => c.face_size() as u32,
             _ => 0,
         };
+        let material_bytes = material_bytes(&materials, &mut atlas);
         let env_chain: Vec<u8> = env_cube.map_or(Vec::new(), |c| {
             (0..c.levels())
                 .flat_map(|level| c.level_texels(level))
@@ -273,7 +271,7 @@ impl SceneData {
                 sphere,
                 tables,
             ),
-            materials: material_bytes(&materials),
+            materials: material_bytes,
             lights: light_bytes(&scene.lights, &light_tables),
             objects: object_bytes.0,
             object_vertices,
@@ -398,22 +396,30 @@ fn scene_bytes(
     b.0
 }
 
-fn material_bytes(materials: &[&Material]) -> Vec<u8> {
+/// The WGSL `array<Material>`; a textured material's image goes into `atlas`.
+fn material_bytes(materials: &[&Material], atlas: &mut Atlas) -> Vec<u8> {
     let mut b = Bytes::default();
     for m in materials {
+        let mut image = [0; 4];
         let (a, bb, scale, kind) = match &m.pattern {
             Pattern::Checker { a, b, scale_m } => (*a, *b, *scale_m, PATTERN_CHECKER),
             Pattern::Solid(c) => (*c, *c, 1.0, PATTERN_SOLID),
-            // check_supported refused textures.
-            Pattern::Textured { .. } => ([0.0; 3], [0.0; 3], 1.0, PATTERN_SOLID),
+            Pattern::Textured { texture, scale_m } => {
+                image = atlas.push(texture.texels(), texture.width(), texture.height());
+                ([0.0; 3], [0.0; 3], *scale_m, PATTERN_TEXTURED)
+            }
         };
         b.vec4(a, scale)
             .vec4(bb, m.shininess)
             .vec4(m.specular, kind);
+        for w in image {
+            b.u32(w);
+        }
     }
     if materials.is_empty() {
         b.vec4([0.0; 3], 1.0)
             .vec4([0.0; 3], 1.0)
+            .vec4([0.0; 3], 0.0)
             .vec4([0.0; 3], 0.0);
     }
     b.0
@@ -434,7 +440,7 @@ fn light_bytes(lights: &[Light], tables: &[u32]) -> Vec<u8> {
     b.0
 }
 
-/// Appends `g`'s triangles as three vertices each (position, normal, tag).
+/// Appends `g`'s triangles as three vertices each (position, normal, tag, uv).
 fn push_geometry(b: &mut Bytes, g: &Geometry) {
     for (t, &tag) in g.triangles.iter().zip(&g.tags) {
         for i in t.map(|i| i as usize) {
@@ -443,6 +449,7 @@ fn push_geometry(b: &mut Bytes, g: &Geometry) {
             b.f32(p.x).f32(p.y).f32(p.z);
             b.f32(a[0]).f32(a[1]).f32(a[2]);
             b.u32(tag);
+            b.f32(a[3]).f32(a[4]);
         }
     }
 }
@@ -593,7 +600,7 @@ fn stack_tables(
 mod tests {
     use std::sync::Arc;
 
-    use render_scene::{BubbleFilm, BubbleMesh, Camera, FilmField, Vec3};
+    use render_scene::{BubbleFilm, BubbleMesh, Camera, FilmField, Ground, Texture, Vec3};
 
     use super::*;
 
@@ -703,6 +710,63 @@ mod tests {
             err.to_string().contains("film fields of 150 texels"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn images_go_into_the_atlas_named_by_the_environment_and_their_materials() {
+        let camera = Camera::look_at(Vec3::new(0.0, 1.0, 3.0), Vec3::ZERO, Vec3::Y, 40.0);
+        let env = Texture::try_new(3, 1, vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0], [7.0; 3]]);
+        let mut scene = RenderScene::new(camera, Environment::Equirect(env.unwrap()));
+        let texture = Texture::try_new(1, 2, vec![[10.0; 3], [11.0; 3]]).unwrap();
+        scene.ground = Some(Ground {
+            height_m: 0.0,
+            material: Material {
+                pattern: Pattern::Textured {
+                    texture,
+                    scale_m: 0.5,
+                },
+                specular: [0.0; 3],
+                shininess: 1.0,
+            },
+        });
+        check_supported(&scene).unwrap();
+        let lut = render_scene::Lut::try_from_fn(2, 2, 1000.0, |_, _| [0.1; 3]).unwrap();
+        let tables = FilmTables::from_reflectivity(lut);
+        let settings = RenderSettings::default();
+        let view = scene.camera.view(16, 16);
+        let pack = |max_side| {
+            SceneData::new(
+                &scene,
+                &tables,
+                &settings,
+                &view,
+                max_side,
+                ReflectionFilter::Footprint,
+            )
+        };
+        let data = pack(3).unwrap();
+        // Rows of 3 texels: the environment's three, the ground's two, one of padding.
+        let (width, height, bytes) = &data.images;
+        assert_eq!((*width, *height), (3, 2));
+        let want = [
+            [1.0, 2.0, 3.0, 1.0],
+            [4.0, 5.0, 6.0, 1.0],
+            [7.0, 7.0, 7.0, 1.0],
+            [10.0, 10.0, 10.0, 1.0],
+            [11.0, 11.0, 11.0, 1.0],
+            [0.0; 4],
+        ];
+        assert_eq!(floats(bytes), want.concat());
+        // Scene.env_image after 9 + 6 vec4s and 8 words: first texel 0, 3 × 1.
+        assert_eq!(words(&data.scene)[68..72], [0, 3, 1, 0]);
+        // The ground, the only material: textured, 0.5 m a repeat, image at texel 3, 1 × 2.
+        let m = words(&data.materials);
+        assert_eq!(f32::from_bits(m[11]), PATTERN_TEXTURED);
+        assert_eq!(f32::from_bits(m[3]), 0.5);
+        assert_eq!(m[12..16], [3, 1, 2, 0]);
+        // Rows of 2: three rows, more than the device's 2: named, never drawn otherwise.
+        let err = pack(2).unwrap_err();
+        assert!(err.to_string().contains("images of 5 texels"), "{err}");
     }
 
     #[test]
