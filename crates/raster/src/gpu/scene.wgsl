@@ -685,11 +685,10 @@ fn cube_lod(footprint_rad: f32, s: f32, t: f32) -> f32 {
     return 0.0;
 }
 
-// cubemap.rs `CubeMap::sample_trilinear`.
-fn cube_trilinear(bubble: u32, dir: vec3<f32>, footprint_rad: f32) -> vec3<f32> {
-    let fst = face_coordinates(dir);
+// cubemap.rs `CubeMap::trilinear`: the seamless trilinear tap at face coordinates `fst`
+// and level `lod` in [0, levels − 1].
+fn cube_trilinear(bubble: u32, fst: vec3<f32>, lod: f32) -> vec3<f32> {
     let last = mip_levels() - 1u;
-    let lod = min(cube_lod(footprint_rad, fst.y, fst.z), f32(last));
     let l0 = u32(lod);
     let frac = lod - f32(l0);
     let a = cube_level_bilinear(bubble, l0, fst);
@@ -700,7 +699,10 @@ fn cube_trilinear(bubble: u32, dir: vec3<f32>, footprint_rad: f32) -> vec3<f32> 
     return a + (b - a) * frac;
 }
 
-// cubemap.rs `CubeMap::sample_footprint` with lod.rs `anisotropic_taps`.
+// cubemap.rs `CubeMap::sample_footprint` with lod.rs `anisotropic_taps`: one level-0
+// bilinear tap while the longer derivative's footprint stays within level 0; else the
+// axis ratio rounded (1 ..= MAX_ANISOTROPY) trilinear taps spread along the longer
+// derivative, all at the level of the footprint at `dir` (one tap: the longer axis's).
 fn cube_footprint(bubble: u32, dir: vec3<f32>, da: vec3<f32>, db: vec3<f32>) -> vec3<f32> {
     var major = da;
     var minor = db;
@@ -708,23 +710,30 @@ fn cube_footprint(bubble: u32, dir: vec3<f32>, da: vec3<f32>, db: vec3<f32>) -> 
         major = db;
         minor = da;
     }
-    let scale = length(dir);
+    let fst = face_coordinates(dir);
     let major_rad = length(major);
+    let major_lod = cube_lod(major_rad, fst.y, fst.z);
+    if (major_lod <= 0.0) {
+        return cube_level_bilinear(bubble, 0u, fst);
+    }
+    let last = f32(mip_levels() - 1u);
     let minor_rad = length(minor);
+    // Rounded, at least 1 (NaN → 1), at most MAX_ANISOTROPY.
     let ratio = major_rad / max(minor_rad, 1e-12);
-    // NaN or ≤ 1 → one tap.
     var taps = 1u;
-    if (ratio > 1.0) {
-        taps = u32(min(ceil(ratio), f32(MAX_ANISOTROPY)));
+    if (ratio + 0.5 >= 2.0) {
+        taps = u32(min(ratio + 0.5, f32(MAX_ANISOTROPY)));
+    }
+    if (taps == 1u) {
+        return cube_trilinear(bubble, fst, min(major_lod, last));
     }
     let footprint = max(major_rad / f32(taps), minor_rad);
-    if (taps == 1u) {
-        return cube_trilinear(bubble, dir, footprint);
-    }
+    let lod = min(cube_lod(footprint, fst.y, fst.z), last);
+    let step = major * length(dir);
     var sum = vec3<f32>(0.0);
     for (var i = 0u; i < taps; i++) {
         let offset = (f32(i) + 0.5) / f32(taps) - 0.5;
-        sum += cube_trilinear(bubble, dir + major * (offset * scale), footprint);
+        sum += cube_trilinear(bubble, face_coordinates(dir + step * offset), lod);
     }
     return sum / f32(taps);
 }
