@@ -32,7 +32,7 @@ pub use render_scene::{
     BubbleFilm, BubbleMesh, Camera, CubeMap, DEFAULT_NEAR_M, Environment, FilmField, FilmSample,
     FilmTables, Frame, FrameTimings, Ground, Irradiance, Light, Lut, MAX_FACE_SIZE,
     MAX_FILM_THICKNESS_NM, MAX_IMAGE_SIDE, Mat3, Material, Object, PartialShading, Pattern,
-    ReflectionFilter, ReflectionMode, RenderError, RenderScene, RenderSettings, SAMPLE_COUNTS, Sky,
-    SphereMap, Texture, ToneMap, TriMesh, Vec3, WATER_IOR, WaterSurface, linear_to_srgb, refract,
-    sphere_map_direction, sphere_map_uv, tone_map,
+    ReflectionFilter, ReflectionMode, ReflectionParallax, RenderError, RenderScene, RenderSettings,
+    SAMPLE_COUNTS, Sky, SphereMap, Texture, ToneMap, TriMesh, Vec3, WATER_IOR, WaterSurface,
+    linear_to_srgb, refract, sphere_map_direction, sphere_map_uv, tone_map,
 };

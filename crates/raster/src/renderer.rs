@@ -13,7 +13,8 @@ use render_scene::reflection::Reflection;
 use render_scene::tessellate::{Geometry, tessellate};
 use render_scene::{
     BubbleMesh, CubeMap, Environment, FilmField, FilmTables, Frame, FrameTimings, Material,
-    PartialShading, ReflectionFilter, ReflectionMode, RenderError, RenderScene, RenderSettings,
+    PartialShading, ReflectionFilter, ReflectionMode, ReflectionParallax, RenderError, RenderScene,
+    RenderSettings,
 };
 
 use crate::passes::bubble::{BubbleCtx, setup_bubble_tris};
@@ -52,6 +53,9 @@ pub struct Renderer {
     water: WaterPass,
     filter: ReflectionFilter,
     partial: PartialShading,
+    parallax: ReflectionParallax,
+    /// Each bubble's centre, where its cube map was rendered from.
+    centres: Vec<Vec3>,
 }
 
 impl Renderer {
@@ -64,6 +68,13 @@ impl Renderer {
     /// footprint; bilinear is the unfiltered lookup, kept to measure the filter against).
     pub fn set_reflection_filter(&mut self, filter: ReflectionFilter) {
         self.filter = filter;
+    }
+
+    /// Chooses where bubbles' reflected rays read their dynamic cube maps from, from the
+    /// next frame on (default: corrected for the ground's parallax; the centre is seed
+    /// 000's read, kept to measure the correction against).
+    pub fn set_reflection_parallax(&mut self, parallax: ReflectionParallax) {
+        self.parallax = parallax;
     }
 
     /// Chooses how bubble pixels covered in part by a triangle are shaded from the next
@@ -117,6 +128,9 @@ impl Renderer {
         self.bubble_bins.build(&self.bubble_tris, strips);
         let setup_s = start.elapsed().as_secs_f64();
 
+        self.centres.clear();
+        self.centres
+            .extend(scene.bubbles.iter().map(BubbleMesh::center));
         let t = Instant::now();
         if let ReflectionMode::DynamicCubeMap { face_size } = settings.reflection {
             self.render_cube_maps(scene, &materials, face_size);
@@ -167,6 +181,13 @@ impl Renderer {
             .iter()
             .map(|b| b.film.as_ref().map(|f| &*f.field))
             .collect();
+        let corrected = self.parallax == ReflectionParallax::Ground
+            && matches!(settings.reflection, ReflectionMode::DynamicCubeMap { .. });
+        let ground_height_m = scene
+            .ground
+            .as_ref()
+            .filter(|_| corrected)
+            .map(|g| g.height_m);
         let bubbles = BubbleCtx {
             view,
             pattern,
@@ -177,6 +198,8 @@ impl Renderer {
             reflections: &reflections,
             films: &films,
             filter: self.filter,
+            parallax_centres: &self.centres,
+            ground_height_m,
             partial: self.partial,
             tris: &self.bubble_tris,
             bins: &self.bubble_bins,
@@ -254,7 +277,8 @@ impl Renderer {
         setup_bubble_tris(scene, view, &mut self.bubble_tris);
     }
 
-    /// Renders each bubble's six cube faces (the scene without bubbles or light spheres).
+    /// Renders each bubble's six cube faces (the scene without bubbles or light spheres) from
+    /// its centre in `self.centres`.
     fn render_cube_maps(&mut self, scene: &RenderScene, materials: &[&Material], face_size: usize) {
         let n = scene.bubbles.len();
         self.cube_maps.truncate(n);
@@ -268,7 +292,6 @@ impl Renderer {
         self.update_env_cube(&scene.environment, face_size);
         let env_cube = self.env_cube.as_ref().map(|(_, c)| c);
         let m = face_size + 2;
-        let centers: Vec<Vec3> = scene.bubbles.iter().map(BubbleMesh::center).collect();
         let ambient = scene.irradiance.plus_uniform(scene.ambient_rgb);
         let objects = &self.objects;
         let jobs: Vec<_> = self
@@ -282,7 +305,7 @@ impl Renderer {
             let (major, s_axis, t_axis) = FACE_BASES[j % 6];
             let wide = m as f32 / face_size as f32;
             let view = View::new(
-                centers[j / 6],
+                self.centres[j / 6],
                 [major, s_axis, -t_axis],
                 (wide, wide),
                 (m, m),

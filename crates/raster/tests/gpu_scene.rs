@@ -690,3 +690,42 @@ fn gpu_cube_mip_chain_is_the_cpus_build_mips_texel_by_texel() {
     eprintln!("cube mip chains: worst relative difference {worst:e} over {lit} lit channels");
     assert!(lit > 1000, "the faces show the scene");
 }
+
+#[test]
+fn gpu_reads_the_ground_with_parallax_as_the_cpu_does() {
+    let Some(mut gpu) = gpu() else { return };
+    let (scene, tables) = (scene(), tables());
+    let s = settings(
+        200,
+        150,
+        4,
+        ReflectionMode::DynamicCubeMap { face_size: 48 },
+    );
+    let cpu_with = |parallax| {
+        let mut cpu = cpu_renderer();
+        cpu.set_reflection_parallax(parallax);
+        let frame = cpu.render(&scene, &tables, &s).unwrap();
+        frame.to_srgb8(s.exposure_ev, s.tonemap)
+    };
+    let cpu = cpu_with(raster::ReflectionParallax::Ground);
+    let centred = cpu_with(raster::ReflectionParallax::Centre);
+    // The pixels the correction moves by more than ΔE 1 on the CPU.
+    let moved = per_pixel_delta_e(&cpu, &centred);
+    let keep = |i: usize| moved[i] > 1.0;
+    let mut gpu_with = |parallax| {
+        gpu.set_reflection_parallax(parallax);
+        gpu.render_srgb8(&scene, &tables, &s).unwrap()
+    };
+    let corrected = gpu_with(raster::ReflectionParallax::Ground);
+    let from_centre = gpu_with(raster::ReflectionParallax::Centre);
+    let (same, n) = mean_over(&cpu, &corrected, keep);
+    let (unported, _) = mean_over(&cpu, &from_centre, keep);
+    eprintln!(
+        "{n} pixels moved by the correction: GPU mean ΔE2000 {same:.3} (GPU from the centre: {unported:.3})"
+    );
+    assert!(n > 300, "only {n} pixels show the correction");
+    assert!(
+        same < 0.25 * unported && same < 1.0,
+        "GPU corrected reads are {same:.3} from the CPU's (uncorrected: {unported:.3})"
+    );
+}

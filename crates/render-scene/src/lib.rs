@@ -12,7 +12,7 @@
 //!   [`WaterSurface`], [`Texture`]s, [`SphereMap`]s and [`CubeMap`]s;
 //! - the per-pixel formulas: opaque [`shading`], the LUT lookup ([`lut_sampler`]), cube-map
 //!   sampling and its footprint filter ([`cubemap`], [`lod`]), a bubble's [`reflection`]
-//!   and light [`highlight`], the ground plane per view ([`ground_view`]), the water's
+//!   with its [`parallax`] correction and light [`highlight`], the ground plane per view ([`ground_view`]), the water's
 //!   Fresnel blend ([`water_shading`]) and the tone curve ([`frame`]);
 //! - [`shader_constants`]: every CPU-defined constant a shader sees, in one list.
 //!
@@ -38,6 +38,7 @@ pub mod lut_sampler;
 mod material;
 pub mod mesh;
 mod obj;
+pub mod parallax;
 pub mod reflection;
 mod scene;
 pub mod settings;
@@ -62,8 +63,8 @@ pub use material::{Material, Pattern};
 pub use mesh::TriMesh;
 pub use scene::{BubbleMesh, FilmTables, Ground, Light, Object, RenderScene};
 pub use settings::{
-    MAX_IMAGE_SIDE, PartialShading, ReflectionFilter, ReflectionMode, RenderSettings,
-    SAMPLE_COUNTS, ToneMap,
+    MAX_IMAGE_SIDE, PartialShading, ReflectionFilter, ReflectionMode, ReflectionParallax,
+    RenderSettings, SAMPLE_COUNTS, ToneMap,
 };
 pub use spheremap::SphereMap;
 pub use texture::Texture;

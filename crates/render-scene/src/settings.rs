@@ -39,6 +39,19 @@ pub enum ReflectionFilter {
     Footprint,
 }
 
+/// Where a bubble's reflected rays start when they read its dynamic cube map.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ReflectionParallax {
+    /// From the film: a ray heading for the ground reads the cube map towards the point
+    /// where it meets the ground plane (`parallax::ground_parallax`), so the near ground
+    /// reflects where a ray traced from the film finds it.
+    #[default]
+    Ground,
+    /// From the bubble's centre, as the cube map was rendered (seed 000 §4.2.2): the near
+    /// ground shifts by up to a bubble radius. Kept to measure the correction against.
+    Centre,
+}
+
 /// How the bubble pass shades a pixel that a triangle covers only in part.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum PartialShading {

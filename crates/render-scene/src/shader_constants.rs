@@ -8,7 +8,7 @@ use crate::frame::{
 };
 use crate::highlight::HIGHLIGHT_SIGMA_PX;
 use crate::lod::{LOD_BIAS, MAX_ANISOTROPY, MIN_FOOTPRINT_TEXELS};
-use crate::shading::FLAT_FOOTPRINT_CELLS;
+use crate::shading::{FLAT_FOOTPRINT_CELLS, GROUND_QUARTER_OFFSET_PX};
 
 pub use crate::cubemap::FACE_BASES;
 pub use crate::frame::{ACES_DENOMINATOR, ACES_NUMERATOR};
@@ -37,9 +37,10 @@ pub const TONE_SCALARS: [(&str, f32); 6] = [
 
 /// The scene shading's f32 constants (highlight filter, checker filter, cube-map LOD), by
 /// WGSL name.
-pub const SCENE_SCALARS: [(&str, f32); 4] = [
+pub const SCENE_SCALARS: [(&str, f32); 5] = [
     ("HIGHLIGHT_SIGMA_PX", HIGHLIGHT_SIGMA_PX),
     ("FLAT_FOOTPRINT_CELLS", FLAT_FOOTPRINT_CELLS),
+    ("GROUND_QUARTER_OFFSET_PX", GROUND_QUARTER_OFFSET_PX),
     ("LOD_BIAS", LOD_BIAS),
     ("MIN_FOOTPRINT_TEXELS", MIN_FOOTPRINT_TEXELS),
 ];

@@ -82,6 +82,42 @@ pub fn ground_albedo(material: &Material, x: f32, z: f32, footprint: [f32; 2]) -
     }
 }
 
+/// Offset, in pixels along each screen axis, of the centres of the four quarter-pixel boxes
+/// the ground's checker is filtered over ([`ground_albedo_over_pixel`]).
+pub const GROUND_QUARTER_OFFSET_PX: f32 = 0.25;
+
+/// Albedo of the ground averaged over the pixel whose centre sees `(x, z)`, the plane point
+/// moving by `dpx` and `dpy` (metres along x and z) per pixel along the screen's x and y.
+///
+/// A box filter over one pixel's axis-aligned footprint `|dpx| + |dpy|` is up to twice as
+/// wide as the pixel along an axis where the checker is seen obliquely (the bounding box
+/// of the pixel's parallelogram), and blurs its edges. The pixel is split in 2 × 2
+/// quarters instead, each box-filtered over its own half-size footprint: their union hugs
+/// the parallelogram. Against the converged reference this took `paper`'s ground from a
+/// mean ΔE2000 of 0.17 to 0.09 (docs/reference.md). Textures are point-sampled at the
+/// centre, as [`ground_albedo`] samples them.
+#[inline]
+pub fn ground_albedo_over_pixel(
+    material: &Material,
+    x: f32,
+    z: f32,
+    dpx: [f32; 2],
+    dpy: [f32; 2],
+) -> [f32; 3] {
+    let Pattern::Checker { a, b, scale_m } = &material.pattern else {
+        return ground_albedo(material, x, z, [0.0; 2]);
+    };
+    let inv = 1.0 / *scale_m;
+    let f = [0, 1].map(|k| 0.5 * (dpx[k].abs() + dpy[k].abs()) * inv);
+    let o = GROUND_QUARTER_OFFSET_PX;
+    let mut sum = 0.0;
+    for (sx, sy) in [(-o, -o), (o, -o), (-o, o), (o, o)] {
+        let q = [x + sx * dpx[0] + sy * dpy[0], z + sx * dpx[1] + sy * dpy[1]];
+        sum += filtered_checker([q[0] * inv, q[1] * inv], f);
+    }
+    crate::environment::lerp3(*a, *b, 0.25 * sum)
+}
+
 /// Radiance leaving point `p` with unit normal `n` towards a viewer looking along `v`
 /// (any positive length: it is normalised only when the material has a specular lobe).
 ///

@@ -15,11 +15,15 @@ pub enum GpuBackend {}
 
 #[cfg(feature = "wgpu")]
 impl GpuBackend {
-    /// Opens the first suitable adapter; without one, an input error (exit 2) naming the
-    /// driver package, `VK_DRIVER_FILES` and `--backend cpu`.
-    pub fn open() -> Result<Self, CliError> {
+    /// Opens the first suitable adapter, reading cube maps with `parallax`; without one,
+    /// an input error (exit 2) naming the driver package, `VK_DRIVER_FILES` and
+    /// `--backend cpu`.
+    pub fn open(parallax: raster::ReflectionParallax) -> Result<Self, CliError> {
         raster::gpu::GpuRenderer::new(raster::gpu::GpuOptions::default())
-            .map(|renderer| GpuBackend(renderer, false))
+            .map(|mut renderer| {
+                renderer.set_reflection_parallax(parallax);
+                GpuBackend(renderer, false)
+            })
             .map_err(|e| CliError::input(format!("--backend wgpu: {e}")))
     }
 
@@ -54,7 +58,7 @@ impl GpuBackend {
 #[cfg(not(feature = "wgpu"))]
 impl GpuBackend {
     /// Always an input error (exit 2): this binary has no wgpu backend.
-    pub fn open() -> Result<Self, CliError> {
+    pub fn open(_: raster::ReflectionParallax) -> Result<Self, CliError> {
         Err(CliError::input(
             "--backend wgpu: this bubbles was built without the wgpu backend; rebuild it with \
              `cargo build --release -p bubbles --features wgpu`, or use --backend cpu",

@@ -16,9 +16,10 @@ use bubble_dynamics::{BubbleParams, Event, World};
 use lut::LutSet;
 use raster::{Camera, FilmTables, Frame, RenderScene, RenderSettings, Renderer};
 
-/// The CPU renderer with `--partial-shading` applied.
+/// The CPU renderer with `--partial-shading` and `--reflection-origin` applied.
 fn renderer(options: &Options) -> Renderer {
     let mut renderer = Renderer::new();
+    renderer.set_reflection_parallax(options.reflection_origin.parallax());
     renderer.set_partial_shading(match options.partial_shading {
         PartialShading::PerSurface => raster::PartialShading::PerSurface,
         PartialShading::PerTriangle => raster::PartialShading::PerTriangle,
@@ -75,7 +76,7 @@ impl FrameJob {
             }
         };
         let gpu = match options.backend {
-            Backend::Wgpu => Some(gpu::GpuBackend::open()?),
+            Backend::Wgpu => Some(gpu::GpuBackend::open(options.reflection_origin.parallax())?),
             Backend::Cpu | Backend::Reference => None,
         };
         Ok(Self {

@@ -22,6 +22,11 @@ pub struct Options {
     /// Bubble reflections: dynamic cube maps, the static environment, or a sphere map (seed 002).
     #[arg(long, value_enum)]
     pub reflection: Option<Reflection>,
+    /// Where reflected rays read the dynamic cube maps from: where they meet the ground
+    /// (parallax-corrected), or the bubble's centre, as seed 000 reads them (to measure the
+    /// correction against). CPU and wgpu backends.
+    #[arg(long, value_enum, default_value_t = ReflectionOrigin::Film)]
+    pub reflection_origin: ReflectionOrigin,
     /// Face size of the dynamic cube maps, 1..=1024 texels (default: the scene's, else 128).
     #[arg(long)]
     pub cube_map_size: Option<usize>,
@@ -72,6 +77,26 @@ pub enum Reflection {
     Static,
     /// A sphere map made from the environment (seed 002).
     SphereMap,
+}
+
+/// Where reflected rays start when they read a dynamic cube map (`raster::ReflectionParallax`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum ReflectionOrigin {
+    /// From the film: rays that meet the ground read it where they meet it.
+    #[default]
+    Film,
+    /// From the bubble's centre (seed 000 §4.2.2).
+    Centre,
+}
+
+impl ReflectionOrigin {
+    /// The renderers' setting.
+    pub fn parallax(self) -> raster::ReflectionParallax {
+        match self {
+            Self::Film => raster::ReflectionParallax::Ground,
+            Self::Centre => raster::ReflectionParallax::Centre,
+        }
+    }
 }
 
 /// How the CPU backend shades partly covered bubble pixels (`raster::PartialShading`).

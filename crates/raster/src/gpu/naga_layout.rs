@@ -6,12 +6,12 @@ use glam::Vec3;
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use naga::{Module, TypeInner};
 use render_scene::{
-    Camera, Environment, FilmTables, Ground, Light, Lut, Material, Object, ReflectionFilter,
-    RenderScene, RenderSettings,
+    Camera, Environment, FilmTables, Ground, Light, Lut, Material, Object, RenderScene,
+    RenderSettings,
 };
 
 use super::scene_data::{
-    BUBBLE_VERTEX_BYTES, OBJECT_VERTEX_BYTES, SceneData, VIEW_BYTES, view_bytes,
+    BUBBLE_VERTEX_BYTES, CubeReads, OBJECT_VERTEX_BYTES, SceneData, VIEW_BYTES, view_bytes,
 };
 use super::shader_source::{scene_wgsl, tonemap_wgsl};
 
@@ -88,7 +88,7 @@ fn packed_scene() -> (SceneData, usize, usize, usize) {
         &settings,
         &view,
         8192,
-        ReflectionFilter::Footprint,
+        CubeReads::default(),
     )
     .unwrap();
     (data, 2, 1, 3)

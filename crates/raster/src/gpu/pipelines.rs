@@ -229,7 +229,7 @@ impl Pipelines {
         })];
         let bubble_attrs = wgpu::vertex_attr_array![
             0 => Float32x3, 1 => Float32x3, 2 => Float32, 3 => Float32, 4 => Uint32,
-            5 => Float32x3, 6 => Uint32x2
+            5 => Float32x3, 6 => Uint32x2, 7 => Float32x3
         ];
         let bubbles = [Some(wgpu::VertexBufferLayout {
             array_stride: BUBBLE_VERTEX_BYTES,

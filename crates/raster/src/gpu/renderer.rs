@@ -5,14 +5,16 @@ use std::time::Instant;
 use wgpu::util::DeviceExt;
 
 use super::pipelines::{DEPTH_FORMAT, HDR_FORMAT, Layouts, Pipelines};
-use super::scene_data::{SceneData, VIEW_BYTES, check_supported, ground_triangles, view_bytes};
+use super::scene_data::{
+    CubeReads, SceneData, VIEW_BYTES, check_supported, ground_triangles, view_bytes,
+};
 use super::{Gpu, GpuError, GpuOptions};
 use render_scene::camera::View;
 use render_scene::cubemap::FACE_BASES;
 use render_scene::ground_view::GroundView;
 use render_scene::{
     BubbleMesh, CubeMap, FilmTables, Frame, FrameTimings, ReflectionFilter, ReflectionMode,
-    RenderScene, RenderSettings,
+    ReflectionParallax, RenderScene, RenderSettings,
 };
 
 /// Size `(width, height, layers)` and sample count of a cached texture.
@@ -38,7 +40,7 @@ pub struct GpuRenderer {
     /// Render targets kept from frame to frame, by role, with their size and samples.
     textures: Vec<(&'static str, TextureKey, wgpu::Texture)>,
     /// How bubbles read their dynamic cube maps.
-    filter: ReflectionFilter,
+    reads: CubeReads,
     /// The last frame's cube mip chains, for [`GpuRenderer::read_cube_mips`].
     last_mips: Option<wgpu::Buffer>,
 }
@@ -61,7 +63,7 @@ impl GpuRenderer {
             pipelines: Vec::new(),
             frame: Frame::default(),
             textures: Vec::new(),
-            filter: ReflectionFilter::default(),
+            reads: CubeReads::default(),
             last_mips: None,
         })
     }
@@ -69,7 +71,13 @@ impl GpuRenderer {
     /// Chooses how bubbles read their dynamic cube maps, as
     /// [`crate::Renderer::set_reflection_filter`] (default: the footprint filter).
     pub fn set_reflection_filter(&mut self, filter: ReflectionFilter) {
-        self.filter = filter;
+        self.reads.filter = filter;
+    }
+
+    /// Chooses where bubbles' reflected rays read their dynamic cube maps from, as
+    /// [`crate::Renderer::set_reflection_parallax`] (default: corrected for the ground).
+    pub fn set_reflection_parallax(&mut self, parallax: ReflectionParallax) {
+        self.reads.parallax = parallax;
     }
 
     /// The device.
@@ -147,7 +155,7 @@ impl GpuRenderer {
         self.gpu.check_size(w, h)?;
         let view = scene.camera.view(settings.width, settings.height);
         let max_side = self.gpu.device.limits().max_texture_dimension_2d;
-        let data = SceneData::new(scene, tables, settings, &view, max_side, self.filter)?;
+        let data = SceneData::new(scene, tables, settings, &view, max_side, self.reads)?;
         let face_size = match settings.reflection {
             ReflectionMode::DynamicCubeMap { face_size } => Some(face_size),
             _ => None,

@@ -43,6 +43,8 @@ struct Scene {
     ground_height_m: f32,
     cube_face_size: u32,
     reflectivity_table: u32,
+    // 1 when dynamic cube maps are read corrected for the ground's parallax (parallax.rs)
+    ground_parallax: u32,
     // The environment image in `images`: first texel, width, height of an equirect; first
     // texel, face size of cube faces (scene_data.rs `Atlas`).
     env_image: vec4<u32>,
@@ -459,13 +461,23 @@ fn fs_ground(in: FullScreen) -> @location(0) vec4<f32> {
     let ddy = view.ground_ddy.xyz;
     let dpx = (ddx - d * (ddx.y * inv_dy)) * t;
     let dpy = (ddy - d * (ddy.y * inv_dy)) * t;
-    let footprint = min(vec2<f32>(abs(dpx.x) + abs(dpy.x), abs(dpx.z) + abs(dpy.z)), vec2<f32>(1e9));
+    // Edge-on the footprint is unbounded: the filter then returns the mean.
+    let ax = clamp(vec2<f32>(dpx.x, dpx.z), vec2<f32>(-1e9), vec2<f32>(1e9));
+    let ay = clamp(vec2<f32>(dpy.x, dpy.z), vec2<f32>(-1e9), vec2<f32>(1e9));
     let m = materials[scene.ground_material];
     var albedo = m.a.xyz;
     if (m.specular.w == PATTERN_CHECKER) {
+        // shading.rs `ground_albedo_over_pixel`: four quarter-pixel boxes.
         let inv = 1.0 / m.a.w;
-        let w = filtered_checker(vec2<f32>(p.x * inv, p.z * inv), footprint * inv);
-        albedo = lerp3(m.a.xyz, m.b.xyz, w);
+        let f = 0.5 * (abs(ax) + abs(ay)) * inv;
+        let o = GROUND_QUARTER_OFFSET_PX;
+        var sum = 0.0;
+        for (var k = 0; k < 4; k++) {
+            let s = vec2<f32>(select(-o, o, (k & 1) != 0), select(-o, o, k >= 2));
+            let q = vec2<f32>(p.x, p.z) + ax * s.x + ay * s.y;
+            sum += filtered_checker(q * inv, f);
+        }
+        albedo = lerp3(m.a.xyz, m.b.xyz, 0.25 * sum);
     }
     // shading.rs `ground_albedo` of an image: one repeat per `scale_m` along x and z.
     if (m.specular.w == PATTERN_TEXTURED) {
@@ -526,6 +538,8 @@ struct BubbleIn {
     @location(5) material_dir: vec3<f32>,
     // the bubble's film field: first texel in `film_texels`, face size (0: no field)
     @location(6) film: vec2<u32>,
+    // the bubble's centre, where its cube map is rendered from
+    @location(7) centre: vec3<f32>,
 }
 
 struct BubbleOut {
@@ -543,13 +557,14 @@ struct BubbleOut {
     // raster.rs attributes 3..6 of a bubble with a film field: perspective-correct
     @location(7) @interpolate(perspective, centroid) material_dir: vec3<f32>,
     @location(8) @interpolate(flat) film: vec2<u32>,
+    @location(9) @interpolate(flat) centre: vec3<f32>,
 }
 
 @vertex
 fn vs_bubble(in: BubbleIn) -> BubbleOut {
     let clip = clip_of(in.position);
     return BubbleOut(clip, in.position, in.normal, in.thickness_nm, in.pixel_angle_rad,
-        in.bubble, in.normal / clip.w, 1.0 / clip.w, in.material_dir, in.film);
+        in.bubble, in.normal / clip.w, 1.0 / clip.w, in.material_dir, in.film, in.centre);
 }
 
 // lut_sampler.rs `split`: lower sample index and the upper one's weight on an axis of n.
@@ -773,6 +788,22 @@ fn reflection(bubble: u32, dir: vec3<f32>, derivatives: array<vec3<f32>, 2>) -> 
     return static_reflection(dir, derivatives);
 }
 
+// parallax.rs `ground_parallax`: the direction from `centre` to where the ray from film
+// point `p` along unit `dir` meets the ground `y = height_m`; `dir` itself when it does
+// not, or when `p` and `centre` are on opposite sides of the plane.
+fn ground_parallax(centre: vec3<f32>, p: vec3<f32>, dir: vec3<f32>, height_m: f32) -> vec3<f32> {
+    let above = p.y - height_m;
+    if (!(dir.y * above < 0.0 && (centre.y - height_m) * above > 0.0)) {
+        return dir;
+    }
+    let to_hit = p - dir * (above / dir.y) - centre;
+    let len = length(to_hit);
+    if (!(len > 0.0 && len < 3.0e38)) {
+        return dir;
+    }
+    return to_hit / len;
+}
+
 // passes.rs `LightSight::visibility`: the highlight filter (see its documentation).
 fn light_visibility(light: Light, p: vec3<f32>, reflected: vec3<f32>, pixel_angle_rad: f32) -> f32 {
     let to_light = light.position.xyz - p;
@@ -912,7 +943,11 @@ fn fs_bubble_add(in: BubbleOut) -> @location(0) vec4<f32> {
         -view.up.xyz * view.tan_half_per_px.w);
     let derivatives = reflection_derivatives(rel / dot(rel, view.forward.xyz), dd, in.normal,
         dn_raw);
-    var add = r * reflection(in.bubble, reflected, derivatives);
+    var dir = reflected;
+    if (scene.ground_parallax != 0u) {
+        dir = ground_parallax(in.centre, in.world, reflected, scene.ground_height_m);
+    }
+    var add = r * reflection(in.bubble, dir, derivatives);
     for (var i = 0u; i < scene.light_count; i++) {
         let light = lights[i];
         let vis = light_visibility(light, in.world, reflected, in.pixel_angle_rad);

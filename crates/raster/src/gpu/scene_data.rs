@@ -13,7 +13,7 @@ use render_scene::ground_view::GroundView;
 use render_scene::tessellate::{Geometry, tessellate};
 use render_scene::{
     Environment, FilmTables, Light, Material, Pattern, ReflectionFilter, ReflectionMode,
-    RenderScene, RenderSettings, Sky,
+    ReflectionParallax, RenderScene, RenderSettings, Sky,
 };
 
 /// `Material.specular.w` of a solid albedo.
@@ -52,9 +52,19 @@ pub(super) const VIEW_BYTES: u64 = 9 * 16;
 /// Bytes of one object vertex: position, normal, tag, texture uv.
 pub(super) const OBJECT_VERTEX_BYTES: u64 = 36;
 /// Bytes of one bubble vertex: position, normal, thickness, pixel angle, bubble index,
-/// material direction (zero without a film field), and the bubble's film field as
-/// (first texel in the film texture, face size; face size 0: no field).
-pub(super) const BUBBLE_VERTEX_BYTES: u64 = 56;
+/// material direction (zero without a film field), the bubble's film field as (first
+/// texel in the film texture, face size; face size 0: no field), and the bubble's centre
+/// (where its cube map is rendered from).
+pub(super) const BUBBLE_VERTEX_BYTES: u64 = 68;
+
+/// How bubbles read their dynamic cube maps: the renderer's choices.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(super) struct CubeReads {
+    /// Footprint-filtered or one bilinear tap.
+    pub filter: ReflectionFilter,
+    /// Corrected for the ground's parallax, or from the centre.
+    pub parallax: ReflectionParallax,
+}
 
 /// Little-endian bytes for a GPU buffer.
 #[derive(Debug, Default)]
@@ -203,7 +213,7 @@ impl SceneData {
         settings: &RenderSettings,
         view: &View,
         max_texture_side: u32,
-        filter: ReflectionFilter,
+        reads: CubeReads,
     ) -> Result<SceneData, GpuError> {
         let mut objects = Geometry::default();
         let mut light_spheres = Geometry::default();
@@ -265,7 +275,7 @@ impl SceneData {
             scene: scene_bytes(
                 scene,
                 &settings.reflection,
-                filter,
+                reads,
                 [face_size, ground_material],
                 env_image,
                 sphere,
@@ -329,7 +339,7 @@ impl Atlas {
 fn scene_bytes(
     scene: &RenderScene,
     reflection: &ReflectionMode,
-    filter: ReflectionFilter,
+    reads: CubeReads,
     [face_size, ground_material]: [u32; 2],
     env_image: [u32; 4],
     sphere: Option<([u32; 4], Mat3)>,
@@ -348,7 +358,7 @@ fn scene_bytes(
     };
     let env_cube = matches!(scene.environment, Environment::CubeFaces(_));
     b.u32(env_kind).u32(scene.lights.len() as u32);
-    b.u32(match (reflection, filter) {
+    b.u32(match (reflection, reads.filter) {
         (ReflectionMode::DynamicCubeMap { .. }, ReflectionFilter::Footprint) => REFLECTION_CUBE,
         (ReflectionMode::DynamicCubeMap { .. }, ReflectionFilter::Bilinear) => {
             REFLECTION_CUBE_BILINEAR
@@ -379,6 +389,11 @@ fn scene_bytes(
     b.vec4(uniform, 0.0);
     let height = scene.ground.as_ref().map_or(0.0, |g| g.height_m);
     b.u32(ground_material).f32(height).u32(face_size).u32(0);
+    // parallax.rs: on for dynamic cube maps over a ground (renderer.rs `ground_height_m`).
+    let parallax = reads.parallax == ReflectionParallax::Ground
+        && scene.ground.is_some()
+        && matches!(reflection, ReflectionMode::DynamicCubeMap { .. });
+    b.u32(u32::from(parallax)).u32(0).u32(0).u32(0);
     // The environment image: (first texel, width, height) of an equirect, (first texel,
     // face size) of cube faces.
     for w in env_image {
@@ -466,6 +481,7 @@ fn bubble_vertices(
     let mut b = Bytes::default();
     let mut draws = Vec::new();
     let mut start = 0u32;
+    let centres: Vec<Vec3> = scene.bubbles.iter().map(|b| b.center()).collect();
     for k in far_to_near(&scene.bubbles, view.eye) {
         let bubble = &scene.bubbles[k];
         for front in [false, true] {
@@ -486,6 +502,8 @@ fn bubble_vertices(
                         .map_or(Vec3::ZERO, |f| f.material_dirs[i]);
                     b.f32(m.x).f32(m.y).f32(m.z);
                     b.u32(films[k][0]).u32(films[k][1]);
+                    let c = centres[k];
+                    b.f32(c.x).f32(c.y).f32(c.z);
                 }
             }
             let end = (b.0.len() as u64 / BUBBLE_VERTEX_BYTES) as u32;
@@ -652,15 +670,8 @@ mod tests {
         );
         let view = scene.camera.view(16, 16);
         // Rows of at most 50 texels: 6·4² + 6·3² = 150 texels, three rows.
-        let data = SceneData::new(
-            &scene,
-            &tables,
-            &settings,
-            &view,
-            50,
-            ReflectionFilter::Footprint,
-        )
-        .unwrap();
+        let data =
+            SceneData::new(&scene, &tables, &settings, &view, 50, CubeReads::default()).unwrap();
         let (width, height, bytes) = &data.films;
         assert_eq!((*width, *height), (50, 3));
         let want: Vec<f32> = shared
@@ -696,15 +707,8 @@ mod tests {
         }
         assert_eq!(seen, [3; 4]);
         // Too tall for the device: named, never drawn otherwise.
-        let err = SceneData::new(
-            &scene,
-            &tables,
-            &settings,
-            &view,
-            10,
-            ReflectionFilter::Footprint,
-        )
-        .unwrap_err();
+        let err = SceneData::new(&scene, &tables, &settings, &view, 10, CubeReads::default())
+            .unwrap_err();
         assert!(matches!(err, GpuError::Unsupported(_)), "{err:?}");
         assert!(
             err.to_string().contains("film fields of 150 texels"),
@@ -741,7 +745,7 @@ mod tests {
                 &settings,
                 &view,
                 max_side,
-                ReflectionFilter::Footprint,
+                CubeReads::default(),
             )
         };
         let data = pack(3).unwrap();
@@ -757,8 +761,8 @@ mod tests {
             [0.0; 4],
         ];
         assert_eq!(floats(bytes), want.concat());
-        // Scene.env_image after 9 + 6 vec4s and 8 words: first texel 0, 3 × 1.
-        assert_eq!(words(&data.scene)[68..72], [0, 3, 1, 0]);
+        // Scene.env_image after 9 + 6 vec4s and 12 words: first texel 0, 3 × 1.
+        assert_eq!(words(&data.scene)[72..76], [0, 3, 1, 0]);
         // The ground, the only material: textured, 0.5 m a repeat, image at texel 3, 1 × 2.
         let m = words(&data.materials);
         assert_eq!(f32::from_bits(m[11]), PATTERN_TEXTURED);

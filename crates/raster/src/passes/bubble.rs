@@ -7,6 +7,7 @@ use render_scene::camera::View;
 use render_scene::highlight::LightSight;
 use render_scene::lod::reflection_derivatives;
 use render_scene::lut_sampler::LutSampler;
+use render_scene::parallax::ground_parallax;
 use render_scene::reflection::Reflection;
 use render_scene::{FilmField, Light, PartialShading, ReflectionFilter, RenderScene};
 
@@ -32,6 +33,12 @@ pub(crate) struct BubbleCtx<'a> {
     pub films: &'a [Option<&'a FilmField>],
     /// How cube maps are read.
     pub filter: ReflectionFilter,
+    /// Per bubble (by original index): its dynamic cube map's centre, when reads of it
+    /// are corrected for parallax over the ground plane at [`BubbleCtx::ground_height_m`].
+    pub parallax_centres: &'a [Vec3],
+    /// Height of the ground plane the parallax correction intersects (`None`: no ground,
+    /// or the correction is off).
+    pub ground_height_m: Option<f32>,
     /// How pixels a triangle covers in part are shaded.
     pub partial: PartialShading,
     pub tris: &'a [SetupTri],
@@ -252,11 +259,12 @@ impl BubbleCtx<'_> {
             [Vec3::ZERO; 2]
         };
         let reflected = Vec3::from(reflected);
-        let env = reflection.sample(reflected, derivatives, self.filter);
+        let p = self.view.eye + Vec3::from(d / inv_w);
+        let dir = self.parallax_dir(tri, p, reflected).unwrap_or(reflected);
+        let env = reflection.sample(dir, derivatives, self.filter);
         let mut add = [r_rgb[0] * env[0], r_rgb[1] * env[1], r_rgb[2] * env[2]];
         let mut shareable = true;
         if !self.lights.is_empty() {
-            let p = self.view.eye + Vec3::from(d / inv_w);
             for (light, table) in self.lights.iter().zip(self.light_tables) {
                 // Beyond the widened reach the visibility below is exactly 0.
                 let sight = LightSight::new(light, p, reflected);
@@ -282,6 +290,15 @@ impl BubbleCtx<'_> {
             );
         }
         (t_rgb, add, shareable)
+    }
+
+    /// The direction bubble `tri.tag` reads its dynamic cube map in for the ray from film
+    /// point `p` along `reflected`, when the parallax correction is on and the ray meets
+    /// the ground (`parallax::ground_parallax`).
+    #[inline]
+    fn parallax_dir(&self, tri: &SetupTri, p: Vec3, reflected: Vec3) -> Option<Vec3> {
+        let centre = *self.parallax_centres.get(tri.tag as usize)?;
+        ground_parallax(centre, p, reflected, self.ground_height_m?)
     }
 
     /// Change of the unit reflected direction per pixel along x and y at the point with

@@ -5,6 +5,7 @@
 use render_scene::camera::View;
 use render_scene::ground_view::GroundView;
 use render_scene::index_f32::index_f32;
+use render_scene::shading::GROUND_QUARTER_OFFSET_PX;
 use render_scene::{Irradiance, Light, Pattern};
 
 use super::SPAN;
@@ -26,7 +27,8 @@ fn floor_small(x: f32) -> f32 {
     nearest - f32::from(u8::from(nearest > x))
 }
 
-/// Box-filtered checker weight, as [`render_scene::shading`]'s scalar version, clamped for range.
+/// Box-filtered checker weight, as [`render_scene::shading`]'s scalar version, clamped for range
+/// (summed over a pixel's quarters as `ground_albedo_over_pixel` sums them).
 #[inline(always)]
 fn checker_weight(p: [f32; 2], footprint: [f32; 2]) -> f32 {
     let tri = |x: f32| (x - floor_small(x) - 0.5).abs();
@@ -81,12 +83,23 @@ pub(crate) fn ground_span(
         // ∂P/∂px = t·(∂d − d·∂d.y/d.y) with 1/d.y = t/(h − eye.y).
         let inv_dy = t * g.inv_height;
         let (kx, ky) = (ddx.y * inv_dy, ddy.y * inv_dy);
-        let fx = ((ddx.x - dx * kx) * t).abs() + ((ddy.x - dx * ky) * t).abs();
-        let fz = ((ddx.z - dz * kx) * t).abs() + ((ddy.z - dz * ky) * t).abs();
-        weight[i] = checker_weight(
-            [px[i] * inv_scale, pz[i] * inv_scale],
-            [fx * inv_scale, fz * inv_scale],
+        // ∂P/∂px and ∂P/∂py in x and z, in checker cells.
+        let (xx, xy) = (
+            (ddx.x - dx * kx) * t * inv_scale,
+            (ddy.x - dx * ky) * t * inv_scale,
         );
+        let (zx, zy) = (
+            (ddx.z - dz * kx) * t * inv_scale,
+            (ddy.z - dz * ky) * t * inv_scale,
+        );
+        let f = [0.5 * (xx.abs() + xy.abs()), 0.5 * (zx.abs() + zy.abs())];
+        let (cx, cz) = (px[i] * inv_scale, pz[i] * inv_scale);
+        let o = GROUND_QUARTER_OFFSET_PX;
+        let mut sum = 0.0;
+        for (sx, sy) in [(-o, -o), (o, -o), (-o, o), (o, o)] {
+            sum += checker_weight([cx + sx * xx + sy * xy, cz + sx * zx + sy * zy], f);
+        }
+        weight[i] = 0.25 * sum;
     }
     let mut irradiance = [[0.0f32; SPAN]; 3];
     let ambient = ambient.diffuse(g.normal);

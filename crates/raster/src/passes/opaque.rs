@@ -6,7 +6,7 @@ use render_scene::camera::View;
 use render_scene::ground_view::GroundView;
 use render_scene::index_f32::index_f32;
 use render_scene::shader_constants::{EMISSIVE, WATER};
-use render_scene::shading::{ground_albedo, lit, object_albedo, surface_footprint};
+use render_scene::shading::{ground_albedo_over_pixel, lit, object_albedo, surface_footprint};
 use render_scene::water_shading::WaterShading;
 use render_scene::{Environment, Irradiance, Light, Material, Pattern};
 
@@ -224,9 +224,9 @@ impl OpaqueCtx<'_> {
         let inv_dy = t * g.inv_height;
         let dpx = (g.ddx - d * (g.ddx.y * inv_dy)) * t;
         let dpy = (g.ddy - d * (g.ddy.y * inv_dy)) * t;
-        let footprint = [dpx.x.abs() + dpy.x.abs(), dpx.z.abs() + dpy.z.abs()];
-        let footprint = footprint.map(|f| if f < 1e9 { f } else { 1e9 });
-        let albedo = ground_albedo(&g.ground.material, p.x, p.z, footprint);
+        // Edge-on the footprint is unbounded: the filter then returns the mean.
+        let bound = |v: Vec3| [v.x, v.z].map(|f| if f.abs() < 1e9 { f } else { 1e9 });
+        let albedo = ground_albedo_over_pixel(&g.ground.material, p.x, p.z, bound(dpx), bound(dpy));
         lit(
             &g.ground.material,
             albedo,
