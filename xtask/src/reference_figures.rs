@@ -20,7 +20,7 @@ struct Variant {
 /// Pairs compared besides "every variant against the reference": (image, against).
 const PAIRS: [(&str, &str); 1] = [("ref-centre", "ref-no-films")];
 
-const VARIANTS: [Variant; 15] = [
+const VARIANTS: [Variant; 16] = [
     Variant {
         name: "reference",
         flags: &["--backend", "reference"],
@@ -29,7 +29,7 @@ const VARIANTS: [Variant; 15] = [
     Variant {
         name: "cpu",
         flags: &[],
-        what: "the CPU backend as shipped (4 samples, dynamic 128² cube maps)",
+        what: "the CPU backend as shipped (4 samples, dynamic 128² cube maps read where reflected rays meet the ground)",
     },
     Variant {
         name: "ref-depth2",
@@ -85,6 +85,11 @@ const VARIANTS: [Variant; 15] = [
         name: "cpu-static",
         flags: &["--reflection", "static"],
         what: "CPU backend, environment only in reflections (no cube map)",
+    },
+    Variant {
+        name: "cpu-centre",
+        flags: &["--reflection-origin", "centre"],
+        what: "CPU backend, cube maps read from the bubble's centre (seed 000), not where reflected rays meet the ground",
     },
     Variant {
         name: "ref-seed1",

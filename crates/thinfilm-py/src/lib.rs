@@ -2,10 +2,12 @@
 //! arrays out. Broadcasting and shapes are done in `python/thinfilm/__init__.py`.
 //!
 //! Every call copies its inputs, releases the GIL and computes in parallel (rayon), so
-//! other Python threads run meanwhile; every bad value raises `ValueError` naming it.
+//! other Python threads run meanwhile; every bad value raises `ValueError` naming it. The
+//! film grid's large outputs are written into buffers kept between calls (`pool.rs`).
 
 mod inverse;
 mod outer;
+mod pool;
 
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
@@ -290,7 +292,8 @@ impl FastFilm {
 /// `(R, T)` of the symmetric film on the outer product `thickness_nm × angle_deg ×
 /// wavelength_nm`, flattened thickness-major (or angle-major, `(angle, thickness,
 /// wavelength)`, with `angle_major`): [`thinfilm::grid::FilmGrid`] computes the Fresnel
-/// terms once per (angle, wavelength), then the rows in parallel.
+/// terms once per (angle, wavelength), then the rows in parallel, exact or (`fast`) on its
+/// f32 kernel.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
 fn film_rt_grid<'py>(
@@ -302,38 +305,83 @@ fn film_rt_grid<'py>(
     n_outside: f64,
     pol: &str,
     angle_major: bool,
+    fast: bool,
 ) -> PyResult<Pair<'py>> {
     let pol = grid_pol(pol_from(pol)?);
     let (d, angle, wl) = (copy(&thickness_nm), copy(&angle_deg), copy(&wavelength_nm));
     let (r, t) = py
         .allow_threads(|| {
             let grid = FilmGrid::try_new(n_outside, n_film, &angle, &wl)?;
-            let row = grid.len();
-            let (mut r, mut t) = (zeroed(d.len() * row), zeroed(d.len() * row));
-            if row == 0 {
-            } else if angle_major {
-                // One task per angle: its (thickness, wavelength) block, a run per thickness.
-                let runs = wl.len();
-                r.par_chunks_mut(d.len() * runs)
-                    .zip(t.par_chunks_mut(d.len() * runs))
-                    .enumerate()
-                    .try_for_each(|(a, (r, t))| {
-                        let runs_r = r.chunks_mut(runs).zip(t.chunks_mut(runs));
-                        for ((r, t), &d) in runs_r.zip(&d) {
-                            grid.try_fill_cells(d, a * runs, pol, r, t)?;
-                        }
-                        Ok::<_, OpticsError>(())
-                    })?;
+            let len = d.len() * grid.len();
+            let (mut r, mut t) = (pool::take(len), pool::take(len));
+            let order = if angle_major {
+                RunOrder::AngleMajor
             } else {
-                r.par_chunks_mut(row)
-                    .zip(t.par_chunks_mut(row))
-                    .zip(d.par_iter())
-                    .try_for_each(|((r, t), &d)| grid.try_fill(d, pol, r, t))?;
-            }
-            Ok::<_, OpticsError>((r, t))
+                RunOrder::ThicknessMajor
+            };
+            let out = (&mut r[..len], &mut t[..len]);
+            fill_film_grid(&grid, &d, wl.len(), order, pol, fast, out)?;
+            Ok::<_, OpticsError>(((r, len), (t, len)))
         })
         .map_err(value_error)?;
-    Ok((r.into_pyarray(py), t.into_pyarray(py)))
+    Ok((
+        pool::into_array(py, r.0, r.1)?,
+        pool::into_array(py, t.0, t.1)?,
+    ))
+}
+
+/// How a film grid's output is laid out: `(angle, thickness, wavelength)` or
+/// `(thickness, angle, wavelength)`, wavelength fastest either way.
+#[derive(Clone, Copy)]
+enum RunOrder {
+    AngleMajor,
+    ThicknessMajor,
+}
+
+/// The fewest points a task of a film grid takes.
+const MIN_TASK_POINTS: usize = 8192;
+
+/// Fills `r` and `t` (the whole grid in `order`) run by run, a run being one thickness at
+/// one angle over every wavelength, exact or (`fast`) on the f32 kernel; runs are grouped
+/// into about sixteen tasks a thread, so that a busy core delays the call by a small task,
+/// not by a share of the grid.
+fn fill_film_grid(
+    grid: &FilmGrid,
+    d: &[f64],
+    width: usize,
+    order: RunOrder,
+    pol: GridPol,
+    fast: bool,
+    (r, t): (&mut [f64], &mut [f64]),
+) -> Result<(), OpticsError> {
+    if r.is_empty() {
+        return Ok(());
+    }
+    let angles = grid.len() / width;
+    let runs = r.len() / width;
+    let tasks = 16 * rayon::current_num_threads();
+    let per_task = runs
+        .div_ceil(tasks)
+        .max(MIN_TASK_POINTS.div_ceil(width))
+        .min(runs);
+    r.par_chunks_mut(per_task * width)
+        .zip(t.par_chunks_mut(per_task * width))
+        .enumerate()
+        .try_for_each(|(task, (r, t))| {
+            let runs_r = r.chunks_mut(width).zip(t.chunks_mut(width));
+            for (k, (r, t)) in (task * per_task..).zip(runs_r) {
+                let (a, thickness) = match order {
+                    RunOrder::AngleMajor => (k / d.len(), d[k % d.len()]),
+                    RunOrder::ThicknessMajor => (k % angles, d[k / angles]),
+                };
+                if fast {
+                    grid.try_fill_cells_fast(thickness, a * width, pol, r, t)?;
+                } else {
+                    grid.try_fill_cells(thickness, a * width, pol, r, t)?;
+                }
+            }
+            Ok(())
+        })
 }
 
 /// Checks the stack of a fit: `n` one longer than `d_nm` at both ends, `layer` an inner
@@ -663,6 +711,12 @@ fn xyz_to_srgb<'py>(
     Ok(out.into_pyarray(py))
 }
 
+/// `(buffers, bytes)` the output pool holds between calls (see `pool.rs`), for the tests.
+#[pyfunction]
+fn pool_held() -> (usize, usize) {
+    pool::held()
+}
+
 /// The native module `thinfilm._native`.
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -677,5 +731,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(film_xyz, m)?)?;
     m.add_function(wrap_pyfunction!(xyz_to_srgb, m)?)?;
     m.add_function(wrap_pyfunction!(inverse::thickness_from_rgb, m)?)?;
+    m.add_function(wrap_pyfunction!(pool_held, m)?)?;
     Ok(())
 }

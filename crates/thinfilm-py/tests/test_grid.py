@@ -78,3 +78,66 @@ def test_bad_grid_input_raises_value_error_naming_it(call, needle):
     with pytest.raises(ValueError) as info:
         call()
     assert needle in str(info.value), str(info.value)
+
+
+@pytest.mark.parametrize("n_out, n_film", [(1.0, 1.33), (1.33, 1.0), (1.5, 3.4)])
+@pytest.mark.parametrize("pol", ["s", "p", "u"])
+def test_fast_grid_is_within_its_documented_bound_of_tmm(n_out, n_film, pol):
+    # The f32 kernel: within 2.4e-7 of exact for films up to 5 um (the docstring's figure;
+    # 5e-7 here). Cells near grazing (89.9 deg) and beyond the critical angle take the
+    # exact path.
+    r, t = thinfilm.film_rt_grid(D, A, L, n_film=n_film, n_outside=n_out, pol=pol, fast=True)
+    r_exact, t_exact = thinfilm.film_rt_grid(D, A, L, n_film=n_film, n_outside=n_out, pol=pol)
+    assert r.dtype == np.float64 and r.shape == (D.size, A.size, L.size)
+    for i, d in enumerate(D):
+        for j, a in enumerate(A):
+            for k, wl in enumerate(L):
+                rs, ts = coh_tmm_rt("s", n_out, n_film, d, a, wl)
+                rp, tp = coh_tmm_rt("p", n_out, n_film, d, a, wl)
+                r_ref, t_ref = {"s": (rs, ts), "p": (rp, tp), "u": (0.5 * (rs + rp), 0.5 * (ts + tp))}[pol]
+                assert abs(r[i, j, k] - r_ref) <= 5e-7, (d, a, wl, r[i, j, k], r_ref)
+                assert abs(t[i, j, k] - t_ref) <= 5e-7, (d, a, wl, t[i, j, k], t_ref)
+    # f32 arithmetic somewhere, not the exact path under another name.
+    assert np.abs(r - r_exact).max() > 1e-10
+
+
+def test_film_rt_fast_takes_the_fast_grid_in_any_axis_order():
+    d, a, wl = np.linspace(0, 3000, 7), np.linspace(0, 80, 5), np.linspace(360, 900, 6)
+    r_grid, t_grid = thinfilm.film_rt_grid(d, a, wl, n_film=1.4, fast=True)
+    r, t = thinfilm.film_rt(d[None, :, None], a[:, None, None], wl, n_film=1.4, fast=True)
+    assert np.array_equal(r, r_grid.transpose(1, 0, 2))
+    assert np.array_equal(t, t_grid.transpose(1, 0, 2))
+    r, t = thinfilm.film_rt(d[None, :, None], a, wl[:, None, None], n_film=1.4, fast=True)
+    assert np.array_equal(r, r_grid.transpose(2, 0, 1))
+
+
+def test_large_outputs_reuse_pooled_buffers_without_showing_old_values():
+    # 2 x 200 x 11 x 471 f64: above the pool's 1 MiB, so the buffers are recycled.
+    d, a, wl = np.arange(0, 2000.0, 10.0), np.arange(0, 75.1, 7.5), np.arange(360, 831.0)
+    first = thinfilm.film_rt_grid(d, a, wl)
+    expected = [x.copy() for x in first]
+    for x in first:
+        x.fill(np.nan)  # what a reused buffer holds before the next call overwrites it
+    del first, x
+    held, bytes_held = thinfilm._native.pool_held()
+    assert held >= 2 and bytes_held <= 64 << 20
+    for fast in (True, False):
+        again = thinfilm.film_rt_grid(d, a, wl, fast=fast)
+        assert not np.isnan(again[0]).any() and not np.isnan(again[1]).any()
+        if not fast:
+            assert np.array_equal(again[0], expected[0]) and np.array_equal(again[1], expected[1])
+        # Every task's runs land where they belong: random points against the point path.
+        rng = np.random.default_rng(5)
+        i, j, k = (rng.integers(0, n, 300) for n in (d.size, a.size, wl.size))
+        r_point, t_point = thinfilm.film_rt(d[i], a[j], wl[k])  # exact, point by point
+        tol = 5e-7 if fast else 1e-13
+        np.testing.assert_allclose(again[0][i, j, k], r_point, rtol=0, atol=tol)
+        np.testing.assert_allclose(again[1][i, j, k], t_point, rtol=0, atol=tol)
+        # The angle-major order that film_rt writes directly, too.
+        r_am, _ = thinfilm.film_rt(d[None, :, None], a[:, None, None], wl, fast=fast)
+        np.testing.assert_array_equal(r_am[j, i, k], again[0][i, j, k])
+        del r_am
+        # A result stays valid (and unshared) while it lives.
+        other = thinfilm.film_rt_grid(d, a, wl, n_film=1.5)
+        assert not np.shares_memory(again[0], other[0]) and not np.shares_memory(again[1], other[1])
+        del again, other

@@ -25,6 +25,7 @@
 use crate::fresnel::{self, OpticsError, check_len};
 
 mod cells;
+pub(crate) mod film_f32;
 pub(crate) mod film_f64;
 mod kernel;
 pub(crate) mod stack_f64;

@@ -114,7 +114,8 @@ def graded_rt(n, d_nm, layer, profile, wavelength_nm, angle_deg, pol="u", tolera
     return r.reshape(shape), t.reshape(shape), e.reshape(shape)
 
 
-def film_rt_grid(thickness_nm, angle_deg, wavelength_nm, n_film=1.33, n_outside=1.0, pol="u"):
+def film_rt_grid(thickness_nm, angle_deg, wavelength_nm, n_film=1.33, n_outside=1.0, pol="u",
+                 fast=False):
     """``(R, T)`` of the film ``n_outside | n_film | n_outside`` on the grid of three 1-d axes,
     shape ``(len(thickness_nm), len(angle_deg), len(wavelength_nm))``.
 
@@ -122,6 +123,13 @@ def film_rt_grid(thickness_nm, angle_deg, wavelength_nm, n_film=1.33, n_outside=
     matrix): the Fresnel terms are computed once per (angle, wavelength), then each
     thickness costs a sine per point, in parallel. ``pol`` is "s", "p" or "u" (the mean).
     ``film_rt`` takes this path by itself when its arguments form such a grid.
+
+    ``fast=True`` evaluates the same closed form in f32 (8 SIMD lanes), still returning
+    float64: within 2.4e-7 of the exact values in R and T for films up to 5 um and 1.8e-6
+    up to 0.1 mm (measured, every angle, low- and high-index films), up to about twice as
+    fast (less where writing the float64 output bounds the call).
+    Cells an f32 phase cannot resolve (near grazing incidence, or the film's critical
+    angle) are computed exactly.
     """
     axes = [np.ascontiguousarray(np.atleast_1d(np.asarray(a, dtype=np.float64))) for a in
             (thickness_nm, angle_deg, wavelength_nm)]
@@ -129,7 +137,8 @@ def film_rt_grid(thickness_nm, angle_deg, wavelength_nm, n_film=1.33, n_outside=
         if a.ndim != 1:
             raise ValueError(f"{name} has shape {a.shape}: film_rt_grid takes 1-d axes")
     d, angle, wl = axes
-    r, t = _native.film_rt_grid(d, angle, wl, float(n_film), float(n_outside), str(pol), False)
+    r, t = _native.film_rt_grid(d, angle, wl, float(n_film), float(n_outside), str(pol), False,
+                                bool(fast))
     shape = (d.size, angle.size, wl.size)
     return r.reshape(shape), t.reshape(shape)
 
@@ -146,9 +155,10 @@ def film_rt(thickness_nm, angle_deg, wavelength_nm, n_film=1.33, n_outside=1.0, 
     cannot hold always take the exact path.
 
     When the three arrays form an outer product (as ``d[:, None, None]``,
-    ``angle[None, :, None]``, ``wl[None, None, :]`` in any order), the exact path runs on
-    :func:`film_rt_grid`, about 50 times faster, and ``fast=True`` takes it too (it is
-    faster than the f32 kernel there, and exact).
+    ``angle[None, :, None]``, ``wl[None, None, :]`` in any order), both run on
+    :func:`film_rt_grid`, about 50 times faster: exact, or with ``fast=True`` its f32
+    kernel, within 2.4e-7 of exact for films up to 5 um (the inputs are not rounded to
+    f32 there).
     """
     axes = _axes(thickness_nm, angle_deg, wavelength_nm)
     if axes is not None:
@@ -161,7 +171,8 @@ def film_rt(thickness_nm, angle_deg, wavelength_nm, n_film=1.33, n_outside=1.0, 
         order = [int(k) for k in np.argsort(positions, kind="stable")]
         # The native call writes thickness- or angle-major directly; other orders transpose.
         angle_major = order == [1, 0, 2]
-        r, t = _native.film_rt_grid(d, angle, wl, float(n_film), float(n_outside), "u", angle_major)
+        r, t = _native.film_rt_grid(d, angle, wl, float(n_film), float(n_outside), "u", angle_major,
+                                    bool(fast))
         if angle_major or order == [0, 1, 2]:
             return r.reshape(shape), t.reshape(shape)
         r = np.transpose(r.reshape(d.size, angle.size, wl.size), order).reshape(shape)

@@ -39,7 +39,9 @@ def film_rt(
     n_outside: float = 1.0,
     fast: bool = False,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """``(R, T)`` of a free-standing film (unpolarised), broadcast."""
+    """``(R, T)`` of a free-standing film (unpolarised), broadcast; exact (1e-15) unless
+    ``fast=True``: f32 arithmetic, within 2.4e-7 of exact on a grid for films up to 5 um
+    (1.8e-6 to 0.1 mm), within 5e-5 point by point (inputs rounded to f32)."""
 
 def film_rt_grid(
     thickness_nm: ArrayLike,
@@ -48,8 +50,11 @@ def film_rt_grid(
     n_film: float = 1.33,
     n_outside: float = 1.0,
     pol: str = "u",
+    fast: bool = False,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """``(R, T)`` on the grid of three 1-d axes, shape ``(thickness, angle, wavelength)``."""
+    """``(R, T)`` on the grid of three 1-d axes, shape ``(thickness, angle, wavelength)``;
+    exact (1e-14) unless ``fast=True``: f32 arithmetic, float64 out, within 2.4e-7 of exact
+    for films up to 5 um and 1.8e-6 up to 0.1 mm."""
 
 class FitResult(TypedDict):
     """What :func:`fit_thickness` returns."""
