@@ -77,6 +77,11 @@ impl SphereMap {
         &self.texture
     }
 
+    /// The rotation from world directions to map space (the inverse of `world_from_map`).
+    pub fn map_from_world(&self) -> Mat3 {
+        self.map_from_world
+    }
+
     /// Bilinear lookup of the radiance reflected along world direction `dir` (any length).
     #[inline]
     pub fn sample(&self, dir: Vec3) -> [f32; 3] {

@@ -82,7 +82,13 @@ impl Layouts {
         };
         let scene = layout(
             "scene",
-            &[entry(0, uniform), entry(1, storage()), entry(2, storage())],
+            &[
+                entry(0, uniform),
+                entry(1, storage()),
+                entry(2, storage()),
+                // The image atlas (Rgba32Float, read with textureLoad).
+                entry(3, texture(wgpu::TextureViewDimension::D2)),
+            ],
         );
         let bubble = layout(
             "bubble tables",
@@ -207,7 +213,9 @@ pub(super) fn add_blend() -> wgpu::BlendState {
 
 impl Pipelines {
     pub(super) fn new(device: &wgpu::Device, layouts: &Layouts, samples: u32) -> Pipelines {
-        let object_attrs = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Uint32];
+        let object_attrs = wgpu::vertex_attr_array![
+            0 => Float32x3, 1 => Float32x3, 2 => Uint32, 3 => Float32x2
+        ];
         let objects = [Some(wgpu::VertexBufferLayout {
             array_stride: OBJECT_VERTEX_BYTES,
             step_mode: wgpu::VertexStepMode::Vertex,

@@ -150,7 +150,7 @@ impl GpuRenderer {
         settings.validate()?;
         scene.validate()?;
         tables.validate_for(scene)?;
-        check_supported(scene, settings)?;
+        check_supported(scene)?;
         let (w, h) = (settings.width as u32, settings.height as u32);
         self.gpu.check_size(w, h)?;
         let view = scene.camera.view(settings.width, settings.height);
@@ -217,6 +217,7 @@ impl GpuRenderer {
                 }),
             }],
         });
+        let images = self.data_texture("images", wgpu::TextureFormat::Rgba32Float, &data.images);
         let scene_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("scene"),
             layout: &self.layouts.scene,
@@ -224,9 +225,14 @@ impl GpuRenderer {
                 bind(0, scene_uniform.as_entire_binding()),
                 bind(1, materials.as_entire_binding()),
                 bind(2, lights.as_entire_binding()),
+                bind(
+                    3,
+                    wgpu::BindingResource::TextureView(&images.create_view(&Default::default())),
+                ),
             ],
         });
-        let mip_floats = face_size.map_or(3, |n| {
+        // The dynamic cube maps' chains, or the static environment's cube faces' chain.
+        let mip_floats = face_size.map_or((data.env_chain.len() as u64 / 4).max(3), |n| {
             3 * CubeMap::stored_texels(n) as u64 * scene.bubbles.len().max(1) as u64
         });
         let limits = device.limits();
@@ -234,20 +240,30 @@ impl GpuRenderer {
             .max_storage_buffer_binding_size
             .min(limits.max_buffer_size);
         if 4 * mip_floats > max_bytes {
+            let what = match face_size {
+                Some(n) => format!(
+                    "{} bubbles with cube maps of {n} texels",
+                    scene.bubbles.len()
+                ),
+                None => "the environment's cube faces".to_string(),
+            };
             return Err(GpuError::Unsupported(format!(
-                "{} bubbles with cube maps of {} texels (their mip chains take {} bytes, \
-                 this device binds at most {max_bytes})",
-                scene.bubbles.len(),
-                face_size.unwrap_or(0),
+                "{what} (their mip chains take {} bytes, this device binds at most \
+                 {max_bytes})",
                 4 * mip_floats
             )));
         }
-        let mips = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("cube mips"),
-            size: 4 * mip_floats,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
+        let mips_usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+        let mips = if face_size.is_none() && !data.env_chain.is_empty() {
+            buffer("cube mips", &data.env_chain, mips_usage)
+        } else {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("cube mips"),
+                size: 4 * mip_floats,
+                usage: mips_usage,
+                mapped_at_creation: false,
+            })
+        };
         let lut_texture = self.data_texture("luts", wgpu::TextureFormat::Rgba32Float, &data.luts);
         let film_texture =
             self.data_texture("film fields", wgpu::TextureFormat::Rg32Float, &data.films);

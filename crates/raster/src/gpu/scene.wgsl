@@ -45,6 +45,13 @@ struct Scene {
     reflectivity_table: u32,
     // 1 when dynamic cube maps are read corrected for the ground's parallax (parallax.rs)
     ground_parallax: u32,
+    // The environment image in `images`: first texel, width, height of an equirect; first
+    // texel, face size of cube faces (scene_data.rs `Atlas`).
+    env_image: vec4<u32>,
+    // The sphere map in `images`: first texel, width, height; then its map_from_world by
+    // rows (spheremap.rs `SphereMap`).
+    sphere_image: vec4<u32>,
+    sphere_from_world: array<vec4<f32>, 3>,
 }
 
 struct Material {
@@ -54,6 +61,9 @@ struct Material {
     b: vec4<f32>,
     // specular rgb, pattern kind
     specular: vec4<f32>,
+    // a textured material's image in `images`: first texel, width, height (its repeat on
+    // the ground is `a.w` metres)
+    image: vec4<u32>,
 }
 
 struct Light {
@@ -77,6 +87,9 @@ struct LutInfo {
 @group(1) @binding(0) var<uniform> scene: Scene;
 @group(1) @binding(1) var<storage, read> materials: array<Material>;
 @group(1) @binding(2) var<storage, read> lights: array<Light>;
+// The image atlas: every image the scene reads (the environment's), row-major one after
+// another, linear texel i at (i mod width, i div width), RGB (scene_data.rs `Atlas`).
+@group(1) @binding(3) var images: texture_2d<f32>;
 @group(2) @binding(0) var luts: texture_2d<f32>;
 @group(2) @binding(1) var<storage, read> lut_info: array<LutInfo>;
 @group(2) @binding(2) var cubes: texture_2d_array<f32>;
@@ -126,6 +139,12 @@ fn env_radiance(dir: vec3<f32>) -> vec3<f32> {
     if (scene.env_kind == ENV_UNIFORM) {
         return scene.uniform_rgb.xyz;
     }
+    if (scene.env_kind == ENV_EQUIRECT) {
+        return equirect_sample(scene.env_image, dir);
+    }
+    if (scene.env_kind == ENV_CUBE) {
+        return env_cube_sample(scene.env_image.x, scene.env_image.y, dir);
+    }
     let d = normalize_or(dir, vec3<f32>(0.0, 1.0, 0.0));
     var out: vec3<f32>;
     if (d.y >= 0.0) {
@@ -138,6 +157,141 @@ fn env_radiance(dir: vec3<f32>) -> vec3<f32> {
         out += scene.sun_rgb.xyz;
     }
     return out;
+}
+
+// ---- images: environment maps and textures ---------------------------------------------
+
+// Linear texel `i` of the image atlas.
+fn image_texel(i: u32) -> vec3<f32> {
+    let width = textureDimensions(images).x;
+    return textureLoad(images, vec2<u32>(i % width, i / width), 0).xyz;
+}
+
+// A texel pair on one axis and the second one's weight (texture.rs `split_repeat`,
+// `split_clamp`).
+struct Split {
+    i0: u32,
+    i1: u32,
+    t: f32,
+}
+
+// texture.rs `split_repeat`: the axis of `n` texels repeats (texel centres at (i + 0.5)/n).
+fn split_repeat(u: f32, n: u32) -> Split {
+    var x = u * f32(n) - 0.5;
+    // Not finite (NaN or infinite) reads as 0.
+    if (!(abs(x) < 3.0e38)) {
+        x = 0.0;
+    }
+    let f = floor(x);
+    var i0: u32;
+    if (abs(f) < 2147483520.0) {
+        let q = i32(f) % i32(n);
+        i0 = u32(select(q, q + i32(n), q < 0));
+    } else {
+        let nf = f32(n);
+        i0 = u32(clamp(f - nf * floor(f / nf), 0.0, nf - 1.0));
+    }
+    return Split(i0, select(i0 + 1u, 0u, i0 + 1u == n), x - f);
+}
+
+// texture.rs `split_clamp`: the axis of `n` texels is clamped to its edges.
+fn split_clamp(u: f32, n: u32) -> Split {
+    var x = clamp(u * f32(n) - 0.5, 0.0, f32(n - 1u));
+    if (x != x) {
+        x = 0.0;
+    }
+    let i0 = u32(x);
+    return Split(i0, min(i0 + 1u, n - 1u), x - f32(i0));
+}
+
+// texture.rs `Texture::bilinear` and `bilerp` of the image whose first texel is `first`
+// and which is `width` texels wide.
+fn image_bilinear(first: u32, width: u32, sx: Split, sy: Split) -> vec3<f32> {
+    let a = image_texel(first + sy.i0 * width + sx.i0);
+    let b = image_texel(first + sy.i0 * width + sx.i1);
+    let c = image_texel(first + sy.i1 * width + sx.i0);
+    let d = image_texel(first + sy.i1 * width + sx.i1);
+    let top = a + (b - a) * sx.t;
+    let bottom = c + (d - c) * sx.t;
+    return top + (bottom - top) * sy.t;
+}
+
+// texture.rs `Texture::sample_equirect` of the image `img` = (first texel, width, height):
+// u = 0.5 + atan2(x, −z)/2π, v = acos(y)/π.
+fn equirect_sample(img: vec4<u32>, dir: vec3<f32>) -> vec3<f32> {
+    let len = length(dir);
+    var y = 1.0;
+    if (len > 0.0) {
+        y = clamp(dir.y / len, -1.0, 1.0);
+    }
+    let u = 0.5 + atan2(dir.x, -dir.z) * (0.5 / PI);
+    let v = acos(y) * (1.0 / PI);
+    return image_bilinear(img.x, img.y, split_repeat(u, img.y), split_clamp(v, img.z));
+}
+
+// texture.rs `Texture::sample_repeat` of the image `img` = (first texel, width, height).
+fn image_repeat(img: vec4<u32>, u: f32, v: f32) -> vec3<f32> {
+    return image_bilinear(img.x, img.y, split_repeat(u, img.y), split_repeat(v, img.z));
+}
+
+// texture.rs `Texture::sample_clamp` of the image `img` = (first texel, width, height).
+fn image_clamp(img: vec4<u32>, u: f32, v: f32) -> vec3<f32> {
+    return image_bilinear(img.x, img.y, split_clamp(u, img.y), split_clamp(v, img.z));
+}
+
+// spheremap.rs `SphereMap::sample`: the mirror ball's image at the reflected direction
+// `dir` (any length) turned into map space: u = r.x/m + ½, v = ½ − r.y/m,
+// m = 2·√(r.x² + r.y² + (r.z + 1)²).
+fn sphere_map_sample(dir: vec3<f32>) -> vec3<f32> {
+    let rows = scene.sphere_from_world;
+    let q = vec3<f32>(dot(rows[0].xyz, dir), dot(rows[1].xyz, dir), dot(rows[2].xyz, dir));
+    let r = normalize_or(q, vec3<f32>(0.0, 0.0, 1.0));
+    let m = 2.0 * sqrt(r.x * r.x + r.y * r.y + (r.z + 1.0) * (r.z + 1.0));
+    // At r = −Z every rim point is the answer: the rim's right-hand side, as the CPU.
+    var uv = vec2<f32>(1.0, 0.5);
+    if (m > 1e-6) {
+        uv = vec2<f32>(r.x / m + 0.5, 0.5 - r.y / m);
+    }
+    return image_clamp(scene.sphere_image, uv.x, uv.y);
+}
+
+// cubemap.rs `CubeMap::sample` of cube faces stored in the atlas: level 0's six bordered
+// (n + 2)² faces from texel `first`, n = `size`; `cube_level_bilinear`'s arithmetic.
+fn env_cube_sample(first: u32, size: u32, dir: vec3<f32>) -> vec3<f32> {
+    let fst = face_coordinates(dir);
+    let n = f32(size);
+    let m = n + 2.0;
+    let fx = clamp((fst.y + 1.0) * 0.5 * n + 0.5, 0.0, m - 1.0);
+    let fy = clamp((fst.z + 1.0) * 0.5 * n + 0.5, 0.0, m - 1.0);
+    let x0 = min(floor(fx), m - 2.0);
+    let y0 = min(floor(fy), m - 2.0);
+    let tx = fx - x0;
+    let ty = fy - y0;
+    let mu = size + 2u;
+    let i = first + (u32(fst.x) * mu + u32(y0)) * mu + u32(x0);
+    let a = image_texel(i);
+    let b = image_texel(i + 1u);
+    let c = image_texel(i + mu);
+    let d = image_texel(i + mu + 1u);
+    let top = a + (b - a) * tx;
+    let bottom = c + (d - c) * tx;
+    return top + (bottom - top) * ty;
+}
+
+// reflection.rs `Reflection::sample` of `Reflection::Env` and `Reflection::Sphere`: the
+// environment's cube faces through their mip chain (chain 0 of `cube_mips`), filtered as
+// a dynamic cube map is, the sphere map, or the environment itself.
+fn static_reflection(dir: vec3<f32>, derivatives: array<vec3<f32>, 2>) -> vec3<f32> {
+    if (scene.reflection == REFLECTION_ENV_CUBE) {
+        return cube_footprint(0u, dir, derivatives[0], derivatives[1]);
+    }
+    if (scene.reflection == REFLECTION_ENV_CUBE_BILINEAR) {
+        return cube_sample(0u, dir);
+    }
+    if (scene.reflection == REFLECTION_SPHERE_MAP) {
+        return sphere_map_sample(dir);
+    }
+    return env_radiance(dir);
 }
 
 // irradiance.rs `Irradiance::diffuse`.
@@ -218,8 +372,12 @@ fn surface_footprint(d: vec3<f32>, t: f32, n: vec3<f32>) -> vec3<f32> {
     return select(vec3<f32>(1e6), f, f < vec3<f32>(1e6));
 }
 
-// shading.rs `object_albedo` (solid, and the 3-D checker box-filtered over `footprint`).
-fn object_albedo(m: Material, p: vec3<f32>, footprint: vec3<f32>) -> vec3<f32> {
+// shading.rs `object_albedo` (solid, the 3-D checker box-filtered over `footprint`, an
+// image at the mesh's `uv`).
+fn object_albedo(m: Material, p: vec3<f32>, uv: vec2<f32>, footprint: vec3<f32>) -> vec3<f32> {
+    if (m.specular.w == PATTERN_TEXTURED) {
+        return image_repeat(m.image, uv.x, uv.y);
+    }
     if (m.specular.w != PATTERN_CHECKER) {
         return m.a.xyz;
     }
@@ -282,9 +440,20 @@ fn vs_ground(@location(0) ndc_depth: vec3<f32>) -> FullScreen {
 
 @fragment
 fn fs_ground(in: FullScreen) -> @location(0) vec4<f32> {
-    let inv_t = max(ground_inv_depth(in.pix), 1e-30);
+    // The CPU shades the ground once per pixel (`background_pixel`), at the centre where
+    // the plane covers every sample: so does this where the plane covers the whole pixel
+    // (its inverse depth, affine in pixel space, positive at all four corners), also
+    // along the internal edges of the clipped polygon, where each triangle's centroid
+    // would fall elsewhere (visible where an image is minified). Elsewhere (the horizon)
+    // at the covered samples' centroid.
+    var pix = in.pix;
+    let corner_margin = 0.5 * (abs(view.ground.y) + abs(view.ground.z));
+    if (ground_inv_depth(in.position.xy) - corner_margin > 0.0) {
+        pix = in.position.xy;
+    }
+    let inv_t = max(ground_inv_depth(pix), 1e-30);
     let t = 1.0 / inv_t;
-    let d = view_ray(in.pix);
+    let d = view_ray(pix);
     let p = view.eye.xyz + d * t;
     // passes.rs `shade_ground`: footprint of one pixel on the plane.
     let inv_dy = t * view.ground.w;
@@ -313,6 +482,10 @@ fn fs_ground(in: FullScreen) -> @location(0) vec4<f32> {
         }
         albedo = lerp3(m.a.xyz, m.b.xyz, w);
     }
+    // shading.rs `ground_albedo` of an image: one repeat per `scale_m` along x and z.
+    if (m.specular.w == PATTERN_TEXTURED) {
+        albedo = image_repeat(m.image, p.x / m.a.w, p.z / m.a.w);
+    }
     let normal = vec3<f32>(0.0, view.ground_ddx.w, 0.0);
     return vec4<f32>(lit(m, albedo, p, normal, d), 1.0);
 }
@@ -323,6 +496,7 @@ struct ObjectIn {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) tag: u32,
+    @location(3) uv: vec2<f32>,
 }
 
 struct ObjectOut {
@@ -330,11 +504,12 @@ struct ObjectOut {
     @location(0) @interpolate(perspective, centroid) world: vec3<f32>,
     @location(1) @interpolate(perspective, centroid) normal: vec3<f32>,
     @location(2) @interpolate(flat) tag: u32,
+    @location(3) @interpolate(perspective, centroid) uv: vec2<f32>,
 }
 
 @vertex
 fn vs_object(in: ObjectIn) -> ObjectOut {
-    return ObjectOut(clip_of(in.position), in.position, in.normal, in.tag);
+    return ObjectOut(clip_of(in.position), in.position, in.normal, in.tag, in.uv);
 }
 
 @fragment
@@ -349,7 +524,8 @@ fn fs_object(in: ObjectOut) -> @location(0) vec4<f32> {
     let rel = in.world - view.eye.xyz;
     let t = dot(rel, view.forward.xyz);
     let footprint = surface_footprint(rel / t, t, n);
-    return vec4<f32>(lit(m, object_albedo(m, in.world, footprint), in.world, n, v), 1.0);
+    let albedo = object_albedo(m, in.world, in.uv, footprint);
+    return vec4<f32>(lit(m, albedo, in.world, n, v), 1.0);
 }
 
 // ---- bubbles -----------------------------------------------------------------------------
@@ -527,11 +703,10 @@ fn cube_lod(footprint_rad: f32, s: f32, t: f32) -> f32 {
     return 0.0;
 }
 
-// cubemap.rs `CubeMap::sample_trilinear`.
-fn cube_trilinear(bubble: u32, dir: vec3<f32>, footprint_rad: f32) -> vec3<f32> {
-    let fst = face_coordinates(dir);
+// cubemap.rs `CubeMap::trilinear`: the seamless trilinear tap at face coordinates `fst`
+// and level `lod` in [0, levels − 1].
+fn cube_trilinear(bubble: u32, fst: vec3<f32>, lod: f32) -> vec3<f32> {
     let last = mip_levels() - 1u;
-    let lod = min(cube_lod(footprint_rad, fst.y, fst.z), f32(last));
     let l0 = u32(lod);
     let frac = lod - f32(l0);
     let a = cube_level_bilinear(bubble, l0, fst);
@@ -542,7 +717,10 @@ fn cube_trilinear(bubble: u32, dir: vec3<f32>, footprint_rad: f32) -> vec3<f32> 
     return a + (b - a) * frac;
 }
 
-// cubemap.rs `CubeMap::sample_footprint` with lod.rs `anisotropic_taps`.
+// cubemap.rs `CubeMap::sample_footprint` with lod.rs `anisotropic_taps`: one level-0
+// bilinear tap while the longer derivative's footprint stays within level 0; else the
+// axis ratio rounded (1 ..= MAX_ANISOTROPY) trilinear taps spread along the longer
+// derivative, all at the level of the footprint at `dir` (one tap: the longer axis's).
 fn cube_footprint(bubble: u32, dir: vec3<f32>, da: vec3<f32>, db: vec3<f32>) -> vec3<f32> {
     var major = da;
     var minor = db;
@@ -550,23 +728,30 @@ fn cube_footprint(bubble: u32, dir: vec3<f32>, da: vec3<f32>, db: vec3<f32>) -> 
         major = db;
         minor = da;
     }
-    let scale = length(dir);
+    let fst = face_coordinates(dir);
     let major_rad = length(major);
+    let major_lod = cube_lod(major_rad, fst.y, fst.z);
+    if (major_lod <= 0.0) {
+        return cube_level_bilinear(bubble, 0u, fst);
+    }
+    let last = f32(mip_levels() - 1u);
     let minor_rad = length(minor);
+    // Rounded, at least 1 (NaN → 1), at most MAX_ANISOTROPY.
     let ratio = major_rad / max(minor_rad, 1e-12);
-    // NaN or ≤ 1 → one tap.
     var taps = 1u;
-    if (ratio > 1.0) {
-        taps = u32(min(ceil(ratio), f32(MAX_ANISOTROPY)));
+    if (ratio + 0.5 >= 2.0) {
+        taps = u32(min(ratio + 0.5, f32(MAX_ANISOTROPY)));
+    }
+    if (taps == 1u) {
+        return cube_trilinear(bubble, fst, min(major_lod, last));
     }
     let footprint = max(major_rad / f32(taps), minor_rad);
-    if (taps == 1u) {
-        return cube_trilinear(bubble, dir, footprint);
-    }
+    let lod = min(cube_lod(footprint, fst.y, fst.z), last);
+    let step = major * length(dir);
     var sum = vec3<f32>(0.0);
     for (var i = 0u; i < taps; i++) {
         let offset = (f32(i) + 0.5) / f32(taps) - 0.5;
-        sum += cube_trilinear(bubble, dir + major * (offset * scale), footprint);
+        sum += cube_trilinear(bubble, face_coordinates(dir + step * offset), lod);
     }
     return sum / f32(taps);
 }
@@ -603,7 +788,7 @@ fn reflection(bubble: u32, dir: vec3<f32>, derivatives: array<vec3<f32>, 2>) -> 
     if (scene.reflection == REFLECTION_CUBE_BILINEAR) {
         return cube_sample(bubble, dir);
     }
-    return env_radiance(dir);
+    return static_reflection(dir, derivatives);
 }
 
 // parallax.rs `ground_parallax`: the direction from `centre` to where the ray from film

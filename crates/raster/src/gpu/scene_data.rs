@@ -4,7 +4,7 @@
 // Without the `wgpu` feature only the naga layout test uses this module.
 #![cfg_attr(not(feature = "wgpu"), allow(dead_code))]
 
-use glam::Vec3;
+use glam::{Mat3, Vec3};
 
 use super::GpuError;
 use render_scene::bubble_order::{far_to_near, is_front_facing, reflection_rate};
@@ -20,10 +20,16 @@ use render_scene::{
 pub(super) const PATTERN_SOLID: f32 = 0.0;
 /// `Material.specular.w` of a checkerboard.
 pub(super) const PATTERN_CHECKER: f32 = 1.0;
+/// `Material.specular.w` of an image (`Material.image` in the image atlas).
+pub(super) const PATTERN_TEXTURED: f32 = 2.0;
 /// `Scene.env_kind` of a procedural sky.
 pub(super) const ENV_SKY: u32 = 0;
 /// `Scene.env_kind` of a uniform environment.
 pub(super) const ENV_UNIFORM: u32 = 1;
+/// `Scene.env_kind` of an equirect (latitude-longitude) image in the image atlas.
+pub(super) const ENV_EQUIRECT: u32 = 2;
+/// `Scene.env_kind` of six cube faces (level 0, bordered) in the image atlas.
+pub(super) const ENV_CUBE: u32 = 3;
 /// `Scene.reflection` of dynamic cube maps.
 pub(super) const REFLECTION_CUBE: u32 = 0;
 /// `Scene.reflection` of the static environment.
@@ -31,13 +37,20 @@ pub(super) const REFLECTION_ENVIRONMENT: u32 = 1;
 /// `Scene.reflection` of dynamic cube maps read with one bilinear tap
 /// ([`ReflectionFilter::Bilinear`]).
 pub(super) const REFLECTION_CUBE_BILINEAR: u32 = 2;
+/// `Scene.reflection` of the static environment when it is cube faces: their mip chain is
+/// chain 0 of `cube_mips`, read with the footprint filter.
+pub(super) const REFLECTION_ENV_CUBE: u32 = 3;
+/// [`REFLECTION_ENV_CUBE`] read with one bilinear tap ([`ReflectionFilter::Bilinear`]).
+pub(super) const REFLECTION_ENV_CUBE_BILINEAR: u32 = 4;
+/// `Scene.reflection` of a sphere map (`Scene.sphere_image` in the image atlas).
+pub(super) const REFLECTION_SPHERE_MAP: u32 = 5;
 /// `Scene.transmittance_table` when `T = 1 − R`.
 pub(super) const NO_TABLE: u32 = u32::MAX;
 
 /// Bytes of the WGSL `View` struct.
 pub(super) const VIEW_BYTES: u64 = 9 * 16;
-/// Bytes of one object vertex: position, normal, tag.
-pub(super) const OBJECT_VERTEX_BYTES: u64 = 28;
+/// Bytes of one object vertex: position, normal, tag, texture uv.
+pub(super) const OBJECT_VERTEX_BYTES: u64 = 36;
 /// Bytes of one bubble vertex: position, normal, thickness, pixel angle, bubble index,
 /// material direction (zero without a film field), the bubble's film field as (first
 /// texel in the film texture, face size; face size 0: no field), and the bubble's centre
@@ -175,6 +188,13 @@ pub(super) struct SceneData {
     /// (`FilmField::bordered`, `[thickness_nm, coverage]` as Rg32Float), one after
     /// another, texel `i` at `(i mod width, i div width)`.
     pub films: FilmTexture,
+    /// The image atlas (`Atlas`): the environment's image or cube faces, the sphere map,
+    /// the materials' images, as Rgba32Float.
+    pub images: LutTexture,
+    /// The environment cube faces' whole mip chain as f32 RGB in `CubeMap`'s level layout
+    /// (what `cube_mips` holds per bubble) when the static environment reflects in the
+    /// bubbles; empty otherwise.
+    pub env_chain: Vec<u8>,
 }
 
 /// Why the wgpu backend cannot draw `what` (it draws the scenes the built-in scenes use).
@@ -183,26 +203,9 @@ fn unsupported(what: impl Into<String>) -> GpuError {
 }
 
 /// Refuses what the wgpu backend does not draw yet, naming it.
-pub(super) fn check_supported(
-    scene: &RenderScene,
-    settings: &RenderSettings,
-) -> Result<(), GpuError> {
-    if let ReflectionMode::SphereMap(_) = settings.reflection {
-        return Err(unsupported("reflection mode sphere-map"));
-    }
+pub(super) fn check_supported(scene: &RenderScene) -> Result<(), GpuError> {
     if scene.water.is_some() {
         return Err(unsupported("a water surface (the [water] section)"));
-    }
-    match scene.environment {
-        Environment::Sky(_) | Environment::Uniform(_) => {}
-        Environment::Equirect(_) => return Err(unsupported("an equirect environment image")),
-        Environment::CubeFaces(_) => return Err(unsupported("a cube-face environment")),
-    }
-    let ground = scene.ground.iter().map(|g| &g.material);
-    for m in scene.objects.iter().map(|o| o.material()).chain(ground) {
-        if let Pattern::Textured { .. } = m.pattern {
-            return Err(unsupported("a textured material"));
-        }
     }
     Ok(())
 }
@@ -240,20 +243,50 @@ impl SceneData {
             .iter()
             .map(|l| l.light_lut.map_or(0, |i| first_light + i as u32))
             .collect();
-        let face_size = match settings.reflection {
-            ReflectionMode::DynamicCubeMap { face_size } => face_size as u32,
+        let mut atlas = Atlas::default();
+        let env_image = match &scene.environment {
+            Environment::Equirect(t) => atlas.push(t.texels(), t.width(), t.height()),
+            Environment::CubeFaces(c) => atlas.push(c.level_texels(0), c.face_size(), 0),
+            Environment::Sky(_) | Environment::Uniform(_) => [0; 4],
+        };
+        let sphere = match &settings.reflection {
+            ReflectionMode::SphereMap(map) => {
+                let t = map.texture();
+                let image = atlas.push(t.texels(), t.width(), t.height());
+                Some((image, map.map_from_world()))
+            }
+            _ => None,
+        };
+        // The static environment's cube faces are read as a bubble's cube map is, from
+        // `cube_mips` (chain 0): `face_size` is then theirs.
+        let env_cube = match (&settings.reflection, &scene.environment) {
+            (ReflectionMode::StaticEnvironment, Environment::CubeFaces(c)) => Some(c),
+            _ => None,
+        };
+        let face_size = match (&settings.reflection, env_cube) {
+            (ReflectionMode::DynamicCubeMap { face_size }, _) => *face_size as u32,
+            (_, Some(c)) => c.face_size() as u32,
             _ => 0,
         };
+        let material_bytes = material_bytes(&materials, &mut atlas);
+        let env_chain: Vec<u8> = env_cube.map_or(Vec::new(), |c| {
+            (0..c.levels())
+                .flat_map(|level| c.level_texels(level))
+                .flatten()
+                .flat_map(|x| x.to_le_bytes())
+                .collect()
+        });
         Ok(SceneData {
             scene: scene_bytes(
                 scene,
                 &settings.reflection,
                 reads,
-                face_size,
-                ground_material,
+                [face_size, ground_material],
+                env_image,
+                sphere,
                 tables,
             ),
-            materials: material_bytes(&materials),
+            materials: material_bytes,
             lights: light_bytes(&scene.lights, &light_tables),
             objects: object_bytes.0,
             object_vertices,
@@ -263,7 +296,48 @@ impl SceneData {
             luts,
             lut_info,
             films,
+            images: atlas.finish(max_texture_side)?,
+            env_chain,
         })
+    }
+}
+
+/// Images as `scene.wgsl` reads them (`images`): each image's texels row-major, one image
+/// after another, linear texel `i` at `(i mod width, i div width)` of one Rgba32Float
+/// texture (rows of at most the device's side, the last row padded).
+#[derive(Debug, Default)]
+struct Atlas {
+    texels: Bytes,
+}
+
+impl Atlas {
+    /// Appends `texels`; returns the WGSL descriptor `(first texel, a, b, 0)`.
+    fn push(&mut self, texels: &[[f32; 3]], a: usize, b: usize) -> [u32; 4] {
+        let first = self.texels.0.len() / 16;
+        for t in texels {
+            self.texels.vec4(*t, 1.0);
+        }
+        // `finish` refuses an atlas past the device's side² (< 2³²) texels.
+        [first as u32, a as u32, b as u32, 0]
+    }
+
+    /// The texture `(width, height, texels)`.
+    ///
+    /// # Errors
+    /// [`GpuError::Unsupported`], naming the texel count and the limit, when the atlas
+    /// would be taller than `max_side`.
+    fn finish(mut self, max_side: u32) -> Result<LutTexture, GpuError> {
+        let count = (self.texels.0.len() / 16).max(1);
+        let width = count.min(max_side as usize);
+        let height = count.div_ceil(width);
+        if height > max_side as usize {
+            return Err(unsupported(format!(
+                "images of {count} texels (the environment's and the textures': their \
+                 texture holds at most {max_side} × {max_side} texels on this device)"
+            )));
+        }
+        self.texels.0.resize(16 * width * height, 0);
+        Ok((width as u32, height as u32, self.texels.0))
     }
 }
 
@@ -271,8 +345,9 @@ fn scene_bytes(
     scene: &RenderScene,
     reflection: &ReflectionMode,
     reads: CubeReads,
-    face_size: u32,
-    ground_material: u32,
+    [face_size, ground_material]: [u32; 2],
+    env_image: [u32; 4],
+    sphere: Option<([u32; 4], Mat3)>,
     tables: &FilmTables,
 ) -> Vec<u8> {
     let mut b = Bytes::default();
@@ -283,15 +358,23 @@ fn scene_bytes(
     let (env_kind, sky, uniform) = match &scene.environment {
         Environment::Uniform(rgb) => (ENV_UNIFORM, Sky::default(), *rgb),
         Environment::Sky(sky) => (ENV_SKY, *sky, [0.0; 3]),
-        // check_supported refused the others.
-        _ => (ENV_UNIFORM, Sky::default(), [0.0; 3]),
+        Environment::Equirect(_) => (ENV_EQUIRECT, Sky::default(), [0.0; 3]),
+        Environment::CubeFaces(_) => (ENV_CUBE, Sky::default(), [0.0; 3]),
     };
+    let env_cube = matches!(scene.environment, Environment::CubeFaces(_));
     b.u32(env_kind).u32(scene.lights.len() as u32);
     b.u32(match (reflection, reads.filter) {
         (ReflectionMode::DynamicCubeMap { .. }, ReflectionFilter::Footprint) => REFLECTION_CUBE,
         (ReflectionMode::DynamicCubeMap { .. }, ReflectionFilter::Bilinear) => {
             REFLECTION_CUBE_BILINEAR
         }
+        (ReflectionMode::StaticEnvironment, ReflectionFilter::Footprint) if env_cube => {
+            REFLECTION_ENV_CUBE
+        }
+        (ReflectionMode::StaticEnvironment, ReflectionFilter::Bilinear) if env_cube => {
+            REFLECTION_ENV_CUBE_BILINEAR
+        }
+        (ReflectionMode::SphereMap(_), _) => REFLECTION_SPHERE_MAP,
         _ => REFLECTION_ENVIRONMENT,
     });
     // Table 0 is the reflectivity, 1 the transmittance when there is one.
@@ -316,25 +399,47 @@ fn scene_bytes(
         && scene.ground.is_some()
         && matches!(reflection, ReflectionMode::DynamicCubeMap { .. });
     b.u32(u32::from(parallax)).u32(0).u32(0).u32(0);
+    // The environment image: (first texel, width, height) of an equirect, (first texel,
+    // face size) of cube faces.
+    for w in env_image {
+        b.u32(w);
+    }
+    // The sphere map: its image (first texel, width, height), then the rows of its
+    // `map_from_world`.
+    let (image, map_from_world) = sphere.unwrap_or(([0; 4], Mat3::IDENTITY));
+    for w in image {
+        b.u32(w);
+    }
+    for row in 0..3 {
+        b.vec4(map_from_world.row(row).to_array(), 0.0);
+    }
     b.0
 }
 
-fn material_bytes(materials: &[&Material]) -> Vec<u8> {
+/// The WGSL `array<Material>`; a textured material's image goes into `atlas`.
+fn material_bytes(materials: &[&Material], atlas: &mut Atlas) -> Vec<u8> {
     let mut b = Bytes::default();
     for m in materials {
+        let mut image = [0; 4];
         let (a, bb, scale, kind) = match &m.pattern {
             Pattern::Checker { a, b, scale_m } => (*a, *b, *scale_m, PATTERN_CHECKER),
             Pattern::Solid(c) => (*c, *c, 1.0, PATTERN_SOLID),
-            // check_supported refused textures.
-            Pattern::Textured { .. } => ([0.0; 3], [0.0; 3], 1.0, PATTERN_SOLID),
+            Pattern::Textured { texture, scale_m } => {
+                image = atlas.push(texture.texels(), texture.width(), texture.height());
+                ([0.0; 3], [0.0; 3], *scale_m, PATTERN_TEXTURED)
+            }
         };
         b.vec4(a, scale)
             .vec4(bb, m.shininess)
             .vec4(m.specular, kind);
+        for w in image {
+            b.u32(w);
+        }
     }
     if materials.is_empty() {
         b.vec4([0.0; 3], 1.0)
             .vec4([0.0; 3], 1.0)
+            .vec4([0.0; 3], 0.0)
             .vec4([0.0; 3], 0.0);
     }
     b.0
@@ -355,7 +460,7 @@ fn light_bytes(lights: &[Light], tables: &[u32]) -> Vec<u8> {
     b.0
 }
 
-/// Appends `g`'s triangles as three vertices each (position, normal, tag).
+/// Appends `g`'s triangles as three vertices each (position, normal, tag, uv).
 fn push_geometry(b: &mut Bytes, g: &Geometry) {
     for (t, &tag) in g.triangles.iter().zip(&g.tags) {
         for i in t.map(|i| i as usize) {
@@ -364,6 +469,7 @@ fn push_geometry(b: &mut Bytes, g: &Geometry) {
             b.f32(p.x).f32(p.y).f32(p.z);
             b.f32(a[0]).f32(a[1]).f32(a[2]);
             b.u32(tag);
+            b.f32(a[3]).f32(a[4]);
         }
     }
 }
@@ -517,7 +623,7 @@ fn stack_tables(
 mod tests {
     use std::sync::Arc;
 
-    use render_scene::{BubbleFilm, BubbleMesh, Camera, FilmField, Vec3};
+    use render_scene::{BubbleFilm, BubbleMesh, Camera, FilmField, Ground, Texture, Vec3};
 
     use super::*;
 
@@ -563,7 +669,7 @@ mod tests {
         scene.bubbles[2].film = film(&other);
         scene.bubbles[3].film = film(&shared);
         // The wgpu backend draws film fields: nothing refuses them.
-        check_supported(&scene, &settings).unwrap();
+        check_supported(&scene).unwrap();
         let tables = FilmTables::from_reflectivity(
             render_scene::Lut::try_from_fn(4, 4, 1000.0, |_, _| [0.1; 3]).unwrap(),
         );
@@ -613,6 +719,63 @@ mod tests {
             err.to_string().contains("film fields of 150 texels"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn images_go_into_the_atlas_named_by_the_environment_and_their_materials() {
+        let camera = Camera::look_at(Vec3::new(0.0, 1.0, 3.0), Vec3::ZERO, Vec3::Y, 40.0);
+        let env = Texture::try_new(3, 1, vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0], [7.0; 3]]);
+        let mut scene = RenderScene::new(camera, Environment::Equirect(env.unwrap()));
+        let texture = Texture::try_new(1, 2, vec![[10.0; 3], [11.0; 3]]).unwrap();
+        scene.ground = Some(Ground {
+            height_m: 0.0,
+            material: Material {
+                pattern: Pattern::Textured {
+                    texture,
+                    scale_m: 0.5,
+                },
+                specular: [0.0; 3],
+                shininess: 1.0,
+            },
+        });
+        check_supported(&scene).unwrap();
+        let lut = render_scene::Lut::try_from_fn(2, 2, 1000.0, |_, _| [0.1; 3]).unwrap();
+        let tables = FilmTables::from_reflectivity(lut);
+        let settings = RenderSettings::default();
+        let view = scene.camera.view(16, 16);
+        let pack = |max_side| {
+            SceneData::new(
+                &scene,
+                &tables,
+                &settings,
+                &view,
+                max_side,
+                CubeReads::default(),
+            )
+        };
+        let data = pack(3).unwrap();
+        // Rows of 3 texels: the environment's three, the ground's two, one of padding.
+        let (width, height, bytes) = &data.images;
+        assert_eq!((*width, *height), (3, 2));
+        let want = [
+            [1.0, 2.0, 3.0, 1.0],
+            [4.0, 5.0, 6.0, 1.0],
+            [7.0, 7.0, 7.0, 1.0],
+            [10.0, 10.0, 10.0, 1.0],
+            [11.0, 11.0, 11.0, 1.0],
+            [0.0; 4],
+        ];
+        assert_eq!(floats(bytes), want.concat());
+        // Scene.env_image after 9 + 6 vec4s and 12 words: first texel 0, 3 × 1.
+        assert_eq!(words(&data.scene)[72..76], [0, 3, 1, 0]);
+        // The ground, the only material: textured, 0.5 m a repeat, image at texel 3, 1 × 2.
+        let m = words(&data.materials);
+        assert_eq!(f32::from_bits(m[11]), PATTERN_TEXTURED);
+        assert_eq!(f32::from_bits(m[3]), 0.5);
+        assert_eq!(m[12..16], [3, 1, 2, 0]);
+        // Rows of 2: three rows, more than the device's 2: named, never drawn otherwise.
+        let err = pack(2).unwrap_err();
+        assert!(err.to_string().contains("images of 5 texels"), "{err}");
     }
 
     #[test]

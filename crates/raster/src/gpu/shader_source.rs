@@ -6,8 +6,9 @@
 #![cfg_attr(not(feature = "wgpu"), allow(dead_code))]
 
 use super::scene_data::{
-    ENV_SKY, ENV_UNIFORM, NO_TABLE, PATTERN_CHECKER, PATTERN_SOLID, REFLECTION_CUBE,
-    REFLECTION_CUBE_BILINEAR, REFLECTION_ENVIRONMENT,
+    ENV_CUBE, ENV_EQUIRECT, ENV_SKY, ENV_UNIFORM, NO_TABLE, PATTERN_CHECKER, PATTERN_SOLID,
+    PATTERN_TEXTURED, REFLECTION_CUBE, REFLECTION_CUBE_BILINEAR, REFLECTION_ENV_CUBE,
+    REFLECTION_ENV_CUBE_BILINEAR, REFLECTION_ENVIRONMENT, REFLECTION_SPHERE_MAP,
 };
 use render_scene::shader_constants::{
     ACES_DENOMINATOR, ACES_NUMERATOR, FACE_BASES, SCENE_SCALARS, SCENE_WORDS, TONE_MATRICES,
@@ -66,6 +67,7 @@ fn scene_constants() -> String {
         ("PI", std::f32::consts::PI),
         ("PATTERN_SOLID", PATTERN_SOLID),
         ("PATTERN_CHECKER", PATTERN_CHECKER),
+        ("PATTERN_TEXTURED", PATTERN_TEXTURED),
     ];
     for (name, value) in SCENE_SCALARS.into_iter().chain(packing_scalars) {
         out += &format!("const {name}: f32 = {};\n", float(value));
@@ -73,9 +75,14 @@ fn scene_constants() -> String {
     let packing_words = [
         ("ENV_SKY", ENV_SKY),
         ("ENV_UNIFORM", ENV_UNIFORM),
+        ("ENV_EQUIRECT", ENV_EQUIRECT),
+        ("ENV_CUBE", ENV_CUBE),
         ("REFLECTION_CUBE", REFLECTION_CUBE),
         ("REFLECTION_ENVIRONMENT", REFLECTION_ENVIRONMENT),
         ("REFLECTION_CUBE_BILINEAR", REFLECTION_CUBE_BILINEAR),
+        ("REFLECTION_ENV_CUBE", REFLECTION_ENV_CUBE),
+        ("REFLECTION_ENV_CUBE_BILINEAR", REFLECTION_ENV_CUBE_BILINEAR),
+        ("REFLECTION_SPHERE_MAP", REFLECTION_SPHERE_MAP),
         ("NO_TABLE", NO_TABLE),
     ];
     for (name, value) in SCENE_WORDS.into_iter().chain(packing_words) {
