@@ -452,3 +452,84 @@ illuminant = "d65"
     assert!(mean <= 0.25, "mean ΔE2000 {mean} > 0.25");
     assert!(p99 <= 1.2, "99th percentile ΔE2000 {p99} > 1.2");
 }
+
+/// `bubbles animate` with `args` plus a 96×96 `paper` of three frames (0.2 s at 15 fps)
+/// in `dir`, or `None` when no adapter was found outside CI.
+fn animate(dir: &Path, args: &[&str]) -> Option<String> {
+    let mut all = vec![
+        "animate",
+        "paper",
+        "--seconds",
+        "0.2",
+        "--fps",
+        "15",
+        "--width",
+        "96",
+        "--height",
+        "96",
+    ];
+    all.extend(args);
+    let (run, err) = run_unless_no_adapter(&all, dir)?;
+    assert!(run.status.success(), "{all:?}: {err}");
+    Some(err)
+}
+
+#[test]
+fn animate_through_wgpu_writes_frames_apng_and_gif_as_the_cpu_path_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let gpu = ["--backend", "wgpu"];
+    // Frames 0..2, then --resume renders the one missing.
+    let first = [&gpu[..], &["--out", "gpu", "--frames", "0..2"]].concat();
+    if animate(d, &first).is_none() {
+        return;
+    }
+    assert!(
+        !d.join("gpu/frame_00002.png").exists(),
+        "--frames 0..2 wrote frame 2"
+    );
+    animate(d, &[&gpu[..], &["--out", "gpu", "--resume"]].concat()).unwrap();
+    // The CPU's frames, shaded like for like (once per triangle, as the GPU shades).
+    animate(d, &["--out", "cpu", "--partial-shading", "per-triangle"]).unwrap();
+    for k in 0..3 {
+        let name = format!("frame_{k:05}.png");
+        let (mean, p99) = compare(d, &format!("cpu/{name}"), &format!("gpu/{name}"));
+        assert!(
+            mean <= 0.25 && p99 <= 1.5,
+            "frame {k}: mean {mean}, p99 {p99}"
+        );
+    }
+    // A resumed GPU directory is refused to the CPU: the manifest names the backend.
+    let mixed = bubbles(
+        &[
+            "animate",
+            "paper",
+            "--seconds",
+            "0.2",
+            "--fps",
+            "15",
+            "--width",
+            "96",
+            "--height",
+            "96",
+            "--out",
+            "gpu",
+            "--resume",
+        ],
+        d,
+    );
+    assert_eq!(mixed.status.code(), Some(2), "{}", stderr(&mixed));
+    // One APNG: its first frame is the directory's first frame, byte for byte.
+    animate(d, &[&gpu[..], &["--out", "gpu.apng"]].concat()).unwrap();
+    let apng = image::open(d.join("gpu.apng")).unwrap().to_rgb8();
+    let frame0 = image::open(d.join("gpu/frame_00000.png"))
+        .unwrap()
+        .to_rgb8();
+    assert_eq!(apng.as_raw(), frame0.as_raw(), "the APNG's first frame");
+    // The GIF preview, with its ΔE against the exact frames said.
+    let err = animate(d, &[&gpu[..], &["--out", "gpu.gif"]].concat()).unwrap();
+    assert!(
+        d.join("gpu.gif").exists() && err.contains("CIEDE2000"),
+        "{err}"
+    );
+}

@@ -32,7 +32,8 @@ pub const MANIFEST: &str = "animation.txt";
 #[derive(Debug, clap::Args)]
 #[command(
     after_help = "Frame k shows the scene at t = k / fps (frame 0 at t = 0), \
-    simulated with the scene's own solver step and rendered with the CPU backend. \
+    simulated with the scene's own solver step and rendered with --backend (the CPU \
+    by default; wgpu in a build with the wgpu feature, the reference tracer too). \
     The animation has round(seconds × fps) frames, at most 10000, with seconds <= 3600 \
     and fps <= 240.\n\n\
     --start-s T simulates to T without rendering and starts there: frame k shows \
