@@ -19,9 +19,10 @@ pub use to_dynamics::sim_error;
 pub use to_raster::bubble_meshes;
 
 /// Built-in scenes, by name, with their TOML source.
-pub const BUILTINS: [(&str, &str); 10] = [
+pub const BUILTINS: [(&str, &str); 11] = [
     ("paper", include_str!("../../scenes/paper.toml")),
     ("crowd", include_str!("../../scenes/crowd.toml")),
+    ("crowd-100", include_str!("../../scenes/crowd-100.toml")),
     (
         "white-furnace",
         include_str!("../../scenes/white-furnace.toml"),
