@@ -9,6 +9,7 @@ use render_scene::camera::View;
 use render_scene::cubemap::FACE_BASES;
 use render_scene::ground_view::{GroundFilter, GroundView};
 use render_scene::lut_sampler::LutSampler;
+use render_scene::parallax::proxy_ground_height_m;
 use render_scene::reflection::Reflection;
 use render_scene::tessellate::{Geometry, tessellate};
 use render_scene::{
@@ -181,13 +182,7 @@ impl Renderer {
             .iter()
             .map(|b| b.film.as_ref().map(|f| &*f.field))
             .collect();
-        let corrected = self.parallax == ReflectionParallax::Ground
-            && matches!(settings.reflection, ReflectionMode::DynamicCubeMap { .. });
-        let ground_height_m = scene
-            .ground
-            .as_ref()
-            .filter(|_| corrected)
-            .map(|g| g.height_m);
+        let ground_height_m = proxy_ground_height_m(self.parallax, &settings.reflection, scene);
         let bubbles = BubbleCtx {
             view,
             pattern,

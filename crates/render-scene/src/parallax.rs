@@ -11,6 +11,22 @@
 
 use glam::Vec3;
 
+use crate::{ReflectionMode, ReflectionParallax, RenderScene};
+
+/// The height of the ground plane that `scene`'s dynamic cube-map reads are corrected
+/// over, when `parallax` asks for the correction, `reflection` reads dynamic cube maps and
+/// the scene has a ground; `None` otherwise (reads from the centre). Both backends decide
+/// by it.
+pub fn proxy_ground_height_m(
+    parallax: ReflectionParallax,
+    reflection: &ReflectionMode,
+    scene: &RenderScene,
+) -> Option<f32> {
+    let on = parallax == ReflectionParallax::Ground
+        && matches!(reflection, ReflectionMode::DynamicCubeMap { .. });
+    scene.ground.as_ref().filter(|_| on).map(|g| g.height_m)
+}
+
 /// The unit direction from a cube map's `centre` to where the ray from film point `p`
 /// along unit `dir` meets the ground plane `y = height_m`.
 ///

@@ -10,6 +10,7 @@ use super::GpuError;
 use render_scene::bubble_order::{far_to_near, is_front_facing, reflection_rate};
 use render_scene::camera::View;
 use render_scene::ground_view::{GroundFilter, GroundView};
+use render_scene::parallax::proxy_ground_height_m;
 use render_scene::tessellate::{Geometry, tessellate};
 use render_scene::{
     Environment, FilmTables, Light, Material, Pattern, ReflectionFilter, ReflectionMode,
@@ -394,10 +395,8 @@ fn scene_bytes(
     b.vec4(uniform, 0.0);
     let height = scene.ground.as_ref().map_or(0.0, |g| g.height_m);
     b.u32(ground_material).f32(height).u32(face_size).u32(0);
-    // parallax.rs: on for dynamic cube maps over a ground (renderer.rs `ground_height_m`).
-    let parallax = reads.parallax == ReflectionParallax::Ground
-        && scene.ground.is_some()
-        && matches!(reflection, ReflectionMode::DynamicCubeMap { .. });
+    // On exactly where the CPU corrects (renderer.rs `ground_height_m`).
+    let parallax = proxy_ground_height_m(reads.parallax, reflection, scene).is_some();
     b.u32(u32::from(parallax)).u32(0).u32(0).u32(0);
     // The environment image: (first texel, width, height) of an equirect, (first texel,
     // face size) of cube faces.
