@@ -259,16 +259,11 @@ fn sphere_map_sample(dir: vec3<f32>) -> vec3<f32> {
 // (n + 2)² faces from texel `first`, n = `size`; `cube_level_bilinear`'s arithmetic.
 fn env_cube_sample(first: u32, size: u32, dir: vec3<f32>) -> vec3<f32> {
     let fst = face_coordinates(dir);
-    let n = f32(size);
-    let m = n + 2.0;
-    let fx = clamp((fst.y + 1.0) * 0.5 * n + 0.5, 0.0, m - 1.0);
-    let fy = clamp((fst.z + 1.0) * 0.5 * n + 0.5, 0.0, m - 1.0);
-    let x0 = min(floor(fx), m - 2.0);
-    let y0 = min(floor(fy), m - 2.0);
-    let tx = fx - x0;
-    let ty = fy - y0;
+    let at = bordered_bilinear(fst, f32(size));
+    let tx = at.z;
+    let ty = at.w;
     let mu = size + 2u;
-    let i = first + (u32(fst.x) * mu + u32(y0)) * mu + u32(x0);
+    let i = first + (u32(fst.x) * mu + u32(at.y)) * mu + u32(at.x);
     let a = image_texel(i);
     let b = image_texel(i + 1u);
     let c = image_texel(i + mu);
@@ -665,19 +660,27 @@ fn mip_texel(i: u32) -> vec3<f32> {
     return vec3<f32>(cube_mips[i], cube_mips[i + 1u], cube_mips[i + 2u]);
 }
 
-// cubemap.rs `Level::bilinear`: seamless bilinear tap of one level at (s, t), borders
-// included.
-fn cube_level_bilinear(bubble: u32, level: u32, fst: vec3<f32>) -> vec3<f32> {
-    let n = f32(mip_size(level));
+// cubemap.rs `Level::bilinear`'s texel position on a bordered face of `n` interior texels
+// at face coordinates `fst`: the lower texel's column and row (borders counted) and the
+// bilinear weights, as (x0, y0, tx, ty).
+fn bordered_bilinear(fst: vec3<f32>, n: f32) -> vec4<f32> {
     let m = n + 2.0;
     let fx = clamp((fst.y + 1.0) * 0.5 * n + 0.5, 0.0, m - 1.0);
     let fy = clamp((fst.z + 1.0) * 0.5 * n + 0.5, 0.0, m - 1.0);
     let x0 = min(floor(fx), m - 2.0);
     let y0 = min(floor(fy), m - 2.0);
-    let tx = fx - x0;
-    let ty = fy - y0;
-    let i = mip_index(bubble, level, u32(fst.x), u32(x0), u32(y0));
-    let row = 3u * u32(m);
+    return vec4<f32>(x0, y0, fx - x0, fy - y0);
+}
+
+// cubemap.rs `Level::bilinear`: seamless bilinear tap of one level at (s, t), borders
+// included.
+fn cube_level_bilinear(bubble: u32, level: u32, fst: vec3<f32>) -> vec3<f32> {
+    let n = f32(mip_size(level));
+    let at = bordered_bilinear(fst, n);
+    let tx = at.z;
+    let ty = at.w;
+    let i = mip_index(bubble, level, u32(fst.x), u32(at.x), u32(at.y));
+    let row = 3u * u32(n + 2.0);
     let a = mip_texel(i);
     let b = mip_texel(i + 3u);
     let c = mip_texel(i + row);
