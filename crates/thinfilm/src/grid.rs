@@ -248,18 +248,13 @@ impl FilmGrid {
             film_f64::row(&self.soa, first, thickness_nm, which(pol), r, t);
             let from = self.exact.partition_point(|&k| k < first);
             for &k in self.exact[from..].iter().take_while(|&&k| k < end) {
-                (r[k - first], t[k - first]) = self.exact_at(self.cells[k], thickness_nm, pol)?;
+                (r[k - first], t[k - first]) = self.cell_at(self.cells[k], thickness_nm, pol)?;
             }
             return Ok(());
         }
         let cells = &self.cells[first..end];
         for ((cell, r), t) in cells.iter().zip(r.iter_mut()).zip(t.iter_mut()) {
-            (*r, *t) = match *cell {
-                Cell::Closed { beta_per_nm, s, p } => {
-                    closed_at(beta_per_nm * thickness_nm, s, p, pol)
-                }
-                Cell::Exact { .. } => self.exact_at(*cell, thickness_nm, pol)?,
-            };
+            (*r, *t) = self.cell_at(*cell, thickness_nm, pol)?;
         }
         Ok(())
     }
@@ -289,12 +284,7 @@ impl FilmGrid {
         film_f32::row(&self.soa32, first, thickness_nm, which(pol), r, t);
         let from = self.f64_cells.partition_point(|&k| k < first);
         for &k in self.f64_cells[from..].iter().take_while(|&&k| k < end) {
-            (r[k - first], t[k - first]) = match self.cells[k] {
-                Cell::Closed { beta_per_nm, s, p } => {
-                    closed_at(beta_per_nm * thickness_nm, s, p, pol)
-                }
-                cell @ Cell::Exact { .. } => self.exact_at(cell, thickness_nm, pol)?,
-            };
+            (r[k - first], t[k - first]) = self.cell_at(self.cells[k], thickness_nm, pol)?;
         }
         Ok(())
     }
@@ -325,26 +315,30 @@ impl FilmGrid {
         })
     }
 
-    /// One cell by the general [`ThinFilm`] path.
-    fn exact_at(
+    /// One cell's `(R, T)`: the closed form at libm's sine, or the general [`ThinFilm`]
+    /// path for an exact cell.
+    fn cell_at(
         &self,
         cell: Cell,
         thickness_nm: f64,
         pol: Polarisation,
     ) -> Result<(f64, f64), OpticsError> {
-        let Cell::Exact {
-            incidence,
-            wavelength_nm,
-        } = cell
-        else {
-            unreachable!("exact_at is called on exact cells only")
-        };
-        let film = ThinFilm::symmetric(
-            self.n_outside,
-            RefractiveIndex::Constant(self.n_film),
-            thickness_nm,
-        );
-        Ok(pick(pol, film.try_response_at(wavelength_nm, incidence)?))
+        match cell {
+            Cell::Closed { beta_per_nm, s, p } => {
+                Ok(closed_at(beta_per_nm * thickness_nm, s, p, pol))
+            }
+            Cell::Exact {
+                incidence,
+                wavelength_nm,
+            } => {
+                let film = ThinFilm::symmetric(
+                    self.n_outside,
+                    RefractiveIndex::Constant(self.n_film),
+                    thickness_nm,
+                );
+                Ok(pick(pol, film.try_response_at(wavelength_nm, incidence)?))
+            }
+        }
     }
 }
 

@@ -10,7 +10,7 @@
 //! [`super::term::term`]) are left to the f64 path; the caller fills them.
 
 use super::film_f64::Which;
-use super::kernel::{reduced_periods, sin2_pi};
+use super::kernel::{nonzero, reduced_periods, sin2_pi};
 use super::term::{MAX_PERIODS, MIN_COS_OUTSIDE, MIN_COS2_IN_FILM, Split, a_and_b};
 
 /// Largest phase `q · d`, in periods, the row takes (`2^21`, as the per-sample kernel).
@@ -126,16 +126,6 @@ struct Ref<'a> {
 #[target_feature(enable = "avx2")]
 fn row_avx2(cells: &Ref<'_>, d: Split, which: Which, r: &mut [f64], t: &mut [f64]) {
     row_body(cells, d, which, r, t);
-}
-
-/// Keeps a denominator off zero (it is zero only with its numerator, where R = 0).
-#[inline(always)]
-fn nonzero(den: f32) -> f32 {
-    if den > f32::MIN_POSITIVE {
-        den
-    } else {
-        f32::MIN_POSITIVE
-    }
 }
 
 /// Points computed together in f32 before they are widened to f64: the f32 loop then

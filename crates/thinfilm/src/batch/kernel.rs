@@ -47,7 +47,7 @@ pub(crate) fn sin2_pi(f: f32) -> f32 {
 /// Keeps a denominator off zero: it is zero only when its numerator is too (a lossless
 /// film at an exact resonance of a total reflector), where the answer is 0.
 #[inline(always)]
-fn nonzero(den: f32) -> f32 {
+pub(super) fn nonzero(den: f32) -> f32 {
     if den > f32::MIN_POSITIVE {
         den
     } else {
