@@ -15,7 +15,7 @@ use common::{
 use raster::gpu::{GpuOptions, GpuRenderer};
 use raster::{
     Environment, FilmTables, Irradiance, Material, Object, Pattern, ReflectionMode, RenderScene,
-    Renderer, Sky, Vec3,
+    RenderSettings, Renderer, Sky, Vec3,
 };
 use thinfilm::colorspace::{XYZ_FROM_SRGB, apply, srgb_decode};
 use thinfilm::{Lab, ciede2000, lab_from_xyz};
@@ -41,6 +41,17 @@ fn cpu_renderer() -> Renderer {
     let mut cpu = Renderer::new();
     cpu.set_partial_shading(raster::PartialShading::PerTriangle);
     cpu
+}
+
+/// `renderer`'s frame of `scene` under `s` as sRGB bytes, tone-mapped as the GPU's are.
+fn srgb8_of(
+    renderer: &mut Renderer,
+    scene: &RenderScene,
+    tables: &FilmTables,
+    s: &RenderSettings,
+) -> Vec<u8> {
+    let frame = renderer.render(scene, tables, s).unwrap();
+    frame.to_srgb8(s.exposure_ev, s.tonemap)
 }
 
 fn lab_of(px: &[u8]) -> Lab {
@@ -113,10 +124,7 @@ fn gpu_frame_matches_the_cpu_backend_in_ciede2000() {
     ] {
         for samples in [1, 4] {
             let s = settings(200, 150, samples, reflection.clone());
-            let cpu = cpu_renderer()
-                .render(&scene, &tables, &s)
-                .unwrap()
-                .to_srgb8(s.exposure_ev, s.tonemap);
+            let cpu = srgb8_of(&mut cpu_renderer(), &scene, &tables, &s);
             let gpu_bytes = gpu.render_srgb8(&scene, &tables, &s).unwrap();
             let (mean, p99) = delta_e(&cpu, &gpu_bytes);
             eprintln!("{reflection:?}, {samples} samples: mean ΔE2000 {mean:.3}, p99 {p99:.3}");
@@ -184,10 +192,7 @@ fn gpu_turned_sphere_map_matches_the_cpu() {
         ReflectionMode::SphereMap(std::sync::Arc::new(map)),
     );
     let tables = tables();
-    let cpu = cpu_renderer()
-        .render(&scene, &tables, &s)
-        .unwrap()
-        .to_srgb8(s.exposure_ev, s.tonemap);
+    let cpu = srgb8_of(&mut cpu_renderer(), &scene, &tables, &s);
     let gpu_bytes = gpu.render_srgb8(&scene, &tables, &s).unwrap();
     let (mean, p99) = delta_e(&cpu, &gpu_bytes);
     eprintln!("turned sphere map: mean ΔE2000 {mean:.3}, p99 {p99:.3}");
@@ -208,10 +213,7 @@ fn cube_frames(gpu: &mut GpuRenderer, filter: raster::ReflectionFilter) -> (Vec<
     let mut cpu = cpu_renderer();
     cpu.set_reflection_filter(filter);
     gpu.set_reflection_filter(filter);
-    let cpu = cpu
-        .render(&scene, &tables, &s)
-        .unwrap()
-        .to_srgb8(s.exposure_ev, s.tonemap);
+    let cpu = srgb8_of(&mut cpu, &scene, &tables, &s);
     (cpu, gpu.render_srgb8(&scene, &tables, &s).unwrap())
 }
 
@@ -293,10 +295,7 @@ fn gpu_static_cube_face_environment_matches_the_cpu_in_both_filters() {
         let mut cpu = cpu_renderer();
         cpu.set_reflection_filter(filter);
         gpu.set_reflection_filter(filter);
-        let cpu = cpu
-            .render(&scene, &tables, &s)
-            .unwrap()
-            .to_srgb8(s.exposure_ev, s.tonemap);
+        let cpu = srgb8_of(&mut cpu, &scene, &tables, &s);
         let got = gpu.render_srgb8(&scene, &tables, &s).unwrap();
         let (mean, p99) = delta_e(&cpu, &got);
         eprintln!("static cube faces, {filter:?}: mean ΔE2000 {mean:.3}, p99 {p99:.3}");
@@ -389,10 +388,7 @@ fn gpu_bubble_reads_the_lut_at_the_cpu_texel_centres() {
         .push(common::bubble(Vec3::ZERO, 0.6, 4, |n| 500.0 + 450.0 * n.y));
     let tables = coarse_tables();
     let s = settings(120, 120, 1, ReflectionMode::StaticEnvironment);
-    let cpu = cpu_renderer()
-        .render(&scene, &tables, &s)
-        .unwrap()
-        .to_srgb8(s.exposure_ev, s.tonemap);
+    let cpu = srgb8_of(&mut cpu_renderer(), &scene, &tables, &s);
     let gpu_bytes = gpu.render_srgb8(&scene, &tables, &s).unwrap();
     let (mean, p99) = delta_e(&cpu, &gpu_bytes);
     eprintln!("coarse LUT: mean ΔE2000 {mean:.3}, p99 {p99:.3}");
@@ -454,12 +450,7 @@ fn gpu_film_field_thickness_replaces_the_vertex_thickness_as_on_the_cpu() {
         (ReflectionMode::StaticEnvironment, 1),
     ] {
         let s = settings(200, 150, samples, reflection.clone());
-        let cpu_render = |scene: &RenderScene| {
-            cpu_renderer()
-                .render(scene, &tables, &s)
-                .unwrap()
-                .to_srgb8(s.exposure_ev, s.tonemap)
-        };
+        let cpu_render = |scene: &RenderScene| srgb8_of(&mut cpu_renderer(), scene, &tables, &s);
         let cpu = cpu_render(&scene);
         let cpu_vertex = cpu_render(&by_vertex);
         let got = gpu.render_srgb8(&scene, &tables, &s).unwrap();
@@ -558,10 +549,7 @@ fn gpu_film_with_coverage_half_matches_the_cpu_blend() {
     let cpu_at = |coverage: f32| {
         let mut scene = flat.clone();
         scene.bubbles = vec![quad(coverage)];
-        cpu_renderer()
-            .render(&scene, &tables, &s)
-            .unwrap()
-            .to_srgb8(s.exposure_ev, s.tonemap)
+        srgb8_of(&mut cpu_renderer(), &scene, &tables, &s)
     };
     let (cpu_half, cpu_full) = (cpu_at(0.5), cpu_at(1.0));
     flat.bubbles = vec![quad(0.5)];
@@ -627,10 +615,7 @@ fn every_cpu_sample_count_renders_at_the_nearest_count_the_device_offers() {
             requested
         };
         let s = at(cpu_count);
-        let cpu = cpu_renderer()
-            .render(&scene, &tables, &s)
-            .unwrap()
-            .to_srgb8(s.exposure_ev, s.tonemap);
+        let cpu = srgb8_of(&mut cpu_renderer(), &scene, &tables, &s);
         let (mean, p99) = delta_e(&cpu, &gpu_bytes);
         eprintln!("{requested} samples (GPU {used}): mean ΔE2000 {mean:.3}, p99 {p99:.3}");
         assert!(
@@ -704,8 +689,7 @@ fn gpu_reads_the_ground_with_parallax_as_the_cpu_does() {
     let cpu_with = |parallax| {
         let mut cpu = cpu_renderer();
         cpu.set_reflection_parallax(parallax);
-        let frame = cpu.render(&scene, &tables, &s).unwrap();
-        frame.to_srgb8(s.exposure_ev, s.tonemap)
+        srgb8_of(&mut cpu, &scene, &tables, &s)
     };
     let cpu = cpu_with(raster::ReflectionParallax::Ground);
     let centred = cpu_with(raster::ReflectionParallax::Centre);

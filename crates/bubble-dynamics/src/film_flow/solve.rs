@@ -619,6 +619,15 @@ mod tests {
         out
     }
 
+    /// Edge weights 10⁴× the mass term on `grid` of `n` cells a side, as a frame's
+    /// Marangoni step gives.
+    fn stiff_weights(grid: &CubeSphere, n: usize) -> Vec<f64> {
+        grid.edges()
+            .iter()
+            .map(|e| 1e4 * e.length / e.dual_length / (n * n) as f64)
+            .collect()
+    }
+
     /// A stiff system (weights 10⁴× the mass term, as a frame's Marangoni step gives)
     /// converges to 1e-12 from zero in at most 20 iterations at n = 16 and 64 alike (the
     /// multigrid preconditioner keeps the count from growing with the grid), and the
@@ -629,11 +638,7 @@ mod tests {
             let grid = CubeSphere::new(n);
             let h = Hierarchy::new(&grid);
             let alpha = grid.areas_sr().to_vec();
-            let weight: Vec<f64> = grid
-                .edges()
-                .iter()
-                .map(|e| 1e4 * e.length / e.dual_length / (n * n) as f64)
-                .collect();
+            let weight = stiff_weights(&grid, n);
             let b: Vec<f64> = grid
                 .centres()
                 .iter()
@@ -667,11 +672,7 @@ mod tests {
         let grid = CubeSphere::new(n);
         let h = Hierarchy::new(&grid);
         let alpha = grid.areas_sr().to_vec();
-        let weight: Vec<f64> = grid
-            .edges()
-            .iter()
-            .map(|e| 1e4 * e.length / e.dual_length / (n * n) as f64)
-            .collect();
+        let weight = stiff_weights(&grid, n);
         let answer: Vec<f64> = grid
             .centres()
             .iter()
