@@ -29,6 +29,7 @@ pub(crate) mod film_f32;
 pub(crate) mod film_f64;
 mod kernel;
 pub(crate) mod stack_f64;
+pub(crate) mod stack_real_f64;
 mod term;
 mod trig_f64;
 

@@ -1,13 +1,16 @@
 //! Coherent multilayer stacks on a grid of angle × wavelength, exact in f64: every
 //! interface's coefficients are computed once per angle, then each (angle, wavelength)
-//! point costs one `e^{iδ}` per layer and a complex division per layer and polarisation
-//! (Rouard's recursion, on the vectorised kernel of [`crate::batch`]).
+//! point is folded through the layers on a vectorised kernel of [`crate::batch`].
 //!
-//! Stacks of constant indices (real or complex) with every layer coherent take the kernel
-//! at every angle except grazing incidence; any other stack or point, and any point where
+//! At an angle where every medium is real and no layer is evanescent (the common case:
+//! dielectric coatings), the kernel multiplies the layers' real-structured characteristic
+//! matrices: one sine and cosine per distinct layer phase and one division per point and
+//! polarisation. Other stacks of constant indices (absorbing, or evanescent at that angle)
+//! take Rouard's recursion, one `e^{iδ}` per layer and a complex division per layer and
+//! polarisation, except at grazing incidence. Any other stack or point, and any point where
 //! the recursion meets a pole (a guided mode of a lossless sub-stack hit exactly), takes
-//! the transfer matrix of [`Stack::try_response_at`], so every point is exact. The two
-//! agree to 1e-13 (the test `optics_stack_grid`).
+//! the transfer matrix of [`Stack::try_response_at`], so every point is exact. All agree
+//! to 1e-13 (the test `optics_stack_grid`).
 //!
 //! ```
 //! use thinfilm::grid::Polarisation;
@@ -22,6 +25,7 @@
 //! ```
 
 use crate::batch::stack_f64::{Amplitudes, Coeffs, LayerTerms, Row};
+use crate::batch::stack_real_f64::{RealLayer, RealRow};
 use crate::dispersion::check_in_range;
 use crate::fresnel::{self, OpticsError, check_len};
 use crate::grid::Polarisation;
@@ -29,9 +33,17 @@ use crate::incidence::Incidence;
 use crate::tmm::Stack;
 use num_complex::Complex64;
 
-/// One angle's terms for the kernel, or the general path.
+/// One angle's terms for a kernel, or the general path.
 #[derive(Clone, Debug)]
 enum AngleRow {
+    /// Every medium real and seen without evanescence: the real characteristic matrices.
+    Real {
+        /// The layers, back to front.
+        layers: Vec<RealLayer>,
+        /// The incident medium's and the substrate's admittances, for s and p.
+        y_incident: [f64; 2],
+        y_substrate: [f64; 2],
+    },
     /// Constant indices, all coherent, `cos θ > 0`.
     Folded {
         /// The direction, for points the recursion cannot take.
@@ -79,7 +91,8 @@ impl StackGrid {
             .map(|&angle| {
                 let incidence = Incidence::try_from_angle_deg(angle)?;
                 Ok(match &media {
-                    Some(media) if incidence.cos() > 0.0 => folded(stack, media, incidence),
+                    Some(media) if incidence.cos() > 0.0 => real(stack, media, incidence)
+                        .unwrap_or_else(|| folded(stack, media, incidence)),
                     _ => AngleRow::General(incidence),
                 })
             })
@@ -178,7 +191,26 @@ impl StackGrid {
                 expected: self.wavelengths(),
             })?;
         let wavelengths = &self.wavelength_nm[span.clone()];
+        let (lead, pols) = match pol {
+            Polarisation::P => (1, 1),
+            Polarisation::S => (0, 1),
+            Polarisation::Unpolarised => (0, 2),
+        };
         match row {
+            AngleRow::Real {
+                layers,
+                y_incident,
+                y_substrate,
+            } => {
+                let pick = |y: [f64; 2]| [y[lead], y[1 - lead]];
+                let layers: Vec<_> = (layers.iter())
+                    .map(|l| RealLayer { y: pick(l.y), ..*l })
+                    .collect();
+                let ends = [pick(*y_incident), pick(*y_substrate)];
+                let inv = &self.inv_wavelength_nm[span];
+                RealRow::default().fill(inv, &layers, ends, pols == 2, r, t);
+                Ok(())
+            }
             AngleRow::Folded {
                 incidence,
                 exit,
@@ -186,11 +218,6 @@ impl StackGrid {
                 power_ratio,
             } => {
                 let mut kernel = Row::default();
-                let (lead, pols) = match pol {
-                    Polarisation::P => (1, 1),
-                    Polarisation::S => (0, 1),
-                    Polarisation::Unpolarised => (0, 2),
-                };
                 let pick = |k: [Coeffs; 2]| [k[lead], k[1 - lead]];
                 let layers: Vec<_> = (layers.iter())
                     .map(|l| LayerTerms {
@@ -270,6 +297,34 @@ fn constant_media(stack: &Stack) -> Option<Vec<Complex64>> {
     }
     media.push(stack.n_substrate.as_constant()?);
     Some(media)
+}
+
+/// The real kernel's terms at one angle, when every medium is real and every
+/// `q = n cos θ` real and positive there (no absorption, no evanescence).
+fn real(stack: &Stack, media: &[Complex64], incidence: Incidence) -> Option<AngleRow> {
+    let n0 = stack.n_incident;
+    let mut y = Vec::with_capacity(media.len());
+    for &n in media {
+        let q = incidence.normal_index(n0, n);
+        if n.im != 0.0 || q.im != 0.0 || q.re <= 0.0 {
+            return None;
+        }
+        // Admittances as in `folded`: `q` for s, `q / n²` for p.
+        y.push((q.re, [q.re, q.re / (n.re * n.re)]));
+    }
+    let last = media.len() - 1;
+    let layers = (1..last)
+        .rev()
+        .map(|m| RealLayer {
+            beta_nm: std::f64::consts::TAU * stack.layers[m - 1].thickness_nm * y[m].0,
+            y: y[m].1,
+        })
+        .collect();
+    Some(AngleRow::Real {
+        layers,
+        y_incident: y[0].1,
+        y_substrate: y[last].1,
+    })
 }
 
 /// The kernel's terms at one angle with `cos θ > 0`.

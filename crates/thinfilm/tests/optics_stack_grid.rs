@@ -1,7 +1,8 @@
-//! `stack_grid::StackGrid` (Rouard's recursion on the vectorised kernel) against the
-//! transfer matrix of `Stack`, point by point: random stacks with absorbing, evanescent
-//! and thick layers, every polarisation, grazing incidence; energy conservation; and the
-//! general path for dispersive and incoherent stacks.
+//! `stack_grid::StackGrid` (the real characteristic-matrix kernel and Rouard's recursion)
+//! against the transfer matrix of `Stack`, point by point: random stacks with absorbing,
+//! evanescent and thick layers, every polarisation, grazing incidence; energy
+//! conservation; a Bragg mirror against its closed form; and the general path for
+//! dispersive and incoherent stacks.
 
 mod optics_common;
 
@@ -213,4 +214,39 @@ fn spans_of_a_row_fill_what_the_row_fills() {
         .try_fill_span(0, 30, Polarisation::S, &mut r, &mut t)
         .unwrap_err();
     assert!(err.to_string().contains("38"), "{err}");
+}
+
+#[test]
+fn a_quarter_wave_bragg_mirror_reflects_as_its_closed_form() {
+    // (HL)⁶H at its design wavelength: each quarter-wave layer maps an admittance Y to
+    // n²/Y, so the stack presents Y = (n_H/n_L)^12 n_H²/n_s and R = ((n₀ − Y)/(n₀ + Y))²
+    // (Macleod, Thin-Film Optical Filters, §6.1). Its layers repeat two phases, which the
+    // grid tabulates once each.
+    let (n_h, n_l, n_s, design_nm) = (2.3, 1.38, 1.52, 550.0);
+    let quarter = |n: f64| Layer::lossless(n, design_nm / (4.0 * n));
+    let mut layers = Vec::new();
+    for _ in 0..6 {
+        layers.extend([quarter(n_h), quarter(n_l)]);
+    }
+    layers.push(quarter(n_h));
+    let stack = Stack::new(1.0, layers, n_s).unwrap();
+    let grid = StackGrid::try_new(&stack, &[0.0], &[500.0, design_nm, 600.0]).unwrap();
+    let y = (n_h / n_l).powi(12) * n_h * n_h / n_s;
+    let expected = ((1.0 - y) / (1.0 + y)).powi(2);
+    for pol in POLS {
+        let (r, t) = filled(&grid, pol);
+        assert_close(&format!("{pol:?} R"), r[1], expected, 1e-13);
+        assert_close(&format!("{pol:?} T"), t[1], 1.0 - expected, 1e-13);
+    }
+    let wavelengths: Vec<f64> = (400..=700).step_by(3).map(f64::from).collect();
+    check_against_matrix(&stack, &[0.0, 20.0, 45.0, 70.0], &wavelengths);
+}
+
+#[test]
+fn a_layer_too_thick_for_the_polynomial_sine_is_exact() {
+    // 5 cm of glass: its phase at 360 nm (1.3e6 rad) is past the polynomial's range, so
+    // its sine and cosine come from libm; beside it, a thin layer takes the polynomial.
+    let layers = vec![Layer::lossless(1.38, 120.0), Layer::lossless(1.5, 5e7)];
+    let stack = Stack::new(1.0, layers, 1.33).unwrap();
+    check_against_matrix(&stack, &[0.0, 30.0], &[360.0, 361.0, 500.0, 830.0]);
 }
