@@ -59,6 +59,10 @@ enum AngleRow {
     General(Incidence),
 }
 
+thread_local! {
+    static REAL_ROW: std::cell::RefCell<RealRow> = std::cell::RefCell::default();
+}
+
 /// A stack's interface terms over angle × wavelength, ready to fill `R` and `T`.
 #[derive(Clone, Debug)]
 pub struct StackGrid {
@@ -203,12 +207,11 @@ impl StackGrid {
                 y_substrate,
             } => {
                 let pick = |y: [f64; 2]| [y[lead], y[1 - lead]];
-                let layers: Vec<_> = (layers.iter())
-                    .map(|l| RealLayer { y: pick(l.y), ..*l })
-                    .collect();
+                let layers = layers.iter().map(|l| RealLayer { y: pick(l.y), ..*l });
                 let ends = [pick(*y_incident), pick(*y_substrate)];
                 let inv = &self.inv_wavelength_nm[span];
-                RealRow::default().fill(inv, &layers, ends, pols == 2, r, t);
+                // Each thread keeps its scratch: a span is ~0.1 ms, its allocations 10 % of it.
+                REAL_ROW.with_borrow_mut(|row| row.fill(inv, layers, ends, pols == 2, r, t));
                 Ok(())
             }
             AngleRow::Folded {

@@ -42,6 +42,8 @@ struct Phase {
 #[derive(Clone, Debug, Default)]
 pub(crate) struct RealRow {
     phases: Vec<Phase>,
+    layers: Vec<RealLayer>,
+    inv_y: Vec<[f64; 2]>,
     layer_phase: Vec<usize>,
     inv_padded: Vec<f64>,
 }
@@ -49,6 +51,9 @@ pub(crate) struct RealRow {
 /// What one row's fold reads: the layers back to front, their phases, the end media.
 struct Fold<'a> {
     layers: &'a [RealLayer],
+    /// `1 / y` of each layer, per polarisation (a division per block would cost more than
+    /// the block's multiplications).
+    inv_y: &'a [[f64; 2]],
     layer_phase: &'a [usize],
     phases: &'a [Phase],
     y_incident: [f64; 2],
@@ -65,16 +70,21 @@ impl RealRow {
     pub(crate) fn fill(
         &mut self,
         inv_wavelength_nm: &[f64],
-        layers: &[RealLayer],
+        layers: impl IntoIterator<Item = RealLayer>,
         y_ends: [[f64; 2]; 2],
         both: bool,
         r: &mut [f64],
         t: &mut [f64],
     ) {
         assert!(r.len() == inv_wavelength_nm.len() && t.len() == r.len());
-        self.tabulate_phases(inv_wavelength_nm, layers);
+        self.layers.clear();
+        self.layers.extend(layers);
+        self.inv_y.clear();
+        (self.inv_y).extend(self.layers.iter().map(|l| l.y.map(|y| 1.0 / y)));
+        self.tabulate_phases(inv_wavelength_nm);
         let fold = Fold {
-            layers,
+            layers: &self.layers,
+            inv_y: &self.inv_y,
             layer_phase: &self.layer_phase,
             phases: &self.phases,
             y_incident: y_ends[0],
@@ -86,7 +96,7 @@ impl RealRow {
     /// `sin δ` and `cos δ` once per distinct `β`, over the row padded to whole blocks:
     /// periodic and symmetric stacks (Bragg mirrors, `HLH` filters) repeat a few layers,
     /// and the sine and cosine are most of a layer's cost.
-    fn tabulate_phases(&mut self, inv_wavelength_nm: &[f64], layers: &[RealLayer]) {
+    fn tabulate_phases(&mut self, inv_wavelength_nm: &[f64]) {
         let padded = inv_wavelength_nm.len().div_ceil(LANES) * LANES;
         self.inv_padded.clear();
         self.inv_padded.extend_from_slice(inv_wavelength_nm);
@@ -94,7 +104,7 @@ impl RealRow {
         let largest = inv_wavelength_nm.iter().fold(0.0f64, |m, &x| m.max(x));
         self.layer_phase.clear();
         let mut count = 0;
-        for layer in layers {
+        for layer in &self.layers {
             let known = self.phases[..count]
                 .iter()
                 .position(|p| p.beta_nm == layer.beta_nm);
@@ -199,14 +209,15 @@ fn block<const P: usize>(fold: &Fold, start: usize) -> ([f64; LANES], [f64; LANE
     let mut b_im = [[0.0; LANES]; P];
     let mut c_re: [[f64; LANES]; P] = std::array::from_fn(|k| [fold.y_substrate[k]; LANES]);
     let mut c_im = [[0.0; LANES]; P];
-    for (layer, &phase) in fold.layers.iter().zip(fold.layer_phase) {
+    let layers = fold.layers.iter().zip(fold.inv_y);
+    for ((layer, inv_y), &phase) in layers.zip(fold.layer_phase) {
         let phase = &fold.phases[phase];
         let (sin, cos) = (
             &phase.sin[start..start + LANES],
             &phase.cos[start..start + LANES],
         );
         for k in 0..P {
-            let (y, inv_y) = (layer.y[k], 1.0 / layer.y[k]);
+            let (y, inv_y) = (layer.y[k], inv_y[k]);
             for l in 0..LANES {
                 let (s_over_y, y_s) = (sin[l] * inv_y, sin[l] * y);
                 let (br, bi, cr, ci) = (b_re[k][l], b_im[k][l], c_re[k][l], c_im[k][l]);
@@ -260,7 +271,8 @@ mod tests {
                 &mut t,
             );
             let fold = Fold {
-                layers: &layers,
+                layers: &row.layers,
+                inv_y: &row.inv_y,
                 layer_phase: &row.layer_phase,
                 phases: &row.phases,
                 y_incident: [1.0, 1.0],
