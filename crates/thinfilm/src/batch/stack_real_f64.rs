@@ -264,7 +264,7 @@ mod tests {
             let (mut r, mut t) = (vec![0.0; inv.len()], vec![0.0; inv.len()]);
             row.fill(
                 &inv,
-                &layers,
+                layers,
                 [[1.0, 1.0], [1.52, 1.0 / 1.52]],
                 both,
                 &mut r,
