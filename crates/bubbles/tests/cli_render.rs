@@ -195,9 +195,10 @@ fn bench_prints_a_breakdown_per_size() {
 }
 
 /// The film flow's step cost is its own column, part of the simulation's: zero for a
-/// scene without film flow, above zero and at most the simulation's for `swirl`.
+/// scene without film flow, above zero and at most the simulation's for `swirl`; baking
+/// the solver's state for the renderer is another, and the parts add up to the frame.
 #[test]
-fn bench_shows_the_film_steps_as_their_own_column() {
+fn bench_shows_the_film_steps_and_the_bake_as_their_own_columns() {
     let dir = tempfile::tempdir().unwrap();
     let column = |scene: &str| {
         let args = [
@@ -232,14 +233,30 @@ fn bench_shows_the_film_steps_as_their_own_column() {
                 .unwrap_or_else(|| panic!("{text}"));
             row[k].parse().unwrap()
         };
-        (at("sim_ms"), at("film_ms"))
+        // The parts add up to the frame (each printed to 1 µs).
+        let parts = [
+            "sim_ms",
+            "bake_ms",
+            "cube_ms",
+            "opaque_ms",
+            "bubbles_ms",
+            "other_ms",
+        ];
+        let sum: f64 = parts.iter().map(|p| at(p)).sum();
+        assert!((sum - at("frame_ms")).abs() <= 0.004, "{text}");
+        (at("sim_ms"), at("film_ms"), at("bake_ms"))
     };
-    let (_, film_free) = column("paper");
+    let (_, film_free, bake_meshes) = column("paper");
     assert_eq!(film_free, 0.0);
-    let (sim, film) = column("swirl");
+    let (sim, film, bake_field) = column("swirl");
     assert!(
         film > 0.0 && film <= sim,
         "film {film} ms, simulation {sim} ms"
+    );
+    // Every frame bakes the meshes; swirl also bakes its 6·64² film field.
+    assert!(
+        bake_meshes > 0.0 && bake_field > 0.0,
+        "{bake_meshes} {bake_field}"
     );
 }
 

@@ -28,6 +28,8 @@ struct Breakdown {
     simulation_s: f64,
     /// The part of `simulation_s` the bubbles' film flows took (their steps' own clocks).
     film_s: f64,
+    /// Baking the solver's state for the renderer: meshes, film fields, water surface.
+    bake_s: f64,
     cube_maps_s: f64,
     opaque_s: f64,
     bubbles_s: f64,
@@ -65,16 +67,17 @@ pub fn run(args: Args) -> CliResult {
         job.dt_s()
     ));
     report.push_str(
-        "size        sim_ms  film_ms  cube_ms  opaque_ms  bubbles_ms  other_ms  frame_ms     fps\n",
+        "size        sim_ms  film_ms  bake_ms  cube_ms  opaque_ms  bubbles_ms  other_ms  frame_ms     fps\n",
     );
     for (w, h) in sizes {
         job.set_size(w, h)?;
         let b = time_frames(&mut job, frames)?;
         report.push_str(&format!(
-            "{:<10} {:>7.3} {:>8.3} {:>8.3} {:>10.3} {:>11.3} {:>9.3} {:>9.3} {:>7.1}\n",
+            "{:<10} {:>7.3} {:>8.3} {:>8.3} {:>8.3} {:>10.3} {:>11.3} {:>9.3} {:>9.3} {:>7.1}\n",
             format!("{w}x{h}"),
             b.simulation_s * 1e3,
             b.film_s * 1e3,
+            b.bake_s * 1e3,
             b.cube_maps_s * 1e3,
             b.opaque_s * 1e3,
             b.bubbles_s * 1e3,
@@ -102,17 +105,20 @@ fn time_frames(job: &mut FrameJob, frames: u32) -> Result<Breakdown, CliError> {
         sum.film_s += (film_step_time_s(job) - film_before).max(0.0);
         let t = job.render()?.timings;
         let total = start.elapsed().as_secs_f64();
+        let bake = job.last_bake_s();
         sum.simulation_s += sim;
+        sum.bake_s += bake;
         sum.cube_maps_s += t.cube_maps_s;
         sum.opaque_s += t.opaque_s;
         sum.bubbles_s += t.bubbles_s;
-        sum.other_s += total - sim - t.cube_maps_s - t.opaque_s - t.bubbles_s;
+        sum.other_s += total - sim - bake - t.cube_maps_s - t.opaque_s - t.bubbles_s;
         sum.total_s += total;
     }
     let n = f64::from(frames);
     Ok(Breakdown {
         simulation_s: sum.simulation_s / n,
         film_s: sum.film_s / n,
+        bake_s: sum.bake_s / n,
         cube_maps_s: sum.cube_maps_s / n,
         opaque_s: sum.opaque_s / n,
         bubbles_s: sum.bubbles_s / n,

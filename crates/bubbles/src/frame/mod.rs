@@ -43,6 +43,9 @@ pub struct FrameJob {
     reference_frame: Frame,
     /// The water's geometry, evaluated at the solver's time each frame.
     water: Option<water::Surface>,
+    /// Wall time the last [`FrameJob::render`] took to bake the solver's state for the
+    /// renderer, s.
+    bake_s: f64,
 }
 
 impl FrameJob {
@@ -91,6 +94,7 @@ impl FrameJob {
             settings,
             renderer: renderer(options),
             water,
+            bake_s: 0.0,
         })
     }
 
@@ -186,6 +190,13 @@ impl FrameJob {
             .map_err(|e| crate::scene::sim_error(&self.scene, e))
     }
 
+    /// Wall time the last [`FrameJob::render`] spent baking the solver's state into the
+    /// renderer's scene (bubble meshes, their film fields as cube-map textures, the water
+    /// surface), s.
+    pub fn last_bake_s(&self) -> f64 {
+        self.bake_s
+    }
+
     /// The solver's time step, in seconds.
     pub fn dt_s(&self) -> f64 {
         self.world.dt_s()
@@ -193,6 +204,7 @@ impl FrameJob {
 
     /// Renders the current state: the bubbles and the water at the solver's time.
     pub fn render(&mut self) -> Result<&Frame, CliError> {
+        let bake_start = std::time::Instant::now();
         self.render_scene.bubbles = bubble_meshes(&self.world);
         if let (Some(surface), Some(out)) = (&mut self.water, &mut self.render_scene.water) {
             let mesh = surface.evaluate(self.world.time_s());
@@ -202,6 +214,7 @@ impl FrameJob {
                 out.triangles.clone_from(&mesh.triangles);
             }
         }
+        self.bake_s = bake_start.elapsed().as_secs_f64();
         if let Some(spec) = &self.film_spec {
             let settings = self.reference.settings(&self.settings);
             self.reference_frame = reference::render(&self.render_scene, spec, &settings, true)?;
