@@ -1,6 +1,6 @@
 //! One frame's work shared by `render` and `bench`: scene → solver → tables → renderer.
 
-mod gpu;
+pub mod gpu;
 mod options;
 pub mod progress;
 pub mod reference;
@@ -191,8 +191,10 @@ impl FrameJob {
         self.world.dt_s()
     }
 
-    /// Renders the current state: the bubbles and the water at the solver's time.
-    pub fn render(&mut self) -> Result<&Frame, CliError> {
+    /// The current state ready for a renderer: the bubbles and the water at the solver's
+    /// time, with the tables and settings (for a renderer the job does not own: the
+    /// viewer's window presenter).
+    pub fn frame_inputs(&mut self) -> (&RenderScene, &FilmTables, &RenderSettings) {
         self.render_scene.bubbles = bubble_meshes(&self.world);
         if let (Some(surface), Some(out)) = (&mut self.water, &mut self.render_scene.water) {
             let mesh = surface.evaluate(self.world.time_s());
@@ -202,6 +204,17 @@ impl FrameJob {
                 out.triangles.clone_from(&mesh.triangles);
             }
         }
+        (&self.render_scene, &self.tables, &self.settings)
+    }
+
+    /// The scene's file or built-in name, for messages.
+    pub fn origin(&self) -> String {
+        self.scene.origin.clone()
+    }
+
+    /// Renders the current state: the bubbles and the water at the solver's time.
+    pub fn render(&mut self) -> Result<&Frame, CliError> {
+        self.frame_inputs();
         if let Some(spec) = &self.film_spec {
             let settings = self.reference.settings(&self.settings);
             self.reference_frame = reference::render(&self.render_scene, spec, &settings, true)?;
