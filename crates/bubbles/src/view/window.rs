@@ -553,7 +553,10 @@ impl App {
     fn presenter(&mut self, window: &Arc<Window>) -> Result<Presenter, String> {
         if self.backend == Backend::Wgpu {
             match self.gpu_presenter(window) {
-                Ok(p) => return Ok(p),
+                Ok(p) => {
+                    eprintln!("view: --backend wgpu: drawing with {}", p.name());
+                    return Ok(p);
+                }
                 Err(why) => {
                     eprintln!("view: --backend wgpu: {why}; drawing on the CPU instead");
                     self.fallback = Some(why);
