@@ -68,7 +68,7 @@ impl GpuPresenter {
         });
         self.renderer
             .present(inputs, &mut self.surface, overlay)
-            .map_err(|e| CliError::input(format!("{origin}: {e}")))
+            .map_err(|e| frame_error(&origin, e))
     }
 
     /// The job's current state rendered on the GPU and read back (for screenshots).
@@ -77,6 +77,18 @@ impl GpuPresenter {
         let (scene, tables, settings) = job.frame_inputs();
         self.renderer
             .render(scene, tables, settings)
-            .map_err(|e| CliError::input(format!("{origin}: {e}")))
+            .map_err(|e| frame_error(&origin, e))
+    }
+}
+
+/// A failed frame: the scene's fault (unsupported, invalid, too large) is an input error
+/// (exit 2, as `bubbles render --backend wgpu`), the device's or the window's a runtime one.
+fn frame_error(origin: &str, e: GpuError) -> CliError {
+    let message = format!("{origin}: {e}");
+    match e {
+        GpuError::Surface(_) | GpuError::Readback(_) | GpuError::Device(_) => {
+            CliError::runtime(message)
+        }
+        _ => CliError::input(message),
     }
 }

@@ -144,3 +144,13 @@ fn vertex_structs_match_the_packed_vertex_streams() {
         "the packed scene has object vertices"
     );
 }
+
+#[cfg(feature = "wgpu")]
+#[test]
+fn the_present_uniform_has_the_size_present_rs_writes() {
+    use super::present::{PRESENT_BYTES, params_bytes};
+    let module = validated(&present_wgsl());
+    let bytes = params_bytes((1.0, render_scene::ToneMap::AcesFitted, true), [(1, 1); 4]);
+    assert_eq!(struct_size(&module, "Present"), PRESENT_BYTES);
+    assert_eq!(bytes.len() as u64, PRESENT_BYTES);
+}

@@ -14,7 +14,7 @@ use super::{Gpu, GpuError, GpuOptions, GpuRenderer};
 use render_scene::{FilmTables, FrameTimings, RenderScene, RenderSettings, ToneMap};
 
 /// Bytes of the shader's `Present` uniform.
-const PRESENT_BYTES: u64 = 48;
+pub(super) const PRESENT_BYTES: u64 = 48;
 
 /// An overlay to blend over the frame: premultiplied-alpha RGBA8 texels, row-major,
 /// `size.0` × `size.1`, its top-left corner at `origin` in window pixels.
@@ -59,7 +59,13 @@ impl GpuRenderer {
         let instance = super::context::instance();
         let surface = instance
             .create_surface(window)
-            .map_err(|e| GpuError::Surface(e.to_string()))?;
+            .map_err(|e| {
+                GpuError::Surface(format!(
+                    "no Vulkan surface for the window ({e}); a Vulkan driver is needed (on \
+                     Debian, mesa-vulkan-drivers gives lavapipe; VK_DRIVER_FILES names its ICD \
+                     json)"
+                ))
+            })?;
         let gpu = Gpu::open(&instance, options, Some(&surface))?;
         let window = WindowSurface::new(&gpu, surface, size)?;
         Ok((GpuRenderer::from_gpu(gpu), window))
@@ -271,7 +277,7 @@ impl WindowSurface {
 
 /// The shader's `Present` uniform: scale, curve, whether to encode sRGB, then the
 /// source, target, overlay origin and overlay size as pairs of u32.
-fn params_bytes((scale, tonemap, encode): (f32, ToneMap, bool), pairs: [(u32, u32); 4]) -> Vec<u8> {
+pub(super) fn params_bytes((scale, tonemap, encode): (f32, ToneMap, bool), pairs: [(u32, u32); 4]) -> Vec<u8> {
     let curve: u32 = match tonemap {
         ToneMap::Clamp => 0,
         ToneMap::Reinhard => 1,
