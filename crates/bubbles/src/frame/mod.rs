@@ -207,7 +207,8 @@ impl FrameJob {
         (&self.render_scene, &self.tables, &self.settings)
     }
 
-    /// The scene's file or built-in name, for messages.
+    /// The scene's file or built-in name, for messages (the wgpu viewer's).
+    #[cfg(feature = "wgpu")]
     pub fn origin(&self) -> String {
         self.scene.origin.clone()
     }

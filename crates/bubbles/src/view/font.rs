@@ -107,6 +107,7 @@ pub fn text_box(text: &str, scale: usize) -> (usize, usize) {
 /// `text` as [`draw_text`] draws it, as a premultiplied-alpha RGBA8 image of its box
 /// (width, height, texels) to blend over a frame: the glyphs opaque white, the box black
 /// at alpha 3/4, which darkens what is under it to a quarter as `draw_text` does.
+#[cfg(any(test, feature = "wgpu"))]
 pub fn text_rgba(text: &str, scale: usize) -> (usize, usize, Vec<u8>) {
     let (w, h) = text_box(text, scale);
     let mut words = vec![0u32; w * h];

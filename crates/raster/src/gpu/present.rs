@@ -57,15 +57,13 @@ impl GpuRenderer {
         size: (u32, u32),
     ) -> Result<(GpuRenderer, WindowSurface), GpuError> {
         let instance = super::context::instance();
-        let surface = instance
-            .create_surface(window)
-            .map_err(|e| {
-                GpuError::Surface(format!(
-                    "no Vulkan surface for the window ({e}); a Vulkan driver is needed (on \
+        let surface = instance.create_surface(window).map_err(|e| {
+            GpuError::Surface(format!(
+                "no Vulkan surface for the window ({e}); a Vulkan driver is needed (on \
                      Debian, mesa-vulkan-drivers gives lavapipe; VK_DRIVER_FILES names its ICD \
                      json)"
-                ))
-            })?;
+            ))
+        })?;
         let gpu = Gpu::open(&instance, options, Some(&surface))?;
         let window = WindowSurface::new(&gpu, surface, size)?;
         Ok((GpuRenderer::from_gpu(gpu), window))
@@ -277,7 +275,10 @@ impl WindowSurface {
 
 /// The shader's `Present` uniform: scale, curve, whether to encode sRGB, then the
 /// source, target, overlay origin and overlay size as pairs of u32.
-pub(super) fn params_bytes((scale, tonemap, encode): (f32, ToneMap, bool), pairs: [(u32, u32); 4]) -> Vec<u8> {
+pub(super) fn params_bytes(
+    (scale, tonemap, encode): (f32, ToneMap, bool),
+    pairs: [(u32, u32); 4],
+) -> Vec<u8> {
     let curve: u32 = match tonemap {
         ToneMap::Clamp => 0,
         ToneMap::Reinhard => 1,
