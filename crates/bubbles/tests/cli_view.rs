@@ -1,5 +1,6 @@
 //! `bubbles view`: without a display it exits 2; under Xvfb, driven by real X input
-//! events (xdotool), it draws the scene, a drag changes the view and Escape exits 0, on
+//! events (xdotool), it draws the scene, a drag changes the view, F shows the overlay, S
+//! saves a screenshot and Escape exits 0, on
 //! the CPU presenter and, built with `--features wgpu`, on the wgpu surface and through its
 //! CPU fallback.
 #![cfg(feature = "view")]
@@ -174,8 +175,8 @@ fn without_the_wgpu_feature_backend_wgpu_exits_2_saying_how_to_build_it() {
 }
 
 /// Runs `bubbles view paper` with `args` and `env` under a fresh Xvfb, drives it with real
-/// X input (a drag, then Escape), checks the window shows the scene, turns on the drag and
-/// exits 0 on Escape, and returns the viewer's stderr; `None` where the tools are missing
+/// X input (a drag, then the keys F, S and Escape), checks the window shows the scene,
+/// turns on the drag, shows the overlay on F, saves a screenshot on S and exits 0 on Escape, and returns the viewer's stderr; `None` where the tools are missing
 /// outside CI (in CI, with `CI` set, that fails instead).
 fn drive_viewer(args: &[&str], env: &[(&str, &str)]) -> Option<String> {
     let tools = ["Xvfb", "xdotool", "xwd"];
@@ -296,6 +297,33 @@ fn drive_viewer(args: &[&str], env: &[(&str, &str)]) -> Option<String> {
     });
 
     run(&display, "xdotool", &["windowfocus", "--sync", &window]);
+    // F: the overlay's white glyphs appear in the top-left corner.
+    let white = |shot: &[[u8; 3]]| {
+        (0..60)
+            .flat_map(|y| (0..200).map(move |x| (x, y)))
+            .filter(|&(x, y)| shot[y * g.2 + x] == [255; 3])
+            .count()
+    };
+    let plain = white(&before);
+    run(&display, "xdotool", &["key", "f"]);
+    wait_for(&display, dir.path(), g, "overlay", |shot| {
+        let lit = white(shot);
+        let why = format!("F must show the overlay: {lit} white pixels, {plain} before");
+        (lit > plain + 200, why)
+    });
+    // S: a screenshot of the frame at the window's size.
+    run(&display, "xdotool", &["key", "s"]);
+    let saved = dir.path().join("bubbles-view-0001.png");
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while png_size(&saved) != Some((320, 240)) {
+        assert!(
+            Instant::now() < deadline,
+            "S must save a 320x240 {}: {:?}",
+            saved.display(),
+            png_size(&saved)
+        );
+        sleep(Duration::from_millis(200));
+    }
     run(&display, "xdotool", &["key", "Escape"]);
     let deadline = Instant::now() + Duration::from_secs(30);
     let status = loop {
@@ -308,6 +336,13 @@ fn drive_viewer(args: &[&str], env: &[(&str, &str)]) -> Option<String> {
     let err = std::fs::read_to_string(&stderr_path).unwrap();
     assert_eq!(status.code(), Some(0), "Escape must exit 0: {err}");
     Some(err)
+}
+
+/// Width and height from a PNG's header, if `path` holds one (complete or not).
+fn png_size(path: &Path) -> Option<(u32, u32)> {
+    let bytes = std::fs::read(path).ok()?;
+    let field = |i: usize| Some(u32::from_be_bytes(bytes.get(i..i + 4)?.try_into().ok()?));
+    (bytes.starts_with(b"\x89PNG") && bytes.len() > 100).then_some((field(16)?, field(20)?))
 }
 
 /// Screenshots the window at `g` every half second until `check` passes, and returns
