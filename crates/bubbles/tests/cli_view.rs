@@ -1,5 +1,8 @@
 //! `bubbles view`: without a display it exits 2; under Xvfb, driven by real X input
-//! events (xdotool), it draws the scene, a drag changes the view and Escape exits 0.
+//! events (xdotool), it draws the scene, a drag changes the view, F shows the overlay, S
+//! saves a screenshot and Escape exits 0, on
+//! the CPU presenter and, built with `--features wgpu`, on the wgpu surface and through its
+//! CPU fallback.
 #![cfg(feature = "view")]
 
 use std::path::Path;
@@ -126,6 +129,56 @@ fn crop(shot: &(usize, usize, Vec<u8>), g: (usize, usize, usize, usize)) -> Vec<
 
 #[test]
 fn view_under_xvfb_draws_the_scene_turns_on_a_drag_and_quits_on_escape() {
+    drive_viewer(&[], &[]);
+}
+
+/// The same drive with `--backend wgpu`: the GPU draws into the window's wgpu surface
+/// (lavapipe in CI, through Mesa's X11 WSI on Xvfb), and says so on stderr.
+#[cfg(feature = "wgpu")]
+#[test]
+fn wgpu_view_under_xvfb_draws_the_scene_turns_on_a_drag_and_quits_on_escape() {
+    let Some(err) = drive_viewer(&["--backend", "wgpu"], &[]) else {
+        return;
+    };
+    assert!(err.contains("drawing with wgpu on"), "{err}");
+    assert!(!err.contains("drawing on the CPU instead"), "{err}");
+}
+
+/// With no Vulkan driver to be found, `--backend wgpu` falls back to the CPU presenter,
+/// says so once on stderr, and the window works as ever.
+#[cfg(feature = "wgpu")]
+#[test]
+fn wgpu_view_without_a_driver_falls_back_to_the_cpu_and_says_so() {
+    let env = [("VK_DRIVER_FILES", "/nonexistent/no_icd.json")];
+    let Some(err) = drive_viewer(&["--backend", "wgpu"], &env) else {
+        return;
+    };
+    assert_eq!(
+        err.matches("drawing on the CPU instead").count(),
+        1,
+        "{err}"
+    );
+}
+
+#[cfg(not(feature = "wgpu"))]
+#[test]
+fn without_the_wgpu_feature_backend_wgpu_exits_2_saying_how_to_build_it() {
+    let out = bubbles()
+        .args(["view", "paper", "--backend", "wgpu"])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--features wgpu"), "{err}");
+}
+
+/// Runs `bubbles view paper` with `args` and `env` under a fresh Xvfb, drives it with real
+/// X input (a drag, then the keys F, S and Escape), checks the window shows the scene,
+/// turns on the drag, shows the overlay on F, saves a screenshot on S and exits 0 on Escape, and returns the viewer's stderr; `None` where the tools are missing
+/// outside CI (in CI, with `CI` set, that fails instead).
+fn drive_viewer(args: &[&str], env: &[(&str, &str)]) -> Option<String> {
     let tools = ["Xvfb", "xdotool", "xwd"];
     let missing: Vec<_> = tools.iter().filter(|t| !have(t)).collect();
     if !missing.is_empty() {
@@ -135,10 +188,12 @@ fn view_under_xvfb_draws_the_scene_turns_on_a_drag_and_quits_on_escape() {
             "CI must install {missing:?} (apt-get install xvfb xdotool x11-apps)"
         );
         eprintln!("skipped: {missing:?} not installed");
-        return;
+        return None;
     }
     let dir = tempfile::tempdir().unwrap();
-    let display = format!(":{}", 100 + std::process::id() % 800);
+    // One display per test (tests run in parallel threads of one process).
+    let offset = 1 + args.len() as u32 + env.len() as u32 * 3;
+    let display = format!(":{}", 100 + (std::process::id() * 4 + offset) % 3000);
     let _xvfb = Reap(
         Command::new("Xvfb")
             .args([
@@ -158,6 +213,7 @@ fn view_under_xvfb_draws_the_scene_turns_on_a_drag_and_quits_on_escape() {
         assert!(Instant::now() < deadline, "Xvfb {display} did not start");
         sleep(Duration::from_millis(100));
     }
+    let stderr_path = dir.path().join("stderr.txt");
     let mut viewer = Reap(
         bubbles()
             .args([
@@ -171,9 +227,12 @@ fn view_under_xvfb_draws_the_scene_turns_on_a_drag_and_quits_on_escape() {
                 "1",
             ])
             .args(["--reflection", "static", "--fixed-scale"])
+            .args(args)
+            .envs(env.iter().copied())
             .env("DISPLAY", &display)
             .env_remove("WAYLAND_DISPLAY")
             .current_dir(dir.path())
+            .stderr(std::fs::File::create(&stderr_path).unwrap())
             .spawn()
             .unwrap(),
     );
@@ -189,28 +248,29 @@ fn view_under_xvfb_draws_the_scene_turns_on_a_drag_and_quits_on_escape() {
         }
         assert!(
             viewer.0.try_wait().unwrap().is_none(),
-            "the viewer exited early"
+            "the viewer exited early: {}",
+            std::fs::read_to_string(&stderr_path).unwrap_or_default()
         );
         assert!(Instant::now() < deadline, "no window appeared");
         sleep(Duration::from_millis(200));
     };
-    sleep(Duration::from_secs(3));
+    // The first frames may take a while (a GPU driver compiles its pipelines): wait, with
+    // a generous deadline, for a window full of the scene.
     let g = geometry(&display, &window);
-    let before = crop(&screenshot(&display, dir.path(), "before.xwd"), g);
-    let mut colours: Vec<[u8; 3]> = before.clone();
-    colours.sort_unstable();
-    colours.dedup();
-    let lit = before.iter().filter(|p| p.iter().any(|&c| c > 40)).count();
-    assert!(
-        colours.len() > 100,
-        "a drawn scene has many colours, got {}",
-        colours.len()
-    );
-    assert!(
-        lit * 10 > before.len() * 9,
-        "the scene (sky, ground) fills the window: {lit} of {} lit",
-        before.len()
-    );
+    let before = wait_for(&display, dir.path(), g, "before", |shot| {
+        let mut colours = shot.to_vec();
+        colours.sort_unstable();
+        colours.dedup();
+        let lit = shot.iter().filter(|p| p.iter().any(|&c| c > 40)).count();
+        let ok = colours.len() > 100 && lit * 10 > shot.len() * 9;
+        let why = format!(
+            "a drawn scene has many colours and fills the window (sky, ground): {} colours, \
+             {lit} of {} lit",
+            colours.len(),
+            shot.len()
+        );
+        (ok, why)
+    });
 
     let (cx, cy) = (g.0 + g.2 / 2, g.1 + g.3 / 2);
     run(
@@ -225,20 +285,45 @@ fn view_under_xvfb_draws_the_scene_turns_on_a_drag_and_quits_on_escape() {
         run(&display, "xdotool", &["mousemove", &x, &cy.to_string()]);
     }
     run(&display, "xdotool", &["mouseup", "1"]);
-    sleep(Duration::from_secs(3));
-    let after = crop(&screenshot(&display, dir.path(), "after.xwd"), g);
-    let diff: u64 = before
-        .iter()
-        .zip(&after)
-        .map(|(a, b)| (0..3).map(|i| u64::from(a[i].abs_diff(b[i]))).sum::<u64>())
-        .sum();
-    let mean = diff as f64 / (3 * before.len()) as f64;
-    assert!(
-        mean > 4.0,
-        "a 120-pixel drag must turn the view: mean change {mean:.2} of 255"
-    );
+    wait_for(&display, dir.path(), g, "after", |after| {
+        let diff: u64 = before
+            .iter()
+            .zip(after)
+            .map(|(a, b)| (0..3).map(|i| u64::from(a[i].abs_diff(b[i]))).sum::<u64>())
+            .sum();
+        let mean = diff as f64 / (3 * before.len()) as f64;
+        let why = format!("a 120-pixel drag must turn the view: mean change {mean:.2} of 255");
+        (mean > 4.0, why)
+    });
 
     run(&display, "xdotool", &["windowfocus", "--sync", &window]);
+    // F: the overlay's white glyphs appear in the top-left corner.
+    let white = |shot: &[[u8; 3]]| {
+        (0..60)
+            .flat_map(|y| (0..200).map(move |x| (x, y)))
+            .filter(|&(x, y)| shot[y * g.2 + x] == [255; 3])
+            .count()
+    };
+    let plain = white(&before);
+    run(&display, "xdotool", &["key", "f"]);
+    wait_for(&display, dir.path(), g, "overlay", |shot| {
+        let lit = white(shot);
+        let why = format!("F must show the overlay: {lit} white pixels, {plain} before");
+        (lit > plain + 200, why)
+    });
+    // S: a screenshot of the frame at the window's size.
+    run(&display, "xdotool", &["key", "s"]);
+    let saved = dir.path().join("bubbles-view-0001.png");
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while png_size(&saved) != Some((320, 240)) {
+        assert!(
+            Instant::now() < deadline,
+            "S must save a 320x240 {}: {:?}",
+            saved.display(),
+            png_size(&saved)
+        );
+        sleep(Duration::from_millis(200));
+    }
     run(&display, "xdotool", &["key", "Escape"]);
     let deadline = Instant::now() + Duration::from_secs(30);
     let status = loop {
@@ -248,7 +333,37 @@ fn view_under_xvfb_draws_the_scene_turns_on_a_drag_and_quits_on_escape() {
         assert!(Instant::now() < deadline, "Escape did not close the viewer");
         sleep(Duration::from_millis(100));
     };
-    assert_eq!(status.code(), Some(0), "Escape must exit 0");
+    let err = std::fs::read_to_string(&stderr_path).unwrap();
+    assert_eq!(status.code(), Some(0), "Escape must exit 0: {err}");
+    Some(err)
+}
+
+/// Width and height from a PNG's header, if `path` holds one (complete or not).
+fn png_size(path: &Path) -> Option<(u32, u32)> {
+    let bytes = std::fs::read(path).ok()?;
+    let field = |i: usize| Some(u32::from_be_bytes(bytes.get(i..i + 4)?.try_into().ok()?));
+    (bytes.starts_with(b"\x89PNG") && bytes.len() > 100).then_some((field(16)?, field(20)?))
+}
+
+/// Screenshots the window at `g` every half second until `check` passes, and returns
+/// that screenshot; fails with `check`'s explanation after a minute.
+fn wait_for(
+    display: &str,
+    dir: &Path,
+    g: (usize, usize, usize, usize),
+    name: &str,
+    check: impl Fn(&[[u8; 3]]) -> (bool, String),
+) -> Vec<[u8; 3]> {
+    let deadline = Instant::now() + Duration::from_secs(60);
+    loop {
+        sleep(Duration::from_millis(500));
+        let shot = crop(&screenshot(display, dir, &format!("{name}.xwd")), g);
+        let (ok, why) = check(&shot);
+        if ok {
+            return shot;
+        }
+        assert!(Instant::now() < deadline, "{why}");
+    }
 }
 
 fn run_ok(display: &str, program: &str, args: &[&str]) -> bool {

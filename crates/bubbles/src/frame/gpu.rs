@@ -40,29 +40,41 @@ impl GpuBackend {
         tables: &FilmTables,
         settings: &RenderSettings,
     ) -> Result<&Frame, raster::gpu::GpuError> {
-        let used = self.0.gpu().sample_count_for(settings.samples);
-        if used != settings.samples && !self.1 {
-            self.1 = true;
-            eprintln!(
-                "bubbles: --samples {} is rendered with {used} samples on {} (the nearest count \
-                 it offers: {:?})",
-                settings.samples,
-                self.0.gpu().adapter_name(),
-                self.0.gpu().sample_counts()
-            );
-        }
+        note_sample_count(self.0.gpu(), settings.samples, &mut self.1);
         self.0.render(scene, tables, settings)
     }
+}
+
+/// Says once on stderr (`said` remembers) when `gpu` renders `requested` samples with
+/// another count, the nearest it offers.
+#[cfg(feature = "wgpu")]
+pub fn note_sample_count(gpu: &raster::gpu::Gpu, requested: u32, said: &mut bool) {
+    let used = gpu.sample_count_for(requested);
+    if used != requested && !*said {
+        *said = true;
+        eprintln!(
+            "bubbles: --samples {requested} is rendered with {used} samples on {} (the nearest \
+             count it offers: {:?})",
+            gpu.adapter_name(),
+            gpu.sample_counts()
+        );
+    }
+}
+
+/// The input error (exit 2) for `--backend wgpu` in a build without the wgpu backend.
+#[cfg(not(feature = "wgpu"))]
+pub fn unavailable() -> CliError {
+    CliError::input(
+        "--backend wgpu: this bubbles was built without the wgpu backend; rebuild it with \
+         `cargo build --release -p bubbles --features wgpu`, or use --backend cpu",
+    )
 }
 
 #[cfg(not(feature = "wgpu"))]
 impl GpuBackend {
     /// Always an input error (exit 2): this binary has no wgpu backend.
     pub fn open(_: raster::ReflectionParallax) -> Result<Self, CliError> {
-        Err(CliError::input(
-            "--backend wgpu: this bubbles was built without the wgpu backend; rebuild it with \
-             `cargo build --release -p bubbles --features wgpu`, or use --backend cpu",
-        ))
+        Err(unavailable())
     }
 
     /// Unreachable: no value of this type exists.

@@ -1,6 +1,6 @@
 //! One frame's work shared by `render` and `bench`: scene → solver → tables → renderer.
 
-mod gpu;
+pub mod gpu;
 mod options;
 pub mod progress;
 pub mod reference;
@@ -202,8 +202,10 @@ impl FrameJob {
         self.world.dt_s()
     }
 
-    /// Renders the current state: the bubbles and the water at the solver's time.
-    pub fn render(&mut self) -> Result<&Frame, CliError> {
+    /// The current state ready for a renderer: the bubbles and the water at the solver's
+    /// time, with the tables and settings (for a renderer the job does not own: the
+    /// viewer's window presenter). Times the bake ([`FrameJob::last_bake_s`]).
+    pub fn frame_inputs(&mut self) -> (&RenderScene, &FilmTables, &RenderSettings) {
         let bake_start = std::time::Instant::now();
         self.render_scene.bubbles = bubble_meshes(&self.world);
         if let (Some(surface), Some(out)) = (&mut self.water, &mut self.render_scene.water) {
@@ -215,6 +217,18 @@ impl FrameJob {
             }
         }
         self.bake_s = bake_start.elapsed().as_secs_f64();
+        (&self.render_scene, &self.tables, &self.settings)
+    }
+
+    /// The scene's file or built-in name, for messages (the wgpu viewer's).
+    #[cfg(feature = "wgpu")]
+    pub fn origin(&self) -> String {
+        self.scene.origin.clone()
+    }
+
+    /// Renders the current state: the bubbles and the water at the solver's time.
+    pub fn render(&mut self) -> Result<&Frame, CliError> {
+        self.frame_inputs();
         if let Some(spec) = &self.film_spec {
             let settings = self.reference.settings(&self.settings);
             self.reference_frame = reference::render(&self.render_scene, spec, &settings, true)?;

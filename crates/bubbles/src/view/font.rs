@@ -68,9 +68,7 @@ pub fn glyph(c: char) -> [u8; GLYPH_H] {
 pub fn draw_text(buf: &mut [u32], width: usize, x: usize, y: usize, scale: usize, text: &str) {
     let height = buf.len() / width.max(1);
     let lines: Vec<&str> = text.lines().collect();
-    let cols = lines.iter().map(|l| l.chars().count()).max().unwrap_or(0);
-    let box_w = (cols * (GLYPH_W + 1) + 1) * scale;
-    let box_h = (lines.len() * (GLYPH_H + 2) + 1) * scale;
+    let (box_w, box_h) = text_box(text, scale);
     for row in y..(y + box_h).min(height) {
         for px in &mut buf[row * width + x.min(width)..row * width + (x + box_w).min(width)] {
             *px = (*px >> 2) & 0x003f_3f3f;
@@ -96,6 +94,32 @@ pub fn draw_text(buf: &mut [u32], width: usize, x: usize, y: usize, scale: usize
             }
         }
     }
+}
+
+/// Width and height in pixels of the dark box [`draw_text`] draws `text` on.
+pub fn text_box(text: &str, scale: usize) -> (usize, usize) {
+    let cols = text.lines().map(|l| l.chars().count()).max().unwrap_or(0);
+    let box_w = (cols * (GLYPH_W + 1) + 1) * scale;
+    let box_h = (text.lines().count() * (GLYPH_H + 2) + 1) * scale;
+    (box_w, box_h)
+}
+
+/// `text` as [`draw_text`] draws it, as a premultiplied-alpha RGBA8 image of its box
+/// (width, height, texels) to blend over a frame: the glyphs opaque white, the box black
+/// at alpha 3/4, which darkens what is under it to a quarter as `draw_text` does.
+#[cfg(any(test, feature = "wgpu"))]
+pub fn text_rgba(text: &str, scale: usize) -> (usize, usize, Vec<u8>) {
+    let (w, h) = text_box(text, scale);
+    let mut words = vec![0u32; w * h];
+    draw_text(&mut words, w, 0, 0, scale, text);
+    let texels = words
+        .iter()
+        .flat_map(|&p| match p {
+            0 => [0, 0, 0, 191],
+            p => [(p >> 16) as u8, (p >> 8) as u8, p as u8, 255],
+        })
+        .collect();
+    (w, h, texels)
 }
 
 fn fill(buf: &mut [u32], width: usize, height: usize, x: usize, y: usize, size: usize) {
@@ -141,5 +165,21 @@ mod tests {
         assert_eq!(buf[20 + 2], 0x00ff_ffff, "top of the 1's stem");
         let mut small = vec![0u32; 4 * 4];
         draw_text(&mut small, 4, 2, 2, 3, "WWW");
+    }
+
+    #[test]
+    fn the_rgba_overlay_is_the_text_box_with_opaque_glyphs_over_a_dark_veil() {
+        let (w, h, rgba) = text_rgba("1\n22", 2);
+        assert_eq!((w, h), text_box("1\n22", 2));
+        assert_eq!((w, h), ((2 * 4 + 1) * 2, (2 * 7 + 1) * 2));
+        assert_eq!(rgba.len(), 4 * w * h);
+        let glyph = rgba.chunks_exact(4).filter(|p| *p == [255, 255, 255, 255]);
+        // '1' lights 8 font pixels, each '2' 11: 30 font pixels of 2x2.
+        assert_eq!(glyph.count(), 4 * (8 + 2 * 11));
+        let veil = rgba
+            .chunks_exact(4)
+            .filter(|p| *p == [0, 0, 0, 191])
+            .count();
+        assert_eq!(veil, w * h - 4 * 30, "every other texel is the veil");
     }
 }

@@ -1,14 +1,18 @@
-//! `bubbles view`: a live window on the CPU renderer (feature `view`).
+//! `bubbles view`: a live window (feature `view`) on the CPU renderer, or with
+//! `--backend wgpu` on the GPU, presented through a wgpu surface.
 
 mod controls;
 mod font;
+#[cfg(feature = "wgpu")]
+mod gpu;
 mod keys;
 mod pixels;
+mod present;
 mod scale;
 mod window;
 
 use crate::error::{CliError, CliResult};
-use crate::frame::Options;
+use crate::frame::{Backend, Options};
 
 /// The controls, printed by `bubbles view --help` and drawn by H in the window.
 pub const CONTROLS: &str = "\
@@ -41,12 +45,17 @@ pub struct Args {
     /// Always render at the window's full resolution (no adaptive scaling).
     #[arg(long)]
     pub fixed_scale: bool,
+    /// Quit after this many seconds, printing the frames drawn and the mean fps on stderr
+    /// (to measure the viewer).
+    #[arg(long, value_name = "SECONDS")]
+    pub quit_after_s: Option<f64>,
     #[command(flatten)]
     pub options: Options,
 }
 
 /// Runs `bubbles view`.
 pub fn run(args: Args) -> CliResult {
+    check_backend(args.options.backend)?;
     check_display(|name| std::env::var_os(name))?;
     if !(args.target_fps.is_finite() && args.target_fps > 0.0) {
         return Err(CliError::input(format!(
@@ -54,7 +63,24 @@ pub fn run(args: Args) -> CliResult {
             crate::scene::values::plain(f64::from(args.target_fps))
         )));
     }
+    if let Some(s) = args.quit_after_s.filter(|s| !(s.is_finite() && *s > 0.0)) {
+        return Err(CliError::input(format!(
+            "--quit-after-s {}: must be a finite number of seconds > 0",
+            crate::scene::values::plain(s)
+        )));
+    }
     window::run(args)
+}
+
+/// `--backend wgpu` in a build without the wgpu backend: the same error (exit 2) as
+/// `bubbles render --backend wgpu`, before any window-system call.
+fn check_backend(backend: Backend) -> CliResult {
+    #[cfg(not(feature = "wgpu"))]
+    if backend == Backend::Wgpu {
+        return Err(crate::frame::gpu::unavailable());
+    }
+    let _ = backend;
+    Ok(())
 }
 
 /// Fails with exit code 2 before any window-system call when there is no display to open.

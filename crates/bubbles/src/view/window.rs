@@ -1,20 +1,20 @@
 //! The window: winit events in, [`ViewState`] updated, the solver stepped at its fixed
-//! step against the wall clock, the CPU renderer drawn through softbuffer.
+//! step against the wall clock, each frame drawn by the [`Presenter`] (the CPU renderer
+//! through softbuffer, or the GPU straight into a wgpu surface).
 
 use super::controls::{self, Command, Input, Orbit, ReflectionKey, ViewState};
-use super::font;
 use super::keys::map_key;
-use super::pixels::{tone_map_into, upscale};
+use super::present::Presenter;
 use super::scale::ResolutionScale;
 use super::{Args, CONTROLS};
 use crate::error::{CliError, CliResult};
-use crate::frame::{FrameJob, Options, Reflection};
+use crate::frame::{Backend, FrameJob, Options, Reflection};
 use bubble_dynamics::Event;
 use glam::Vec3;
 use std::collections::VecDeque;
 use std::num::NonZeroU32;
 use std::path::PathBuf;
-use std::rc::Rc;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 use winit::application::ApplicationHandler;
 use winit::dpi::{PhysicalPosition, PhysicalSize};
@@ -39,12 +39,18 @@ const BLOW_DISTANCE: f64 = 0.45;
 const EVENT_LIFETIME: Duration = Duration::from_secs(6);
 
 /// Opens the window and runs until Escape or close.
-pub fn run(args: Args) -> CliResult {
+pub fn run(mut args: Args) -> CliResult {
+    // The job renders on the CPU; a GPU presenter brings its own device (one made for the
+    // window's surface), so the job must not open a headless one too.
+    let backend = args.options.backend;
+    if backend == Backend::Wgpu {
+        args.options.backend = Backend::Cpu;
+    }
     let job = FrameJob::prepare(args.scene.as_deref(), &args.options)?;
     let event_loop =
         EventLoop::new().map_err(|e| CliError::input(format!("cannot open the display: {e}")))?;
     event_loop.set_control_flow(ControlFlow::Poll);
-    let mut app = App::new(job, args)?;
+    let mut app = App::new(job, args, backend)?;
     event_loop
         .run_app(&mut app)
         .map_err(|e| CliError::runtime(format!("window event loop failed: {e}")))?;
@@ -52,8 +58,8 @@ pub fn run(args: Args) -> CliResult {
 }
 
 struct Gfx {
-    window: Rc<Window>,
-    surface: softbuffer::Surface<Rc<Window>, Rc<Window>>,
+    window: Arc<Window>,
+    presenter: Presenter,
     size: (u32, u32),
 }
 
@@ -73,8 +79,18 @@ struct Stats {
     cube_s: f64,
     opaque_s: f64,
     bubbles_s: f64,
+    /// The GPU presenter's encoding (CPU) and GPU time.
+    setup_s: f64,
+    gpu_s: f64,
     frame_s: f64,
     slow_motion: bool,
+}
+
+/// `--quit-after-s`: when to quit, and the frames drawn since the first.
+struct QuitAfter {
+    after_s: f64,
+    first: Option<Instant>,
+    frames: u64,
 }
 
 struct App {
@@ -87,13 +103,17 @@ struct App {
     last_frame: Option<Instant>,
     behind_s: f64,
     stats: Stats,
-    internal: Vec<u32>,
     events: VecDeque<(String, Instant)>,
     error: Option<CliError>,
+    /// `--backend`: the presenter asked for.
+    backend: Backend,
+    /// Why the wgpu presenter could not open, shown at the top of the overlay.
+    fallback: Option<String>,
+    quit_after: Option<QuitAfter>,
 }
 
 impl App {
-    fn new(job: FrameJob, args: Args) -> Result<App, CliError> {
+    fn new(job: FrameJob, args: Args, backend: Backend) -> Result<App, CliError> {
         let cam = job.camera();
         let target = Vec3::from_array(job.scene_target_m().map(|v| v as f32));
         let orbit = Orbit::from_eye(cam.eye(), target, cam.vfov_deg())
@@ -114,9 +134,15 @@ impl App {
             last_frame: None,
             behind_s: 0.0,
             stats: Stats::default(),
-            internal: Vec::new(),
             events: VecDeque::new(),
             error: None,
+            backend,
+            fallback: None,
+            quit_after: args.quit_after_s.map(|after_s| QuitAfter {
+                after_s,
+                first: None,
+                frames: 0,
+            }),
         })
     }
 
@@ -259,12 +285,10 @@ impl App {
 
     fn screenshot(&mut self) -> CliResult {
         let path = next_screenshot_path();
-        let (ev, tone) = (self.job.settings().exposure_ev, self.job.settings().tonemap);
-        let frame = self.job.render()?;
-        frame
-            .write_png(&path, ev, tone)
-            .map_err(|e| CliError::runtime(format!("cannot write {}: {e}", path.display())))?;
-        let (w, h) = (frame.width(), frame.height());
+        let Some(gfx) = self.gfx.as_mut() else {
+            return Ok(());
+        };
+        let (w, h) = gfx.presenter.screenshot(&mut self.job, &path)?;
         self.note(format!("saved {} ({w}x{h})", path.display()));
         Ok(())
     }
@@ -321,13 +345,14 @@ impl App {
         }
         let (iw, ih) = self.scale.internal_size(win_w as usize, win_h as usize);
         self.job.set_size(iw, ih)?;
-        let (ev, tone) = (self.job.settings().exposure_ev, self.job.settings().tonemap);
-        let frame = self.job.render()?;
-        let t = frame.timings;
-        tone_map_into(&mut self.internal, frame.rgb(), ev, tone);
-        let render_s = t.total_s();
-        self.scale.update(render_s as f32);
-        self.present(iw, ih)?;
+        let overlay = self.overlay_text(iw, ih);
+        let Some(gfx) = self.gfx.as_mut() else {
+            return Ok(());
+        };
+        let t = gfx
+            .presenter
+            .draw(&mut self.job, (win_w, win_h), overlay.as_deref())?;
+        self.scale.update(t.total_s() as f32);
         let frame_s = start.elapsed().as_secs_f64();
         let k = 0.1;
         let s = &mut self.stats;
@@ -342,48 +367,77 @@ impl App {
         s.cube_s = mix(s.cube_s, t.cube_maps_s);
         s.opaque_s = mix(s.opaque_s, t.opaque_s);
         s.bubbles_s = mix(s.bubbles_s, t.bubbles_s);
+        s.setup_s = mix(s.setup_s, t.setup_s);
+        s.gpu_s = mix(s.gpu_s, t.resolve_s);
         s.frame_s = mix(s.frame_s, frame_s);
         Ok(())
     }
 
-    fn present(&mut self, iw: usize, ih: usize) -> CliResult {
-        let overlay = self.overlay_text(iw, ih);
-        let Some(gfx) = self.gfx.as_mut() else {
-            return Ok(());
+    /// Counts a frame for `--quit-after-s`; past the time, prints the mean rate on stderr
+    /// and quits.
+    fn count_frame(&mut self, event_loop: &ActiveEventLoop) {
+        let Some(q) = &mut self.quit_after else {
+            return;
         };
-        let (w, h) = (gfx.size.0 as usize, gfx.size.1 as usize);
-        let mut buffer = gfx
-            .surface
-            .buffer_mut()
-            .map_err(|e| CliError::runtime(format!("window buffer: {e}")))?;
-        upscale(&self.internal, iw, ih, &mut buffer, w, h);
-        if let Some(text) = overlay {
-            font::draw_text(&mut buffer, w, 8, 8, 2, &text);
+        let now = Instant::now();
+        let first = *q.first.get_or_insert(now);
+        q.frames += 1;
+        let elapsed_s = (now - first).as_secs_f64();
+        if elapsed_s < q.after_s {
+            return;
         }
-        buffer
-            .present()
-            .map_err(|e| CliError::runtime(format!("window present: {e}")))
+        let presenter = self
+            .gfx
+            .as_ref()
+            .map_or(String::new(), |g| g.presenter.name());
+        let (iw, ih) = (self.job.settings().width, self.job.settings().height);
+        // The first frame starts the clock, so `frames - 1` frames fill `elapsed_s`.
+        eprintln!(
+            "view: {} frames in {elapsed_s:.2} s: {:.1} fps ({presenter}, last frame {iw}x{ih}, \
+             scale {:.0}%)",
+            q.frames - 1,
+            (q.frames - 1) as f64 / elapsed_s.max(1e-9),
+            self.scale.scale() * 100.0
+        );
+        event_loop.exit();
     }
 
     fn overlay_text(&mut self, iw: usize, ih: usize) -> Option<String> {
         let now = Instant::now();
         self.events.retain(|(_, at)| now - *at < EVENT_LIFETIME);
         let mut text = String::new();
+        if let Some(why) = &self.fallback {
+            text += &format!("wgpu failed, drawing on the cpu: {why}\n");
+        }
         if self.state.overlay {
             let s = self.stats;
             let world = self.job.world();
+            let gpu = self.gfx.as_ref().is_some_and(|g| g.presenter.is_gpu());
+            let presenter = self
+                .gfx
+                .as_ref()
+                .map_or(String::new(), |g| g.presenter.name());
             text += &format!(
                 "fps {:.1}  frame {:.1} ms\n",
                 1.0 / s.frame_s.max(1e-9),
                 s.frame_s * 1e3
             );
-            text += &format!(
-                "sim {:.1}  cube {:.1}  opaque {:.1}  bubbles {:.1} ms\n",
-                s.sim_s * 1e3,
-                s.cube_s * 1e3,
-                s.opaque_s * 1e3,
-                s.bubbles_s * 1e3
-            );
+            text += &if gpu {
+                format!(
+                    "sim {:.1}  encode {:.1}  gpu {:.1} ms\n",
+                    s.sim_s * 1e3,
+                    s.setup_s * 1e3,
+                    s.gpu_s * 1e3
+                )
+            } else {
+                format!(
+                    "sim {:.1}  cube {:.1}  opaque {:.1}  bubbles {:.1} ms\n",
+                    s.sim_s * 1e3,
+                    s.cube_s * 1e3,
+                    s.opaque_s * 1e3,
+                    s.bubbles_s * 1e3
+                )
+            };
             text += &format!(
                 "scale {:.0}% ({}) {iw}x{ih}{}\n",
                 self.scale.scale() * 100.0,
@@ -410,6 +464,7 @@ impl App {
                 self.state.reflection,
                 self.state.samples()
             );
+            text += &format!("backend {presenter}\n");
             for (e, _) in &self.events {
                 text += e;
                 text.push('\n');
@@ -435,14 +490,11 @@ impl ApplicationHandler for App {
             .create_window(attrs)
             .map_err(|e| e.to_string())
             .and_then(|window| {
-                let window = Rc::new(window);
-                let context =
-                    softbuffer::Context::new(window.clone()).map_err(|e| e.to_string())?;
-                let surface = softbuffer::Surface::new(&context, window.clone())
-                    .map_err(|e| e.to_string())?;
+                let window = Arc::new(window);
+                let presenter = self.presenter(&window)?;
                 Ok(Gfx {
                     window,
-                    surface,
+                    presenter,
                     size: (0, 0),
                 })
             });
@@ -462,11 +514,10 @@ impl ApplicationHandler for App {
         match event {
             WindowEvent::CloseRequested => self.input(event_loop, Input::Close),
             WindowEvent::Resized(_) => self.resize(),
-            WindowEvent::RedrawRequested => {
-                if let Err(err) = self.redraw() {
-                    self.fail(event_loop, err);
-                }
-            }
+            WindowEvent::RedrawRequested => match self.redraw() {
+                Ok(()) => self.count_frame(event_loop),
+                Err(err) => self.fail(event_loop, err),
+            },
             WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
                 if let Some(key) = map_key(&event.logical_key) {
                     self.input(event_loop, Input::Key(key));
@@ -496,13 +547,46 @@ impl ApplicationHandler for App {
 }
 
 impl App {
+    /// The presenter `--backend` asks for on `window`: with `wgpu`, the GPU one, or where it
+    /// cannot open (no adapter, no surface), the CPU one, said once on stderr and kept at
+    /// the top of the overlay.
+    fn presenter(&mut self, window: &Arc<Window>) -> Result<Presenter, String> {
+        if self.backend == Backend::Wgpu {
+            match self.gpu_presenter(window) {
+                Ok(p) => {
+                    eprintln!("view: --backend wgpu: drawing with {}", p.name());
+                    return Ok(p);
+                }
+                Err(why) => {
+                    eprintln!("view: --backend wgpu: {why}; drawing on the CPU instead");
+                    self.fallback = Some(why);
+                }
+            }
+        }
+        Presenter::cpu(window)
+    }
+
+    #[cfg(feature = "wgpu")]
+    fn gpu_presenter(&self, window: &Arc<Window>) -> Result<Presenter, String> {
+        let parallax = self.options.reflection_origin.parallax();
+        super::gpu::GpuPresenter::open(window, parallax)
+            .map(|p| Presenter::Gpu(Box::new(p)))
+            .map_err(|e| e.to_string())
+    }
+
+    /// Unreachable: `bubbles view` refuses `--backend wgpu` in a build without it.
+    #[cfg(not(feature = "wgpu"))]
+    fn gpu_presenter(&self, _: &Arc<Window>) -> Result<Presenter, String> {
+        Err("this bubbles was built without the wgpu backend".into())
+    }
+
     fn resize(&mut self) {
         let Some(gfx) = self.gfx.as_mut() else { return };
         let size = gfx.window.inner_size();
         let (Some(w), Some(h)) = (NonZeroU32::new(size.width), NonZeroU32::new(size.height)) else {
             return;
         };
-        if gfx.size != (size.width, size.height) && gfx.surface.resize(w, h).is_ok() {
+        if gfx.size != (size.width, size.height) && gfx.presenter.resize(w, h) {
             gfx.size = (size.width, size.height);
         }
     }

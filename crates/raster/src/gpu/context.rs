@@ -13,12 +13,15 @@ pub struct GpuOptions {
 /// A headless wgpu device with the backend's pipelines compiled.
 ///
 /// # Guarantees
-/// Holds an open device and queue; no window or surface is involved.
+/// Holds an open device and queue; a window's surface, when there is one, is a
+/// [`super::WindowSurface`] beside it.
 #[derive(Debug)]
 pub struct Gpu {
     pub(super) device: wgpu::Device,
     pub(super) queue: wgpu::Queue,
     info: wgpu::AdapterInfo,
+    /// The adapter, kept to ask what a window surface offers.
+    pub(super) adapter: wgpu::Adapter,
     pub(super) tone_map: ToneMapPass,
     /// The frame's sample counts this device renders, ascending (always 1 and 4).
     sample_counts: Vec<u32>,
@@ -27,13 +30,20 @@ pub struct Gpu {
 impl Gpu {
     /// Opens the first suitable adapter (Vulkan first) and compiles the pipelines.
     pub fn new(options: GpuOptions) -> Result<Gpu, GpuError> {
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-        desc.backends = wgpu::Backends::VULKAN;
-        let instance = wgpu::Instance::new(desc);
+        Gpu::open(&instance(), options, None)
+    }
+
+    /// Opens the first adapter that can present to `surface` (made by `instance`), as
+    /// [`Gpu::new`] does.
+    pub(super) fn open(
+        instance: &wgpu::Instance,
+        options: GpuOptions,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<Gpu, GpuError> {
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             force_fallback_adapter: options.force_cpu_adapter,
-            compatible_surface: None,
+            compatible_surface: surface,
             ..Default::default()
         }))
         .map_err(|e| GpuError::NoAdapter {
@@ -60,6 +70,7 @@ impl Gpu {
             queue,
             tone_map,
             sample_counts: sample_counts(&adapter, !specific.is_empty()),
+            adapter,
         })
     }
 
@@ -104,6 +115,13 @@ impl Gpu {
         }
         Ok(())
     }
+}
+
+/// The Vulkan instance (with wgpu's environment overrides) every device is opened from.
+pub(super) fn instance() -> wgpu::Instance {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+    desc.backends = wgpu::Backends::VULKAN;
+    wgpu::Instance::new(desc)
 }
 
 /// The frame's sample counts: 1, 4 (every WebGPU device), and with the adapter's own format

@@ -24,6 +24,8 @@ pub enum GpuError {
     },
     /// Mapping the read-back buffer failed.
     Readback(String),
+    /// A window's surface could not be made, configured or presented to.
+    Surface(String),
     /// The scene or settings are invalid (the same check as the CPU backend's).
     Invalid(render_scene::RenderError),
     /// The scene uses something the wgpu backend does not draw (named).
@@ -46,6 +48,7 @@ impl fmt::Display for GpuError {
                 size.0, size.1
             ),
             GpuError::Readback(reason) => write!(f, "reading the frame back failed: {reason}"),
+            GpuError::Surface(reason) => write!(f, "the window's wgpu surface failed: {reason}"),
             GpuError::Invalid(e) => write!(f, "{e}"),
             GpuError::Unsupported(what) => write!(
                 f,

@@ -11,6 +11,10 @@
 //! `FilmField::sample` with `textureLoad` (`film_sample`), shades with the field's thickness and blends by the
 //! coverage `c`: `1 − T' = c·(1 − T)`, `add' = c·add`; `c = 0` leaves the pixel as it is.
 //!
+//! `GpuRenderer::for_window` opens the device for a window instead, and
+//! `GpuRenderer::present` puts each frame on it (`present`): tone-mapped and upscaled
+//! straight into the surface texture, the overlay blended on top, nothing read back.
+//!
 //! The CPU backend is the specification: every shader function names the Rust function it
 //! ports. Constants the two must share (tone curve, sRGB encoding, highlight filter, tag
 //! bits) are injected into the WGSL from the Rust constants, never retyped; see
@@ -30,6 +34,8 @@ mod naga_layout;
 #[cfg(feature = "wgpu")]
 mod pipelines;
 #[cfg(feature = "wgpu")]
+mod present;
+#[cfg(feature = "wgpu")]
 mod renderer;
 mod scene_data;
 mod shader_source;
@@ -39,5 +45,7 @@ mod tonemap;
 #[cfg(feature = "wgpu")]
 pub use context::{Gpu, GpuOptions};
 pub use error::GpuError;
+#[cfg(feature = "wgpu")]
+pub use present::{Overlay, WindowSurface};
 #[cfg(feature = "wgpu")]
 pub use renderer::GpuRenderer;

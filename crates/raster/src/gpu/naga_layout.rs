@@ -13,7 +13,7 @@ use render_scene::{
 use super::scene_data::{
     BUBBLE_VERTEX_BYTES, CubeReads, OBJECT_VERTEX_BYTES, SceneData, VIEW_BYTES, view_bytes,
 };
-use super::shader_source::{scene_wgsl, tonemap_wgsl};
+use super::shader_source::{present_wgsl, scene_wgsl, tonemap_wgsl};
 
 /// `source` parsed and validated, or a panic with naga's report.
 fn validated(source: &str) -> Module {
@@ -95,9 +95,10 @@ fn packed_scene() -> (SceneData, usize, usize, usize) {
 }
 
 #[test]
-fn both_shaders_parse_and_validate() {
+fn every_shader_parses_and_validates() {
     validated(&scene_wgsl());
     validated(&tonemap_wgsl());
+    validated(&present_wgsl());
 }
 
 #[test]
@@ -142,4 +143,14 @@ fn vertex_structs_match_the_packed_vertex_streams() {
         !data.objects.is_empty(),
         "the packed scene has object vertices"
     );
+}
+
+#[cfg(feature = "wgpu")]
+#[test]
+fn the_present_uniform_has_the_size_present_rs_writes() {
+    use super::present::{PRESENT_BYTES, params_bytes};
+    let module = validated(&present_wgsl());
+    let bytes = params_bytes((1.0, render_scene::ToneMap::AcesFitted, true), [(1, 1); 4]);
+    assert_eq!(struct_size(&module, "Present"), PRESENT_BYTES);
+    assert_eq!(bytes.len() as u64, PRESENT_BYTES);
 }

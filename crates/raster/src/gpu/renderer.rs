@@ -30,10 +30,11 @@ const VIEW_STRIDE: u64 = 256;
 ///
 /// # Guarantees
 /// Holds an open device with the scene pipelines compiled; every frame is read back to
-/// the CPU as a linear HDR [`Frame`].
+/// the CPU as a linear HDR [`Frame`], except those [`GpuRenderer::present`] puts on a
+/// window.
 #[derive(Debug)]
 pub struct GpuRenderer {
-    gpu: Gpu,
+    pub(super) gpu: Gpu,
     layouts: Layouts,
     pipelines: Vec<Pipelines>,
     frame: Frame,
@@ -55,9 +56,13 @@ struct Target<'a> {
 impl GpuRenderer {
     /// Opens the device (see [`Gpu::new`]) and compiles the pipelines.
     pub fn new(options: GpuOptions) -> Result<GpuRenderer, GpuError> {
-        let gpu = Gpu::new(options)?;
+        Ok(GpuRenderer::from_gpu(Gpu::new(options)?))
+    }
+
+    /// The renderer on an open device (headless, or one that presents to a window).
+    pub(super) fn from_gpu(gpu: Gpu) -> GpuRenderer {
         let layouts = Layouts::new(&gpu.device);
-        Ok(GpuRenderer {
+        GpuRenderer {
             gpu,
             layouts,
             pipelines: Vec::new(),
@@ -65,7 +70,7 @@ impl GpuRenderer {
             textures: Vec::new(),
             reads: CubeReads::default(),
             last_mips: None,
-        })
+        }
     }
 
     /// Chooses how bubbles read their dynamic cube maps, as
@@ -141,7 +146,7 @@ impl GpuRenderer {
     }
 
     /// Records the frame's passes; returns the encoder and the resolved HDR texture.
-    fn encode(
+    pub(super) fn encode(
         &mut self,
         scene: &RenderScene,
         tables: &FilmTables,

@@ -20,9 +20,20 @@ pub(super) fn scene_wgsl() -> String {
     with_shared_constants(include_str!("scene.wgsl"))
 }
 
-/// The tone-map shader (`tonemap.wgsl`) with the shared constants in place.
+/// The tone-map shader: the tone curves (`tone_curve.wgsl`) with the shared constants in
+/// place, then the read-back pass (`tonemap.wgsl`).
 pub(super) fn tonemap_wgsl() -> String {
-    with_shared_constants(include_str!("tonemap.wgsl"))
+    with_tone_curve(include_str!("tonemap.wgsl"))
+}
+
+/// The window's present shader: the tone curves, then `present.wgsl`.
+pub(super) fn present_wgsl() -> String {
+    with_tone_curve(include_str!("present.wgsl"))
+}
+
+/// `pass` after the tone curves, so two passes share one port of `Frame::to_srgb8`.
+fn with_tone_curve(pass: &str) -> String {
+    with_shared_constants(include_str!("tone_curve.wgsl")) + pass
 }
 
 /// The marker a WGSL source puts where the shared constants go.

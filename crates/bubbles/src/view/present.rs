@@ -1,0 +1,145 @@
+//! How a frame reaches the window: [`Presenter`] is the one seam between the event loop
+//! (window.rs, shared) and the two ways of drawing. The CPU presenter renders with the
+//! job's own renderer, tone-maps and upscales on the CPU and copies into softbuffer; the
+//! wgpu presenter (`--backend wgpu`, view/gpu.rs) renders, tone-maps and upscales on the GPU
+//! straight into the window's surface.
+
+use super::font;
+use super::pixels::{tone_map_into, upscale};
+use crate::error::{CliError, CliResult};
+use crate::frame::FrameJob;
+use raster::FrameTimings;
+use std::num::NonZeroU32;
+use std::path::Path;
+use std::sync::Arc;
+use winit::window::Window;
+
+/// Where the overlay's top-left corner sits, in window pixels, and its font scale.
+pub(super) const OVERLAY_AT: (usize, usize) = (8, 8);
+pub(super) const OVERLAY_SCALE: usize = 2;
+
+/// The window's presenter.
+pub(super) enum Presenter {
+    /// softbuffer, fed by the CPU.
+    Cpu(CpuPresenter),
+    /// A wgpu surface, fed by the GPU.
+    #[cfg(feature = "wgpu")]
+    Gpu(Box<super::gpu::GpuPresenter>),
+}
+
+/// The CPU presenter: the window's softbuffer surface and the tone-mapped frame's words.
+pub(super) struct CpuPresenter {
+    surface: softbuffer::Surface<Arc<Window>, Arc<Window>>,
+    internal: Vec<u32>,
+}
+
+impl Presenter {
+    /// The CPU presenter on `window`.
+    pub(super) fn cpu(window: &Arc<Window>) -> Result<Presenter, String> {
+        let context = softbuffer::Context::new(window.clone()).map_err(|e| e.to_string())?;
+        let surface =
+            softbuffer::Surface::new(&context, window.clone()).map_err(|e| e.to_string())?;
+        Ok(Presenter::Cpu(CpuPresenter {
+            surface,
+            internal: Vec::new(),
+        }))
+    }
+
+    /// Who draws, for the overlay: `cpu` or `wgpu on <adapter>`.
+    pub(super) fn name(&self) -> String {
+        match self {
+            Presenter::Cpu(_) => "cpu".to_string(),
+            #[cfg(feature = "wgpu")]
+            Presenter::Gpu(gpu) => gpu.name(),
+        }
+    }
+
+    /// Whether frames are drawn on the GPU (their timings are encode and GPU time).
+    pub(super) fn is_gpu(&self) -> bool {
+        !matches!(self, Presenter::Cpu(_))
+    }
+
+    /// Resizes the presenter's surface to `width` × `height`; false when it could not.
+    pub(super) fn resize(&mut self, width: NonZeroU32, height: NonZeroU32) -> bool {
+        match self {
+            Presenter::Cpu(cpu) => cpu.surface.resize(width, height).is_ok(),
+            #[cfg(feature = "wgpu")]
+            Presenter::Gpu(gpu) => {
+                gpu.resize(width.get(), height.get());
+                true
+            }
+        }
+    }
+
+    /// Renders the job's current state at its size, upscales it to the window's `size`,
+    /// draws `overlay` over it and presents; returns the render's timings.
+    pub(super) fn draw(
+        &mut self,
+        job: &mut FrameJob,
+        size: (u32, u32),
+        overlay: Option<&str>,
+    ) -> Result<FrameTimings, CliError> {
+        match self {
+            Presenter::Cpu(cpu) => cpu.draw(job, size, overlay),
+            #[cfg(feature = "wgpu")]
+            Presenter::Gpu(gpu) => gpu.draw(job, overlay),
+        }
+    }
+
+    /// Renders the job's current state at its size (no overlay) into a PNG at `path`;
+    /// returns the image's size.
+    pub(super) fn screenshot(
+        &mut self,
+        job: &mut FrameJob,
+        path: &Path,
+    ) -> Result<(usize, usize), CliError> {
+        let (ev, tone) = (job.settings().exposure_ev, job.settings().tonemap);
+        let frame = match self {
+            Presenter::Cpu(_) => job.render()?,
+            #[cfg(feature = "wgpu")]
+            Presenter::Gpu(gpu) => gpu.frame(job)?,
+        };
+        frame
+            .write_png(path, ev, tone)
+            .map_err(|e| CliError::runtime(format!("cannot write {}: {e}", path.display())))?;
+        Ok((frame.width(), frame.height()))
+    }
+}
+
+impl CpuPresenter {
+    fn draw(
+        &mut self,
+        job: &mut FrameJob,
+        (w, h): (u32, u32),
+        overlay: Option<&str>,
+    ) -> Result<FrameTimings, CliError> {
+        let (ev, tone) = (job.settings().exposure_ev, job.settings().tonemap);
+        let (iw, ih) = (job.settings().width, job.settings().height);
+        let frame = job.render()?;
+        let timings = frame.timings;
+        tone_map_into(&mut self.internal, frame.rgb(), ev, tone);
+        self.present(iw, ih, (w as usize, h as usize), overlay)?;
+        Ok(timings)
+    }
+
+    fn present(
+        &mut self,
+        iw: usize,
+        ih: usize,
+        (w, h): (usize, usize),
+        overlay: Option<&str>,
+    ) -> CliResult {
+        let mut buffer = self
+            .surface
+            .buffer_mut()
+            .map_err(|e| CliError::runtime(format!("window buffer: {e}")))?;
+        upscale(&self.internal, iw, ih, &mut buffer, w, h);
+        if let Some(text) = overlay {
+            let (x, y) = OVERLAY_AT;
+            font::draw_text(&mut buffer, w, x, y, OVERLAY_SCALE, text);
+        }
+        buffer
+            .present()
+            .map_err(|e| CliError::runtime(format!("window present: {e}")))
+    }
+}
