@@ -59,6 +59,26 @@ pub enum Key {
     H,
 }
 
+impl Key {
+    /// Whether holding the key down acts again at the keyboard's repeat rate: the wind's
+    /// adjustments, blowing and stepping do; a toggle, a mode, a screenshot or a reset
+    /// acts once per press (held, or with a press and release the system saw late, it
+    /// would flip back and forth or save a burst of files).
+    pub fn repeats(self) -> bool {
+        matches!(
+            self,
+            Key::Left
+                | Key::Right
+                | Key::Up
+                | Key::Down
+                | Key::Plus
+                | Key::Minus
+                | Key::Space
+                | Key::Period
+        )
+    }
+}
+
 /// One input, in window pixels.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Input {
@@ -352,6 +372,35 @@ mod tests {
     fn assert_close(what: &str, a: Vec3, b: Vec3) {
         let d = (a - b).length();
         assert!(d < 1e-5, "{what}: {a} vs {b}, difference {d:e}");
+    }
+
+    /// A held F (or a release the X server saw late, so it auto-repeated) used to flip
+    /// the overlay on and off again: the viewer's end-to-end test failed under load.
+    #[test]
+    fn toggles_act_once_per_press_and_adjustments_repeat() {
+        for key in [
+            Key::F,
+            Key::H,
+            Key::P,
+            Key::S,
+            Key::R,
+            Key::W,
+            Key::M,
+            Key::Escape,
+        ] {
+            assert!(!key.repeats(), "{key:?}");
+        }
+        assert!(!Key::Digit(1).repeats());
+        for key in [
+            Key::Left,
+            Key::Right,
+            Key::Up,
+            Key::Down,
+            Key::Plus,
+            Key::Minus,
+        ] {
+            assert!(key.repeats(), "{key:?}");
+        }
     }
 
     #[test]

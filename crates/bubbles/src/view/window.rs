@@ -519,7 +519,9 @@ impl ApplicationHandler for App {
                 Err(err) => self.fail(event_loop, err),
             },
             WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
-                if let Some(key) = map_key(&event.logical_key) {
+                if let Some(key) = map_key(&event.logical_key)
+                    && (!event.repeat || key.repeats())
+                {
                     self.input(event_loop, Input::Key(key));
                 }
             }
