@@ -9,6 +9,7 @@ use crate::frame::{
 use crate::highlight::HIGHLIGHT_SIGMA_PX;
 use crate::lod::{LOD_BIAS, MAX_ANISOTROPY, MIN_FOOTPRINT_TEXELS};
 use crate::shading::{FLAT_FOOTPRINT_CELLS, GROUND_HALF_OFFSET_PX};
+use crate::water::FRESNEL_STEPS;
 
 pub use crate::cubemap::FACE_BASES;
 pub use crate::frame::{ACES_DENOMINATOR, ACES_NUMERATOR};
@@ -45,11 +46,13 @@ pub const SCENE_SCALARS: [(&str, f32); 5] = [
     ("MIN_FOOTPRINT_TEXELS", MIN_FOOTPRINT_TEXELS),
 ];
 
-/// The scene shading's integer constants (tag bits, anisotropic tap limit), by WGSL name.
-pub const SCENE_WORDS: [(&str, u32); 3] = [
+/// The scene shading's integer constants (tag bits, anisotropic tap limit, the water's
+/// Fresnel table intervals), by WGSL name.
+pub const SCENE_WORDS: [(&str, u32); 4] = [
     ("EMISSIVE", EMISSIVE),
     ("WATER", WATER),
     ("MAX_ANISOTROPY", MAX_ANISOTROPY as u32),
+    ("FRESNEL_STEPS", FRESNEL_STEPS as u32),
 ];
 
 #[cfg(test)]

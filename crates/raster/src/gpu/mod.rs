@@ -11,6 +11,12 @@
 //! `FilmField::sample` with `textureLoad` (`film_sample`), shades with the field's thickness and blends by the
 //! coverage `c`: `1 − T' = c·(1 − T)`, `add' = c·add`; `c = 0` leaves the pixel as it is.
 //!
+//! A water surface (`RenderScene::water`) is drawn as the CPU draws it: its triangles join
+//! the opaque pass (`fs_water`, a port of `WaterShading::radiance`), and with dynamic cube
+//! maps its reflections come from six more faces rendered from the eye mirrored in its
+//! rest plane, the bubbles (sorted for that eye) blended into them; bubbles' own cube maps
+//! do not see the water, as on the CPU.
+//!
 //! The CPU backend is the specification: every shader function names the Rust function it
 //! ports. Constants the two must share (tone curve, sRGB encoding, highlight filter, tag
 //! bits) are injected into the WGSL from the Rust constants, never retyped; see
@@ -35,6 +41,7 @@ mod scene_data;
 mod shader_source;
 #[cfg(feature = "wgpu")]
 mod tonemap;
+mod water_data;
 
 #[cfg(feature = "wgpu")]
 pub use context::{Gpu, GpuOptions};

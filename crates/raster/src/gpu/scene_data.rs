@@ -7,6 +7,7 @@
 use glam::{Mat3, Vec3};
 
 use super::GpuError;
+use super::water_data::WaterData;
 use render_scene::bubble_order::{far_to_near, is_front_facing, reflection_rate};
 use render_scene::camera::View;
 use render_scene::ground_view::{GroundFilter, GroundView};
@@ -72,17 +73,17 @@ pub(super) struct CubeReads {
 pub(super) struct Bytes(pub Vec<u8>);
 
 impl Bytes {
-    fn f32(&mut self, x: f32) -> &mut Self {
+    pub(super) fn f32(&mut self, x: f32) -> &mut Self {
         self.0.extend_from_slice(&x.to_le_bytes());
         self
     }
 
-    fn u32(&mut self, x: u32) -> &mut Self {
+    pub(super) fn u32(&mut self, x: u32) -> &mut Self {
         self.0.extend_from_slice(&x.to_le_bytes());
         self
     }
 
-    fn vec4(&mut self, xyz: [f32; 3], w: f32) -> &mut Self {
+    pub(super) fn vec4(&mut self, xyz: [f32; 3], w: f32) -> &mut Self {
         for x in xyz {
             self.f32(x);
         }
@@ -167,7 +168,8 @@ fn clip(poly: &[[f32; 2]], f: impl Fn([f32; 2]) -> f32) -> Vec<[f32; 2]> {
 pub(super) struct SceneData {
     /// The WGSL `Scene` uniform.
     pub scene: Vec<u8>,
-    /// `array<Material>`: the objects' materials, then the ground's.
+    /// `array<Material>`: the objects' materials, then the ground's, then the water
+    /// floor's.
     pub materials: Vec<u8>,
     /// `array<Light>`.
     pub lights: Vec<u8>,
@@ -181,6 +183,11 @@ pub(super) struct SceneData {
     pub bubbles: Vec<u8>,
     /// Vertex ranges of the bubble draws, in order: far to near, back faces then front.
     pub bubble_draws: Vec<std::ops::Range<u32>>,
+    /// Per bubble: its film field as (first texel, face size), `(0, 0)` without one (for
+    /// the bubble vertices of other views, [`bubble_vertices`]).
+    pub film_places: Vec<[u32; 2]>,
+    /// The water surface, when the scene has one.
+    pub water: Option<WaterData>,
     /// The LUT texture: `(width, height, Rgba32Float texels)`.
     pub luts: LutTexture,
     /// `array<LutInfo>`.
@@ -198,17 +205,9 @@ pub(super) struct SceneData {
     pub env_chain: Vec<u8>,
 }
 
-/// Why the wgpu backend cannot draw `what` (it draws the scenes the built-in scenes use).
+/// Why the wgpu backend cannot draw `what` on this device (an adapter limit, named).
 fn unsupported(what: impl Into<String>) -> GpuError {
     GpuError::Unsupported(what.into())
-}
-
-/// Refuses what the wgpu backend does not draw yet, naming it.
-pub(super) fn check_supported(scene: &RenderScene) -> Result<(), GpuError> {
-    if scene.water.is_some() {
-        return Err(unsupported("a water surface (the [water] section)"));
-    }
-    Ok(())
 }
 
 impl SceneData {
@@ -228,6 +227,10 @@ impl SceneData {
         if let Some(g) = &scene.ground {
             materials.push(&g.material);
         }
+        let water = scene.water.as_ref().map(|w| {
+            materials.push(&w.floor);
+            WaterData::new(w, scene, &settings.reflection, materials.len() as u32 - 1)
+        });
         let mut object_bytes = Bytes::default();
         push_geometry(&mut object_bytes, &objects);
         let object_vertices = (object_bytes.0.len() as u64 / OBJECT_VERTEX_BYTES) as u32;
@@ -294,6 +297,8 @@ impl SceneData {
             all_vertices,
             bubbles,
             bubble_draws,
+            film_places,
+            water,
             luts,
             lut_info,
             films,
@@ -477,7 +482,7 @@ fn push_geometry(b: &mut Bytes, g: &Geometry) {
 /// to near, each bubble's back faces then its front faces; one draw range per side.
 ///
 /// `films[k]` is bubble `k`'s film field as (first texel, face size), `(0, 0)` without one.
-fn bubble_vertices(
+pub(super) fn bubble_vertices(
     scene: &RenderScene,
     view: &View,
     films: &[[u32; 2]],
@@ -668,7 +673,6 @@ mod tests {
         scene.bubbles[2].film = film(&other);
         scene.bubbles[3].film = film(&shared);
         // The wgpu backend draws film fields: nothing refuses them.
-        check_supported(&scene).unwrap();
         let tables = FilmTables::from_reflectivity(
             render_scene::Lut::try_from_fn(4, 4, 1000.0, |_, _| [0.1; 3]).unwrap(),
         );
@@ -737,7 +741,6 @@ mod tests {
                 shininess: 1.0,
             },
         });
-        check_supported(&scene).unwrap();
         let lut = render_scene::Lut::try_from_fn(2, 2, 1000.0, |_, _| [0.1; 3]).unwrap();
         let tables = FilmTables::from_reflectivity(lut);
         let settings = RenderSettings::default();
