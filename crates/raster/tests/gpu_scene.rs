@@ -809,8 +809,10 @@ fn water_delta_e(gpu: &mut GpuRenderer, reflection: ReflectionMode) -> (f64, f64
     let gpu_bytes = gpu.render_srgb8(&scene, &tables, &s).unwrap();
     let measured = delta_e(&cpu, &gpu_bytes);
     eprintln!(
-        "water, {reflection:?}: mean ΔE2000 {:.3}, p99 {:.3}",
-        measured.0, measured.1
+        "water, {}: mean ΔE2000 {:.3}, p99 {:.3}",
+        reflection_name(&reflection),
+        measured.0,
+        measured.1
     );
     if let Some(dir) = std::env::var_os("GPU_SCENE_IMAGES") {
         for (which, bytes) in [("cpu", &cpu), ("gpu", &gpu_bytes)] {
@@ -837,8 +839,8 @@ fn reflection_name(reflection: &ReflectionMode) -> &'static str {
 fn gpu_water_with_its_mirrored_cube_map_matches_the_cpu() {
     let Some(mut gpu) = gpu() else { return };
     let (mean, p99) = water_delta_e(&mut gpu, ReflectionMode::DynamicCubeMap { face_size: 32 });
-    assert!(mean <= 0.25, "mean ΔE2000 {mean} > 0.25");
-    assert!(p99 <= 1.2, "99th percentile ΔE2000 {p99} > 1.2");
+    assert!(mean <= 0.15, "mean ΔE2000 {mean} > 0.15");
+    assert!(p99 <= 1.0, "99th percentile ΔE2000 {p99} > 1.0");
 }
 
 /// The water reflecting the environment alone, and through a sphere map made from it
@@ -854,7 +856,7 @@ fn gpu_water_with_environment_and_sphere_map_reflections_matches_the_cpu() {
         ReflectionMode::SphereMap(std::sync::Arc::new(map)),
     ] {
         let (mean, p99) = water_delta_e(&mut gpu, reflection);
-        assert!(mean <= 0.25, "mean ΔE2000 {mean} > 0.25");
-        assert!(p99 <= 1.2, "99th percentile ΔE2000 {p99} > 1.2");
+        assert!(mean <= 0.15, "mean ΔE2000 {mean} > 0.15");
+        assert!(p99 <= 1.0, "99th percentile ΔE2000 {p99} > 1.0");
     }
 }

@@ -20,6 +20,12 @@ pub const EMISSIVE: u32 = 1 << 31;
 /// Tag bit marking a water triangle in the opaque pass.
 pub const WATER: u32 = 1 << 30;
 
+/// The 4-sample pattern (D3D's and Vulkan's standard one): each sample's offset from the
+/// pixel centre in 1/16 pixel, y down, in sample order. The CPU rasteriser samples there,
+/// and the GPU's water shades a partly covered pixel at its first covered one as the CPU
+/// does.
+pub const SAMPLE_OFFSETS_4_SIXTEENTHS: [(i64, i64); 4] = [(-2, -6), (6, -2), (-6, 2), (2, 6)];
+
 /// The tone curve's 3×3 matrices (rows), by WGSL name.
 pub const TONE_MATRICES: [(&str, [[f32; 3]; 3]); 2] = [
     ("ACES_FROM_SRGB", ACES_FROM_SRGB),

@@ -98,7 +98,7 @@ fn packed_scene() -> (SceneData, usize, usize, usize) {
         &scene,
         &tables,
         &settings,
-        &view,
+        (&view, 4),
         8192,
         CubeReads::default(),
     )

@@ -330,7 +330,7 @@ impl Pipelines {
             water: make(
                 Desc {
                     label: "water",
-                    vertex: "vs_object",
+                    vertex: "vs_water",
                     fragment: "fs_water",
                     buffers: &objects,
                     depth_write: true,

@@ -167,7 +167,16 @@ impl GpuRenderer {
         self.gpu.check_size(w, h)?;
         let view = scene.camera.view(settings.width, settings.height);
         let max_side = self.gpu.device.limits().max_texture_dimension_2d;
-        let data = SceneData::new(scene, tables, settings, &view, max_side, self.reads)?;
+        // The nearest count the device renders (the caller is told by `sample_count_for`).
+        let samples = self.gpu.sample_count_for(settings.samples);
+        let data = SceneData::new(
+            scene,
+            tables,
+            settings,
+            (&view, samples),
+            max_side,
+            self.reads,
+        )?;
         let face_size = match settings.reflection {
             ReflectionMode::DynamicCubeMap { face_size } => Some(face_size),
             _ => None,
@@ -200,8 +209,6 @@ impl GpuRenderer {
         } else {
             1
         };
-        // The nearest count the device renders (the caller is told by `sample_count_for`).
-        let samples = self.gpu.sample_count_for(settings.samples);
         let cubes = self.texture("cube faces", ((m, m, layers), 1), hdr_texture);
         let face_depth = self.texture("face depth", ((m, m, 1), 1), depth_texture);
         let resolved = self.texture("frame", ((w, h, 1), 1), hdr_texture);

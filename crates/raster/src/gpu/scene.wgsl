@@ -45,6 +45,8 @@ struct Scene {
     reflectivity_table: u32,
     // 1 when dynamic cube maps are read corrected for the ground's parallax (parallax.rs)
     ground_parallax: u32,
+    // the main view's sample count (`fs_water` shades where the CPU does)
+    frame_samples: u32,
     // The environment image in `images`: first texel, width, height of an equirect; first
     // texel, face size of cube faces (scene_data.rs `Atlas`).
     env_image: vec4<u32>,
@@ -687,14 +689,51 @@ fn water_radiance(p: vec3<f32>, v: vec3<f32>, n: vec3<f32>, footprint_m: f32) ->
     return r * reflected + (1.0 - r) * transmitted;
 }
 
+// The water's attributes over w and 1/w, interpolated affinely in screen space: from them
+// and their differences between neighbouring pixels `fs_water` evaluates the
+// perspective-correct position and normal anywhere in the pixel, as raster.rs
+// `SetupTri::interpolate` does.
+struct WaterOut {
+    @builtin(position) position: vec4<f32>,
+    @location(0) @interpolate(linear, center) world_over_w: vec3<f32>,
+    @location(1) @interpolate(linear, center) normal_over_w: vec3<f32>,
+    @location(2) @interpolate(linear, center) inv_w: f32,
+}
+
+@vertex
+fn vs_water(in: ObjectIn) -> WaterOut {
+    let clip = clip_of(in.position);
+    return WaterOut(clip, in.position / clip.w, in.normal / clip.w, 1.0 / clip.w);
+}
+
+// Where passes/opaque.rs `OpaqueCtx::triangle` shades a pixel whose samples `covered` the
+// triangle covers, as an offset from the pixel centre: the centre when it covers them all,
+// else its first covered sample (the 4-sample pattern is the CPU's, injected; with 2, 8 or
+// 16 samples, the centre).
+fn water_shading_offset(covered: u32) -> vec2<f32> {
+    let full = (1u << scene.frame_samples) - 1u;
+    if (scene.frame_samples != 4u || (covered & full) == full) {
+        return vec2<f32>(0.0);
+    }
+    return SAMPLE_OFFSETS_4[min(firstTrailingBit(covered & full), 3u)];
+}
+
 // passes/opaque.rs `OpaqueCtx::shade_water`: a water pixel of the opaque pass.
 @fragment
-fn fs_water(in: ObjectOut) -> @location(0) vec4<f32> {
-    let rel = in.world - view.eye.xyz;
+fn fs_water(in: WaterOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f32> {
+    // Derivatives need uniform control flow, so they come first.
+    let dw = array<vec3<f32>, 2>(dpdxFine(in.world_over_w), dpdyFine(in.world_over_w));
+    let dn = array<vec3<f32>, 2>(dpdxFine(in.normal_over_w), dpdyFine(in.normal_over_w));
+    let di = vec2<f32>(dpdxFine(in.inv_w), dpdyFine(in.inv_w));
+    let o = water_shading_offset(covered);
+    let inv_w = max(in.inv_w + di.x * o.x + di.y * o.y, 1e-20);
+    let world = (in.world_over_w + dw[0] * o.x + dw[1] * o.y) / inv_w;
+    let normal = (in.normal_over_w + dn[0] * o.x + dn[1] * o.y) / inv_w;
+    let rel = world - view.eye.xyz;
     let v = normalize_or(rel, view.forward.xyz);
-    let n = normalize_or(in.normal, vec3<f32>(0.0, 1.0, 0.0));
+    let n = normalize_or(normal, vec3<f32>(0.0, 1.0, 0.0));
     let footprint_m = length(rel) * view.tan_half_per_px.z;
-    return vec4<f32>(water_radiance(in.world, v, n, footprint_m), 1.0);
+    return vec4<f32>(water_radiance(world, v, n, footprint_m), 1.0);
 }
 
 // ---- bubbles -----------------------------------------------------------------------------

@@ -211,12 +211,13 @@ fn unsupported(what: impl Into<String>) -> GpuError {
 }
 
 impl SceneData {
-    /// Packs `scene` for the main view `view` (bubbles sorted and split by side for its eye).
+    /// Packs `scene` for the main view `view` (bubbles sorted and split by side for its eye),
+    /// rendered with `frame_samples` samples a pixel.
     pub(super) fn new(
         scene: &RenderScene,
         tables: &FilmTables,
         settings: &RenderSettings,
-        view: &View,
+        (view, frame_samples): (&View, u32),
         max_texture_side: u32,
         reads: CubeReads,
     ) -> Result<SceneData, GpuError> {
@@ -285,7 +286,7 @@ impl SceneData {
                 scene,
                 &settings.reflection,
                 reads,
-                [face_size, ground_material],
+                [face_size, ground_material, frame_samples],
                 env_image,
                 sphere,
                 tables,
@@ -351,7 +352,7 @@ fn scene_bytes(
     scene: &RenderScene,
     reflection: &ReflectionMode,
     reads: CubeReads,
-    [face_size, ground_material]: [u32; 2],
+    [face_size, ground_material, frame_samples]: [u32; 3],
     env_image: [u32; 4],
     sphere: Option<([u32; 4], Mat3)>,
     tables: &FilmTables,
@@ -402,7 +403,8 @@ fn scene_bytes(
     b.u32(ground_material).f32(height).u32(face_size).u32(0);
     // On exactly where the CPU corrects (renderer.rs `ground_height_m`).
     let parallax = proxy_ground_height_m(reads.parallax, reflection, scene).is_some();
-    b.u32(u32::from(parallax)).u32(0).u32(0).u32(0);
+    // The main view's sample count (the water's shading point in a partly covered pixel).
+    b.u32(u32::from(parallax)).u32(frame_samples).u32(0).u32(0);
     // The environment image: (first texel, width, height) of an equirect, (first texel,
     // face size) of cube faces.
     for w in env_image {
@@ -679,7 +681,7 @@ mod tests {
         let view = scene.camera.view(16, 16);
         // Rows of at most 50 texels: 6·4² + 6·3² = 150 texels, three rows.
         let data =
-            SceneData::new(&scene, &tables, &settings, &view, 50, CubeReads::default()).unwrap();
+            SceneData::new(&scene, &tables, &settings, (&view, 1), 50, CubeReads::default()).unwrap();
         let (width, height, bytes) = &data.films;
         assert_eq!((*width, *height), (50, 3));
         let want: Vec<f32> = shared
@@ -715,7 +717,7 @@ mod tests {
         }
         assert_eq!(seen, [3; 4]);
         // Too tall for the device: named, never drawn otherwise.
-        let err = SceneData::new(&scene, &tables, &settings, &view, 10, CubeReads::default())
+        let err = SceneData::new(&scene, &tables, &settings, (&view, 1), 10, CubeReads::default())
             .unwrap_err();
         assert!(matches!(err, GpuError::Unsupported(_)), "{err:?}");
         assert!(
@@ -750,7 +752,7 @@ mod tests {
                 &scene,
                 &tables,
                 &settings,
-                &view,
+                (&view, 1),
                 max_side,
                 CubeReads::default(),
             )
