@@ -715,7 +715,7 @@ fn gpu_reads_the_ground_with_parallax_as_the_cpu_does() {
     );
 }
 
-/// A rippled pond (`n` × `n` quads over x ∈ [−1.2, 1.2], z ∈ [−2.4, 0.6], two crossing
+/// A rippled pond (`n` × `n` quads over x ∈ [−1.2, 1.2], z ∈ [−2.4, 1.2], two crossing
 /// waves, analytic normals) over a checker floor 0.4 m down, in murky water whose
 /// absorption differs by channel: the refracted floor's colour depends on Beer–Lambert.
 fn rippled_water(n: u32) -> raster::WaterSurface {
@@ -731,7 +731,7 @@ fn rippled_water(n: u32) -> raster::WaterSurface {
     for j in 0..=n {
         for i in 0..=n {
             let x = -1.2 + 2.4 * i as f32 / n as f32;
-            let z = -2.4 + 3.0 * j as f32 / n as f32;
+            let z = -2.4 + 3.6 * j as f32 / n as f32;
             let (h, normal) = wave(x, z);
             positions.push(Vec3::new(x, h, z));
             normals.push(normal);
@@ -761,8 +761,8 @@ fn rippled_water(n: u32) -> raster::WaterSurface {
 /// it (both seen in the water's reflections), a bank around it, a sun and a lamp.
 fn water_scene() -> RenderScene {
     let camera = raster::Camera::look_at(
-        Vec3::new(0.0, 0.3, 0.55),
-        Vec3::new(0.0, 0.05, -0.5),
+        Vec3::new(0.0, 0.12, 0.6),
+        Vec3::new(0.0, 0.06, -0.5),
         Vec3::Y,
         50.0,
     );
@@ -788,7 +788,7 @@ fn water_scene() -> RenderScene {
     });
     scene
         .bubbles
-        .push(bubble(Vec3::new(-0.12, 0.2, -0.35), 0.1, 3, draining));
+        .push(bubble(Vec3::new(-0.08, 0.12, -0.3), 0.09, 3, draining));
     scene.objects.push(Object::Sphere {
         center: Vec3::new(0.3, 0.06, -0.7),
         radius_m: 0.12,

@@ -689,21 +689,20 @@ fn water_radiance(p: vec3<f32>, v: vec3<f32>, n: vec3<f32>, footprint_m: f32) ->
     return r * reflected + (1.0 - r) * transmitted;
 }
 
-// The water's attributes over w and 1/w, interpolated affinely in screen space: from them
-// and their differences between neighbouring pixels `fs_water` evaluates the
-// perspective-correct position and normal anywhere in the pixel, as raster.rs
-// `SetupTri::interpolate` does.
+// The water's position and normal at the pixel centre, perspective-correct (whether the
+// centre is covered or not). Times 1/w they are affine in screen space, so their
+// differences between neighbouring pixels give them anywhere in the pixel exactly, as
+// raster.rs `SetupTri::interpolate` does. (Screen-linear varyings would be affine too, but
+// a triangle clipped at the near plane gets them wrong on lavapipe.)
 struct WaterOut {
     @builtin(position) position: vec4<f32>,
-    @location(0) @interpolate(linear, center) world_over_w: vec3<f32>,
-    @location(1) @interpolate(linear, center) normal_over_w: vec3<f32>,
-    @location(2) @interpolate(linear, center) inv_w: f32,
+    @location(0) @interpolate(perspective, center) world: vec3<f32>,
+    @location(1) @interpolate(perspective, center) normal: vec3<f32>,
 }
 
 @vertex
 fn vs_water(in: ObjectIn) -> WaterOut {
-    let clip = clip_of(in.position);
-    return WaterOut(clip, in.position / clip.w, in.normal / clip.w, 1.0 / clip.w);
+    return WaterOut(clip_of(in.position), in.position, in.normal);
 }
 
 // Where passes/opaque.rs `OpaqueCtx::triangle` shades a pixel whose samples `covered` the
@@ -722,13 +721,16 @@ fn water_shading_offset(covered: u32) -> vec2<f32> {
 @fragment
 fn fs_water(in: WaterOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f32> {
     // Derivatives need uniform control flow, so they come first.
-    let dw = array<vec3<f32>, 2>(dpdxFine(in.world_over_w), dpdyFine(in.world_over_w));
-    let dn = array<vec3<f32>, 2>(dpdxFine(in.normal_over_w), dpdyFine(in.normal_over_w));
-    let di = vec2<f32>(dpdxFine(in.inv_w), dpdyFine(in.inv_w));
+    let centre_inv_w = 1.0 / dot(in.world - view.eye.xyz, view.forward.xyz);
+    let world_over_w = in.world * centre_inv_w;
+    let normal_over_w = in.normal * centre_inv_w;
+    let dw = array<vec3<f32>, 2>(dpdxFine(world_over_w), dpdyFine(world_over_w));
+    let dn = array<vec3<f32>, 2>(dpdxFine(normal_over_w), dpdyFine(normal_over_w));
+    let di = vec2<f32>(dpdxFine(centre_inv_w), dpdyFine(centre_inv_w));
     let o = water_shading_offset(covered);
-    let inv_w = max(in.inv_w + di.x * o.x + di.y * o.y, 1e-20);
-    let world = (in.world_over_w + dw[0] * o.x + dw[1] * o.y) / inv_w;
-    let normal = (in.normal_over_w + dn[0] * o.x + dn[1] * o.y) / inv_w;
+    let inv_w = max(centre_inv_w + di.x * o.x + di.y * o.y, 1e-20);
+    let world = (world_over_w + dw[0] * o.x + dw[1] * o.y) / inv_w;
+    let normal = (normal_over_w + dn[0] * o.x + dn[1] * o.y) / inv_w;
     let rel = world - view.eye.xyz;
     let v = normalize_or(rel, view.forward.xyz);
     let n = normalize_or(normal, vec3<f32>(0.0, 1.0, 0.0));
