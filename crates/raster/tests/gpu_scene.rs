@@ -788,7 +788,7 @@ fn water_scene() -> RenderScene {
     });
     scene
         .bubbles
-        .push(bubble(Vec3::new(-0.08, 0.12, -0.3), 0.09, 3, draining));
+        .push(bubble(Vec3::new(-0.1, 0.16, -0.25), 0.14, 3, draining));
     scene.objects.push(Object::Sphere {
         center: Vec3::new(0.3, 0.06, -0.7),
         radius_m: 0.12,
