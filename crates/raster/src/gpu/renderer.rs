@@ -6,13 +6,14 @@ use wgpu::util::DeviceExt;
 
 use super::pipelines::{DEPTH_FORMAT, HDR_FORMAT, Layouts, Pipelines};
 use super::scene_data::{
-    BUBBLE_VERTEX_BYTES, CubeReads, SceneData, VIEW_BYTES, bubble_vertices, ground_triangles, view_bytes,
+    BUBBLE_VERTEX_BYTES, CubeReads, SceneData, VIEW_BYTES, bubble_vertices, ground_triangles,
+    view_bytes,
 };
 use super::{Gpu, GpuError, GpuOptions};
+use glam::Vec3;
 use render_scene::camera::View;
 use render_scene::cubemap::FACE_BASES;
 use render_scene::ground_view::{GroundFilter, GroundView};
-use glam::Vec3;
 use render_scene::{
     BubbleMesh, CubeMap, FilmTables, Frame, FrameTimings, ReflectionFilter, ReflectionMode,
     ReflectionParallax, RenderScene, RenderSettings,
@@ -524,11 +525,23 @@ impl GpuRenderer {
                 let first = (bytes.len() as u64 / BUBBLE_VERTEX_BYTES) as u32;
                 let (b, ranges) = bubble_vertices(scene, v, &data.film_places);
                 bytes.extend(b);
-                draws.push(ranges.into_iter().map(|r| r.start + first..r.end + first).collect());
+                draws.push(
+                    ranges
+                        .into_iter()
+                        .map(|r| r.start + first..r.end + first)
+                        .collect(),
+                );
             }
-            (buffer("water face bubbles", &bytes, wgpu::BufferUsages::VERTEX), draws)
+            (
+                buffer("water face bubbles", &bytes, wgpu::BufferUsages::VERTEX),
+                draws,
+            )
         });
-        let vertices = buffer("water vertices", &water.vertices, wgpu::BufferUsages::VERTEX);
+        let vertices = buffer(
+            "water vertices",
+            &water.vertices,
+            wgpu::BufferUsages::VERTEX,
+        );
         Some(WaterDraw {
             vertices,
             count: water.vertex_count,
@@ -703,7 +716,13 @@ fn face_views_from(centre: Vec3, face_size: usize, near_m: f32) -> Vec<View> {
     FACE_BASES
         .iter()
         .map(|&(major, s_axis, t_axis)| {
-            View::new(centre, [major, s_axis, -t_axis], (wide, wide), (m, m), near_m)
+            View::new(
+                centre,
+                [major, s_axis, -t_axis],
+                (wide, wide),
+                (m, m),
+                near_m,
+            )
         })
         .collect()
 }

@@ -680,8 +680,15 @@ mod tests {
         );
         let view = scene.camera.view(16, 16);
         // Rows of at most 50 texels: 6·4² + 6·3² = 150 texels, three rows.
-        let data =
-            SceneData::new(&scene, &tables, &settings, (&view, 1), 50, CubeReads::default()).unwrap();
+        let data = SceneData::new(
+            &scene,
+            &tables,
+            &settings,
+            (&view, 1),
+            50,
+            CubeReads::default(),
+        )
+        .unwrap();
         let (width, height, bytes) = &data.films;
         assert_eq!((*width, *height), (50, 3));
         let want: Vec<f32> = shared
@@ -717,8 +724,15 @@ mod tests {
         }
         assert_eq!(seen, [3; 4]);
         // Too tall for the device: named, never drawn otherwise.
-        let err = SceneData::new(&scene, &tables, &settings, (&view, 1), 10, CubeReads::default())
-            .unwrap_err();
+        let err = SceneData::new(
+            &scene,
+            &tables,
+            &settings,
+            (&view, 1),
+            10,
+            CubeReads::default(),
+        )
+        .unwrap_err();
         assert!(matches!(err, GpuError::Unsupported(_)), "{err:?}");
         assert!(
             err.to_string().contains("film fields of 150 texels"),
