@@ -24,8 +24,8 @@
 //! (`render_scene::bubble_order`, `render_scene::tessellate`), as the CPU renderer's do.
 //!
 //! **Invariant:** this module imports the scene crate and never the CPU renderer's modules
-//! (`tests/layout.rs` checks it). Its pure-CPU half (`scene_data`, `shader_source`, `error`)
-//! compiles without the feature, so `cargo test` checks the generated WGSL with naga and
+//! (`tests/layout.rs` checks it). Its pure-CPU half (`scene_data`, `water_data`,
+//! `shader_source`, `error`) compiles without the feature, so `cargo test` checks the generated WGSL with naga and
 //! the packed struct sizes against it without a GPU or wgpu.
 
 #[cfg(feature = "wgpu")]

@@ -178,6 +178,7 @@ impl GpuRenderer {
             max_side,
             self.reads,
         )?;
+        check_water_fits(&data, self.gpu.device.limits().max_buffer_size)?;
         let face_size = match settings.reflection {
             ReflectionMode::DynamicCubeMap { face_size } => Some(face_size),
             _ => None,
@@ -696,6 +697,23 @@ impl GpuRenderer {
             wgpu::util::TextureDataOrder::LayerMajor,
             texels,
         )
+    }
+}
+
+/// Refuses a water surface whose vertex buffer is larger than the device's
+/// `max_buffer_size`, naming the limit and the value (an adapter limit, not a refusal of
+/// water).
+fn check_water_fits(data: &SceneData, max_buffer_size: u64) -> Result<(), GpuError> {
+    match &data.water {
+        Some(w) if w.vertices.len() as u64 > max_buffer_size => {
+            Err(GpuError::Unsupported(format!(
+                "a water surface of {} triangles (its vertices take {} bytes, this device's \
+                 max_buffer_size is {max_buffer_size})",
+                w.vertex_count / 3,
+                w.vertices.len()
+            )))
+        }
+        _ => Ok(()),
     }
 }
 

@@ -674,7 +674,6 @@ mod tests {
         scene.bubbles[1].film = film(&shared);
         scene.bubbles[2].film = film(&other);
         scene.bubbles[3].film = film(&shared);
-        // The wgpu backend draws film fields: nothing refuses them.
         let tables = FilmTables::from_reflectivity(
             render_scene::Lut::try_from_fn(4, 4, 1000.0, |_, _| [0.1; 3]).unwrap(),
         );
