@@ -192,7 +192,9 @@ fn pond_through_wgpu_matches_the_cpu_backend_in_ciede2000() {
     let Some(measured) = wgpu_against_cpu("pond", dir.path()) else {
         return;
     };
-    assert_within("pond", measured, (0.25, 1.2));
+    // Lavapipe measured mean 0.056, p99 0.79 (the Fresnel blend flipped or Beer–Lambert
+    // dropped is several ΔE).
+    assert_within("pond", measured, (0.15, 1.0));
 }
 
 /// `pond`'s water in each reflection mode at 128×128: the mirrored cube map, the
@@ -208,8 +210,9 @@ fn pond_in_every_reflection_mode_through_wgpu_matches_the_cpu_backend() {
         return;
     };
     measured.push(("sphere-map", d));
+    // Lavapipe measured mean 0.061–0.074, p99 0.79–0.81.
     for (reflection, d) in measured {
-        assert_within(reflection, d, (0.25, 1.2));
+        assert_within(reflection, d, (0.15, 1.0));
     }
 }
 
