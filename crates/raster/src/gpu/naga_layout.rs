@@ -156,11 +156,8 @@ fn vertex_structs_match_the_packed_vertex_streams() {
     assert_eq!(data.objects.len() as u64 % OBJECT_VERTEX_BYTES, 0);
     // The water's vertices are object vertices (`fs_water` shares `vs_object`).
     let water = data.water.as_ref().expect("the packed scene has water");
-    assert_eq!(
-        water.vertices.len() as u64,
-        OBJECT_VERTEX_BYTES * u64::from(water.vertex_count)
-    );
-    assert_eq!(water.vertex_count, 3);
+    assert_eq!(water.vertices.len() as u64, OBJECT_VERTEX_BYTES * 3);
+    assert_eq!((water.index_count, water.indices.len()), (3, 12));
     assert!(
         !data.objects.is_empty(),
         "the packed scene has object vertices"

@@ -52,6 +52,7 @@ pub struct GpuRenderer {
 /// draw ranges.
 struct WaterDraw {
     vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
     count: u32,
     group: wgpu::BindGroup,
     /// The cube map's six faces, with dynamic cube maps.
@@ -391,11 +392,12 @@ impl GpuRenderer {
             pass.set_bind_group(1, &scene_group, &[]);
             let ground = (&ground, ground_draws[0].clone());
             draw_opaque(&mut pass, p, ground, objects.as_ref(), data.all_vertices);
-            if let Some(water) = &water {
+            if let Some(water) = water.as_ref().filter(|w| w.count > 0) {
                 pass.set_pipeline(&p.water);
                 pass.set_bind_group(3, &water.group, &[]);
                 pass.set_vertex_buffer(0, water.vertices.slice(..));
-                pass.draw(0..water.count, 0..1);
+                pass.set_index_buffer(water.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..water.count, 0, 0..1);
             }
             if let Some(bubbles) = &bubbles {
                 pass.set_bind_group(2, &bubble_group, &[]);
@@ -543,9 +545,11 @@ impl GpuRenderer {
             &water.vertices,
             wgpu::BufferUsages::VERTEX,
         );
+        let indices = buffer("water indices", &water.indices, wgpu::BufferUsages::INDEX);
         Some(WaterDraw {
             vertices,
-            count: water.vertex_count,
+            indices,
+            count: water.index_count,
             group,
             cube: (!water_views.is_empty()).then_some(cube),
             face_bubbles,
@@ -705,12 +709,13 @@ impl GpuRenderer {
 /// water).
 fn check_water_fits(data: &SceneData, max_buffer_size: u64) -> Result<(), GpuError> {
     match &data.water {
-        Some(w) if w.vertices.len() as u64 > max_buffer_size => {
+        Some(w) if w.vertices.len().max(w.indices.len()) as u64 > max_buffer_size => {
             Err(GpuError::Unsupported(format!(
-                "a water surface of {} triangles (its vertices take {} bytes, this device's \
-                 max_buffer_size is {max_buffer_size})",
-                w.vertex_count / 3,
-                w.vertices.len()
+                "a water surface of {} triangles (its vertices take {} bytes and its indices \
+                 {}, this device's max_buffer_size is {max_buffer_size})",
+                w.index_count / 3,
+                w.vertices.len(),
+                w.indices.len()
             )))
         }
         _ => Ok(()),
