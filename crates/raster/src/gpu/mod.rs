@@ -25,9 +25,10 @@
 //!
 //! **Invariant:** this module imports the scene crate and never the CPU renderer's modules
 //! (`tests/layout.rs` checks it). Its pure-CPU half (`scene_data`, `water_data`,
-//! `shader_source`, `error`) compiles without the feature, so `cargo test` checks the generated WGSL with naga and
+//! `bytes`, `shader_source`, `error`) compiles without the feature, so `cargo test` checks the generated WGSL with naga and
 //! the packed struct sizes against it without a GPU or wgpu.
 
+mod bytes;
 #[cfg(feature = "wgpu")]
 mod context;
 mod error;

@@ -7,6 +7,7 @@
 use glam::{Mat3, Vec3};
 
 use super::GpuError;
+use super::bytes::Bytes;
 use super::water_data::WaterData;
 use render_scene::bubble_order::{far_to_near, is_front_facing, reflection_rate};
 use render_scene::camera::View;
@@ -66,29 +67,6 @@ pub(super) struct CubeReads {
     pub filter: ReflectionFilter,
     /// Corrected for the ground's parallax, or from the centre.
     pub parallax: ReflectionParallax,
-}
-
-/// Little-endian bytes for a GPU buffer.
-#[derive(Debug, Default)]
-pub(super) struct Bytes(pub Vec<u8>);
-
-impl Bytes {
-    pub(super) fn f32(&mut self, x: f32) -> &mut Self {
-        self.0.extend_from_slice(&x.to_le_bytes());
-        self
-    }
-
-    pub(super) fn u32(&mut self, x: u32) -> &mut Self {
-        self.0.extend_from_slice(&x.to_le_bytes());
-        self
-    }
-
-    pub(super) fn vec4(&mut self, xyz: [f32; 3], w: f32) -> &mut Self {
-        for x in xyz {
-            self.f32(x);
-        }
-        self.f32(w)
-    }
 }
 
 /// The WGSL `View` of `view`, with the ground plane's constants when it is drawn.

@@ -8,7 +8,7 @@ use render_scene::shader_constants::WATER;
 use render_scene::water::FresnelTable;
 use render_scene::{ReflectionMode, RenderScene, WaterSurface};
 
-use super::scene_data::Bytes;
+use super::bytes::Bytes;
 
 /// `Water.reflection` of the cube map seen from the mirrored eye (`water_cube`).
 pub(super) const WATER_REFLECTION_CUBE: u32 = 0;
