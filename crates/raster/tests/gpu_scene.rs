@@ -860,3 +860,33 @@ fn gpu_water_with_environment_and_sphere_map_reflections_matches_the_cpu() {
         assert!(p99 <= 1.0, "99th percentile ΔE2000 {p99} > 1.0");
     }
 }
+
+/// The water seen from under its surface (no bank: its plane would hide the surface): the
+/// Fresnel table from water into air, total internal reflection beyond the critical angle
+/// (the floor mirrored), the sky refracted within it.
+#[test]
+fn gpu_water_seen_from_below_matches_the_cpu() {
+    let Some(mut gpu) = gpu() else { return };
+    let mut scene = water_scene();
+    scene.ground = None;
+    scene.camera = raster::Camera::look_at(
+        Vec3::new(0.0, -0.12, 0.4),
+        Vec3::new(0.0, 0.05, -0.6),
+        Vec3::Y,
+        60.0,
+    );
+    let tables = tables();
+    let s = settings(200, 150, 4, ReflectionMode::StaticEnvironment);
+    let cpu = srgb8_of(&mut cpu_renderer(), &scene, &tables, &s);
+    let gpu_bytes = gpu.render_srgb8(&scene, &tables, &s).unwrap();
+    let (mean, p99) = delta_e(&cpu, &gpu_bytes);
+    eprintln!("water from below: mean ΔE2000 {mean:.3}, p99 {p99:.3}");
+    if let Some(dir) = std::env::var_os("GPU_SCENE_IMAGES") {
+        for (which, bytes) in [("cpu", &cpu), ("gpu", &gpu_bytes)] {
+            let path = std::path::Path::new(&dir).join(format!("water_below_{which}.png"));
+            image::save_buffer(&path, bytes, 200, 150, image::ColorType::Rgb8).unwrap();
+        }
+    }
+    assert!(mean <= 0.15, "mean ΔE2000 {mean} > 0.15");
+    assert!(p99 <= 1.0, "99th percentile ΔE2000 {p99} > 1.0");
+}
