@@ -870,8 +870,8 @@ fn gpu_water_seen_from_below_matches_the_cpu() {
     let mut scene = water_scene();
     scene.ground = None;
     scene.camera = raster::Camera::look_at(
-        Vec3::new(0.0, -0.12, 0.4),
-        Vec3::new(0.0, 0.05, -0.6),
+        Vec3::new(0.0, -0.15, 0.2),
+        Vec3::new(0.0, 0.3, -0.4),
         Vec3::Y,
         60.0,
     );
