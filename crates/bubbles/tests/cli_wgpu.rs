@@ -183,32 +183,37 @@ fn wgpu_without_an_adapter_is_an_input_error_naming_the_fix() {
     assert!(!dir.path().join("x.png").exists(), "no image on failure");
 }
 
-/// The wgpu backend has no water pass: `pond` must be refused by name, never drawn
-/// without its water (found when water and wgpu landed in the same session).
+/// `pond` (issue 24) as its file renders it: the water's floor refracted with
+/// Beer–Lambert absorption, the exact Fresnel blend, and reflections from the cube map
+/// seen from the mirrored eye with the bubbles in it; the bubbles over the water.
 #[test]
-fn pond_through_wgpu_is_refused_naming_the_water() {
+fn pond_through_wgpu_matches_the_cpu_backend_in_ciede2000() {
     let dir = tempfile::tempdir().unwrap();
-    let args = [
-        "render",
-        "pond",
-        "--backend",
-        "wgpu",
-        "--width",
-        "16",
-        "--height",
-        "12",
-        "--out",
-        "x.png",
-    ];
-    let Some((out, err)) = run_unless_no_adapter(&args, dir.path()) else {
+    let Some(measured) = wgpu_against_cpu("pond", dir.path()) else {
         return;
     };
-    assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("water") && err.contains("--backend cpu"),
-        "{err}"
-    );
-    assert!(!dir.path().join("x.png").exists(), "no image on failure");
+    // Lavapipe measured mean 0.056, p99 0.79 (the Fresnel blend flipped or Beer–Lambert
+    // dropped is several ΔE).
+    assert_within("pond", measured, (0.15, 1.0));
+}
+
+/// `pond`'s water in each reflection mode at 128×128: the mirrored cube map, the
+/// environment alone, and the sphere map read through seed 002's view space.
+#[test]
+fn pond_in_every_reflection_mode_through_wgpu_matches_the_cpu_backend() {
+    let dir = tempfile::tempdir().unwrap();
+    let Some(mut measured) = dynamic_and_static_against_cpu("pond", dir.path()) else {
+        return;
+    };
+    let sphere = ["--reflection", "sphere-map"];
+    let Some(d) = scene_file_against_cpu("pond", dir.path(), 128, &sphere) else {
+        return;
+    };
+    measured.push(("sphere-map", d));
+    // Lavapipe measured mean 0.061–0.074, p99 0.79–0.81.
+    for (reflection, d) in measured {
+        assert_within(reflection, d, (0.15, 1.0));
+    }
 }
 
 /// `--samples 9` has no MSAA count anywhere: the frame is rendered at the nearest count

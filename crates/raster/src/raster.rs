@@ -134,7 +134,7 @@ impl SamplePattern {
         // Offsets from the pixel centre in 1/16 pixel.
         let sixteenths: &[(i64, i64)] = match count {
             1 => &[(0, 0)],
-            4 => &[(-2, -6), (6, -2), (-6, 2), (2, 6)],
+            4 => &render_scene::shader_constants::SAMPLE_OFFSETS_4_SIXTEENTHS,
             8 => &[
                 (1, -3),
                 (-1, 3),

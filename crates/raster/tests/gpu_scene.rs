@@ -10,7 +10,8 @@
 mod common;
 
 use common::{
-    bubble, film_field, lossless_tables, paper_scene, settings, synthetic_reflectivity, with_film,
+    bubble, draining, film_field, lossless_tables, paper_scene, settings, synthetic_reflectivity,
+    with_film,
 };
 use raster::gpu::{GpuOptions, GpuRenderer};
 use raster::{
@@ -712,4 +713,180 @@ fn gpu_reads_the_ground_with_parallax_as_the_cpu_does() {
         same < 0.25 * unported && same < 1.0,
         "GPU corrected reads are {same:.3} from the CPU's (uncorrected: {unported:.3})"
     );
+}
+
+/// A rippled pond (`n` × `n` quads over x ∈ [−1.2, 1.2], z ∈ [−2.4, 1.2], two crossing
+/// waves, analytic normals) over a checker floor 0.4 m down, in murky water whose
+/// absorption differs by channel: the refracted floor's colour depends on Beer–Lambert.
+fn rippled_water(n: u32) -> raster::WaterSurface {
+    // Height and its gradient: two sines.
+    let wave = |x: f32, z: f32| {
+        let (a, b) = (9.0 * x - 4.0 * z, -5.0 * x - 11.0 * z);
+        let h = 0.006 * a.sin() + 0.004 * b.sin();
+        let dx = 0.006 * 9.0 * a.cos() - 0.004 * 5.0 * b.cos();
+        let dz = -0.006 * 4.0 * a.cos() - 0.004 * 11.0 * b.cos();
+        (h, Vec3::new(-dx, 1.0, -dz).normalize())
+    };
+    let (mut positions, mut normals) = (Vec::new(), Vec::new());
+    for j in 0..=n {
+        for i in 0..=n {
+            let x = -1.2 + 2.4 * i as f32 / n as f32;
+            let z = -2.4 + 3.6 * j as f32 / n as f32;
+            let (h, normal) = wave(x, z);
+            positions.push(Vec3::new(x, h, z));
+            normals.push(normal);
+        }
+    }
+    let mut triangles = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            let v = j * (n + 1) + i;
+            triangles.push([v, v + n + 1, v + 1]);
+            triangles.push([v + 1, v + n + 1, v + n + 2]);
+        }
+    }
+    raster::WaterSurface {
+        positions,
+        normals,
+        triangles,
+        rest_height_m: 0.0,
+        ior: 1.333,
+        floor_depth_m: 0.4,
+        floor: Material::checker([0.75, 0.7, 0.55], [0.15, 0.25, 0.3], 0.15),
+        absorption_per_m: [1.6, 0.4, 0.15],
+    }
+}
+
+/// Issue 24's water: a camera low over the rippled pond, a bubble and a specular ball above
+/// it (both seen in the water's reflections), a bank around it, a sun and a lamp.
+fn water_scene() -> RenderScene {
+    let camera = raster::Camera::look_at(
+        Vec3::new(0.0, 0.12, 0.6),
+        Vec3::new(0.0, 0.06, -0.5),
+        Vec3::Y,
+        50.0,
+    );
+    let sky = Sky {
+        sun_rgb: [30.0, 28.0, 25.0],
+        sun_direction: Vec3::new(-0.3, 0.5, -1.0),
+        sun_radius_deg: 2.0,
+        ..Sky::default()
+    };
+    let mut scene = RenderScene::new(camera, Environment::Sky(sky));
+    scene.irradiance = Irradiance::from_environment(&scene.environment);
+    scene.ambient_rgb = [0.05; 3];
+    scene.ground = Some(raster::Ground {
+        height_m: -0.03,
+        material: Material::checker([0.32, 0.45, 0.2], [0.26, 0.38, 0.16], 0.5),
+    });
+    scene.water = Some(rippled_water(96));
+    scene.lights.push(raster::Light {
+        position: Vec3::new(0.6, 0.9, 0.2),
+        radius_m: 0.05,
+        radiance: [300.0, 290.0, 270.0],
+        light_lut: None,
+    });
+    scene
+        .bubbles
+        .push(bubble(Vec3::new(-0.1, 0.16, -0.25), 0.14, 3, draining));
+    scene.objects.push(Object::Sphere {
+        center: Vec3::new(0.3, 0.06, -0.7),
+        radius_m: 0.12,
+        material: Material {
+            pattern: Pattern::Solid([0.7, 0.2, 0.15]),
+            specular: [0.5; 3],
+            shininess: 40.0,
+        },
+    });
+    scene
+}
+
+/// The water scene at 200×150 with `reflection`, CPU against GPU: `(mean, p99)` ΔE2000.
+fn water_delta_e(gpu: &mut GpuRenderer, reflection: ReflectionMode) -> (f64, f64) {
+    let (scene, tables) = (water_scene(), tables());
+    let s = settings(200, 150, 4, reflection.clone());
+    let cpu = srgb8_of(&mut cpu_renderer(), &scene, &tables, &s);
+    let gpu_bytes = gpu.render_srgb8(&scene, &tables, &s).unwrap();
+    let measured = delta_e(&cpu, &gpu_bytes);
+    eprintln!(
+        "water, {}: mean ΔE2000 {:.3}, p99 {:.3}",
+        reflection_name(&reflection),
+        measured.0,
+        measured.1
+    );
+    if let Some(dir) = std::env::var_os("GPU_SCENE_IMAGES") {
+        for (which, bytes) in [("cpu", &cpu), ("gpu", &gpu_bytes)] {
+            let name = format!("water_{}_{which}.png", reflection_name(&reflection));
+            let path = std::path::Path::new(&dir).join(name);
+            image::save_buffer(&path, bytes, 200, 150, image::ColorType::Rgb8).unwrap();
+        }
+    }
+    measured
+}
+
+fn reflection_name(reflection: &ReflectionMode) -> &'static str {
+    match reflection {
+        ReflectionMode::DynamicCubeMap { .. } => "dynamic",
+        ReflectionMode::StaticEnvironment => "static",
+        ReflectionMode::SphereMap(_) => "sphere",
+    }
+}
+
+/// The water with dynamic cube maps: the floor refracted with Beer–Lambert, the exact
+/// Fresnel blend, and the cube map seen from the mirrored eye with the ball and the
+/// bubble in it (the bubble reading its own cube map, which does not see the water).
+#[test]
+fn gpu_water_with_its_mirrored_cube_map_matches_the_cpu() {
+    let Some(mut gpu) = gpu() else { return };
+    let (mean, p99) = water_delta_e(&mut gpu, ReflectionMode::DynamicCubeMap { face_size: 32 });
+    assert!(mean <= 0.15, "mean ΔE2000 {mean} > 0.15");
+    assert!(p99 <= 1.0, "99th percentile ΔE2000 {p99} > 1.0");
+}
+
+/// The water reflecting the environment alone, and through a sphere map made from it
+/// (seed 002's view-space coordinates, `WaterReflection::Sphere`).
+#[test]
+fn gpu_water_with_environment_and_sphere_map_reflections_matches_the_cpu() {
+    let Some(mut gpu) = gpu() else { return };
+    let scene = water_scene();
+    let map = raster::SphereMap::from_environment(&scene.environment, 64, raster::Mat3::IDENTITY)
+        .unwrap();
+    for reflection in [
+        ReflectionMode::StaticEnvironment,
+        ReflectionMode::SphereMap(std::sync::Arc::new(map)),
+    ] {
+        let (mean, p99) = water_delta_e(&mut gpu, reflection);
+        assert!(mean <= 0.15, "mean ΔE2000 {mean} > 0.15");
+        assert!(p99 <= 1.0, "99th percentile ΔE2000 {p99} > 1.0");
+    }
+}
+
+/// The water seen from under its surface (no bank: its plane would hide the surface): the
+/// Fresnel table from water into air, total internal reflection beyond the critical angle
+/// (the floor mirrored), the sky refracted within it.
+#[test]
+fn gpu_water_seen_from_below_matches_the_cpu() {
+    let Some(mut gpu) = gpu() else { return };
+    let mut scene = water_scene();
+    scene.ground = None;
+    scene.camera = raster::Camera::look_at(
+        Vec3::new(0.0, -0.15, 0.2),
+        Vec3::new(0.0, 0.3, -0.4),
+        Vec3::Y,
+        60.0,
+    );
+    let tables = tables();
+    let s = settings(200, 150, 4, ReflectionMode::StaticEnvironment);
+    let cpu = srgb8_of(&mut cpu_renderer(), &scene, &tables, &s);
+    let gpu_bytes = gpu.render_srgb8(&scene, &tables, &s).unwrap();
+    let (mean, p99) = delta_e(&cpu, &gpu_bytes);
+    eprintln!("water from below: mean ΔE2000 {mean:.3}, p99 {p99:.3}");
+    if let Some(dir) = std::env::var_os("GPU_SCENE_IMAGES") {
+        for (which, bytes) in [("cpu", &cpu), ("gpu", &gpu_bytes)] {
+            let path = std::path::Path::new(&dir).join(format!("water_below_{which}.png"));
+            image::save_buffer(&path, bytes, 200, 150, image::ColorType::Rgb8).unwrap();
+        }
+    }
+    assert!(mean <= 0.15, "mean ΔE2000 {mean} > 0.15");
+    assert!(p99 <= 1.0, "99th percentile ΔE2000 {p99} > 1.0");
 }

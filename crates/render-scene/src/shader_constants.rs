@@ -9,6 +9,7 @@ use crate::frame::{
 use crate::highlight::HIGHLIGHT_SIGMA_PX;
 use crate::lod::{LOD_BIAS, MAX_ANISOTROPY, MIN_FOOTPRINT_TEXELS};
 use crate::shading::{FLAT_FOOTPRINT_CELLS, GROUND_HALF_OFFSET_PX};
+use crate::water::FRESNEL_STEPS;
 
 pub use crate::cubemap::FACE_BASES;
 pub use crate::frame::{ACES_DENOMINATOR, ACES_NUMERATOR};
@@ -18,6 +19,12 @@ pub const EMISSIVE: u32 = 1 << 31;
 
 /// Tag bit marking a water triangle in the opaque pass.
 pub const WATER: u32 = 1 << 30;
+
+/// The 4-sample pattern (D3D's and Vulkan's standard one): each sample's offset from the
+/// pixel centre in 1/16 pixel, y down, in sample order. The CPU rasteriser samples there,
+/// and the GPU's water shades a partly covered pixel at its first covered one as the CPU
+/// does.
+pub const SAMPLE_OFFSETS_4_SIXTEENTHS: [(i64, i64); 4] = [(-2, -6), (6, -2), (-6, 2), (2, 6)];
 
 /// The tone curve's 3×3 matrices (rows), by WGSL name.
 pub const TONE_MATRICES: [(&str, [[f32; 3]; 3]); 2] = [
@@ -45,11 +52,13 @@ pub const SCENE_SCALARS: [(&str, f32); 5] = [
     ("MIN_FOOTPRINT_TEXELS", MIN_FOOTPRINT_TEXELS),
 ];
 
-/// The scene shading's integer constants (tag bits, anisotropic tap limit), by WGSL name.
-pub const SCENE_WORDS: [(&str, u32); 3] = [
+/// The scene shading's integer constants (tag bits, anisotropic tap limit, the water's
+/// Fresnel table intervals), by WGSL name.
+pub const SCENE_WORDS: [(&str, u32); 4] = [
     ("EMISSIVE", EMISSIVE),
     ("WATER", WATER),
     ("MAX_ANISOTROPY", MAX_ANISOTROPY as u32),
+    ("FRESNEL_STEPS", FRESNEL_STEPS as u32),
 ];
 
 #[cfg(test)]

@@ -130,8 +130,9 @@ pub struct FresnelTable {
     r: Vec<f32>,
 }
 
-/// Intervals of [`FresnelTable`] over `cos θ ∈ [0, 1]`.
-const FRESNEL_STEPS: usize = 1024;
+/// Intervals of [`FresnelTable`] over `cos θ ∈ [0, 1]` (the GPU backend reads the table
+/// with the same count, injected into its shader).
+pub const FRESNEL_STEPS: usize = 1024;
 
 impl FresnelTable {
     /// `R(cos θ)` from a medium of index `n_incident` into one of `n_transmitted`.
@@ -148,6 +149,12 @@ impl FresnelTable {
             .map(|i| interface.response(i as f64 / FRESNEL_STEPS as f64).r() as f32)
             .collect();
         Self { r }
+    }
+
+    /// The table's samples: `R` at `cos θ = i / FRESNEL_STEPS`, `i = 0 ..= FRESNEL_STEPS`
+    /// (what the GPU backend uploads and interpolates as [`FresnelTable::reflectance`]).
+    pub fn samples(&self) -> &[f32] {
+        &self.r
     }
 
     /// Unpolarised reflectance at `cos_theta` (clamped to `[0, 1]`; NaN reads as grazing).

@@ -15,6 +15,12 @@
 //! `GpuRenderer::present` puts each frame on it (`present`): tone-mapped and upscaled
 //! straight into the surface texture, the overlay blended on top, nothing read back.
 //!
+//! A water surface (`RenderScene::water`) is drawn as the CPU draws it: its triangles join
+//! the opaque pass (`fs_water`, a port of `WaterShading::radiance`), and with dynamic cube
+//! maps its reflections come from six more faces rendered from the eye mirrored in its
+//! rest plane, the bubbles (sorted for that eye) blended into them; bubbles' own cube maps
+//! do not see the water, as on the CPU.
+//!
 //! The CPU backend is the specification: every shader function names the Rust function it
 //! ports. Constants the two must share (tone curve, sRGB encoding, highlight filter, tag
 //! bits) are injected into the WGSL from the Rust constants, never retyped; see
@@ -22,10 +28,11 @@
 //! (`render_scene::bubble_order`, `render_scene::tessellate`), as the CPU renderer's do.
 //!
 //! **Invariant:** this module imports the scene crate and never the CPU renderer's modules
-//! (`tests/layout.rs` checks it). Its pure-CPU half (`scene_data`, `shader_source`, `error`)
-//! compiles without the feature, so `cargo test` checks the generated WGSL with naga and
+//! (`tests/layout.rs` checks it). Its pure-CPU half (`scene_data`, `water_data`,
+//! `bytes`, `shader_source`, `error`) compiles without the feature, so `cargo test` checks the generated WGSL with naga and
 //! the packed struct sizes against it without a GPU or wgpu.
 
+mod bytes;
 #[cfg(feature = "wgpu")]
 mod context;
 mod error;
@@ -41,6 +48,7 @@ mod scene_data;
 mod shader_source;
 #[cfg(feature = "wgpu")]
 mod tonemap;
+mod water_data;
 
 #[cfg(feature = "wgpu")]
 pub use context::{Gpu, GpuOptions};

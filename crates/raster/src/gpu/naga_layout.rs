@@ -5,9 +5,10 @@
 use glam::Vec3;
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use naga::{Module, TypeInner};
+use render_scene::water::FRESNEL_STEPS;
 use render_scene::{
     Camera, Environment, FilmTables, Ground, Light, Lut, Material, Object, RenderScene,
-    RenderSettings,
+    RenderSettings, WaterSurface,
 };
 
 use super::scene_data::{
@@ -54,8 +55,9 @@ fn packed_size(module: &Module, name: &str) -> u64 {
         .sum()
 }
 
-/// A scene using every packed array: two materials (an object's and the ground's), one
-/// light, and three tables (reflectivity, transmittance, the light's own).
+/// A scene using every packed array: three materials (an object's, the ground's and the
+/// water floor's), one light, three tables (reflectivity, transmittance, the light's own)
+/// and a water surface.
 fn packed_scene() -> (SceneData, usize, usize, usize) {
     let camera = Camera::look_at(Vec3::new(0.0, 0.5, 2.0), Vec3::ZERO, Vec3::Y, 45.0);
     let mut scene = RenderScene::new(camera, Environment::Uniform([0.2; 3]));
@@ -67,6 +69,16 @@ fn packed_scene() -> (SceneData, usize, usize, usize) {
     scene.ground = Some(Ground {
         height_m: -0.5,
         material: Material::matte([0.5; 3]),
+    });
+    scene.water = Some(WaterSurface {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Z],
+        normals: vec![Vec3::Y; 3],
+        triangles: vec![[0, 2, 1]],
+        rest_height_m: 0.0,
+        ior: 1.333,
+        floor_depth_m: 0.5,
+        floor: Material::matte([0.5; 3]),
+        absorption_per_m: [0.1, 0.2, 0.3],
     });
     scene.lights.push(Light {
         position: Vec3::new(1.0, 2.0, 1.0),
@@ -86,12 +98,12 @@ fn packed_scene() -> (SceneData, usize, usize, usize) {
         &scene,
         &tables,
         &settings,
-        &view,
+        (&view, 4),
         8192,
         CubeReads::default(),
     )
     .unwrap();
-    (data, 2, 1, 3)
+    (data, 3, 1, 3)
 }
 
 #[test]
@@ -107,6 +119,9 @@ fn uniform_and_storage_structs_have_the_sizes_scene_data_writes() {
     let (data, materials, lights, tables) = packed_scene();
     let camera = Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0);
     let view = view_bytes(&camera.view(8, 8), None);
+    let water = data.water.as_ref().expect("the packed scene has water");
+    // Two Fresnel tables (from air, from water) of FRESNEL_STEPS + 1 samples each.
+    assert_eq!(water.fresnel.len(), 2 * 4 * (FRESNEL_STEPS + 1));
     let checks = [
         ("View", 1, VIEW_BYTES as usize),
         ("View", 1, view.len()),
@@ -114,6 +129,7 @@ fn uniform_and_storage_structs_have_the_sizes_scene_data_writes() {
         ("Material", materials, data.materials.len()),
         ("Light", lights, data.lights.len()),
         ("LutInfo", tables, data.lut_info.len()),
+        ("Water", 1, water.uniform.len()),
     ];
     for (name, count, rust_bytes) in checks {
         let wgsl = struct_size(&module, name) as usize * count;
@@ -139,6 +155,10 @@ fn vertex_structs_match_the_packed_vertex_streams() {
     }
     let (data, ..) = packed_scene();
     assert_eq!(data.objects.len() as u64 % OBJECT_VERTEX_BYTES, 0);
+    // The water's vertices are object vertices (`fs_water` shares `vs_object`).
+    let water = data.water.as_ref().expect("the packed scene has water");
+    assert_eq!(water.vertices.len() as u64, OBJECT_VERTEX_BYTES * 3);
+    assert_eq!((water.index_count, water.indices.len()), (3, 12));
     assert!(
         !data.objects.is_empty(),
         "the packed scene has object vertices"

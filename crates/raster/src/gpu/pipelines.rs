@@ -2,6 +2,7 @@
 
 use super::scene_data::{BUBBLE_VERTEX_BYTES, OBJECT_VERTEX_BYTES, VIEW_BYTES};
 use super::shader_source::scene_wgsl;
+use super::water_data::WATER_UNIFORM_BYTES;
 
 /// Colour format of the HDR targets (frame and cube faces): blendable and resolvable.
 pub(super) const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -23,7 +24,11 @@ pub(super) struct Layouts {
     pub mip_downsample: wgpu::ComputePipeline,
     /// Refills one level's borders from the neighbouring faces.
     pub mip_borders: wgpu::ComputePipeline,
+    /// The water's (group 3, bindings 3..6): `Water` uniform, Fresnel tables, the cube
+    /// map seen from the mirrored eye.
+    pub water: wgpu::BindGroupLayout,
     opaque: wgpu::PipelineLayout,
+    water_pass: wgpu::PipelineLayout,
     bubbles: wgpu::PipelineLayout,
     module: wgpu::ShaderModule,
 }
@@ -122,6 +127,21 @@ impl Layouts {
                 compute(2, uniform),
             ],
         );
+        let water = layout(
+            "water",
+            &[
+                entry(
+                    3,
+                    wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: wgpu::BufferSize::new(WATER_UNIFORM_BYTES),
+                    },
+                ),
+                entry(4, storage()),
+                entry(5, texture(wgpu::TextureViewDimension::D2Array)),
+            ],
+        );
         let pipeline_layout = |groups: &[Option<&wgpu::BindGroupLayout>]| {
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: None,
@@ -130,6 +150,7 @@ impl Layouts {
             })
         };
         let opaque = pipeline_layout(&[Some(&view), Some(&scene)]);
+        let water_pass = pipeline_layout(&[Some(&view), Some(&scene), None, Some(&water)]);
         let bubbles = pipeline_layout(&[Some(&view), Some(&scene), Some(&bubble)]);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("scene"),
@@ -154,7 +175,9 @@ impl Layouts {
             mip_downsample: compute_pipeline("cs_mip_downsample"),
             mip_borders: compute_pipeline("cs_mip_borders"),
             mip,
+            water,
             opaque,
+            water_pass,
             bubbles,
             module,
         }
@@ -168,6 +191,8 @@ pub(super) struct Pipelines {
     pub sky: wgpu::RenderPipeline,
     pub ground: wgpu::RenderPipeline,
     pub objects: wgpu::RenderPipeline,
+    /// The water's triangles (object vertices), shaded by `fs_water`.
+    pub water: wgpu::RenderPipeline,
     /// Bubble film, blended (Zero, OneMinusSrc): `dest ← dest ⊙ T`.
     pub transmit: wgpu::RenderPipeline,
     /// Bubble film, blended (One, One): `dest ← dest + R ⊙ env + highlights`.
@@ -302,6 +327,18 @@ impl Pipelines {
             sky: opaque("sky", "vs_sky", "fs_sky", &[], Always),
             ground: opaque("ground", "vs_ground", "fs_ground", &ground, Greater),
             objects: opaque("objects", "vs_object", "fs_object", &objects, Greater),
+            water: make(
+                Desc {
+                    label: "water",
+                    vertex: "vs_water",
+                    fragment: "fs_water",
+                    buffers: &objects,
+                    depth_write: true,
+                    depth_compare: Greater,
+                    blend: None,
+                },
+                &layouts.water_pass,
+            ),
             transmit: film("bubble transmit", "fs_bubble_transmit", transmit_blend()),
             add: film("bubble add", "fs_bubble_add", add_blend()),
         }

@@ -6,9 +6,11 @@ use wgpu::util::DeviceExt;
 
 use super::pipelines::{DEPTH_FORMAT, HDR_FORMAT, Layouts, Pipelines};
 use super::scene_data::{
-    CubeReads, SceneData, VIEW_BYTES, check_supported, ground_triangles, view_bytes,
+    BUBBLE_VERTEX_BYTES, CubeReads, SceneData, VIEW_BYTES, bubble_vertices, ground_triangles,
+    view_bytes,
 };
 use super::{Gpu, GpuError, GpuOptions};
+use glam::Vec3;
 use render_scene::camera::View;
 use render_scene::cubemap::FACE_BASES;
 use render_scene::ground_view::{GroundFilter, GroundView};
@@ -44,6 +46,19 @@ pub struct GpuRenderer {
     reads: CubeReads,
     /// The last frame's cube mip chains, for [`GpuRenderer::read_cube_mips`].
     last_mips: Option<wgpu::Buffer>,
+}
+
+/// The water's draw: its vertices and bind group (group 3), and with dynamic cube maps
+/// the bubbles' vertices for the six faces seen from the mirrored eye and each face's
+/// draw ranges.
+struct WaterDraw {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    count: u32,
+    group: wgpu::BindGroup,
+    /// The cube map's six faces, with dynamic cube maps.
+    cube: Option<wgpu::Texture>,
+    face_bubbles: Option<(wgpu::Buffer, Vec<Vec<std::ops::Range<u32>>>)>,
 }
 
 /// The targets one view renders into.
@@ -155,17 +170,35 @@ impl GpuRenderer {
         settings.validate()?;
         scene.validate()?;
         tables.validate_for(scene)?;
-        check_supported(scene)?;
         let (w, h) = (settings.width as u32, settings.height as u32);
         self.gpu.check_size(w, h)?;
         let view = scene.camera.view(settings.width, settings.height);
         let max_side = self.gpu.device.limits().max_texture_dimension_2d;
-        let data = SceneData::new(scene, tables, settings, &view, max_side, self.reads)?;
+        // The nearest count the device renders (the caller is told by `sample_count_for`).
+        let samples = self.gpu.sample_count_for(settings.samples);
+        let data = SceneData::new(
+            scene,
+            tables,
+            settings,
+            (&view, samples),
+            max_side,
+            self.reads,
+        )?;
+        check_water_fits(&data, self.gpu.device.limits().max_buffer_size)?;
         let face_size = match settings.reflection {
             ReflectionMode::DynamicCubeMap { face_size } => Some(face_size),
             _ => None,
         };
         let face_views = face_size.map_or(Vec::new(), |n| cube_face_views(scene, n));
+        // With dynamic cube maps the water reflects six faces seen from the mirrored eye.
+        let water_views = match (&scene.water, face_size) {
+            (Some(w), Some(n)) => {
+                let eye = scene.camera.eye();
+                let mirrored = Vec3::new(eye.x, 2.0 * w.rest_height_m - eye.y, eye.z);
+                face_views_from(mirrored, n, scene.camera.near_m())
+            }
+            _ => Vec::new(),
+        };
         if let Some(n) = face_size {
             self.gpu.check_size(n as u32 + 2, n as u32 + 2)?;
             let max_layers = self.gpu.device.limits().max_texture_array_layers as usize;
@@ -184,8 +217,6 @@ impl GpuRenderer {
         } else {
             1
         };
-        // The nearest count the device renders (the caller is told by `sample_count_for`).
-        let samples = self.gpu.sample_count_for(settings.samples);
         let cubes = self.texture("cube faces", ((m, m, layers), 1), hdr_texture);
         let face_depth = self.texture("face depth", ((m, m, 1), 1), depth_texture);
         let resolved = self.texture("frame", ((w, h, 1), 1), hdr_texture);
@@ -194,7 +225,11 @@ impl GpuRenderer {
         let depth = self.texture("depth", ((w, h, 1), samples), depth_texture);
         let mut views = vec![view];
         views.extend(&face_views);
-        let (view_buffer, ground, ground_draws) = self.view_buffers(scene, &views);
+        // The water's faces leave the ground out (raster's `WaterPass::render_cube`).
+        let grounded = views.len();
+        views.extend(&water_views);
+        let (view_buffer, ground, ground_draws) = self.view_buffers(scene, &views, grounded);
+        let water = self.water_draw(scene, &data, &water_views, m);
         let device = &self.gpu.device;
         let buffer = |label, contents: &[u8], usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -332,6 +367,12 @@ impl GpuRenderer {
         if let Some(n) = face_size {
             self.encode_mips(&mut encoder, (&cubes, &mips), &scene_group, n, layers);
         }
+        if let Some(water) = &water {
+            let groups = [&view_group, &scene_group, &bubble_group];
+            let first_view = 1 + face_views.len();
+            let opaque = (objects.as_ref(), data.all_vertices);
+            self.encode_water_cube(&mut encoder, water, groups, first_view, &face_depth, opaque);
+        }
         self.last_mips = face_size.map(|_| mips.clone());
         let main = self.pipelines_for(samples);
         let resolved_view = resolved.create_view(&Default::default());
@@ -356,17 +397,16 @@ impl GpuRenderer {
             pass.set_bind_group(1, &scene_group, &[]);
             let ground = (&ground, ground_draws[0].clone());
             draw_opaque(&mut pass, p, ground, objects.as_ref(), data.all_vertices);
+            if let Some(water) = water.as_ref().filter(|w| w.count > 0) {
+                pass.set_pipeline(&p.water);
+                pass.set_bind_group(3, &water.group, &[]);
+                pass.set_vertex_buffer(0, water.vertices.slice(..));
+                pass.set_index_buffer(water.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..water.count, 0, 0..1);
+            }
             if let Some(bubbles) = &bubbles {
                 pass.set_bind_group(2, &bubble_group, &[]);
-                pass.set_vertex_buffer(0, bubbles.slice(..));
-                // Per side of each bubble: dest ← dest ⊙ T, then dest ← dest + added light,
-                // which is the CPU's dest ⊙ T + add where a side's triangles do not overlap.
-                for range in &data.bubble_draws {
-                    pass.set_pipeline(&p.transmit);
-                    pass.draw(range.clone(), 0..1);
-                    pass.set_pipeline(&p.add);
-                    pass.draw(range.clone(), 0..1);
-                }
+                draw_bubbles(&mut pass, p, bubbles, &data.bubble_draws);
             }
         }
         let size = wgpu::Extent3d {
@@ -443,6 +483,127 @@ impl GpuRenderer {
         }
     }
 
+    /// The water's vertices, bind group and cube texture (`m`² texels a face, six faces,
+    /// with dynamic cube maps; one unused texel otherwise), and the bubbles' vertices for
+    /// each of `water_views` (sorted and split by side for the mirrored eye, their
+    /// highlight filter's rate for each face, as the CPU sets them up per face); `None`
+    /// without water.
+    fn water_draw(
+        &mut self,
+        scene: &RenderScene,
+        data: &SceneData,
+        water_views: &[View],
+        m: u32,
+    ) -> Option<WaterDraw> {
+        let water = data.water.as_ref()?;
+        let key = if water_views.is_empty() {
+            ((1, 1, 1), 1)
+        } else {
+            ((m, m, 6), 1)
+        };
+        let cube = self.texture("water cube", key, hdr_texture);
+        let device = &self.gpu.device;
+        let buffer = |label, contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
+        let uniform = buffer("water", &water.uniform, wgpu::BufferUsages::UNIFORM);
+        let fresnel = buffer("fresnel", &water.fresnel, wgpu::BufferUsages::STORAGE);
+        let cube_view = cube.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("water"),
+            layout: &self.layouts.water,
+            entries: &[
+                bind(3, uniform.as_entire_binding()),
+                bind(4, fresnel.as_entire_binding()),
+                bind(5, wgpu::BindingResource::TextureView(&cube_view)),
+            ],
+        });
+        let scene_bubbles = !data.bubbles.is_empty() && !water_views.is_empty();
+        let face_bubbles = scene_bubbles.then(|| {
+            let mut bytes = Vec::new();
+            let mut draws = Vec::with_capacity(water_views.len());
+            for v in water_views {
+                let first = (bytes.len() as u64 / BUBBLE_VERTEX_BYTES) as u32;
+                let (b, ranges) = bubble_vertices(scene, v, &data.film_places);
+                bytes.extend(b);
+                draws.push(
+                    ranges
+                        .into_iter()
+                        .map(|r| r.start + first..r.end + first)
+                        .collect(),
+                );
+            }
+            (
+                buffer("water face bubbles", &bytes, wgpu::BufferUsages::VERTEX),
+                draws,
+            )
+        });
+        let vertices = buffer(
+            "water vertices",
+            &water.vertices,
+            wgpu::BufferUsages::VERTEX,
+        );
+        let indices = buffer("water indices", &water.indices, wgpu::BufferUsages::INDEX);
+        Some(WaterDraw {
+            vertices,
+            indices,
+            count: water.index_count,
+            group,
+            cube: (!water_views.is_empty()).then_some(cube),
+            face_bubbles,
+        })
+    }
+
+    /// The water's cube map, as raster's `WaterPass::render_cube`: per face (views
+    /// `first_view..first_view + 6`), the sky, the objects and light spheres of `opaque`
+    /// (no ground, no water), then the bubbles blended over them reading their own cube
+    /// maps (`groups`: view, scene, bubble tables).
+    fn encode_water_cube(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        water: &WaterDraw,
+        groups: [&wgpu::BindGroup; 3],
+        first_view: usize,
+        face_depth: &wgpu::TextureView,
+        (objects, vertices): (Option<&wgpu::Buffer>, u32),
+    ) {
+        let Some(cube) = &water.cube else {
+            return;
+        };
+        let single = self.pipelines_for(1);
+        let p = &self.pipelines[single];
+        for face in 0..6 {
+            let layer = cube.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_array_layer: face as u32,
+                array_layer_count: Some(1),
+                ..Default::default()
+            });
+            let target = Target {
+                color: &layer,
+                resolve: None,
+                depth: face_depth,
+            };
+            let mut pass = begin(encoder, &target);
+            let offset = (VIEW_STRIDE * (first_view + face) as u64) as u32;
+            pass.set_bind_group(0, groups[0], &[offset]);
+            pass.set_bind_group(1, groups[1], &[]);
+            let no_ground = (&water.vertices, 0..0);
+            draw_opaque(&mut pass, p, no_ground, objects, vertices);
+            if let Some((bubbles, draws)) = &water.face_bubbles {
+                pass.set_bind_group(2, groups[2], &[]);
+                draw_bubbles(&mut pass, p, bubbles, &draws[face]);
+            }
+        }
+    }
+
     /// The texture of `role` with `key`, made on first use and when its key changes.
     fn texture(&mut self, role: &'static str, key: TextureKey, make: MakeTexture) -> wgpu::Texture {
         if let Some((_, k, t)) = self.textures.iter().find(|(r, ..)| *r == role) {
@@ -467,11 +628,13 @@ impl GpuRenderer {
     }
 
     /// Every view's `View` uniform, `VIEW_STRIDE` bytes apart; the ground triangles of
-    /// every view in one vertex buffer, and each view's vertex range in it.
+    /// every view before `grounded` in one vertex buffer, and each view's vertex range in
+    /// it (empty from `grounded` on).
     fn view_buffers(
         &self,
         scene: &RenderScene,
         views: &[View],
+        grounded: usize,
     ) -> (wgpu::Buffer, wgpu::Buffer, Vec<std::ops::Range<u32>>) {
         let mut bytes = Vec::with_capacity(views.len() * VIEW_STRIDE as usize);
         let mut ground_bytes: Vec<u8> = Vec::new();
@@ -487,6 +650,7 @@ impl GpuRenderer {
             let ground = scene
                 .ground
                 .as_ref()
+                .filter(|_| k < grounded)
                 .and_then(|g| GroundView::new(g, v))
                 .map(|g| g.with_filter(filter));
             bytes.extend(view_bytes(v, ground.as_ref()));
@@ -545,24 +709,67 @@ impl GpuRenderer {
     }
 }
 
-/// The six face views of each bubble's cube map, exactly as the CPU's `render_cube_maps`:
-/// from the bubble's centre, one texel wider on each side for the border ring.
+/// Refuses a water surface whose vertex buffer is larger than the device's
+/// `max_buffer_size`, naming the limit and the value (an adapter limit, not a refusal of
+/// water).
+fn check_water_fits(data: &SceneData, max_buffer_size: u64) -> Result<(), GpuError> {
+    match &data.water {
+        Some(w) if w.vertices.len().max(w.indices.len()) as u64 > max_buffer_size => {
+            Err(GpuError::Unsupported(format!(
+                "a water surface of {} triangles (its vertices take {} bytes and its indices \
+                 {}, this device's max_buffer_size is {max_buffer_size})",
+                w.index_count / 3,
+                w.vertices.len(),
+                w.indices.len()
+            )))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// The six face views of each bubble's cube map, exactly as the CPU's `render_cube_maps`.
 fn cube_face_views(scene: &RenderScene, face_size: usize) -> Vec<View> {
+    let near_m = scene.camera.near_m();
+    (scene.bubbles.iter().map(BubbleMesh::center))
+        .flat_map(|centre| face_views_from(centre, face_size, near_m))
+        .collect()
+}
+
+/// The six face views of a cube map seen from `centre`, as the CPU's `render_cube_maps`
+/// and `WaterPass::render_cube` make them: one texel wider on each side for the border
+/// ring.
+fn face_views_from(centre: Vec3, face_size: usize, near_m: f32) -> Vec<View> {
     let m = face_size + 2;
     let wide = m as f32 / face_size as f32;
-    let mut views = Vec::with_capacity(6 * scene.bubbles.len());
-    for center in scene.bubbles.iter().map(BubbleMesh::center) {
-        for (major, s_axis, t_axis) in FACE_BASES {
-            views.push(View::new(
-                center,
+    FACE_BASES
+        .iter()
+        .map(|&(major, s_axis, t_axis)| {
+            View::new(
+                centre,
                 [major, s_axis, -t_axis],
                 (wide, wide),
                 (m, m),
-                scene.camera.near_m(),
-            ));
-        }
+                near_m,
+            )
+        })
+        .collect()
+}
+
+/// Per side of each bubble, in `draws`' order: dest ← dest ⊙ T, then dest ← dest + added
+/// light, which is the CPU's dest ⊙ T + add where a side's triangles do not overlap.
+fn draw_bubbles(
+    pass: &mut wgpu::RenderPass<'_>,
+    p: &Pipelines,
+    bubbles: &wgpu::Buffer,
+    draws: &[std::ops::Range<u32>],
+) {
+    pass.set_vertex_buffer(0, bubbles.slice(..));
+    for range in draws {
+        pass.set_pipeline(&p.transmit);
+        pass.draw(range.clone(), 0..1);
+        pass.set_pipeline(&p.add);
+        pass.draw(range.clone(), 0..1);
     }
-    views
 }
 
 fn begin<'e>(encoder: &'e mut wgpu::CommandEncoder, target: &Target<'_>) -> wgpu::RenderPass<'e> {

@@ -45,6 +45,8 @@ struct Scene {
     reflectivity_table: u32,
     // 1 when dynamic cube maps are read corrected for the ground's parallax (parallax.rs)
     ground_parallax: u32,
+    // the main view's sample count (`fs_water` shades where the CPU does)
+    frame_samples: u32,
     // The environment image in `images`: first texel, width, height of an equirect; first
     // texel, face size of cube faces (scene_data.rs `Atlas`).
     env_image: vec4<u32>,
@@ -521,6 +523,219 @@ fn fs_object(in: ObjectOut) -> @location(0) vec4<f32> {
     let footprint = surface_footprint(rel / t, t, n);
     let albedo = object_albedo(m, in.world, in.uv, footprint);
     return vec4<f32>(lit(m, albedo, in.world, n, v), 1.0);
+}
+
+// ---- water -------------------------------------------------------------------------------
+//
+// water_shading.rs `WaterShading::radiance`, drawn by the opaque pass for the triangles
+// tagged WATER (raster passes/opaque.rs `OpaqueCtx::shade_water`).
+
+struct Water {
+    // absorption per metre (rgb), refractive index
+    absorption_ior: vec4<f32>,
+    // water.rs `WaterSurface::floor_height_m`
+    floor_height_m: f32,
+    // the floor's entry in `materials`
+    floor_material: u32,
+    // WATER_REFLECTION_CUBE, WATER_REFLECTION_ENVIRONMENT or WATER_REFLECTION_SPHERE_MAP
+    reflection: u32,
+    // face size of `water_cube` (dynamic cube maps only)
+    cube_face_size: u32,
+    // the camera's eye_from_world by rows (sphere-map reflections)
+    eye_from_world: array<vec4<f32>, 3>,
+}
+
+// Bindings 3.. of group 3: the cube mip passes hold 0..2 of that group in this module.
+@group(3) @binding(3) var<uniform> water: Water;
+// water.rs `FresnelTable` samples: from air (table 0), then from water (table 1), each
+// FRESNEL_STEPS + 1 values of R at cos θ = i / FRESNEL_STEPS.
+@group(3) @binding(4) var<storage, read> fresnel: array<f32>;
+// The cube map seen from the eye mirrored in the rest plane: six bordered (n + 2)² faces
+// (raster passes/water.rs `WaterPass::render_cube`), level 0 only.
+@group(3) @binding(5) var water_cube: texture_2d_array<f32>;
+
+// water.rs `FresnelTable::reflectance` of table `table`.
+fn fresnel_reflectance(table: u32, cos_theta: f32) -> f32 {
+    var c = 0.0;
+    if (cos_theta >= 0.0) {
+        c = min(cos_theta, 1.0);
+    }
+    let x = c * f32(FRESNEL_STEPS);
+    let i = min(u32(x), FRESNEL_STEPS - 1u);
+    let t = x - f32(i);
+    let k = table * (FRESNEL_STEPS + 1u) + i;
+    return fresnel[k] + (fresnel[k + 1u] - fresnel[k]) * t;
+}
+
+// water.rs `refract`: the refracted direction in xyz, w = 1; w = 0 under total internal
+// reflection.
+fn refract_or_none(incident: vec3<f32>, normal: vec3<f32>, eta: f32) -> vec4<f32> {
+    let cos_i = -dot(incident, normal);
+    let sin2_t = eta * eta * max(1.0 - cos_i * cos_i, 0.0);
+    if (sin2_t >= 1.0) {
+        return vec4<f32>(0.0);
+    }
+    let cos_t = sqrt(1.0 - sin2_t);
+    return vec4<f32>(incident * eta + normal * (eta * cos_i - cos_t), 1.0);
+}
+
+// shading.rs `ground_albedo`: the material's pattern repeating along x and z, a checker
+// box-filtered over `footprint` metres, an image point-sampled.
+fn ground_albedo(m: Material, x: f32, z: f32, footprint: vec2<f32>) -> vec3<f32> {
+    if (m.specular.w == PATTERN_CHECKER) {
+        let inv = 1.0 / m.a.w;
+        let t = filtered_checker(vec2<f32>(x * inv, z * inv), footprint * inv);
+        return lerp3(m.a.xyz, m.b.xyz, t);
+    }
+    if (m.specular.w == PATTERN_TEXTURED) {
+        return image_repeat(m.image, x / m.a.w, z / m.a.w);
+    }
+    return m.a.xyz;
+}
+
+// water_shading.rs `WaterShading::floor_radiance` with `floor_hit`: the lit floor seen
+// from `p` along `dir` through the water, dimmed by Beer–Lambert absorption over the path;
+// black when the ray does not go down to the floor.
+fn water_floor(p: vec3<f32>, dir: vec3<f32>, footprint_m: f32) -> vec3<f32> {
+    if (!(dir.y < 0.0) || !all(abs(dir) < vec3<f32>(3.0e38))) {
+        return vec3<f32>(0.0);
+    }
+    let path_m = max((water.floor_height_m - p.y) / dir.y, 0.0);
+    let q = p + dir * path_m;
+    let m = materials[water.floor_material];
+    let albedo = ground_albedo(m, q.x, q.z, vec2<f32>(footprint_m));
+    let floor = lit(m, albedo, q, vec3<f32>(0.0, 1.0, 0.0), dir);
+    return floor * exp(-water.absorption_ior.xyz * path_m);
+}
+
+// cubemap.rs `CubeMap::sample` of the water's cube map: one bilinear tap of level 0.
+fn water_cube_sample(dir: vec3<f32>) -> vec3<f32> {
+    let fst = face_coordinates(dir);
+    let at = bordered_bilinear(fst, f32(water.cube_face_size));
+    let face = i32(fst.x);
+    let x = i32(at.x);
+    let y = i32(at.y);
+    let a = textureLoad(water_cube, vec2<i32>(x, y), face, 0).xyz;
+    let b = textureLoad(water_cube, vec2<i32>(x + 1, y), face, 0).xyz;
+    let c = textureLoad(water_cube, vec2<i32>(x, y + 1), face, 0).xyz;
+    let d = textureLoad(water_cube, vec2<i32>(x + 1, y + 1), face, 0).xyz;
+    let top = a + (b - a) * at.z;
+    let bottom = c + (d - c) * at.z;
+    return top + (bottom - top) * at.w;
+}
+
+// water.rs `sphere_map_uv`: seed 002's texture coordinates of view-space direction `r`.
+fn sphere_map_uv(r_view: vec3<f32>) -> vec2<f32> {
+    let r = normalize_or(r_view, vec3<f32>(0.0));
+    return clamp((r.xy + vec2<f32>(1.0)) * 0.5, vec2<f32>(0.0), vec2<f32>(1.0));
+}
+
+// water.rs `sphere_map_direction`: the view-space direction a seed 002 coordinate stands
+// for, on the far side (z ≤ 0); outside the unit disc, the rim.
+fn sphere_map_direction(uv: vec2<f32>) -> vec3<f32> {
+    let xy = 2.0 * uv - vec2<f32>(1.0);
+    let r2 = dot(xy, xy);
+    if (r2 >= 1.0) {
+        return normalize_or(vec3<f32>(xy, 0.0), vec3<f32>(0.0, 0.0, -1.0));
+    }
+    return vec3<f32>(xy, -sqrt(1.0 - r2));
+}
+
+// water_shading.rs `WaterReflection::sample`: radiance reflected along unit `dir`.
+fn water_reflection(dir: vec3<f32>) -> vec3<f32> {
+    if (water.reflection == WATER_REFLECTION_CUBE) {
+        return water_cube_sample(dir);
+    }
+    if (water.reflection == WATER_REFLECTION_SPHERE_MAP) {
+        let rows = water.eye_from_world;
+        let e = vec3<f32>(dot(rows[0].xyz, dir), dot(rows[1].xyz, dir), dot(rows[2].xyz, dir));
+        let back = sphere_map_direction(sphere_map_uv(e));
+        // eye_from_world transposed: the rows' combination.
+        let world = rows[0].xyz * back.x + rows[1].xyz * back.y + rows[2].xyz * back.z;
+        return sphere_map_sample(world);
+    }
+    return env_radiance(dir);
+}
+
+// water_shading.rs `WaterShading::radiance`: the exact Fresnel blend of the reflected
+// scene and the floor refracted through the water, at `p` with unit normal `n` (up) seen
+// along unit `v`; `footprint_m` is a pixel's width there.
+fn water_radiance(p: vec3<f32>, v: vec3<f32>, n: vec3<f32>, footprint_m: f32) -> vec3<f32> {
+    let ior = water.absorption_ior.w;
+    let c = dot(v, n);
+    var r: f32;
+    var reflected: vec3<f32>;
+    var transmitted = vec3<f32>(0.0);
+    if (c <= 0.0) {
+        // From the air: reflect the scene, refract onto the floor.
+        r = fresnel_reflectance(0u, -c);
+        let t = refract_or_none(v, n, 1.0 / ior);
+        if (t.w > 0.0) {
+            transmitted = water_floor(p, t.xyz, footprint_m);
+        }
+        reflected = water_reflection(v - n * (2.0 * c));
+    } else {
+        // From under the water: reflect the floor, refract the scene above; total
+        // internal reflection reflects everything.
+        let m = -n;
+        let t = refract_or_none(v, m, ior);
+        reflected = water_floor(p, v - m * (2.0 * dot(v, m)), footprint_m);
+        r = 1.0;
+        if (t.w > 0.0) {
+            r = fresnel_reflectance(1u, c);
+            transmitted = water_reflection(t.xyz);
+        }
+    }
+    return r * reflected + (1.0 - r) * transmitted;
+}
+
+// The water's position and normal at the pixel centre, perspective-correct (whether the
+// centre is covered or not). Times 1/w they are affine in screen space, so their
+// differences between neighbouring pixels give them anywhere in the pixel exactly, as
+// raster.rs `SetupTri::interpolate` does. (Screen-linear varyings would be affine too, but
+// a triangle clipped at the near plane gets them wrong on lavapipe.)
+struct WaterOut {
+    @builtin(position) position: vec4<f32>,
+    @location(0) @interpolate(perspective, center) world: vec3<f32>,
+    @location(1) @interpolate(perspective, center) normal: vec3<f32>,
+}
+
+@vertex
+fn vs_water(in: ObjectIn) -> WaterOut {
+    return WaterOut(clip_of(in.position), in.position, in.normal);
+}
+
+// Where passes/opaque.rs `OpaqueCtx::triangle` shades a pixel whose samples `covered` the
+// triangle covers, as an offset from the pixel centre: the centre when it covers them all,
+// else its first covered sample (the 4-sample pattern is the CPU's, injected; with 2, 8 or
+// 16 samples, the centre).
+fn water_shading_offset(covered: u32) -> vec2<f32> {
+    let full = (1u << scene.frame_samples) - 1u;
+    if (scene.frame_samples != 4u || (covered & full) == full) {
+        return vec2<f32>(0.0);
+    }
+    return SAMPLE_OFFSETS_4[min(firstTrailingBit(covered & full), 3u)];
+}
+
+// passes/opaque.rs `OpaqueCtx::shade_water`: a water pixel of the opaque pass.
+@fragment
+fn fs_water(in: WaterOut, @builtin(sample_mask) covered: u32) -> @location(0) vec4<f32> {
+    // Derivatives need uniform control flow, so they come first.
+    let centre_inv_w = 1.0 / dot(in.world - view.eye.xyz, view.forward.xyz);
+    let world_over_w = in.world * centre_inv_w;
+    let normal_over_w = in.normal * centre_inv_w;
+    let dw = array<vec3<f32>, 2>(dpdxFine(world_over_w), dpdyFine(world_over_w));
+    let dn = array<vec3<f32>, 2>(dpdxFine(normal_over_w), dpdyFine(normal_over_w));
+    let di = vec2<f32>(dpdxFine(centre_inv_w), dpdyFine(centre_inv_w));
+    let o = water_shading_offset(covered);
+    let inv_w = max(centre_inv_w + di.x * o.x + di.y * o.y, 1e-20);
+    let world = (world_over_w + dw[0] * o.x + dw[1] * o.y) / inv_w;
+    let normal = (normal_over_w + dn[0] * o.x + dn[1] * o.y) / inv_w;
+    let rel = world - view.eye.xyz;
+    let v = normalize_or(rel, view.forward.xyz);
+    let n = normalize_or(normal, vec3<f32>(0.0, 1.0, 0.0));
+    let footprint_m = length(rel) * view.tan_half_per_px.z;
+    return vec4<f32>(water_radiance(world, v, n, footprint_m), 1.0);
 }
 
 // ---- bubbles -----------------------------------------------------------------------------

@@ -7,6 +7,8 @@
 use glam::{Mat3, Vec3};
 
 use super::GpuError;
+use super::bytes::Bytes;
+use super::water_data::WaterData;
 use render_scene::bubble_order::{far_to_near, is_front_facing, reflection_rate};
 use render_scene::camera::View;
 use render_scene::ground_view::{GroundFilter, GroundView};
@@ -65,29 +67,6 @@ pub(super) struct CubeReads {
     pub filter: ReflectionFilter,
     /// Corrected for the ground's parallax, or from the centre.
     pub parallax: ReflectionParallax,
-}
-
-/// Little-endian bytes for a GPU buffer.
-#[derive(Debug, Default)]
-pub(super) struct Bytes(pub Vec<u8>);
-
-impl Bytes {
-    fn f32(&mut self, x: f32) -> &mut Self {
-        self.0.extend_from_slice(&x.to_le_bytes());
-        self
-    }
-
-    fn u32(&mut self, x: u32) -> &mut Self {
-        self.0.extend_from_slice(&x.to_le_bytes());
-        self
-    }
-
-    fn vec4(&mut self, xyz: [f32; 3], w: f32) -> &mut Self {
-        for x in xyz {
-            self.f32(x);
-        }
-        self.f32(w)
-    }
 }
 
 /// The WGSL `View` of `view`, with the ground plane's constants when it is drawn.
@@ -167,7 +146,8 @@ fn clip(poly: &[[f32; 2]], f: impl Fn([f32; 2]) -> f32) -> Vec<[f32; 2]> {
 pub(super) struct SceneData {
     /// The WGSL `Scene` uniform.
     pub scene: Vec<u8>,
-    /// `array<Material>`: the objects' materials, then the ground's.
+    /// `array<Material>`: the objects' materials, then the ground's, then the water
+    /// floor's.
     pub materials: Vec<u8>,
     /// `array<Light>`.
     pub lights: Vec<u8>,
@@ -181,6 +161,11 @@ pub(super) struct SceneData {
     pub bubbles: Vec<u8>,
     /// Vertex ranges of the bubble draws, in order: far to near, back faces then front.
     pub bubble_draws: Vec<std::ops::Range<u32>>,
+    /// Per bubble: its film field as (first texel, face size), `(0, 0)` without one (for
+    /// the bubble vertices of other views, [`bubble_vertices`]).
+    pub film_places: Vec<[u32; 2]>,
+    /// The water surface, when the scene has one.
+    pub water: Option<WaterData>,
     /// The LUT texture: `(width, height, Rgba32Float texels)`.
     pub luts: LutTexture,
     /// `array<LutInfo>`.
@@ -198,26 +183,19 @@ pub(super) struct SceneData {
     pub env_chain: Vec<u8>,
 }
 
-/// Why the wgpu backend cannot draw `what` (it draws the scenes the built-in scenes use).
+/// Why the wgpu backend cannot draw `what` on this device (an adapter limit, named).
 fn unsupported(what: impl Into<String>) -> GpuError {
     GpuError::Unsupported(what.into())
 }
 
-/// Refuses what the wgpu backend does not draw yet, naming it.
-pub(super) fn check_supported(scene: &RenderScene) -> Result<(), GpuError> {
-    if scene.water.is_some() {
-        return Err(unsupported("a water surface (the [water] section)"));
-    }
-    Ok(())
-}
-
 impl SceneData {
-    /// Packs `scene` for the main view `view` (bubbles sorted and split by side for its eye).
+    /// Packs `scene` for the main view `view` (bubbles sorted and split by side for its eye),
+    /// rendered with `frame_samples` samples a pixel.
     pub(super) fn new(
         scene: &RenderScene,
         tables: &FilmTables,
         settings: &RenderSettings,
-        view: &View,
+        (view, frame_samples): (&View, u32),
         max_texture_side: u32,
         reads: CubeReads,
     ) -> Result<SceneData, GpuError> {
@@ -228,6 +206,10 @@ impl SceneData {
         if let Some(g) = &scene.ground {
             materials.push(&g.material);
         }
+        let water = scene.water.as_ref().map(|w| {
+            materials.push(&w.floor);
+            WaterData::new(w, scene, &settings.reflection, materials.len() as u32 - 1)
+        });
         let mut object_bytes = Bytes::default();
         push_geometry(&mut object_bytes, &objects);
         let object_vertices = (object_bytes.0.len() as u64 / OBJECT_VERTEX_BYTES) as u32;
@@ -282,7 +264,7 @@ impl SceneData {
                 scene,
                 &settings.reflection,
                 reads,
-                [face_size, ground_material],
+                [face_size, ground_material, frame_samples],
                 env_image,
                 sphere,
                 tables,
@@ -294,6 +276,8 @@ impl SceneData {
             all_vertices,
             bubbles,
             bubble_draws,
+            film_places,
+            water,
             luts,
             lut_info,
             films,
@@ -346,7 +330,7 @@ fn scene_bytes(
     scene: &RenderScene,
     reflection: &ReflectionMode,
     reads: CubeReads,
-    [face_size, ground_material]: [u32; 2],
+    [face_size, ground_material, frame_samples]: [u32; 3],
     env_image: [u32; 4],
     sphere: Option<([u32; 4], Mat3)>,
     tables: &FilmTables,
@@ -397,7 +381,8 @@ fn scene_bytes(
     b.u32(ground_material).f32(height).u32(face_size).u32(0);
     // On exactly where the CPU corrects (renderer.rs `ground_height_m`).
     let parallax = proxy_ground_height_m(reads.parallax, reflection, scene).is_some();
-    b.u32(u32::from(parallax)).u32(0).u32(0).u32(0);
+    // The main view's sample count (the water's shading point in a partly covered pixel).
+    b.u32(u32::from(parallax)).u32(frame_samples).u32(0).u32(0);
     // The environment image: (first texel, width, height) of an equirect, (first texel,
     // face size) of cube faces.
     for w in env_image {
@@ -477,7 +462,7 @@ fn push_geometry(b: &mut Bytes, g: &Geometry) {
 /// to near, each bubble's back faces then its front faces; one draw range per side.
 ///
 /// `films[k]` is bubble `k`'s film field as (first texel, face size), `(0, 0)` without one.
-fn bubble_vertices(
+pub(super) fn bubble_vertices(
     scene: &RenderScene,
     view: &View,
     films: &[[u32; 2]],
@@ -667,15 +652,20 @@ mod tests {
         scene.bubbles[1].film = film(&shared);
         scene.bubbles[2].film = film(&other);
         scene.bubbles[3].film = film(&shared);
-        // The wgpu backend draws film fields: nothing refuses them.
-        check_supported(&scene).unwrap();
         let tables = FilmTables::from_reflectivity(
             render_scene::Lut::try_from_fn(4, 4, 1000.0, |_, _| [0.1; 3]).unwrap(),
         );
         let view = scene.camera.view(16, 16);
         // Rows of at most 50 texels: 6·4² + 6·3² = 150 texels, three rows.
-        let data =
-            SceneData::new(&scene, &tables, &settings, &view, 50, CubeReads::default()).unwrap();
+        let data = SceneData::new(
+            &scene,
+            &tables,
+            &settings,
+            (&view, 1),
+            50,
+            CubeReads::default(),
+        )
+        .unwrap();
         let (width, height, bytes) = &data.films;
         assert_eq!((*width, *height), (50, 3));
         let want: Vec<f32> = shared
@@ -711,8 +701,15 @@ mod tests {
         }
         assert_eq!(seen, [3; 4]);
         // Too tall for the device: named, never drawn otherwise.
-        let err = SceneData::new(&scene, &tables, &settings, &view, 10, CubeReads::default())
-            .unwrap_err();
+        let err = SceneData::new(
+            &scene,
+            &tables,
+            &settings,
+            (&view, 1),
+            10,
+            CubeReads::default(),
+        )
+        .unwrap_err();
         assert!(matches!(err, GpuError::Unsupported(_)), "{err:?}");
         assert!(
             err.to_string().contains("film fields of 150 texels"),
@@ -737,7 +734,6 @@ mod tests {
                 shininess: 1.0,
             },
         });
-        check_supported(&scene).unwrap();
         let lut = render_scene::Lut::try_from_fn(2, 2, 1000.0, |_, _| [0.1; 3]).unwrap();
         let tables = FilmTables::from_reflectivity(lut);
         let settings = RenderSettings::default();
@@ -747,7 +743,7 @@ mod tests {
                 &scene,
                 &tables,
                 &settings,
-                &view,
+                (&view, 1),
                 max_side,
                 CubeReads::default(),
             )

@@ -10,9 +10,12 @@ use super::scene_data::{
     PATTERN_TEXTURED, REFLECTION_CUBE, REFLECTION_CUBE_BILINEAR, REFLECTION_ENV_CUBE,
     REFLECTION_ENV_CUBE_BILINEAR, REFLECTION_ENVIRONMENT, REFLECTION_SPHERE_MAP,
 };
+use super::water_data::{
+    WATER_REFLECTION_CUBE, WATER_REFLECTION_ENVIRONMENT, WATER_REFLECTION_SPHERE_MAP,
+};
 use render_scene::shader_constants::{
-    ACES_DENOMINATOR, ACES_NUMERATOR, FACE_BASES, SCENE_SCALARS, SCENE_WORDS, TONE_MATRICES,
-    TONE_SCALARS,
+    ACES_DENOMINATOR, ACES_NUMERATOR, FACE_BASES, SAMPLE_OFFSETS_4_SIXTEENTHS, SCENE_SCALARS,
+    SCENE_WORDS, TONE_MATRICES, TONE_SCALARS,
 };
 
 /// The scene shader (`scene.wgsl`) with the shared constants in place.
@@ -95,10 +98,25 @@ fn scene_constants() -> String {
         ("REFLECTION_ENV_CUBE_BILINEAR", REFLECTION_ENV_CUBE_BILINEAR),
         ("REFLECTION_SPHERE_MAP", REFLECTION_SPHERE_MAP),
         ("NO_TABLE", NO_TABLE),
+        ("WATER_REFLECTION_CUBE", WATER_REFLECTION_CUBE),
+        ("WATER_REFLECTION_ENVIRONMENT", WATER_REFLECTION_ENVIRONMENT),
+        ("WATER_REFLECTION_SPHERE_MAP", WATER_REFLECTION_SPHERE_MAP),
     ];
     for (name, value) in SCENE_WORDS.into_iter().chain(packing_words) {
         out += &format!("const {name}: u32 = {value}u;\n");
     }
+    // The 4-sample pattern's offsets from the pixel centre, in pixels.
+    let offsets: Vec<String> = SAMPLE_OFFSETS_4_SIXTEENTHS
+        .iter()
+        .map(|&(x, y)| {
+            let px = |s: i64| float(s as f32 / 16.0);
+            format!("vec2<f32>({}, {})", px(x), px(y))
+        })
+        .collect();
+    out += &format!(
+        "const SAMPLE_OFFSETS_4 = array<vec2<f32>, 4>({});\n",
+        offsets.join(", ")
+    );
     // cubemap.rs `FACE_BASES`: major, s and t axes of each face.
     for (name, pick) in [("FACE_MAJOR", 0usize), ("FACE_S", 1), ("FACE_T", 2)] {
         let axes: Vec<String> = FACE_BASES
