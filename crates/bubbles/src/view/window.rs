@@ -18,8 +18,9 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 use winit::application::ApplicationHandler;
 use winit::dpi::{PhysicalPosition, PhysicalSize};
-use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event::{ElementState, KeyEvent, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::PhysicalKey;
 use winit::window::{Window, WindowId};
 
 /// Solver steps allowed per displayed frame; beyond it the simulation runs in slow
@@ -109,6 +110,8 @@ struct App {
     backend: Backend,
     /// Why the wgpu presenter could not open, shown at the top of the overlay.
     fallback: Option<String>,
+    /// Keys pressed and not yet released.
+    held_keys: std::collections::HashSet<PhysicalKey>,
     quit_after: Option<QuitAfter>,
 }
 
@@ -138,6 +141,7 @@ impl App {
             error: None,
             backend,
             fallback: None,
+            held_keys: Default::default(),
             quit_after: args.quit_after_s.map(|after_s| QuitAfter {
                 after_s,
                 first: None,
@@ -402,6 +406,24 @@ impl App {
         event_loop.exit();
     }
 
+    /// A key press becomes an input once: a toggle ignores auto-repeat and a second press
+    /// of a key still held. Under Xvfb, winit sometimes reports one press of a
+    /// character key twice before its release, which flipped the overlay back off.
+    fn keyboard(&mut self, event_loop: &ActiveEventLoop, event: &KeyEvent) {
+        let held = match event.state {
+            ElementState::Pressed => !self.held_keys.insert(event.physical_key),
+            ElementState::Released => {
+                self.held_keys.remove(&event.physical_key);
+                return;
+            }
+        };
+        if let Some(key) = map_key(&event.logical_key)
+            && (key.repeats() || !(event.repeat || held))
+        {
+            self.input(event_loop, Input::Key(key));
+        }
+    }
+
     fn overlay_text(&mut self, iw: usize, ih: usize) -> Option<String> {
         let now = Instant::now();
         self.events.retain(|(_, at)| now - *at < EVENT_LIFETIME);
@@ -518,13 +540,9 @@ impl ApplicationHandler for App {
                 Ok(()) => self.count_frame(event_loop),
                 Err(err) => self.fail(event_loop, err),
             },
-            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
-                if let Some(key) = map_key(&event.logical_key)
-                    && (!event.repeat || key.repeats())
-                {
-                    self.input(event_loop, Input::Key(key));
-                }
-            }
+            WindowEvent::KeyboardInput { event, .. } => self.keyboard(event_loop, &event),
+            // A release that happens elsewhere never arrives: forget what was held.
+            WindowEvent::Focused(false) => self.held_keys.clear(),
             WindowEvent::ModifiersChanged(m) => self.pointer.shift = m.state().shift_key(),
             WindowEvent::MouseInput { state, button, .. } => {
                 self.mouse_button(event_loop, state, button)
