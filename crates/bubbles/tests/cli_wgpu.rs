@@ -408,6 +408,37 @@ fn cube_face_environment_through_wgpu_matches_the_cpu_backend_in_ciede2000() {
     }
 }
 
+/// A scene of a ground (`ground` adds to its section), one object (`object`, its
+/// placement) wearing `tex.png`, and a 500 nm bubble beside it whose cube map shows both.
+fn beside_a_bubble(ground: &str, object: &str) -> String {
+    format!(
+        r#"[camera]
+eye_m = [0.0, 0.12, 0.3]
+target_m = [0.0, 0.05, 0.0]
+vfov_deg = 60.0
+
+[ground]
+height_m = 0.0
+{ground}
+
+[[objects]]
+{object}
+material = {{ kind = "image", path = "tex.png", scale_m = 1.0 }}
+
+[[bubbles]]
+center_m = [0.06, 0.06, 0.02]
+radius_m = 0.05
+mean_thickness_nm = 500.0
+subdivisions = 3
+seed = 1
+
+[film]
+n_film = 1.33
+illuminant = "d65"
+"#
+    )
+}
+
 /// Textured materials (issue 24): the ground repeats an image every `scale_m` along x and
 /// z, a sphere wears it by its mesh UVs, as `ground_albedo` and `object_albedo` read it;
 /// the bubble's dynamic cube map shows both. The image varies along both axes, so a
@@ -423,32 +454,12 @@ fn textured_materials_through_wgpu_match_the_cpu_backend_in_ciede2000() {
             (220 - 6 * x - 5 * y) as u8,
         ]
     });
-    let scene = r#"[camera]
-eye_m = [0.0, 0.12, 0.3]
-target_m = [0.0, 0.05, 0.0]
-vfov_deg = 60.0
-
-[ground]
-height_m = 0.0
-material = { kind = "image", path = "tex.png", scale_m = 0.07 }
-
-[[objects]]
-kind = "sphere"
+    let scene = beside_a_bubble(
+        r#"material = { kind = "image", path = "tex.png", scale_m = 0.07 }"#,
+        r#"kind = "sphere"
 center_m = [-0.06, 0.05, -0.05]
-radius_m = 0.05
-material = { kind = "image", path = "tex.png", scale_m = 1.0 }
-
-[[bubbles]]
-center_m = [0.06, 0.06, 0.02]
-radius_m = 0.05
-mean_thickness_nm = 500.0
-subdivisions = 3
-seed = 1
-
-[film]
-n_film = 1.33
-illuminant = "d65"
-"#;
+radius_m = 0.05"#,
+    );
     std::fs::write(dir.path().join("textured.toml"), scene).unwrap();
     let Some(measured) = scene_file_against_cpu("textured.toml", dir.path(), 128, &[]) else {
         return;
@@ -474,32 +485,13 @@ fn obj_mesh_objects_through_wgpu_match_the_cpu_backend_in_ciede2000() {
                f 1/1 3/3 5/5\nf 3/3 2/2 5/5\nf 2/2 4/4 5/5\nf 4/4 1/1 5/5\n\
                f 3/3 1/1 6/6\nf 2/2 3/3 6/6\nf 4/4 2/2 6/6\nf 1/1 4/4 6/6\n";
     std::fs::write(dir.path().join("octa.obj"), obj).unwrap();
-    let scene = r#"[camera]
-eye_m = [0.0, 0.12, 0.3]
-target_m = [0.0, 0.05, 0.0]
-vfov_deg = 60.0
-
-[ground]
-height_m = 0.0
-
-[[objects]]
-kind = "mesh"
+    let scene = beside_a_bubble(
+        "",
+        r#"kind = "mesh"
 path = "octa.obj"
 offset_m = [-0.06, 0.05, -0.04]
-scale = 0.05
-material = { kind = "image", path = "tex.png", scale_m = 1.0 }
-
-[[bubbles]]
-center_m = [0.06, 0.06, 0.02]
-radius_m = 0.05
-mean_thickness_nm = 500.0
-subdivisions = 3
-seed = 1
-
-[film]
-n_film = 1.33
-illuminant = "d65"
-"#;
+scale = 0.05"#,
+    );
     std::fs::write(dir.path().join("obj.toml"), scene).unwrap();
     let Some(measured) = scene_file_against_cpu("obj.toml", dir.path(), 128, &[]) else {
         return;

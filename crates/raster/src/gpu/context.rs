@@ -28,6 +28,22 @@ pub struct Gpu {
 }
 
 impl Gpu {
+    /// A buffer holding `contents`, for `usage`.
+    pub(super) fn buffer(
+        &self,
+        label: &str,
+        contents: &[u8],
+        usage: wgpu::BufferUsages,
+    ) -> wgpu::Buffer {
+        use wgpu::util::DeviceExt;
+        self.device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+    }
+
     /// Opens the first suitable adapter (Vulkan first) and compiles the pipelines.
     pub fn new(options: GpuOptions) -> Result<Gpu, GpuError> {
         Gpu::open(&instance(), options, None)

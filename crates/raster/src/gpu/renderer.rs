@@ -231,13 +231,7 @@ impl GpuRenderer {
         let (view_buffer, ground, ground_draws) = self.view_buffers(scene, &views, grounded);
         let water = self.water_draw(scene, &data, &water_views, m);
         let device = &self.gpu.device;
-        let buffer = |label, contents: &[u8], usage| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage,
-            })
-        };
+        let buffer = |label, contents: &[u8], usage| self.gpu.buffer(label, contents, usage);
         let scene_uniform = buffer("scene", &data.scene, wgpu::BufferUsages::UNIFORM);
         let materials = buffer("materials", &data.materials, wgpu::BufferUsages::STORAGE);
         let lights = buffer("lights", &data.lights, wgpu::BufferUsages::STORAGE);
@@ -451,11 +445,9 @@ impl GpuRenderer {
                     0,
                 ];
                 let bytes: Vec<u8> = step.iter().flat_map(|x| x.to_le_bytes()).collect();
-                let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("mip step"),
-                    contents: &bytes,
-                    usage: wgpu::BufferUsages::UNIFORM,
-                });
+                let uniform = self
+                    .gpu
+                    .buffer("mip step", &bytes, wgpu::BufferUsages::UNIFORM);
                 device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("cube mips"),
                     layout: &self.layouts.mip,
@@ -503,13 +495,7 @@ impl GpuRenderer {
         };
         let cube = self.texture("water cube", key, hdr_texture);
         let device = &self.gpu.device;
-        let buffer = |label, contents: &[u8], usage| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage,
-            })
-        };
+        let buffer = |label, contents: &[u8], usage| self.gpu.buffer(label, contents, usage);
         let uniform = buffer("water", &water.uniform, wgpu::BufferUsages::UNIFORM);
         let fresnel = buffer("fresnel", &water.fresnel, wgpu::BufferUsages::STORAGE);
         let cube_view = cube.create_view(&wgpu::TextureViewDescriptor {
@@ -663,15 +649,7 @@ impl GpuRenderer {
         }
         // A vertex buffer may not be empty.
         ground_bytes.resize(ground_bytes.len().max(12), 0);
-        let buffer = |label, contents: &[u8], usage| {
-            self.gpu
-                .device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents,
-                    usage,
-                })
-        };
+        let buffer = |label, contents: &[u8], usage| self.gpu.buffer(label, contents, usage);
         (
             buffer("views", &bytes, wgpu::BufferUsages::UNIFORM),
             buffer("ground", &ground_bytes, wgpu::BufferUsages::VERTEX),
