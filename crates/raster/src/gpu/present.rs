@@ -9,6 +9,7 @@
 
 use std::time::Instant;
 
+use super::renderer::bind;
 use super::shader_source::present_wgsl;
 use super::{Gpu, GpuError, GpuOptions, GpuRenderer};
 use render_scene::{FilmTables, FrameTimings, RenderScene, RenderSettings, ToneMap};
@@ -205,12 +206,12 @@ impl WindowSurface {
             label: Some("present"),
             layout: &self.layout,
             entries: &[
-                entry(
+                bind(
                     0,
                     wgpu::BindingResource::TextureView(&hdr.create_view(&Default::default())),
                 ),
-                entry(1, wgpu::BindingResource::TextureView(&overlay_view)),
-                entry(2, self.params.as_entire_binding()),
+                bind(1, wgpu::BindingResource::TextureView(&overlay_view)),
+                bind(2, self.params.as_entire_binding()),
             ],
         });
         let view = target.texture.create_view(&Default::default());
@@ -386,8 +387,4 @@ fn overlay_texture(device: &wgpu::Device, (width, height): (u32, u32)) -> wgpu::
         usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     })
-}
-
-fn entry(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {
-    wgpu::BindGroupEntry { binding, resource }
 }

@@ -334,12 +334,7 @@ impl GpuRenderer {
         let single = self.pipelines_for(1);
         let face_depth = face_depth.create_view(&Default::default());
         for (k, _) in face_views.iter().enumerate() {
-            let layer = cubes.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2),
-                base_array_layer: k as u32,
-                array_layer_count: Some(1),
-                ..Default::default()
-            });
+            let layer = array_layer(&cubes, k);
             let target = Target {
                 color: &layer,
                 resolve: None,
@@ -566,12 +561,7 @@ impl GpuRenderer {
         let single = self.pipelines_for(1);
         let p = &self.pipelines[single];
         for face in 0..6 {
-            let layer = cube.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2),
-                base_array_layer: face as u32,
-                array_layer_count: Some(1),
-                ..Default::default()
-            });
+            let layer = array_layer(cube, face);
             let target = Target {
                 color: &layer,
                 resolve: None,
@@ -798,7 +788,18 @@ fn draw_opaque(
     }
 }
 
-fn bind(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {
+/// Layer `k` of a 2-D array texture as a plain 2-D render target.
+fn array_layer(texture: &wgpu::Texture, k: usize) -> wgpu::TextureView {
+    texture.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2),
+        base_array_layer: k as u32,
+        array_layer_count: Some(1),
+        ..Default::default()
+    })
+}
+
+/// Bind-group entry `binding` holding `resource`.
+pub(super) fn bind(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {
     wgpu::BindGroupEntry { binding, resource }
 }
 

@@ -1,5 +1,6 @@
 //! The last pass: linear HDR frame → tone-mapped 8-bit sRGB, read back to the CPU.
 
+use super::renderer::bind;
 use super::shader_source::tonemap_wgsl;
 use super::{Gpu, GpuError};
 use render_scene::{Frame, ToneMap};
@@ -99,15 +100,15 @@ impl Gpu {
             label: Some("tonemap"),
             layout: &self.tone_map.layout,
             entries: &[
-                entry(
+                bind(
                     0,
                     wgpu::BindingResource::TextureView(&hdr.create_view(&Default::default())),
                 ),
-                entry(
+                bind(
                     1,
                     wgpu::BindingResource::TextureView(&ldr.create_view(&Default::default())),
                 ),
-                entry(2, params.as_entire_binding()),
+                bind(2, params.as_entire_binding()),
             ],
         });
         let mut encoder = self.device.create_command_encoder(&Default::default());
@@ -226,8 +227,4 @@ impl Gpu {
             .get_mapped_range(..)
             .map_err(|e| GpuError::Readback(e.to_string()))
     }
-}
-
-fn entry(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {
-    wgpu::BindGroupEntry { binding, resource }
 }
