@@ -16,14 +16,7 @@ fn bubbles() -> Command {
 
 #[test]
 fn without_a_display_view_exits_2_naming_the_variables() {
-    let out = bubbles()
-        .args(["view", "paper"])
-        .env_remove("DISPLAY")
-        .env_remove("WAYLAND_DISPLAY")
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(2), "{out:?}");
-    let err = String::from_utf8_lossy(&out.stderr);
+    let err = view_without_a_display_exits_2(&[]);
     assert!(
         err.contains("DISPLAY") && err.contains("WAYLAND_DISPLAY"),
         "{err}"
@@ -163,15 +156,22 @@ fn wgpu_view_without_a_driver_falls_back_to_the_cpu_and_says_so() {
 #[cfg(not(feature = "wgpu"))]
 #[test]
 fn without_the_wgpu_feature_backend_wgpu_exits_2_saying_how_to_build_it() {
+    let err = view_without_a_display_exits_2(&["--backend", "wgpu"]);
+    assert!(err.contains("--features wgpu"), "{err}");
+}
+
+/// `bubbles view paper` with `args` and no display variables: it must exit 2; returns
+/// its stderr.
+fn view_without_a_display_exits_2(args: &[&str]) -> String {
     let out = bubbles()
-        .args(["view", "paper", "--backend", "wgpu"])
+        .args(["view", "paper"])
+        .args(args)
         .env_remove("DISPLAY")
         .env_remove("WAYLAND_DISPLAY")
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2), "{out:?}");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("--features wgpu"), "{err}");
+    String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
 /// Runs `bubbles view paper` with `args` and `env` under a fresh Xvfb, drives it with real

@@ -56,7 +56,6 @@ impl GpuPresenter {
         job: &mut FrameJob,
         overlay: Option<&str>,
     ) -> Result<FrameTimings, CliError> {
-        let origin = job.origin();
         let inputs = job.frame_inputs();
         let gpu = self.renderer.gpu();
         note_sample_count(gpu, inputs.2.samples, &mut self.said_samples);
@@ -66,18 +65,15 @@ impl GpuPresenter {
             size: (*w as u32, *h as u32),
             origin: (OVERLAY_AT.0 as u32, OVERLAY_AT.1 as u32),
         });
-        self.renderer
-            .present(inputs, &mut self.surface, overlay)
-            .map_err(|e| frame_error(&origin, e))
+        let presented = self.renderer.present(inputs, &mut self.surface, overlay);
+        presented.map_err(|e| frame_error(&job.origin(), e))
     }
 
     /// The job's current state rendered on the GPU and read back (for screenshots).
     pub(super) fn frame(&mut self, job: &mut FrameJob) -> Result<&Frame, CliError> {
-        let origin = job.origin();
         let (scene, tables, settings) = job.frame_inputs();
-        self.renderer
-            .render(scene, tables, settings)
-            .map_err(|e| frame_error(&origin, e))
+        let rendered = self.renderer.render(scene, tables, settings);
+        rendered.map_err(|e| frame_error(&job.origin(), e))
     }
 }
 
