@@ -98,8 +98,11 @@ impl StackGrid {
             .map(|&angle| {
                 let incidence = Incidence::try_from_angle_deg(angle)?;
                 Ok(match &media {
-                    Some(media) if incidence.cos() > 0.0 => real(stack, media, incidence)
-                        .unwrap_or_else(|| folded(stack, media, incidence)),
+                    Some(media) if incidence.cos() > 0.0 => {
+                        let q = normal_indices(stack, media, incidence);
+                        real(stack, media, &q)
+                            .unwrap_or_else(|| folded(stack, media, &q, incidence))
+                    }
                     _ => AngleRow::General(incidence),
                 })
             })
@@ -305,43 +308,46 @@ fn constant_media(stack: &Stack) -> Option<Vec<Complex64>> {
     Some(media)
 }
 
+/// Each medium's `q = n cos θ` at `incidence`, front to back.
+fn normal_indices(stack: &Stack, media: &[Complex64], incidence: Incidence) -> Vec<Complex64> {
+    (media.iter())
+        .map(|&n| incidence.normal_index(stack.n_incident, n))
+        .collect()
+}
+
+/// A medium's admittances for s and p: `q` and `q / n²` (the p solve works with `H_y`).
+fn admittances(n: Complex64, q: Complex64) -> [Complex64; 2] {
+    [q, q / (n * n)]
+}
+
 /// The real kernel's terms at one angle, when every medium is real and every
-/// `q = n cos θ` real and positive there (no absorption, no evanescence).
-fn real(stack: &Stack, media: &[Complex64], incidence: Incidence) -> Option<AngleRow> {
-    let n0 = stack.n_incident;
-    let mut y = Vec::with_capacity(media.len());
-    for &n in media {
-        let q = incidence.normal_index(n0, n);
-        if n.im != 0.0 || q.im != 0.0 || q.re <= 0.0 {
-            return None;
-        }
-        // Admittances as in `folded`: `q` for s, `q / n²` for p.
-        y.push((q.re, [q.re, q.re / (n.re * n.re)]));
+/// `q = n cos θ` (`q`, front to back) real and positive there (no absorption, no
+/// evanescence).
+fn real(stack: &Stack, media: &[Complex64], q: &[Complex64]) -> Option<AngleRow> {
+    if !(media.iter().zip(q)).all(|(n, q)| n.im == 0.0 && q.im == 0.0 && q.re > 0.0) {
+        return None;
     }
+    // `admittances` in real arithmetic.
+    let y = |m: usize| [q[m].re, q[m].re / (media[m].re * media[m].re)];
     let last = media.len() - 1;
     let layers = (1..last)
         .rev()
         .map(|m| RealLayer {
-            beta_nm: std::f64::consts::TAU * stack.layers[m - 1].thickness_nm * y[m].0,
-            y: y[m].1,
+            beta_nm: std::f64::consts::TAU * stack.layers[m - 1].thickness_nm * q[m].re,
+            y: y(m),
         })
         .collect();
     Some(AngleRow::Real {
         layers,
-        y_incident: y[0].1,
-        y_substrate: y[last].1,
+        y_incident: y(0),
+        y_substrate: y(last),
     })
 }
 
-/// The kernel's terms at one angle with `cos θ > 0`.
-fn folded(stack: &Stack, media: &[Complex64], incidence: Incidence) -> AngleRow {
-    let n0 = stack.n_incident;
-    let q: Vec<Complex64> = media
-        .iter()
-        .map(|&n| incidence.normal_index(n0, n))
-        .collect();
-    // Admittances: `q` for s, `q / n²` for p (the p solve works with `H_y`).
-    let y = |m: usize| [q[m], q[m] / (media[m] * media[m])];
+/// The kernel's terms at one angle with `cos θ > 0`, where the media have the normal
+/// indices `q`.
+fn folded(stack: &Stack, media: &[Complex64], q: &[Complex64], incidence: Incidence) -> AngleRow {
+    let y = |m: usize| admittances(media[m], q[m]);
     let interface = |m: usize| {
         let (front, back) = (y(m), y(m + 1));
         [0, 1].map(|p| Coeffs {
