@@ -16,6 +16,7 @@ use glam::DVec3;
 
 use super::advect::{AdvectionGeometry, AdvectionScratch, advect_momentum};
 use super::burst::{BurstParams, BurstState, Hole};
+use super::capillary::{Capillary, CapillaryScratch, smooth_thickness};
 use super::grid::CubeSphere;
 use super::solve::{Hierarchy, SolveLimits, SolveReport, Work};
 
@@ -128,6 +129,7 @@ struct Scratch {
     gradient: Vec<DVec3>,
     drag: Vec<f64>,
     advect: AdvectionScratch,
+    capillary: CapillaryScratch,
 }
 
 impl FilmFlow {
@@ -276,6 +278,7 @@ impl FilmFlow {
         self.air_shear(&mut s, dt_s, forcing.air_m_per_s);
         let report = self.marangoni_implicit(&mut s, dt_s);
         self.transport_thickness(&mut s, dt_s, forcing.g_eff_m_per_s2);
+        self.capillary_smoothing(&mut s, dt_s);
         let evaporated = self.params.evaporation_nm_per_s * 1e-9 * dt_s;
         if evaporated > 0.0 {
             self.h_m
@@ -506,6 +509,23 @@ impl FilmFlow {
             apply_fluxes(&g, flux, dt_s / r, &mut self.gamma);
         }
         report
+    }
+
+    /// The capillary pressure's flow relative to the surfaces (module `capillary`); none
+    /// without drainage (immobile liquid between the surfaces).
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
+    fn capillary_smoothing(&mut self, s: &mut Scratch, dt_s: f64) {
+        let p = &self.params;
+        let mu = p.drainage_viscosity_pa_s;
+        if !(mu.is_finite() && mu > 0.0 && p.burst.sigma_n_per_m > 0.0) {
+            return;
+        }
+        let c = Capillary {
+            sigma_n_per_m: p.burst.sigma_n_per_m,
+            drainage_viscosity_pa_s: mu,
+            radius_m: p.radius_m,
+        };
+        smooth_thickness(&self.grid, c, dt_s, &mut self.h_m, &mut s.capillary);
     }
 
     /// Moves Γ upwind with the step's starting velocity, in sub-steps of per-edge Courant

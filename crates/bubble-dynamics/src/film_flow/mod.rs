@@ -4,6 +4,7 @@
 
 mod advect;
 mod burst;
+mod capillary;
 mod cell_map;
 mod flow;
 pub mod grid;
