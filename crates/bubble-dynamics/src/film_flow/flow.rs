@@ -22,7 +22,7 @@ use super::solve::{Hierarchy, SolveLimits, SolveReport, Work};
 /// film keeps a finite (if huge) stiffness.
 const H_FLOOR_M: f64 = 1e-9;
 /// Largest fraction of a cell's content that may leave it in one transport sub-step.
-const MAX_OUTFLOW_FRACTION: f64 = 0.5;
+pub(super) const MAX_OUTFLOW_FRACTION: f64 = 0.5;
 /// Residual of the Marangoni solve relative to its warm start's (the previous step's
 /// surfactant): the step's change to 6 digits. The velocity takes the gradient of this
 /// solution, so an inexact one is an inexact backward-Euler step: at 1e-4 the swirl film
@@ -110,20 +110,23 @@ pub struct FilmFlow {
     scratch: Scratch,
 }
 
+/// Buffers a step reuses from step to step (no allocation once the first has run).
 #[derive(Clone, Debug, Default)]
-struct Scratch {
+pub(super) struct Scratch {
     work: Work,
-    edge: Vec<f64>,
-    edge2: Vec<f64>,
-    cell: Vec<f64>,
+    pub(super) edge: Vec<f64>,
+    pub(super) edge2: Vec<f64>,
+    pub(super) cell: Vec<f64>,
     cell2: Vec<f64>,
     vertex: Vec<f64>,
     weight: Vec<f64>,
     u_start: Vec<f64>,
     stiffness: Vec<f64>,
     guess: Vec<f64>,
-    gradient: Vec<DVec3>,
+    pub(super) gradient: Vec<DVec3>,
     drag: Vec<f64>,
+    /// Per edge: the drainage speed's coefficient over `h²`, s⁻¹·m⁻¹.
+    pub(super) drain_rate: Vec<f64>,
 }
 
 impl FilmFlow {
@@ -510,101 +513,6 @@ impl FilmFlow {
             apply_fluxes(&g, flux, dt_s / r, &mut self.gamma);
         }
         report
-    }
-
-    /// Moves liquid with the surfaces (upwind) and by the drainage flux relative to them,
-    /// in sub-steps that keep each cell's outflow below half its content.
-    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
-    fn transport_thickness(&mut self, s: &mut Scratch, dt_s: f64, g_eff: DVec3) {
-        let p = self.params;
-        let r = p.radius_m;
-        let g = std::sync::Arc::clone(&self.grid);
-        let drain = if p.drainage_viscosity_pa_s.is_finite() && p.drainage_viscosity_pa_s > 0.0 {
-            p.density_kg_per_m3 / (3.0 * p.drainage_viscosity_pa_s)
-        } else {
-            0.0
-        };
-        // Speed of every edge: the surfaces' plus the drainage's (ρ g_t h²/(3μ)).
-        let ea = g.edge_arrays();
-        s.edge.resize(ea.cells.len(), 0.0);
-        self.edge_speeds(&mut s.edge, drain, g_eff);
-        let courant = ea
-            .cells
-            .iter()
-            .zip(&ea.length)
-            .zip(s.edge.iter())
-            .map(|(([a, b], l), v)| {
-                let a = g.areas_sr()[*a as usize].min(g.areas_sr()[*b as usize]);
-                v.abs() * dt_s * l / (a * r)
-            })
-            .fold(0.0, f64::max);
-        // A cell drains through at most two edges of a smooth flow: 2·courant per step, kept
-        // within one sub-step's content; the outflow limit guards the rest.
-        let substeps = (2.0 * courant).ceil().clamp(1.0, 64.0) as u32;
-        let h_dt = dt_s / f64::from(substeps);
-        for k in 0..substeps {
-            if k > 0 {
-                self.edge_speeds(&mut s.edge, drain, g_eff);
-            }
-            self.upwind_substep(s, h_dt);
-        }
-    }
-
-    /// Each edge's transport speed: the surfaces' `u` plus the drainage `c·h_up²` with
-    /// `c = drain·g_eff·n`, the upwind cell chosen by the sign of the speed at the mean
-    /// thickness.
-    fn edge_speeds(&self, speed: &mut [f64], drain: f64, g_eff: DVec3) {
-        let ea = self.grid.edge_arrays();
-        let edges = ea.cells.iter().zip(&ea.normal);
-        for ((v, &u), ([a, b], normal)) in speed.iter_mut().zip(&self.u_m_per_s).zip(edges) {
-            let c = drain * g_eff.dot(*normal);
-            let (ha, hb) = (self.h_m[*a as usize], self.h_m[*b as usize]);
-            let mean = 0.5 * (ha + hb);
-            let h = if u + c * mean * mean >= 0.0 { ha } else { hb };
-            *v = u + c * h * h;
-        }
-    }
-
-    /// One transport of `h` with the edge speeds in `s.edge`: second-order upwind (the
-    /// upwind cell's Green–Gauss gradient carried to the edge midpoint, clamped between
-    /// the two cells' values so no new extremum appears), outflow-limited.
-    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
-    fn upwind_substep(&mut self, s: &mut Scratch, dt_s: f64) {
-        let r = self.params.radius_m;
-        let g = &self.grid;
-        let areas = g.areas_sr();
-        // Cell gradients of h on the unit sphere, per radian.
-        s.gradient.clear();
-        s.gradient.resize(g.cells(), DVec3::ZERO);
-        let ea = g.edge_arrays();
-        for (([a, b], normal), l) in ea.cells.iter().zip(&ea.normal).zip(&ea.length) {
-            let (a, b) = (*a as usize, *b as usize);
-            let flux = *normal * (0.5 * (self.h_m[a] + self.h_m[b]) * l);
-            s.gradient[a] += flux;
-            s.gradient[b] -= flux;
-        }
-        for ((grad, a), c) in s.gradient.iter_mut().zip(areas).zip(g.centres()) {
-            *grad /= *a;
-            *grad -= *c * grad.dot(*c);
-        }
-        let (speed, volume) = (&s.edge, &mut s.edge2);
-        volume.clear();
-        // Volume across each edge over the step, per R² (m × sr).
-        let edges = ea.cells.iter().zip(&ea.reach).zip(&ea.length);
-        for (&v, (([a, b], reach), l)) in speed.iter().zip(edges) {
-            let (up, down, to_edge) = if v >= 0.0 {
-                (*a, *b, reach[0])
-            } else {
-                (*b, *a, reach[1])
-            };
-            let (up, down) = (up as usize, down as usize);
-            let (h_up, h_down) = (self.h_m[up], self.h_m[down]);
-            let reach = s.gradient[up].dot(to_edge);
-            let h_face = (h_up + reach).clamp(h_up.min(h_down), h_up.max(h_down));
-            volume.push(h_face * v * l * dt_s / r);
-        }
-        limit_outflow(g, volume, 1.0, &self.h_m, &mut s.cell);
-        apply_fluxes(g, volume, 1.0, &mut self.h_m);
     }
 }
 

@@ -8,6 +8,7 @@ mod flow;
 pub mod grid;
 pub(crate) mod on_bubble;
 pub mod solve;
+mod transport;
 
 pub use burst::{BLACK_RELAX_S, BurstParams, Hole, RIM_CELLS_PER_SUBSTEP};
 pub use cell_map::CellMap;
