@@ -9,14 +9,16 @@
 //! `E_f = dT/d ln A`), the thin viscous sheet's stress `ν(−∇×∇×u + 2Ku + 4∇∇·u)`, and the
 //! air's shear. The Marangoni term is the stiff one (waves at `√(E_f/(ρh))`, 10 m/s on a
 //! 500 nm film): it is taken backward-Euler, which leaves one linear system per step (see
-//! `solve`), and is then stable for any step. Viscosity is explicit, sub-stepped under
-//! its bound; transport is upwind under a Courant bound of 1/2 an edge.
+//! `solve`), and is then stable for any step. Viscosity is explicit, under
+//! its bound in the stages of a Runge–Kutta–Legendre step (`viscosity`); transport is
+//! upwind under a Courant bound of 1/2 an edge (`transport`).
 
 use glam::DVec3;
 
 use super::burst::{BurstParams, BurstState, Hole};
 use super::grid::CubeSphere;
 use super::solve::{Hierarchy, SolveLimits, SolveReport, Work};
+use super::viscosity::viscous_bound;
 
 /// Thickness floor of the Marangoni coefficient `E_f/(ρh)`, m: a hole or a Newton black
 /// film keeps a finite (if huge) stiffness.
@@ -100,7 +102,7 @@ pub struct FilmFlow {
     pub(crate) params: FlowParams,
     pub(super) burst: Option<Box<BurstState>>,
     /// The viscous operator's Gershgorin bound per unit ν/R², fixed by the grid.
-    viscous_bound: f64,
+    pub(super) viscous_bound: f64,
     pub(crate) h_m: Vec<f64>,
     pub(crate) gamma: Vec<f64>,
     pub(crate) u_m_per_s: Vec<f64>,
@@ -118,7 +120,7 @@ pub(super) struct Scratch {
     pub(super) edge2: Vec<f64>,
     pub(super) cell: Vec<f64>,
     cell2: Vec<f64>,
-    vertex: Vec<f64>,
+    pub(super) vertex: Vec<f64>,
     weight: Vec<f64>,
     u_start: Vec<f64>,
     stiffness: Vec<f64>,
@@ -127,6 +129,8 @@ pub(super) struct Scratch {
     drag: Vec<f64>,
     /// Per edge: the drainage speed's coefficient over `h²`, s⁻¹·m⁻¹.
     pub(super) drain_rate: Vec<f64>,
+    /// The viscous step's stage before the one under way, m/s per edge.
+    pub(super) stage: Vec<f64>,
 }
 
 impl FilmFlow {
@@ -301,52 +305,7 @@ impl FilmFlow {
         }
         let nu = self.params.viscosity_pa_s / self.params.density_kg_per_m3;
         if nu > 0.0 {
-            let substeps = (dt_s * self.viscous_rate_bound(nu) / 1.5).ceil().max(1.0);
-            for _ in 0..substeps as u32 {
-                self.viscous_substep(s, nu, dt_s / substeps);
-            }
-        }
-    }
-
-    /// An upper bound of the viscous operator's eigenvalues (Gershgorin), 1/s.
-    fn viscous_rate_bound(&self, nu: f64) -> f64 {
-        let r = self.params.radius_m;
-        self.viscous_bound * nu / (r * r)
-    }
-
-    /// One explicit step of the sheet's viscous stress over `dt_s`.
-    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
-    fn viscous_substep(&mut self, s: &mut Scratch, nu: f64, dt_s: f64) {
-        let r = self.params.radius_m;
-        let g = &self.grid;
-        let vorticity = &mut s.vertex;
-        vorticity.clear();
-        vorticity.resize(g.vertex_areas_sr().len(), 0.0);
-        let divergence = &mut s.cell;
-        divergence.clear();
-        divergence.resize(g.cells(), 0.0);
-        let ea = g.edge_arrays();
-        let lengths = ea.length.iter().zip(&ea.dual_length);
-        let ends = ea.cells.iter().zip(&ea.vertices);
-        for ((&u, (l, d)), ([a, b], [v0, v1])) in self.u_m_per_s.iter().zip(lengths).zip(ends) {
-            vorticity[*v1 as usize] += u * d;
-            vorticity[*v0 as usize] -= u * d;
-            divergence[*a as usize] += u * l;
-            divergence[*b as usize] -= u * l;
-        }
-        for (z, a) in vorticity.iter_mut().zip(g.vertex_areas_sr()) {
-            *z /= a * r;
-        }
-        for (d, a) in divergence.iter_mut().zip(g.areas_sr()) {
-            *d /= a * r;
-        }
-        let k = 1.0 / (r * r);
-        let lengths = ea.length.iter().zip(&ea.dual_length);
-        let ends = ea.cells.iter().zip(&ea.vertices);
-        for ((u, (l, d)), ([a, b], [v0, v1])) in self.u_m_per_s.iter_mut().zip(lengths).zip(ends) {
-            let curl_curl = (vorticity[*v1 as usize] - vorticity[*v0 as usize]) / (l * r);
-            let grad_div = (divergence[*b as usize] - divergence[*a as usize]) / (d * r);
-            *u += dt_s * nu * (-curl_curl + 2.0 * k * *u + 4.0 * grad_div);
+            self.viscous_step(s, nu, dt_s);
         }
     }
 
@@ -514,22 +473,6 @@ impl FilmFlow {
         }
         report
     }
-}
-
-/// The viscous operator's Gershgorin bound on the unit sphere for ν = 1: per edge, the
-/// curl-curl, grad-div and curvature terms' row sums, the largest of them.
-fn viscous_bound(g: &CubeSphere) -> f64 {
-    let (cells, verts) = (g.areas_sr(), g.vertex_areas_sr());
-    g.edges()
-        .iter()
-        .map(|e| {
-            let curl =
-                2.0 * e.dual_length / e.length / verts[e.v0 as usize].min(verts[e.v1 as usize]);
-            let div =
-                4.0 * 2.0 * e.length / e.dual_length / cells[e.a as usize].min(cells[e.b as usize]);
-            4.0 * (curl + div) + 2.0
-        })
-        .fold(0.0, f64::max)
 }
 
 /// Moves `scale·flux_e` (per unit sphere area) from cell `a` to `b` of every edge.

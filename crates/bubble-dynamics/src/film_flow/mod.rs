@@ -9,6 +9,7 @@ pub mod grid;
 pub(crate) mod on_bubble;
 pub mod solve;
 mod transport;
+mod viscosity;
 
 pub use burst::{BLACK_RELAX_S, BurstParams, Hole, RIM_CELLS_PER_SUBSTEP};
 pub use cell_map::CellMap;
