@@ -6,6 +6,7 @@ mod burst;
 mod cell_map;
 mod flow;
 pub mod grid;
+mod marangoni;
 pub(crate) mod on_bubble;
 pub mod solve;
 mod transport;
