@@ -35,7 +35,7 @@ impl FilmFlow {
     /// system's weight `dt² E l/(ρ h d R²)/(1 + dt k)` into `s.weight`.
     fn transport_fluxes_and_weights(&self, s: &mut Scratch, dt_s: f64) {
         let p = &self.params;
-        let r = p.radius_m;
+        let (dt_per_r, per_r2) = (dt_s / p.radius_m, 1.0 / (p.radius_m * p.radius_m));
         let g = &self.grid;
         let ea = g.edge_arrays();
         let (gamma, h) = (&self.gamma, &self.h_m);
@@ -45,17 +45,17 @@ impl FilmFlow {
         s.cell.clear();
         s.cell.resize(g.cells(), 0.0);
         let velocities = self.u_m_per_s.iter().zip(&s.u_start).zip(&s.drag);
-        let lengths = ea.length.iter().zip(&ea.dual_length);
-        for (((&u, &u0), drag), ([a, b], (l, d))) in velocities.zip(ea.cells.iter().zip(lengths)) {
+        let lengths = ea.length.iter().zip(&ea.inverse_dual_length);
+        for (((&u, &u0), drag), ([a, b], (l, id))) in velocities.zip(ea.cells.iter().zip(lengths)) {
             let (a, b) = (*a as usize, *b as usize);
             let (ga, gb) = (gamma[a], gamma[b]);
             let (up, g_up) = if u0 >= 0.0 { (a, ga) } else { (b, gb) };
             s.edge.push((g_up * u0 + 0.5 * (ga + gb) * (u - u0)) * l);
-            s.cell[up] += dt_s * (g_up * u0 * l).abs() / r;
+            s.cell[up] += dt_per_r * (g_up * u0 * l).abs();
             let h_edge = (0.5 * (h[a] + h[b])).max(H_FLOOR_M);
             let k = dt_s * p.elasticity_n_per_m / (p.density_kg_per_m3 * h_edge) * drag;
             s.stiffness.push(k);
-            s.weight.push(dt_s * k * l / (d * r * r));
+            s.weight.push(dt_s * k * l * id * per_r2);
         }
     }
 
@@ -64,7 +64,7 @@ impl FilmFlow {
     /// more than [`MAX_OUTFLOW_FRACTION`] of its surfactant (a fast film on a coarse step
     /// would otherwise drive Γ negative).
     fn limited_right_hand_side(&self, s: &mut Scratch, dt_s: f64) {
-        let r = self.params.radius_m;
+        let dt_per_r = dt_s / self.params.radius_m;
         let g = &self.grid;
         let (ea, areas, gamma) = (g.edge_arrays(), g.areas_sr(), &self.gamma);
         let (outflow, rhs) = (&s.cell, &mut s.rhs);
@@ -78,8 +78,8 @@ impl FilmFlow {
             if outflow[up] > budget {
                 *f -= (1.0 - budget / outflow[up]) * gamma[up] * u0 * l;
             }
-            rhs[a] -= dt_s * *f / r;
-            rhs[b] += dt_s * *f / r;
+            rhs[a] -= dt_per_r * *f;
+            rhs[b] += dt_per_r * *f;
         }
     }
 
@@ -119,22 +119,26 @@ impl FilmFlow {
     fn correct_velocity_and_move_surfactant(&mut self, s: &mut Scratch, dt_s: f64) {
         let r = self.params.radius_m;
         let g = std::sync::Arc::clone(&self.grid);
-        let (ea, areas) = (g.edge_arrays(), g.areas_sr());
+        let (ea, per_area) = (g.edge_arrays(), g.inverse_areas_per_sr());
         let (solution, gamma) = (&s.cell2, &self.gamma);
         let next = &mut s.rhs;
         next.clear();
         next.extend_from_slice(gamma);
         let scale = dt_s / r;
         let per_edge = self.u_m_per_s.iter_mut().zip(&s.edge).zip(&s.stiffness);
-        let edges = ea.cells.iter().zip(ea.length.iter().zip(&ea.dual_length));
-        for (((u, f_adv), k), ([a, b], (l, d))) in per_edge.zip(edges) {
+        let edges = ea
+            .cells
+            .iter()
+            .zip(ea.length.iter().zip(&ea.inverse_dual_length));
+        for (((u, f_adv), k), ([a, b], (l, id))) in per_edge.zip(edges) {
             let (a, b) = (*a as usize, *b as usize);
             let gamma_c = 0.5 * (gamma[a] + gamma[b]);
-            let du = -k * (solution[b] - solution[a]) / (gamma_c.max(f64::MIN_POSITIVE) * d * r);
+            let slope = (solution[b] - solution[a]) * id / r;
+            let du = -k * slope / gamma_c.max(f64::MIN_POSITIVE);
             *u += du;
             let moved = scale * (f_adv + gamma_c * du * l);
-            next[a] -= moved / areas[a];
-            next[b] += moved / areas[b];
+            next[a] -= moved * per_area[a];
+            next[b] += moved * per_area[b];
         }
         if !next.iter().any(|&x| x < 0.0) {
             std::mem::swap(&mut self.gamma, next);

@@ -73,12 +73,13 @@ impl FilmFlow {
             };
         }
         let cells = &self.grid.edge_arrays().cells;
+        let per_area = self.grid.inverse_areas_per_sr();
         for ([a, b], f) in cells.iter().zip(&s.edge2) {
             let (a, b) = (*a as usize, *b as usize);
             let donor = if *f >= 0.0 { a } else { b };
             let moved = f * s.cell[donor];
-            self.h_m[a] -= moved / areas[a];
-            self.h_m[b] += moved / areas[b];
+            self.h_m[a] -= moved * per_area[a];
+            self.h_m[b] += moved * per_area[b];
         }
     }
 
@@ -95,8 +96,9 @@ impl FilmFlow {
             gradient[a] += flux;
             gradient[b] -= flux;
         }
-        for ((grad, a), c) in gradient.iter_mut().zip(g.areas_sr()).zip(g.centres()) {
-            *grad /= *a;
+        let per_area = g.inverse_areas_per_sr();
+        for ((grad, ia), c) in gradient.iter_mut().zip(per_area).zip(g.centres()) {
+            *grad *= *ia;
             *grad -= *c * grad.dot(*c);
         }
     }
@@ -104,7 +106,7 @@ impl FilmFlow {
     /// The volume across each edge over `dt_s` per R² (m × sr) into `s.edge2`, and each
     /// donor's total outflow into `s.cell`.
     fn upwind_volumes(&self, s: &mut Scratch, dt_s: f64) {
-        let r = self.params.radius_m;
+        let dt_per_r = dt_s / self.params.radius_m;
         let ea = self.grid.edge_arrays();
         let (volume, outflow, gradient) = (&mut s.edge2, &mut s.cell, &s.gradient);
         volume.clear();
@@ -124,7 +126,7 @@ impl FilmFlow {
             let (h_up, h_down) = (self.h_m[up], self.h_m[down]);
             let reach = gradient[up].dot(to_edge);
             let h_face = (h_up + reach).clamp(h_up.min(h_down), h_up.max(h_down));
-            let f = h_face * v * l * dt_s / r;
+            let f = h_face * v * l * dt_per_r;
             volume.push(f);
             let donor = if f >= 0.0 { *a } else { *b } as usize;
             outflow[donor] += f.abs();

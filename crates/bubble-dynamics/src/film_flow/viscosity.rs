@@ -38,22 +38,22 @@ impl FilmFlow {
     /// One stage: `u ← mu·u + nu_prev·s.stage + dt_s·M(u)` with the stage before last in
     /// `s.stage`, which then holds the `u` this stage started from.
     fn viscous_stage(&mut self, s: &mut Scratch, nu: f64, dt_s: f64, mu: f64, nu_prev: f64) {
-        let r = self.params.radius_m;
         self.vorticity_and_divergence(s);
-        let g = &self.grid;
-        let ea = g.edge_arrays();
+        let ea = self.grid.edge_arrays();
         let (vorticity, divergence) = (&s.vertex, &s.cell);
-        let k = 1.0 / (r * r);
-        let lengths = ea.length.iter().zip(&ea.dual_length);
+        // Vorticity and divergence per R (of the unit sphere's), and each difference of
+        // them per R again: every term of the stress carries 1/R², taken once here.
+        let r = self.params.radius_m;
+        let rate = dt_s * nu / (r * r);
+        let per_length = ea.inverse_length.iter().zip(&ea.inverse_dual_length);
         let ends = ea.cells.iter().zip(&ea.vertices);
         let velocities = self.u_m_per_s.iter_mut().zip(s.stage.iter_mut());
-        for ((u, y_prev), ((l, d), ([a, b], [v0, v1]))) in velocities.zip(lengths.zip(ends)) {
-            let curl_curl = (vorticity[*v1 as usize] - vorticity[*v0 as usize]) / (l * r);
-            let grad_div = (divergence[*b as usize] - divergence[*a as usize]) / (d * r);
+        for ((u, y_prev), ((il, id), ([a, b], [v0, v1]))) in velocities.zip(per_length.zip(ends)) {
+            let curl_curl = (vorticity[*v1 as usize] - vorticity[*v0 as usize]) * il;
+            let grad_div = (divergence[*b as usize] - divergence[*a as usize]) * id;
             let y = *u;
-            let change = dt_s * nu * (-curl_curl + 2.0 * k * y + 4.0 * grad_div);
-            // The first stage (mu 1, nu_prev 0) is a plain forward-Euler step: no blend,
-            // so one stage gives what one sub-step did, bit for bit.
+            let change = rate * (4.0 * grad_div - curl_curl + 2.0 * y);
+            // The first stage (mu 1, nu_prev 0) is a plain forward-Euler step: no blend.
             *u = if nu_prev == 0.0 {
                 y + change
             } else {
@@ -64,9 +64,8 @@ impl FilmFlow {
     }
 
     /// The vorticity at each grid vertex into `s.vertex` and the divergence of each cell
-    /// into `s.cell`, of the edge velocities, per s.
+    /// into `s.cell`, of the edge velocities, on the unit sphere (m/s per rad).
     fn vorticity_and_divergence(&self, s: &mut Scratch) {
-        let r = self.params.radius_m;
         let g = &self.grid;
         let vorticity = &mut s.vertex;
         vorticity.clear();
@@ -83,11 +82,11 @@ impl FilmFlow {
             divergence[*a as usize] += u * l;
             divergence[*b as usize] -= u * l;
         }
-        for (z, a) in vorticity.iter_mut().zip(g.vertex_areas_sr()) {
-            *z /= a * r;
+        for (z, ia) in vorticity.iter_mut().zip(g.inverse_vertex_areas_per_sr()) {
+            *z *= ia;
         }
-        for (d, a) in divergence.iter_mut().zip(g.areas_sr()) {
-            *d /= a * r;
+        for (d, ia) in divergence.iter_mut().zip(g.inverse_areas_per_sr()) {
+            *d *= ia;
         }
     }
 }
