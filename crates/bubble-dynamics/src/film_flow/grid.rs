@@ -60,6 +60,9 @@ pub struct EdgeArrays {
     pub inverse_length: Vec<f64>,
     /// `1/dual_length`, per rad.
     pub inverse_dual_length: Vec<f64>,
+    /// `length/min(area_a, area_b)`, per rad: a speed times this and a step, per R, is the
+    /// fraction of the smaller cell's content the edge can carry (a Courant number).
+    pub length_per_smaller_area: Vec<f64>,
     /// `(centre_b − centre_a)/dual_length`, per rad: `G·` this is the discrete gradient
     /// across the edge of a linear potential `G·x` (gravity, the wind's potential flow).
     pub centre_gradient: Vec<DVec3>,
@@ -71,9 +74,11 @@ pub struct EdgeArrays {
 }
 
 impl EdgeArrays {
-    fn new(edges: &[GridEdge], centres: &[DVec3]) -> Self {
+    fn new(edges: &[GridEdge], centres: &[DVec3], areas_sr: &[f64]) -> Self {
         let centre = |c: u32| centres[c as usize];
+        let smaller_area = |e: &GridEdge| areas_sr[e.a as usize].min(areas_sr[e.b as usize]);
         Self {
+            length_per_smaller_area: edges.iter().map(|e| e.length / smaller_area(e)).collect(),
             cells: edges.iter().map(|e| [e.a, e.b]).collect(),
             vertices: edges.iter().map(|e| [e.v0, e.v1]).collect(),
             length: edges.iter().map(|e| e.length).collect(),
@@ -160,7 +165,7 @@ impl CubeSphere {
             }
         }
         let edges = build_edges(&cell_corners, &centres, &vertex_dirs);
-        let edge_arrays = EdgeArrays::new(&edges, &centres);
+        let edge_arrays = EdgeArrays::new(&edges, &centres, &areas_sr);
         let inverse = |areas: &[f64]| areas.iter().map(|a| 1.0 / a).collect();
         Self {
             n,

@@ -40,18 +40,20 @@ impl FilmFlow {
 
     /// The largest fraction of a cell's width any edge's speed carries over `dt_s`.
     fn courant_number(&self, drain_rate: &[f64], dt_s: f64) -> f64 {
-        let (g, r) = (&self.grid, self.params.radius_m);
-        let ea = g.edge_arrays();
-        let areas = g.areas_sr();
-        let edges = ea.cells.iter().zip(&ea.length).zip(drain_rate);
-        edges
+        let ea = self.grid.edge_arrays();
+        let edges = ea
+            .cells
+            .iter()
+            .zip(&ea.length_per_smaller_area)
+            .zip(drain_rate);
+        let fastest = edges
             .zip(&self.u_m_per_s)
-            .map(|((([a, b], l), &c), &u)| {
-                let (a, b) = (*a as usize, *b as usize);
-                let v = edge_speed(u, c, self.h_m[a], self.h_m[b]);
-                v.abs() * dt_s * l / (areas[a].min(areas[b]) * r)
+            .map(|((([a, b], per_area), &c), &u)| {
+                let v = edge_speed(u, c, self.h_m[*a as usize], self.h_m[*b as usize]);
+                v.abs() * per_area
             })
-            .fold(0.0, f64::max)
+            .fold(0.0, f64::max);
+        fastest * dt_s / self.params.radius_m
     }
 
     /// One transport of `h` over `dt_s`: second-order upwind (the upwind cell's
