@@ -9,8 +9,8 @@
 //! `E_f = dT/d ln A`), the thin viscous sheet's stress `ν(−∇×∇×u + 2Ku + 4∇∇·u)`, and the
 //! air's shear. The Marangoni term is the stiff one (waves at `√(E_f/(ρh))`, 10 m/s on a
 //! 500 nm film): it is taken backward-Euler, which leaves one linear system per step (see
-//! `solve`), and is then stable for any step. Viscosity is explicit, under
-//! its bound in the stages of a Runge–Kutta–Legendre step (`viscosity`); transport is
+//! `solve`, `marangoni`), and is then stable for any step. Viscosity is explicit, in the
+//! stages of one Runge–Kutta–Legendre step under its bound (`viscosity`); transport is
 //! upwind under a Courant bound of 1/2 an edge (`transport`).
 
 use glam::DVec3;
