@@ -322,8 +322,15 @@ impl FaceForces {
         sums: &mut [VertexSums],
     ) -> f64 {
         let mut six_volume = 0.0;
+        let n = positions.len();
+        let (relative_velocities, sums) = (&relative_velocities[..n], &mut sums[..n]);
         for (t, inv_rest_area) in triangles.iter().zip(inv_rest_face_area) {
             let [ia, ib, ic] = t.map(|i| i as usize);
+            // One check here lets the compiler drop the nine at the accesses below.
+            assert!(
+                ia < n && ib < n && ic < n,
+                "triangle {t:?} beyond {n} vertices"
+            );
             let (a, b, c) = (positions[ia], positions[ib], positions[ic]);
             let (ab, bc, ca) = (b - a, c - b, a - c);
             // n2 = (b − a) × (c − a) = 2A n̂.

@@ -150,33 +150,35 @@ impl Bubble {
         out: &mut Vec<f64>,
     ) {
         let x = &self.positions_m;
-        let triangles = self.topology.triangles();
         let rho = self.film.density_kg_per_m3;
         // ρ·ρ h³/(3μ) times g·e·(cot α + cot β)/2, and cot = u·v/(2A) at the corner
         // opposite the edge.
         let mobility = rho * rho / (12.0 * self.film.drainage_viscosity_pa_s);
-        let cot_times_2a = |f: usize, i: usize, j: usize| {
-            let t = triangles[f];
-            let k = t[0] as usize + t[1] as usize + t[2] as usize - i - j;
-            (x[i] - x[k]).dot(x[j] - x[k])
-        };
+        let cot_times_2a = |k: usize, i: usize, j: usize| (x[i] - x[k]).dot(x[j] - x[k]);
+        let edges = self.topology.edges();
         out.clear();
-        out.extend(self.topology.edges().iter().map(|e| {
-            let [i, j] = e.vertices.map(|v| v as usize);
-            // The sign of a flux is as good as random: select the index, not the branch.
-            let upwind = |q: f64| h[if q > 0.0 { i } else { j }];
-            let [fa, fb] = e.faces.map(|f| f as usize);
-            let g_dot_e = g_eff.dot(x[j] - x[i]);
-            let hu = upwind(g_dot_e);
-            let cot_sum =
-                cot_times_2a(fa, i, j) / face_areas[fa] + cot_times_2a(fb, i, j) / face_areas[fb];
-            let mut q = mobility * g_dot_e * cot_sum * (hu * hu * hu);
-            if let Some(psi) = swirl {
-                let volume_rate = psi[fa] - psi[fb];
-                q += rho * volume_rate * upwind(volume_rate);
-            }
-            q
-        }));
+        out.extend(
+            edges
+                .iter()
+                .zip(self.topology.opposite_vertices())
+                .map(|(e, k)| {
+                    let [i, j] = e.vertices.map(|v| v as usize);
+                    let [ka, kb] = k.map(|v| v as usize);
+                    // The sign of a flux is as good as random: select the index, not the branch.
+                    let upwind = |q: f64| h[if q > 0.0 { i } else { j }];
+                    let [fa, fb] = e.faces.map(|f| f as usize);
+                    let g_dot_e = g_eff.dot(x[j] - x[i]);
+                    let hu = upwind(g_dot_e);
+                    let cot_sum = cot_times_2a(ka, i, j) / face_areas[fa]
+                        + cot_times_2a(kb, i, j) / face_areas[fb];
+                    let mut q = mobility * g_dot_e * cot_sum * (hu * hu * hu);
+                    if let Some(psi) = swirl {
+                        let volume_rate = psi[fa] - psi[fb];
+                        q += rho * volume_rate * upwind(volume_rate);
+                    }
+                    q
+                }),
+        );
     }
 
     /// Moves `flux·dt` along the edges, each donor limited so it keeps at least half its

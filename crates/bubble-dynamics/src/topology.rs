@@ -18,6 +18,8 @@ pub struct Edge {
 pub struct Topology {
     triangles: Vec<[u32; 3]>,
     edges: Vec<Edge>,
+    /// Per edge, the third vertex of `faces[0]` and of `faces[1]`.
+    opposite_vertices: Vec<[u32; 2]>,
     vertex_face_offsets: Vec<u32>,
     vertex_faces: Vec<u32>,
     neighbor_offsets: Vec<u32>,
@@ -51,9 +53,17 @@ impl Topology {
                 ]
             }),
         );
+        let opposite_vertices = edges
+            .iter()
+            .map(|e| {
+                e.faces
+                    .map(|f| third_vertex(triangles[f as usize], e.vertices))
+            })
+            .collect();
         let topology = Self {
             triangles,
             edges,
+            opposite_vertices,
             vertex_face_offsets,
             vertex_faces,
             neighbor_offsets,
@@ -72,6 +82,12 @@ impl Topology {
     /// Every undirected edge once, sorted by vertex pair.
     pub fn edges(&self) -> &[Edge] {
         &self.edges
+    }
+
+    /// Per edge (in [`Topology::edges`] order), the vertex opposite it in each of its
+    /// two faces, in the order of `Edge::faces`.
+    pub fn opposite_vertices(&self) -> &[[u32; 2]] {
+        &self.opposite_vertices
     }
 
     /// Number of vertices.
@@ -95,6 +111,12 @@ impl Topology {
     pub fn neighbors_of(&self, v: usize) -> &[u32] {
         &self.neighbors[self.neighbor_offsets[v] as usize..self.neighbor_offsets[v + 1] as usize]
     }
+}
+
+/// The corner of `triangle` that is neither end of `edge`.
+fn third_vertex(triangle: [u32; 3], edge: [u32; 2]) -> u32 {
+    let [a, b, c] = triangle;
+    a + b + c - edge[0] - edge[1]
 }
 
 fn collect_edges(triangles: &[[u32; 3]], vertex_count: usize) -> Option<Vec<Edge>> {

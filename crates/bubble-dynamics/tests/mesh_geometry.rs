@@ -155,6 +155,23 @@ fn topology_rejects_open_or_inconsistent_meshes() {
     );
 }
 
+/// Each edge's opposite vertices complete its two faces, in the order of `Edge::faces`.
+#[test]
+fn opposite_vertices_complete_each_edges_faces() {
+    let mesh = icosphere(2);
+    let n = mesh.positions.len();
+    let topology = Topology::try_new(mesh.triangles, n).expect("closed");
+    for (e, opposite) in topology.edges().iter().zip(topology.opposite_vertices()) {
+        for (f, k) in e.faces.iter().zip(opposite) {
+            let mut corners = topology.triangles()[*f as usize];
+            let mut expected = [e.vertices[0], e.vertices[1], *k];
+            corners.sort_unstable();
+            expected.sort_unstable();
+            assert_eq!(corners, expected, "edge {:?}", e.vertices);
+        }
+    }
+}
+
 /// The rest mesh is a discrete equilibrium: one pressure balances the tension at every
 /// vertex. Its radii spread shrinks ~h² and its pressure tends to Laplace's 4σ/R.
 #[test]

@@ -39,6 +39,9 @@ pub(crate) struct Capillary {
 /// Buffers reused across steps.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct CapillaryScratch {
+    /// The grid's Laplacian ∞-norm on the unit sphere and the cell count it is for (it
+    /// depends on the grid alone).
+    laplacian_norm: Option<(usize, f64)>,
     laplacian: Vec<f64>,
     mobility: Vec<f64>,
     flux: Vec<f64>,
@@ -54,30 +57,23 @@ pub(crate) fn smooth_thickness(
     s: &mut CapillaryScratch,
 ) {
     let ea = grid.edge_arrays();
-    let r2 = c.radius_m * c.radius_m;
     // Per edge: h³/(3μ_d) at the mean thickness, times σ/2 (the pressure's factor).
     s.mobility.clear();
     s.mobility.extend(ea.cells.iter().map(|[a, b]| {
         let h = 0.5 * (h_m[*a as usize] + h_m[*b as usize]);
         0.5 * c.sigma_n_per_m * h * h * h / (3.0 * c.drainage_viscosity_pa_s)
     }));
-    // Gershgorin: |∇·(M∇)| ≤ 2 max Σ M l/(d A R²) and |∇²| ≤ 2 max Σ l/(d A R²).
-    let row_sums = |weight: &dyn Fn(usize) -> f64| {
-        let mut sums = vec![0.0; grid.cells()];
-        for (e, [a, b]) in ea.cells.iter().enumerate() {
-            let w = weight(e) * ea.length[e] / (ea.dual_length[e] * r2);
-            sums[*a as usize] += w;
-            sums[*b as usize] += w;
+    // Gershgorin: |∇·(M∇)| ≤ max M · |∇²| and |∇²| ≤ 2 max Σ l/(d A R²).
+    let norm = match s.laplacian_norm {
+        Some((cells, norm)) if cells == grid.cells() => norm,
+        _ => {
+            let norm = laplacian_norm(grid);
+            s.laplacian_norm = Some((grid.cells(), norm));
+            norm
         }
-        let areas = grid.areas_sr();
-        2.0 * sums
-            .iter()
-            .zip(areas)
-            .map(|(s, a)| s / a)
-            .fold(0.0, f64::max)
     };
-    let laplacian_bound = row_sums(&|_| 1.0);
-    let rate = row_sums(&|e| s.mobility[e]) * laplacian_bound;
+    let max_mobility = s.mobility.iter().copied().fold(0.0, f64::max);
+    let rate = max_mobility * (norm / (c.radius_m * c.radius_m)).powi(2);
     if rate * dt_s < 1e-3 {
         return; // a smoothing the step cannot see (every film of the optics' range)
     }
@@ -87,12 +83,28 @@ pub(crate) fn smooth_thickness(
     let sub_dt = dt_s / substeps;
     if rate * sub_dt > STABLE_RATE_DT {
         // Cap the mobility where the sub-steps cannot resolve the rate.
-        let cap = s.mobility.iter().copied().fold(0.0, f64::max) * STABLE_RATE_DT / (rate * sub_dt);
+        let cap = max_mobility * STABLE_RATE_DT / (rate * sub_dt);
         s.mobility.iter_mut().for_each(|m| *m = m.min(cap));
     }
     for _ in 0..substeps as u32 {
         substep(grid, c.radius_m, sub_dt, h_m, s);
     }
+}
+
+/// The ∞-norm of the grid's Laplacian on the unit sphere, `2 max_c Σ l/(d A)`.
+fn laplacian_norm(grid: &CubeSphere) -> f64 {
+    let ea = grid.edge_arrays();
+    let mut sums = vec![0.0; grid.cells()];
+    for (([a, b], l), d) in ea.cells.iter().zip(&ea.length).zip(&ea.dual_length) {
+        sums[*a as usize] += l / d;
+        sums[*b as usize] += l / d;
+    }
+    let areas = grid.areas_sr();
+    2.0 * sums
+        .iter()
+        .zip(areas)
+        .map(|(s, a)| s / a)
+        .fold(0.0, f64::max)
 }
 
 /// One forward-Euler sub-step of `∂h/∂t = −∇·(M ∇(−∇²h))` with `s.mobility` as M.

@@ -9,8 +9,9 @@
 //! `E_f = dT/d ln A`), the thin viscous sheet's stress `ν(−∇×∇×u + 2Ku + 4∇∇·u)`, and the
 //! air's shear. The Marangoni term is the stiff one (waves at `√(E_f/(ρh))`, 10 m/s on a
 //! 500 nm film): it is taken backward-Euler, which leaves one linear system per step (see
-//! `solve`), and is then stable for any step. Viscosity is explicit, sub-stepped under
-//! its bound; transport is upwind under a Courant bound of 1/2 an edge.
+//! `solve`, `marangoni`), and is then stable for any step. Viscosity is explicit, in the
+//! stages of one Runge–Kutta–Legendre step under its bound (`viscosity`); transport is
+//! upwind under a Courant bound of 1/2 an edge (`transport`).
 
 use glam::DVec3;
 
@@ -18,20 +19,21 @@ use super::advect::{AdvectionGeometry, AdvectionScratch, advect_momentum};
 use super::burst::{BurstParams, BurstState, Hole};
 use super::capillary::{Capillary, CapillaryScratch, smooth_thickness};
 use super::grid::CubeSphere;
-use super::solve::{Hierarchy, SolveLimits, SolveReport, Work};
+use super::solve::{Hierarchy, SolveReport, Work};
+use super::viscosity::viscous_bound;
 
 /// Thickness floor of the Marangoni coefficient `E_f/(ρh)`, m: a hole or a Newton black
 /// film keeps a finite (if huge) stiffness.
-const H_FLOOR_M: f64 = 1e-9;
+pub(super) const H_FLOOR_M: f64 = 1e-9;
 /// Largest fraction of a cell's content that may leave it in one transport sub-step.
-const MAX_OUTFLOW_FRACTION: f64 = 0.5;
+pub(super) const MAX_OUTFLOW_FRACTION: f64 = 0.5;
 /// Residual of the Marangoni solve relative to its warm start's (the previous step's
 /// surfactant): the step's change to 6 digits. The velocity takes the gradient of this
 /// solution, so an inexact one is an inexact backward-Euler step: at 1e-4 the swirl film
 /// at n = 64 blew up within 20 steps (`film_profile 64 0 9.81`), at 1e-6 it holds.
-const SOLVE_TOLERANCE: f64 = 1e-6;
+pub(super) const SOLVE_TOLERANCE: f64 = 1e-6;
 /// Iteration cap of the Marangoni solve (it takes 3–8).
-const SOLVE_MAX_ITERATIONS: u32 = 40;
+pub(super) const SOLVE_MAX_ITERATIONS: u32 = 40;
 
 /// The physical constants of one bubble's film.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,36 +100,43 @@ pub struct Forcing {
 #[derive(Clone, Debug)]
 pub struct FilmFlow {
     pub(crate) grid: std::sync::Arc<CubeSphere>,
-    hierarchy: std::sync::Arc<Hierarchy>,
+    pub(super) hierarchy: std::sync::Arc<Hierarchy>,
     /// The momentum advection's weights, fixed by the grid.
     advection: std::sync::Arc<AdvectionGeometry>,
     pub(crate) params: FlowParams,
     pub(super) burst: Option<Box<BurstState>>,
     /// The viscous operator's Gershgorin bound per unit ν/R², fixed by the grid.
-    viscous_bound: f64,
+    pub(super) viscous_bound: f64,
     pub(crate) h_m: Vec<f64>,
     pub(crate) gamma: Vec<f64>,
     pub(crate) u_m_per_s: Vec<f64>,
     /// The last Marangoni solve's change of Γ (empty before the first): the next solve's
     /// first guess.
-    surfactant_change: Vec<f64>,
+    pub(super) surfactant_change: Vec<f64>,
     scratch: Scratch,
 }
 
+/// Buffers a step reuses from step to step (no allocation once the first has run).
 #[derive(Clone, Debug, Default)]
-struct Scratch {
-    work: Work,
-    edge: Vec<f64>,
-    edge2: Vec<f64>,
-    cell: Vec<f64>,
-    cell2: Vec<f64>,
-    vertex: Vec<f64>,
-    weight: Vec<f64>,
-    u_start: Vec<f64>,
-    stiffness: Vec<f64>,
-    guess: Vec<f64>,
-    gradient: Vec<DVec3>,
-    drag: Vec<f64>,
+pub(super) struct Scratch {
+    pub(super) work: Work,
+    pub(super) edge: Vec<f64>,
+    pub(super) edge2: Vec<f64>,
+    pub(super) cell: Vec<f64>,
+    pub(super) cell2: Vec<f64>,
+    pub(super) vertex: Vec<f64>,
+    pub(super) weight: Vec<f64>,
+    pub(super) u_start: Vec<f64>,
+    pub(super) stiffness: Vec<f64>,
+    pub(super) guess: Vec<f64>,
+    pub(super) gradient: Vec<DVec3>,
+    pub(super) drag: Vec<f64>,
+    /// Per edge: the drainage speed's coefficient over `h²`, s⁻¹·m⁻¹.
+    pub(super) drain_rate: Vec<f64>,
+    /// The viscous step's stage before the one under way, m/s per edge.
+    pub(super) stage: Vec<f64>,
+    /// The Marangoni system's right-hand side, then the surfactant the step ends with.
+    pub(super) rhs: Vec<f64>,
     advect: AdvectionScratch,
     capillary: CapillaryScratch,
 }
@@ -315,52 +324,7 @@ impl FilmFlow {
         }
         let nu = self.params.viscosity_pa_s / self.params.density_kg_per_m3;
         if nu > 0.0 {
-            let substeps = (dt_s * self.viscous_rate_bound(nu) / 1.5).ceil().max(1.0);
-            for _ in 0..substeps as u32 {
-                self.viscous_substep(s, nu, dt_s / substeps);
-            }
-        }
-    }
-
-    /// An upper bound of the viscous operator's eigenvalues (Gershgorin), 1/s.
-    fn viscous_rate_bound(&self, nu: f64) -> f64 {
-        let r = self.params.radius_m;
-        self.viscous_bound * nu / (r * r)
-    }
-
-    /// One explicit step of the sheet's viscous stress over `dt_s`.
-    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
-    fn viscous_substep(&mut self, s: &mut Scratch, nu: f64, dt_s: f64) {
-        let r = self.params.radius_m;
-        let g = &self.grid;
-        let vorticity = &mut s.vertex;
-        vorticity.clear();
-        vorticity.resize(g.vertex_areas_sr().len(), 0.0);
-        let divergence = &mut s.cell;
-        divergence.clear();
-        divergence.resize(g.cells(), 0.0);
-        let ea = g.edge_arrays();
-        let lengths = ea.length.iter().zip(&ea.dual_length);
-        let ends = ea.cells.iter().zip(&ea.vertices);
-        for ((&u, (l, d)), ([a, b], [v0, v1])) in self.u_m_per_s.iter().zip(lengths).zip(ends) {
-            vorticity[*v1 as usize] += u * d;
-            vorticity[*v0 as usize] -= u * d;
-            divergence[*a as usize] += u * l;
-            divergence[*b as usize] -= u * l;
-        }
-        for (z, a) in vorticity.iter_mut().zip(g.vertex_areas_sr()) {
-            *z /= a * r;
-        }
-        for (d, a) in divergence.iter_mut().zip(g.areas_sr()) {
-            *d /= a * r;
-        }
-        let k = 1.0 / (r * r);
-        let lengths = ea.length.iter().zip(&ea.dual_length);
-        let ends = ea.cells.iter().zip(&ea.vertices);
-        for ((u, (l, d)), ([a, b], [v0, v1])) in self.u_m_per_s.iter_mut().zip(lengths).zip(ends) {
-            let curl_curl = (vorticity[*v1 as usize] - vorticity[*v0 as usize]) / (l * r);
-            let grad_div = (divergence[*b as usize] - divergence[*a as usize]) / (d * r);
-            *u += dt_s * nu * (-curl_curl + 2.0 * k * *u + 4.0 * grad_div);
+            self.viscous_step(s, nu, dt_s);
         }
     }
 
@@ -403,114 +367,6 @@ impl FilmFlow {
         }
     }
 
-    /// Backward-Euler Marangoni step: solves for the surfactant the step ends with, sets
-    /// the velocities from its gradient, and moves the surfactant with fluxes that sum to
-    /// zero (so it is conserved to rounding whatever the solver's residual).
-    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
-    fn marangoni_implicit(&mut self, s: &mut Scratch, dt_s: f64) -> SolveReport {
-        let p = self.params;
-        let r = p.radius_m;
-        let g = std::sync::Arc::clone(&self.grid);
-        // The transport with the velocity the step started with, upwind in sub-steps
-        // of its own; the step's change of velocity (the forces' part) carries Γ
-        // centrally in the implicit solve (an upwind flux there would diffuse Γ at
-        // |g dt| and no gradient could hold a film at rest).
-        self.transport_surfactant(s, dt_s);
-        let ea = g.edge_arrays();
-        let advective = &mut s.edge;
-        advective.clear();
-        let edges = ea.cells.iter().zip(&ea.length);
-        advective.extend(self.u_m_per_s.iter().zip(&s.u_start).zip(edges).map(
-            |((&u, &u0), ([a, b], l))| {
-                let (ga, gb) = (self.gamma[*a as usize], self.gamma[*b as usize]);
-                0.5 * (ga + gb) * (u - u0) * l
-            },
-        ));
-        // Rows divided by R²: α = A (sr), w = dt² E l/(ρ h d R²)/(1 + dt k),
-        // b = A Γ − dt Σ F/R.
-        // Each edge's dt·E/(ρh)/(1 + dt k), once: the weights and the velocity correction
-        // both use it.
-        let stiffness = &mut s.stiffness;
-        stiffness.clear();
-        stiffness.extend(ea.cells.iter().zip(&s.drag).map(|([a, b], drag)| {
-            let h = (0.5 * (self.h_m[*a as usize] + self.h_m[*b as usize])).max(H_FLOOR_M);
-            dt_s * p.elasticity_n_per_m / (p.density_kg_per_m3 * h) * drag
-        }));
-        s.weight.clear();
-        let lengths = ea.length.iter().zip(&ea.dual_length);
-        s.weight.extend(
-            stiffness
-                .iter()
-                .zip(lengths)
-                .map(|(k, (l, d))| dt_s * k * l / (d * r * r)),
-        );
-        let rhs = &mut s.cell;
-        rhs.clear();
-        rhs.extend(g.areas_sr().iter().zip(&self.gamma).map(|(a, gm)| a * gm));
-        for ([a, b], f) in ea.cells.iter().zip(advective.iter()) {
-            rhs[*a as usize] -= dt_s * f / r;
-            rhs[*b as usize] += dt_s * f / r;
-        }
-        let solution = &mut s.cell2;
-        solution.clear();
-        solution.extend_from_slice(&self.gamma);
-        // The last step's change again as the first guess: a film in steady motion
-        // changes alike from step to step. The tolerance stays relative to Γⁿ's residual.
-        let guess = &mut s.guess;
-        guess.clear();
-        let change = &self.surfactant_change;
-        guess.extend(self.gamma.iter().zip(change).map(|(gm, d)| gm + d));
-        let report = self.hierarchy.solve_with_guess(
-            &mut s.work,
-            g.areas_sr(),
-            &s.weight,
-            rhs,
-            solution,
-            Some(guess.as_slice()),
-            SolveLimits {
-                tolerance: SOLVE_TOLERANCE,
-                max_iterations: SOLVE_MAX_ITERATIONS,
-            },
-        );
-        self.surfactant_change.clear();
-        let changes = solution.iter().zip(&self.gamma).map(|(x, gm)| x - gm);
-        self.surfactant_change.extend(changes);
-        // Velocity correction and the conservative surfactant update.
-        let flux = &mut s.edge2;
-        flux.clear();
-        let edges = ea.cells.iter().zip(ea.length.iter().zip(&ea.dual_length));
-        let per_edge = self
-            .u_m_per_s
-            .iter_mut()
-            .zip(advective.iter())
-            .zip(stiffness.iter());
-        for (((u, f_adv), k), ([a, b], (l, d))) in per_edge.zip(edges) {
-            let (a, b) = (*a as usize, *b as usize);
-            let gamma_c = 0.5 * (self.gamma[a] + self.gamma[b]);
-            let du = -k * (solution[b] - solution[a]) / (gamma_c.max(f64::MIN_POSITIVE) * d * r);
-            *u += du;
-            flux.push(f_adv + gamma_c * du * l);
-        }
-        let before = &mut s.cell2;
-        before.clear();
-        before.extend_from_slice(&self.gamma);
-        apply_fluxes(&g, flux, dt_s / r, &mut self.gamma);
-        if self.gamma.iter().any(|&x| x < 0.0) {
-            // A violent step (a film torn near zero thickness, where the waves run at
-            // hundreds of m/s) overshot: redo it with every flux upwind and each donor
-            // limited, which keeps Γ positive and still conserves it.
-            self.gamma.copy_from_slice(before);
-            let edges = ea.cells.iter().zip(&ea.length);
-            for ((f, &u), ([a, b], l)) in flux.iter_mut().zip(&self.u_m_per_s).zip(edges) {
-                let up = if u >= 0.0 { *a } else { *b } as usize;
-                *f = self.gamma[up] * u * l;
-            }
-            limit_outflow(&g, flux, dt_s / r, &self.gamma, &mut s.cell);
-            apply_fluxes(&g, flux, dt_s / r, &mut self.gamma);
-        }
-        report
-    }
-
     /// The capillary pressure's flow relative to the surfaces (module `capillary`); none
     /// without drainage (immobile liquid between the surfaces).
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
@@ -527,157 +383,10 @@ impl FilmFlow {
         };
         smooth_thickness(&self.grid, c, dt_s, &mut self.h_m, &mut s.capillary);
     }
-
-    /// Moves Γ upwind with the step's starting velocity, in sub-steps of per-edge Courant
-    /// ≤ ½ like the thickness, each donor limited to half its content.
-    ///
-    /// Why sub-steps: in one step a cell whose outflow exceeded that budget had its flux
-    /// cut, so Γ no longer saw the velocity's divergence there and no Marangoni stress
-    /// resisted it; a solid rotation of 10 cm/s on a 1 cm film at n = 64 and 1 ms steps
-    /// (corner cells at Courant ≈ 0.9) then piled the film up at the cube's corners and
-    /// blew up within 80 steps.
-    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
-    fn transport_surfactant(&mut self, s: &mut Scratch, dt_s: f64) {
-        let r = self.params.radius_m;
-        let g = std::sync::Arc::clone(&self.grid);
-        let ea = g.edge_arrays();
-        let courant = courant_number(&g, &s.u_start, dt_s / r);
-        if courant == 0.0 {
-            return;
-        }
-        let substeps = (2.0 * courant).ceil().clamp(1.0, 64.0) as u32;
-        let sub_dt = dt_s / f64::from(substeps);
-        for _ in 0..substeps {
-            let flux = &mut s.edge2;
-            flux.clear();
-            let edges = ea.cells.iter().zip(&ea.length);
-            flux.extend(edges.zip(&s.u_start).map(|(([a, b], l), &u0)| {
-                let up = if u0 >= 0.0 { *a } else { *b } as usize;
-                self.gamma[up] * u0 * l
-            }));
-            limit_outflow(&g, flux, sub_dt / r, &self.gamma, &mut s.cell);
-            apply_fluxes(&g, flux, sub_dt / r, &mut self.gamma);
-        }
-    }
-
-    /// Moves liquid with the surfaces (upwind) and by the drainage flux relative to them,
-    /// in sub-steps that keep each cell's outflow below half its content.
-    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
-    fn transport_thickness(&mut self, s: &mut Scratch, dt_s: f64, g_eff: DVec3) {
-        let p = self.params;
-        let r = p.radius_m;
-        let g = std::sync::Arc::clone(&self.grid);
-        let drain = if p.drainage_viscosity_pa_s.is_finite() && p.drainage_viscosity_pa_s > 0.0 {
-            p.density_kg_per_m3 / (3.0 * p.drainage_viscosity_pa_s)
-        } else {
-            0.0
-        };
-        // Speed of every edge: the surfaces' plus the drainage's (ρ g_t h²/(3μ)).
-        let ea = g.edge_arrays();
-        s.edge.resize(ea.cells.len(), 0.0);
-        self.edge_speeds(&mut s.edge, drain, g_eff);
-        let courant = courant_number(&g, &s.edge, dt_s / r);
-        // A cell drains through at most two edges of a smooth flow: 2·courant per step, kept
-        // within one sub-step's content; the outflow limit guards the rest.
-        let substeps = (2.0 * courant).ceil().clamp(1.0, 64.0) as u32;
-        let h_dt = dt_s / f64::from(substeps);
-        for k in 0..substeps {
-            if k > 0 {
-                self.edge_speeds(&mut s.edge, drain, g_eff);
-            }
-            self.upwind_substep(s, h_dt);
-        }
-    }
-
-    /// Each edge's transport speed: the surfaces' `u` plus the drainage `c·h_up²` with
-    /// `c = drain·g_eff·n`, the upwind cell chosen by the sign of the speed at the mean
-    /// thickness.
-    fn edge_speeds(&self, speed: &mut [f64], drain: f64, g_eff: DVec3) {
-        let ea = self.grid.edge_arrays();
-        let edges = ea.cells.iter().zip(&ea.normal);
-        for ((v, &u), ([a, b], normal)) in speed.iter_mut().zip(&self.u_m_per_s).zip(edges) {
-            let c = drain * g_eff.dot(*normal);
-            let (ha, hb) = (self.h_m[*a as usize], self.h_m[*b as usize]);
-            let mean = 0.5 * (ha + hb);
-            let h = if u + c * mean * mean >= 0.0 { ha } else { hb };
-            *v = u + c * h * h;
-        }
-    }
-
-    /// One transport of `h` with the edge speeds in `s.edge`: second-order upwind (the
-    /// upwind cell's Green–Gauss gradient carried to the edge midpoint, clamped between
-    /// the two cells' values so no new extremum appears), outflow-limited.
-    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
-    fn upwind_substep(&mut self, s: &mut Scratch, dt_s: f64) {
-        let r = self.params.radius_m;
-        let g = &self.grid;
-        let areas = g.areas_sr();
-        // Cell gradients of h on the unit sphere, per radian.
-        s.gradient.clear();
-        s.gradient.resize(g.cells(), DVec3::ZERO);
-        let ea = g.edge_arrays();
-        for (([a, b], normal), l) in ea.cells.iter().zip(&ea.normal).zip(&ea.length) {
-            let (a, b) = (*a as usize, *b as usize);
-            let flux = *normal * (0.5 * (self.h_m[a] + self.h_m[b]) * l);
-            s.gradient[a] += flux;
-            s.gradient[b] -= flux;
-        }
-        for ((grad, a), c) in s.gradient.iter_mut().zip(areas).zip(g.centres()) {
-            *grad /= *a;
-            *grad -= *c * grad.dot(*c);
-        }
-        let (speed, volume) = (&s.edge, &mut s.edge2);
-        volume.clear();
-        // Volume across each edge over the step, per R² (m × sr).
-        let edges = ea.cells.iter().zip(&ea.reach).zip(&ea.length);
-        for (&v, (([a, b], reach), l)) in speed.iter().zip(edges) {
-            let (up, down, to_edge) = if v >= 0.0 {
-                (*a, *b, reach[0])
-            } else {
-                (*b, *a, reach[1])
-            };
-            let (up, down) = (up as usize, down as usize);
-            let (h_up, h_down) = (self.h_m[up], self.h_m[down]);
-            let reach = s.gradient[up].dot(to_edge);
-            let h_face = (h_up + reach).clamp(h_up.min(h_down), h_up.max(h_down));
-            volume.push(h_face * v * l * dt_s / r);
-        }
-        limit_outflow(g, volume, 1.0, &self.h_m, &mut s.cell);
-        apply_fluxes(g, volume, 1.0, &mut self.h_m);
-    }
-}
-
-/// The viscous operator's Gershgorin bound on the unit sphere for ν = 1: per edge, the
-/// curl-curl, grad-div and curvature terms' row sums, the largest of them.
-fn viscous_bound(g: &CubeSphere) -> f64 {
-    let (cells, verts) = (g.areas_sr(), g.vertex_areas_sr());
-    g.edges()
-        .iter()
-        .map(|e| {
-            let curl =
-                2.0 * e.dual_length / e.length / verts[e.v0 as usize].min(verts[e.v1 as usize]);
-            let div =
-                4.0 * 2.0 * e.length / e.dual_length / cells[e.a as usize].min(cells[e.b as usize]);
-            4.0 * (curl + div) + 2.0
-        })
-        .fold(0.0, f64::max)
 }
 
 /// Moves `scale·flux_e` (per unit sphere area) from cell `a` to `b` of every edge.
-/// The largest per-edge Courant number `|v| Δt l/A` (the smaller cell's area) of edge
-/// speeds `speed` over `dt_per_r` (the step over the radius).
-fn courant_number(g: &CubeSphere, speed: &[f64], dt_per_r: f64) -> f64 {
-    let ea = g.edge_arrays();
-    let areas = g.areas_sr();
-    ea.cells
-        .iter()
-        .zip(&ea.length)
-        .zip(speed)
-        .map(|(([a, b], l), v)| v.abs() * dt_per_r * l / areas[*a as usize].min(areas[*b as usize]))
-        .fold(0.0, f64::max)
-}
-
-fn apply_fluxes(g: &CubeSphere, flux: &[f64], scale: f64, values: &mut [f64]) {
+pub(super) fn apply_fluxes(g: &CubeSphere, flux: &[f64], scale: f64, values: &mut [f64]) {
     for ([a, b], f) in g.edge_arrays().cells.iter().zip(flux) {
         let (a, b) = (*a as usize, *b as usize);
         let moved = scale * f;
@@ -688,7 +397,7 @@ fn apply_fluxes(g: &CubeSphere, flux: &[f64], scale: f64, values: &mut [f64]) {
 
 /// Scales each donor's outgoing fluxes so no cell gives more than
 /// [`MAX_OUTFLOW_FRACTION`] of its content in one step (`outflow` is scratch).
-fn limit_outflow(
+pub(super) fn limit_outflow(
     g: &CubeSphere,
     flux: &mut [f64],
     scale: f64,

@@ -55,6 +55,14 @@ pub struct EdgeArrays {
     pub length: Vec<f64>,
     /// Arc length between the centres of its cells, rad.
     pub dual_length: Vec<f64>,
+    /// `1/length`, per rad: the passes over the edges multiply where they divided (a
+    /// division takes several multiplies' time).
+    pub inverse_length: Vec<f64>,
+    /// `1/dual_length`, per rad.
+    pub inverse_dual_length: Vec<f64>,
+    /// `length/min(area_a, area_b)`, per rad: a speed times this and a step, per R, is the
+    /// fraction of the smaller cell's content the edge can carry (a Courant number).
+    pub length_per_smaller_area: Vec<f64>,
     /// `(centre_b − centre_a)/dual_length`, per rad: `G·` this is the discrete gradient
     /// across the edge of a linear potential `G·x` (gravity, the wind's potential flow).
     pub centre_gradient: Vec<DVec3>,
@@ -66,13 +74,17 @@ pub struct EdgeArrays {
 }
 
 impl EdgeArrays {
-    fn new(edges: &[GridEdge], centres: &[DVec3]) -> Self {
+    fn new(edges: &[GridEdge], centres: &[DVec3], areas_sr: &[f64]) -> Self {
         let centre = |c: u32| centres[c as usize];
+        let smaller_area = |e: &GridEdge| areas_sr[e.a as usize].min(areas_sr[e.b as usize]);
         Self {
+            length_per_smaller_area: edges.iter().map(|e| e.length / smaller_area(e)).collect(),
             cells: edges.iter().map(|e| [e.a, e.b]).collect(),
             vertices: edges.iter().map(|e| [e.v0, e.v1]).collect(),
             length: edges.iter().map(|e| e.length).collect(),
             dual_length: edges.iter().map(|e| e.dual_length).collect(),
+            inverse_length: edges.iter().map(|e| 1.0 / e.length).collect(),
+            inverse_dual_length: edges.iter().map(|e| 1.0 / e.dual_length).collect(),
             centre_gradient: edges
                 .iter()
                 .map(|e| (centre(e.b) - centre(e.a)) / e.dual_length)
@@ -100,6 +112,8 @@ pub struct CubeSphere {
     edges: Vec<GridEdge>,
     edge_arrays: EdgeArrays,
     vertex_areas_sr: Vec<f64>,
+    inverse_areas_per_sr: Vec<f64>,
+    inverse_vertex_areas_per_sr: Vec<f64>,
 }
 
 impl CubeSphere {
@@ -151,9 +165,12 @@ impl CubeSphere {
             }
         }
         let edges = build_edges(&cell_corners, &centres, &vertex_dirs);
-        let edge_arrays = EdgeArrays::new(&edges, &centres);
+        let edge_arrays = EdgeArrays::new(&edges, &centres, &areas_sr);
+        let inverse = |areas: &[f64]| areas.iter().map(|a| 1.0 / a).collect();
         Self {
             n,
+            inverse_areas_per_sr: inverse(&areas_sr),
+            inverse_vertex_areas_per_sr: inverse(&vertex_areas_sr),
             centres,
             areas_sr,
             edges,
@@ -195,6 +212,16 @@ impl CubeSphere {
     /// Dual area of each grid vertex (a quarter of each cell around it), sr.
     pub fn vertex_areas_sr(&self) -> &[f64] {
         &self.vertex_areas_sr
+    }
+
+    /// `1/area` of each cell, per sr.
+    pub fn inverse_areas_per_sr(&self) -> &[f64] {
+        &self.inverse_areas_per_sr
+    }
+
+    /// `1/area` of each grid vertex's dual cell, per sr.
+    pub fn inverse_vertex_areas_per_sr(&self) -> &[f64] {
+        &self.inverse_vertex_areas_per_sr
     }
 }
 

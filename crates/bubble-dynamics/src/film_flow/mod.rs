@@ -8,8 +8,11 @@ mod capillary;
 mod cell_map;
 mod flow;
 pub mod grid;
+mod marangoni;
 pub(crate) mod on_bubble;
 pub mod solve;
+mod transport;
+mod viscosity;
 
 pub use burst::{BLACK_RELAX_S, BurstParams, Hole, RIM_CELLS_PER_SUBSTEP};
 pub use cell_map::CellMap;

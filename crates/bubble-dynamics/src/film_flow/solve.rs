@@ -438,13 +438,17 @@ fn gauss_seidel(
     z: &mut [f64],
     back: bool,
 ) {
-    let nb = &level.neighbours;
+    // Every row's numbers cut to the level's length once, so the loops index them
+    // without a bounds check per cell (only the neighbours' `z` keep theirs).
+    let cells = level.cells;
+    let (nb, stencil) = (&level.neighbours[..cells], &stencil[..cells]);
+    let (inv_diag, r, z) = (&inv_diag[..cells], &r[..cells], &mut z[..cells]);
     if back {
-        for i in (0..level.cells).rev() {
+        for i in (0..cells).rev() {
             relax(i, &nb[i], &stencil[i], inv_diag[i], r[i], z);
         }
     } else {
-        for i in 0..level.cells {
+        for i in 0..cells {
             relax(i, &nb[i], &stencil[i], inv_diag[i], r[i], z);
         }
     }

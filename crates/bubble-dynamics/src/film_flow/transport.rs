@@ -1,0 +1,146 @@
+//! Transport of the film's thickness: liquid moves with the surfaces (second-order
+//! upwind) and by the drainage flux relative to them, in sub-steps under a Courant bound,
+//! each donor's outflow limited to a fraction of its content.
+//!
+//! A sub-step walks the edges three times (the upwind cells' gradients; the edge speeds,
+//! volumes and each donor's outflow; the limited volumes applied) and the cells twice: the
+//! edge speeds are computed where the volumes are, from the thickness the sub-step starts
+//! with, so no pass stores them.
+
+use glam::DVec3;
+
+use super::flow::{FilmFlow, MAX_OUTFLOW_FRACTION, Scratch};
+
+impl FilmFlow {
+    /// Moves liquid with the surfaces (upwind) and by the drainage flux relative to them,
+    /// in sub-steps that keep each cell's outflow below half its content.
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
+    pub(super) fn transport_thickness(&mut self, s: &mut Scratch, dt_s: f64, g_eff: DVec3) {
+        let p = self.params;
+        let drain = if p.drainage_viscosity_pa_s.is_finite() && p.drainage_viscosity_pa_s > 0.0 {
+            p.density_kg_per_m3 / (3.0 * p.drainage_viscosity_pa_s)
+        } else {
+            0.0
+        };
+        // The drainage speed's coefficient `c = drain·g_eff·n` of every edge, fixed over
+        // the step: each sub-step's speeds are `u + c·h_up²`.
+        let ea = self.grid.edge_arrays();
+        s.drain_rate.clear();
+        s.drain_rate
+            .extend(ea.normal.iter().map(|normal| drain * g_eff.dot(*normal)));
+        let courant = self.courant_number(&s.drain_rate, dt_s);
+        // A cell drains through at most two edges of a smooth flow: 2·courant per step, kept
+        // within one sub-step's content; the outflow limit guards the rest.
+        let substeps = (2.0 * courant).ceil().clamp(1.0, 64.0) as u32;
+        let h_dt = dt_s / f64::from(substeps);
+        for _ in 0..substeps {
+            self.upwind_substep(s, h_dt);
+        }
+    }
+
+    /// The largest fraction of a cell's width any edge's speed carries over `dt_s`.
+    fn courant_number(&self, drain_rate: &[f64], dt_s: f64) -> f64 {
+        let ea = self.grid.edge_arrays();
+        let edges = ea
+            .cells
+            .iter()
+            .zip(&ea.length_per_smaller_area)
+            .zip(drain_rate);
+        let fastest = edges
+            .zip(&self.u_m_per_s)
+            .map(|((([a, b], per_area), &c), &u)| {
+                let v = edge_speed(u, c, self.h_m[*a as usize], self.h_m[*b as usize]);
+                v.abs() * per_area
+            })
+            .fold(0.0, f64::max);
+        fastest * dt_s / self.params.radius_m
+    }
+
+    /// One transport of `h` over `dt_s`: second-order upwind (the upwind cell's
+    /// Green–Gauss gradient carried to the edge midpoint, clamped between the two cells'
+    /// values so no new extremum appears), outflow-limited.
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
+    fn upwind_substep(&mut self, s: &mut Scratch, dt_s: f64) {
+        self.thickness_gradients(&mut s.gradient);
+        self.upwind_volumes(s, dt_s);
+        let areas = self.grid.areas_sr();
+        // Each donor's factor `budget/outflow` where it would give more than its budget
+        // (1 elsewhere: multiplying by it then changes nothing).
+        for ((ratio, a), h) in s.cell.iter_mut().zip(areas).zip(&self.h_m) {
+            let budget = MAX_OUTFLOW_FRACTION * a * h;
+            *ratio = if *ratio > budget {
+                budget / *ratio
+            } else {
+                1.0
+            };
+        }
+        let cells = &self.grid.edge_arrays().cells;
+        let per_area = self.grid.inverse_areas_per_sr();
+        for ([a, b], f) in cells.iter().zip(&s.edge2) {
+            let (a, b) = (*a as usize, *b as usize);
+            let donor = if *f >= 0.0 { a } else { b };
+            let moved = f * s.cell[donor];
+            self.h_m[a] -= moved * per_area[a];
+            self.h_m[b] += moved * per_area[b];
+        }
+    }
+
+    /// Each cell's Green–Gauss gradient of `h` on the unit sphere, per radian, projected
+    /// onto the sphere's tangent plane.
+    fn thickness_gradients(&self, gradient: &mut Vec<DVec3>) {
+        let g = &self.grid;
+        gradient.clear();
+        gradient.resize(g.cells(), DVec3::ZERO);
+        let ea = g.edge_arrays();
+        for (([a, b], normal), l) in ea.cells.iter().zip(&ea.normal).zip(&ea.length) {
+            let (a, b) = (*a as usize, *b as usize);
+            let flux = *normal * (0.5 * (self.h_m[a] + self.h_m[b]) * l);
+            gradient[a] += flux;
+            gradient[b] -= flux;
+        }
+        let per_area = g.inverse_areas_per_sr();
+        for ((grad, ia), c) in gradient.iter_mut().zip(per_area).zip(g.centres()) {
+            *grad *= *ia;
+            *grad -= *c * grad.dot(*c);
+        }
+    }
+
+    /// The volume across each edge over `dt_s` per R² (m × sr) into `s.edge2`, and each
+    /// donor's total outflow into `s.cell`.
+    fn upwind_volumes(&self, s: &mut Scratch, dt_s: f64) {
+        let dt_per_r = dt_s / self.params.radius_m;
+        let ea = self.grid.edge_arrays();
+        let (volume, outflow, gradient) = (&mut s.edge2, &mut s.cell, &s.gradient);
+        volume.clear();
+        outflow.clear();
+        outflow.resize(self.grid.cells(), 0.0);
+        let edges = ea.cells.iter().zip(&ea.reach).zip(&ea.length);
+        let speeds = self.u_m_per_s.iter().zip(&s.drain_rate);
+        for ((&u, &c), (([a, b], reach), l)) in speeds.zip(edges) {
+            let (ha, hb) = (self.h_m[*a as usize], self.h_m[*b as usize]);
+            let v = edge_speed(u, c, ha, hb);
+            let (up, down, to_edge) = if v >= 0.0 {
+                (*a, *b, reach[0])
+            } else {
+                (*b, *a, reach[1])
+            };
+            let (up, down) = (up as usize, down as usize);
+            let (h_up, h_down) = (self.h_m[up], self.h_m[down]);
+            let reach = gradient[up].dot(to_edge);
+            let h_face = (h_up + reach).clamp(h_up.min(h_down), h_up.max(h_down));
+            let f = h_face * v * l * dt_per_r;
+            volume.push(f);
+            let donor = if f >= 0.0 { *a } else { *b } as usize;
+            outflow[donor] += f.abs();
+        }
+    }
+}
+
+/// An edge's transport speed: the surfaces' `u` plus the drainage `c·h_up²`, the upwind
+/// cell chosen by the sign of the speed at the mean thickness.
+#[inline(always)]
+fn edge_speed(u: f64, c: f64, ha: f64, hb: f64) -> f64 {
+    let mean = 0.5 * (ha + hb);
+    let h = if u + c * mean * mean >= 0.0 { ha } else { hb };
+    u + c * h * h
+}
