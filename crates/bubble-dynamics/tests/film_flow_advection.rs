@@ -46,6 +46,15 @@ fn edge_pattern(f: &FilmFlow, field: impl Fn(DVec3) -> DVec3) -> Vec<f64> {
         .collect()
 }
 
+/// Each edge's weight `l·d` in the kinetic energy `Σ l d u²` (and in projections).
+fn energy_weights(f: &FilmFlow) -> Vec<f64> {
+    f.grid()
+        .edges()
+        .iter()
+        .map(|e| e.length * e.dual_length)
+        .collect()
+}
+
 /// `Σ a b w / Σ b b w`.
 fn projection(a: &[f64], b: &[f64], w: &[f64]) -> f64 {
     let num: f64 = a.iter().zip(b).zip(w).map(|((x, y), w)| x * y * w).sum();
@@ -65,12 +74,7 @@ fn pattern_turn(n: usize, m: u32, t_end: f64, steps: u32) -> (f64, f64) {
     let (vc, vs) = (velocity(cos_m, amplitude), velocity(sin_m, amplitude));
     f.set_velocity(|d| rotation(d) + vc(d));
     let (pc, ps) = (edge_pattern(&f, &vc), edge_pattern(&f, &vs));
-    let w: Vec<f64> = f
-        .grid()
-        .edges()
-        .iter()
-        .map(|e| e.length * e.dual_length)
-        .collect();
+    let w = energy_weights(&f);
     let energy = |u: &[f64]| -> f64 { u.iter().zip(&w).map(|(u, w)| u * u * w).sum() };
     let e0 = energy(f.edge_velocity_m_per_s());
     let dt = t_end / f64::from(steps);
@@ -137,12 +141,7 @@ fn a_solid_rotation_about_a_tilted_axis_keeps_its_axis_and_rate() {
     let mut f = flow(32);
     let spin = DVec3::new(1.0, 0.0, 1.0).normalize() * OMEGA_RAD_PER_S;
     f.set_velocity(|d| spin.cross(d) * RADIUS_M);
-    let w: Vec<f64> = f
-        .grid()
-        .edges()
-        .iter()
-        .map(|e| e.length * e.dual_length)
-        .collect();
+    let w = energy_weights(&f);
     // The rotation vector, read off as the amplitudes of the rotations about x, y and z.
     let axes = [DVec3::X, DVec3::Y, DVec3::Z];
     let patterns = axes.map(|a| edge_pattern(&f, |d| a.cross(d) * RADIUS_M));
