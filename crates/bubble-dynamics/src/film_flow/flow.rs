@@ -15,7 +15,9 @@
 
 use glam::DVec3;
 
+use super::advect::{AdvectionGeometry, AdvectionScratch, advect_momentum};
 use super::burst::{BurstParams, BurstState, Hole};
+use super::capillary::{Capillary, CapillaryScratch, smooth_thickness};
 use super::grid::CubeSphere;
 use super::solve::{Hierarchy, SolveReport, Work};
 use super::viscosity::viscous_bound;
@@ -99,6 +101,8 @@ pub struct Forcing {
 pub struct FilmFlow {
     pub(crate) grid: std::sync::Arc<CubeSphere>,
     pub(super) hierarchy: std::sync::Arc<Hierarchy>,
+    /// The momentum advection's weights, fixed by the grid.
+    advection: std::sync::Arc<AdvectionGeometry>,
     pub(crate) params: FlowParams,
     pub(super) burst: Option<Box<BurstState>>,
     /// The viscous operator's Gershgorin bound per unit ν/R², fixed by the grid.
@@ -133,6 +137,8 @@ pub(super) struct Scratch {
     pub(super) stage: Vec<f64>,
     /// The Marangoni system's right-hand side, then the surfactant the step ends with.
     pub(super) rhs: Vec<f64>,
+    advect: AdvectionScratch,
+    capillary: CapillaryScratch,
 }
 
 impl FilmFlow {
@@ -152,6 +158,7 @@ impl FilmFlow {
         Self {
             burst: Some(Box::new(BurstState::new(params.burst, cells, params.seed))),
             viscous_bound: viscous_bound(&grid),
+            advection: std::sync::Arc::new(AdvectionGeometry::new(&grid)),
             params,
             h_m: h,
             gamma: vec![1.0; cells],
@@ -280,6 +287,7 @@ impl FilmFlow {
         self.air_shear(&mut s, dt_s, forcing.air_m_per_s);
         let report = self.marangoni_implicit(&mut s, dt_s);
         self.transport_thickness(&mut s, dt_s, forcing.g_eff_m_per_s2);
+        self.capillary_smoothing(&mut s, dt_s);
         let evaporated = self.params.evaporation_nm_per_s * 1e-9 * dt_s;
         if evaporated > 0.0 {
             self.h_m
@@ -294,9 +302,18 @@ impl FilmFlow {
         report
     }
 
-    /// `u ← u + dt (g_t + viscous)`.
+    /// `u ← u + dt (−u·∇u + g_t + viscous)`.
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn momentum_explicit(&mut self, s: &mut Scratch, dt_s: f64, forcing: &Forcing) {
+        let r = self.params.radius_m;
+        advect_momentum(
+            &self.grid,
+            &self.advection,
+            r,
+            dt_s,
+            &mut self.u_m_per_s,
+            &mut s.advect,
+        );
         // Gravity as the discrete gradient of the potential g·x between cell centres, so
         // a discrete Marangoni gradient can balance it exactly (the edge projection g·n
         // carries an O(Δx) curl that no tension gradient can hold).
@@ -348,6 +365,23 @@ impl FilmFlow {
             *factor = 1.0 / (1.0 + dt_s * (k_out + k_in));
             *u = (*u + dt_s * k_out * outside) * *factor;
         }
+    }
+
+    /// The capillary pressure's flow relative to the surfaces (module `capillary`); none
+    /// without drainage (immobile liquid between the surfaces).
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
+    fn capillary_smoothing(&mut self, s: &mut Scratch, dt_s: f64) {
+        let p = &self.params;
+        let mu = p.drainage_viscosity_pa_s;
+        if !(mu.is_finite() && mu > 0.0 && p.burst.sigma_n_per_m > 0.0) {
+            return;
+        }
+        let c = Capillary {
+            sigma_n_per_m: p.burst.sigma_n_per_m,
+            drainage_viscosity_pa_s: mu,
+            radius_m: p.radius_m,
+        };
+        smooth_thickness(&self.grid, c, dt_s, &mut self.h_m, &mut s.capillary);
     }
 }
 

@@ -2,7 +2,9 @@
 //! than the particle mesh, moved by gravity, Marangoni stress, the sheet's viscosity,
 //! drainage, the air's shear and evaporation (docs/dynamics.md, "Film flow").
 
+mod advect;
 mod burst;
+mod capillary;
 mod cell_map;
 mod flow;
 pub mod grid;

@@ -1,0 +1,155 @@
+//! Capillary smoothing of the film's thickness: the liquid's pressure under a curved
+//! interface, `p = −(σ/2)∇²h` (each of the two interfaces sits at ±h/2 and bends by
+//! half the thickness's curvature), drives a Poiseuille flux relative to the surfaces with
+//! the drainage's own mobility, `q = −h³/(3μ_d) ∇p`, so
+//! `∂h/∂t = −(σ/(6μ_d)) ∇·(h³ ∇∇²h)`: a thickness bump of degree l on a sphere of radius R
+//! decays at `σh³(l(l+1))²/(6μ_d R⁴)`.
+//!
+//! Explicit, in sub-steps under a Gershgorin bound of the discrete operator, at most
+//! [`MAX_SUBSTEPS`] of them. The rate grows as h³: a film pooled to tens of µm at a
+//! bubble's bottom would need thousands of sub-steps, so there each edge's mobility is
+//! capped at what the sub-steps resolve. Such a film is smoothed within a step anyway;
+//! the cap only slows how fast, and films under a few µm (every film the optics colour)
+//! keep the exact law. Fluxes that sum to zero keep liquid conserved to rounding, each
+//! donor limited to half its content keeps h ≥ 0.
+
+use super::grid::CubeSphere;
+
+/// Most explicit sub-steps a film step spends on capillary smoothing.
+pub(crate) const MAX_SUBSTEPS: u32 = 64;
+
+/// Largest `sub_dt·bound` a sub-step takes. The operator is similar to a symmetric
+/// positive semi-definite one (a weighted Laplacian times a Laplacian), so its eigenvalues
+/// λ are real and ≥ 0, forward Euler is stable for `sub_dt·λ ≤ 2`, and the bound (the
+/// product of the two Laplacians' ∞-norms) is ≥ every λ; 1.8 keeps the finest mode
+/// damped.
+const STABLE_RATE_DT: f64 = 1.8;
+
+/// What the smoothing reads: the film's surface tension and the drainage's viscosity.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Capillary {
+    /// One interface's surface tension σ, N/m.
+    pub sigma_n_per_m: f64,
+    /// The drainage's effective viscosity μ_d, Pa·s (finite and positive).
+    pub drainage_viscosity_pa_s: f64,
+    /// Radius of the sphere, m.
+    pub radius_m: f64,
+}
+
+/// Buffers reused across steps.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct CapillaryScratch {
+    /// The grid's Laplacian ∞-norm on the unit sphere and the cell count it is for (it
+    /// depends on the grid alone).
+    laplacian_norm: Option<(usize, f64)>,
+    laplacian: Vec<f64>,
+    mobility: Vec<f64>,
+    flux: Vec<f64>,
+    outflow: Vec<f64>,
+}
+
+/// Moves liquid by the capillary pressure over `dt_s`; `h_m` per cell.
+pub(crate) fn smooth_thickness(
+    grid: &CubeSphere,
+    c: Capillary,
+    dt_s: f64,
+    h_m: &mut [f64],
+    s: &mut CapillaryScratch,
+) {
+    let ea = grid.edge_arrays();
+    // Per edge: h³/(3μ_d) at the mean thickness, times σ/2 (the pressure's factor).
+    s.mobility.clear();
+    s.mobility.extend(ea.cells.iter().map(|[a, b]| {
+        let h = 0.5 * (h_m[*a as usize] + h_m[*b as usize]);
+        0.5 * c.sigma_n_per_m * h * h * h / (3.0 * c.drainage_viscosity_pa_s)
+    }));
+    // Gershgorin: |∇·(M∇)| ≤ max M · |∇²| and |∇²| ≤ 2 max Σ l/(d A R²).
+    let norm = match s.laplacian_norm {
+        Some((cells, norm)) if cells == grid.cells() => norm,
+        _ => {
+            let norm = laplacian_norm(grid);
+            s.laplacian_norm = Some((grid.cells(), norm));
+            norm
+        }
+    };
+    let max_mobility = s.mobility.iter().copied().fold(0.0, f64::max);
+    let rate = max_mobility * (norm / (c.radius_m * c.radius_m)).powi(2);
+    if rate * dt_s < 1e-3 {
+        return; // a smoothing the step cannot see (every film of the optics' range)
+    }
+    let substeps = (rate * dt_s / STABLE_RATE_DT)
+        .ceil()
+        .min(f64::from(MAX_SUBSTEPS));
+    let sub_dt = dt_s / substeps;
+    if rate * sub_dt > STABLE_RATE_DT {
+        // Cap the mobility where the sub-steps cannot resolve the rate.
+        let cap = max_mobility * STABLE_RATE_DT / (rate * sub_dt);
+        s.mobility.iter_mut().for_each(|m| *m = m.min(cap));
+    }
+    for _ in 0..substeps as u32 {
+        substep(grid, c.radius_m, sub_dt, h_m, s);
+    }
+}
+
+/// The ∞-norm of the grid's Laplacian on the unit sphere, `2 max_c Σ l/(d A)`.
+fn laplacian_norm(grid: &CubeSphere) -> f64 {
+    let ea = grid.edge_arrays();
+    let mut sums = vec![0.0; grid.cells()];
+    for (([a, b], l), d) in ea.cells.iter().zip(&ea.length).zip(&ea.dual_length) {
+        sums[*a as usize] += l / d;
+        sums[*b as usize] += l / d;
+    }
+    let areas = grid.areas_sr();
+    2.0 * sums
+        .iter()
+        .zip(areas)
+        .map(|(s, a)| s / a)
+        .fold(0.0, f64::max)
+}
+
+/// One forward-Euler sub-step of `∂h/∂t = −∇·(M ∇(−∇²h))` with `s.mobility` as M.
+fn substep(grid: &CubeSphere, radius_m: f64, dt_s: f64, h_m: &mut [f64], s: &mut CapillaryScratch) {
+    let ea = grid.edge_arrays();
+    let r2 = radius_m * radius_m;
+    s.laplacian.clear();
+    s.laplacian.resize(grid.cells(), 0.0);
+    for (([a, b], l), d) in ea.cells.iter().zip(&ea.length).zip(&ea.dual_length) {
+        let (a, b) = (*a as usize, *b as usize);
+        let f = (h_m[b] - h_m[a]) * l / d;
+        s.laplacian[a] += f;
+        s.laplacian[b] -= f;
+    }
+    for (lap, area) in s.laplacian.iter_mut().zip(grid.areas_sr()) {
+        *lap /= area * r2;
+    }
+    // Volume from a to b over the sub-step, per R² (m·sr): the flux runs down the
+    // pressure −(σ/2)∇²h, i.e. up the gradient of ∇²h (the ½σ is in the mobility), so
+    // out of a bump, whose top has the lowest ∇²h.
+    s.flux.clear();
+    let edges = ea.cells.iter().zip(&ea.length).zip(&ea.dual_length);
+    s.flux
+        .extend(edges.zip(&s.mobility).map(|((([a, b], l), d), m)| {
+            let rise = s.laplacian[*b as usize] - s.laplacian[*a as usize];
+            m * rise / (d * radius_m) * l * dt_s / radius_m
+        }));
+    // Each donor gives at most half its content: h stays ≥ 0.
+    s.outflow.clear();
+    s.outflow.resize(grid.cells(), 0.0);
+    for ([a, b], f) in ea.cells.iter().zip(&s.flux) {
+        let donor = if *f >= 0.0 { *a } else { *b } as usize;
+        s.outflow[donor] += f.abs();
+    }
+    let areas = grid.areas_sr();
+    for ([a, b], f) in ea.cells.iter().zip(s.flux.iter_mut()) {
+        let donor = if *f >= 0.0 { *a } else { *b } as usize;
+        let budget = 0.5 * areas[donor] * h_m[donor];
+        if s.outflow[donor] > budget {
+            *f *= budget / s.outflow[donor];
+        }
+    }
+    for ([a, b], f) in ea.cells.iter().zip(&s.flux) {
+        let (a, b) = (*a as usize, *b as usize);
+        h_m[a] -= f / areas[a];
+        h_m[b] += f / areas[b];
+    }
+}
