@@ -14,16 +14,6 @@ struct Film {
     rest_area_m2: Vec<f64>,
 }
 
-fn face_areas_m2(x: &[DVec3], triangles: &[[u32; 3]]) -> Vec<f64> {
-    triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| x[i as usize]);
-            0.5 * (b - a).cross(c - a).length()
-        })
-        .collect()
-}
-
 /// ∂E/∂x of E = Σ 2σA + E(A − A⁰)²/(2A⁰): T ∂A/∂x with T = 2σ + E(A/A⁰ − 1), N.
 fn gradient_n(film: &Film, x: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
     let mut g = vec![DVec3::ZERO; x.len()];
@@ -109,7 +99,7 @@ fn report(name: &str, bubble: BubbleParams) {
     let film = Film {
         sigma_n_per_m: bubble.sigma_n_per_m,
         elasticity_n_per_m: bubble.gibbs_elasticity_n_per_m,
-        rest_area_m2: face_areas_m2(r.positions_m(), r.triangles()),
+        rest_area_m2: bubble_dynamics::geometry::face_areas_m2(r.positions_m(), r.triangles()),
     };
     let mut world = World::try_new(params(), vec![bubble]).expect("valid scene");
     world.step().expect("one step");

@@ -115,7 +115,7 @@ impl Bubble {
         let unit_volume = enclosed_volume_m3(unit_positions, triangles);
         let scale = params.radius_m * (4.0 / 3.0 * PI / unit_volume).cbrt();
         let rest: Vec<DVec3> = unit_positions.iter().map(|&u| u * scale).collect();
-        let rest_face_area_m2 = face_areas_m2(&rest, triangles);
+        let rest_face_area_m2 = geometry::face_areas_m2(&rest, triangles);
         let rest_area = rest_face_area_m2.iter().sum::<f64>();
         let rest_volume_m3 = enclosed_volume_m3(&rest, triangles);
         let p_in_pa = world.p_out_pa
@@ -415,20 +415,6 @@ impl Bubble {
 /// (A = 4πR², V = 4πR³/3) is Laplace's 4σ/R.
 pub fn rest_pressure_excess_pa(sigma_n_per_m: f64, area_m2: f64, volume_m3: f64) -> f64 {
     4.0 * sigma_n_per_m * area_m2 / (3.0 * volume_m3)
-}
-
-pub(crate) fn face_areas_m2(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<f64> {
-    triangles
-        .iter()
-        .map(|t| {
-            0.5 * geometry::double_area_vector(
-                positions[t[0] as usize],
-                positions[t[1] as usize],
-                positions[t[2] as usize],
-            )
-            .length()
-        })
-        .collect()
 }
 
 /// Film mass per vertex, kg: ρ·h·A in total, shared by `distribution`, modulated by a

@@ -21,6 +21,17 @@ pub fn triangle_area_gradient(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
     0.5 * n.cross(c - b)
 }
 
+/// Area of each triangle in m².
+pub fn face_areas_m2(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<f64> {
+    triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            0.5 * double_area_vector(a, b, c).length()
+        })
+        .collect()
+}
+
 /// Total area of the mesh in m².
 pub fn surface_area_m2(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
     triangles

@@ -12,21 +12,11 @@ mod common;
 use bubble_dynamics::{BubbleParams, DVec3, World, WorldParams};
 use common::{isolated, plain_bubble, world};
 
-fn face_areas_m2(x: &[DVec3], triangles: &[[u32; 3]]) -> Vec<f64> {
-    triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| x[i as usize]);
-            0.5 * (b - a).cross(c - a).length()
-        })
-        .collect()
-}
-
 /// H of bubble 0 with rest face areas `rest`, J.
 fn total_energy_j(w: &World, bubble: &BubbleParams, p_out_pa: f64, rest: &[f64]) -> f64 {
     let b = &w.bubbles()[0];
     let (sigma, e) = (bubble.sigma_n_per_m, bubble.gibbs_elasticity_n_per_m);
-    let film: f64 = face_areas_m2(b.positions_m(), b.triangles())
+    let film: f64 = bubble_dynamics::geometry::face_areas_m2(b.positions_m(), b.triangles())
         .iter()
         .zip(rest)
         .map(|(a, a0)| 2.0 * sigma * a + e * (a - a0).powi(2) / (2.0 * a0))
@@ -73,7 +63,7 @@ fn energy_excess_j(bubble: &BubbleParams, dt_s: f64, seconds: f64) -> Vec<f64> {
     };
     let rest_world = world(isolated(), vec![at_rest]);
     let rest_b = &rest_world.bubbles()[0];
-    let rest = face_areas_m2(rest_b.positions_m(), rest_b.triangles());
+    let rest = bubble_dynamics::geometry::face_areas_m2(rest_b.positions_m(), rest_b.triangles());
     let p_out = isolated().p_out_pa;
     let h_rest = total_energy_j(&rest_world, bubble, p_out, &rest);
     let mut w = world(WorldParams { dt_s, ..isolated() }, vec![bubble.clone()]);
