@@ -41,6 +41,15 @@ fn legendre(l: usize, z: f64) -> (f64, f64) {
     (p1, dp)
 }
 
+/// `P_l(z)` at each cell centre of `f`'s grid.
+fn zonal_cell_pattern(f: &FilmFlow, l: usize) -> Vec<f64> {
+    f.grid()
+        .centres()
+        .iter()
+        .map(|c| legendre(l, c.z).0)
+        .collect()
+}
+
 /// Σ a·b weighted by `w`, over `Σ b·b·w`: the amplitude of pattern `b` in `a`.
 fn projection(a: &[f64], b: &[f64], w: &[f64]) -> f64 {
     let num: f64 = a.iter().zip(b).zip(w).map(|((x, y), w)| x * y * w).sum();
@@ -108,12 +117,7 @@ fn measured_frequency(n: usize, l: usize, h_m: f64, periods: f64) -> f64 {
     let mut p = params(0.05);
     p.viscosity_pa_s = 0.0;
     let mut f = flow(n, p, |_| h_m);
-    let pattern: Vec<f64> = f
-        .grid()
-        .centres()
-        .iter()
-        .map(|c| legendre(l, c.z).0)
-        .collect();
+    let pattern = zonal_cell_pattern(&f, l);
     f.set_surfactant(|d| 1.0 + 1e-4 * legendre(l, d.z).0);
     let c = (p.elasticity_n_per_m / (p.density_kg_per_m3 * h_m)).sqrt();
     let omega = c * ((l * (l + 1)) as f64).sqrt() / p.radius_m;
@@ -349,12 +353,7 @@ fn capillary_decay(n: usize, l: usize, h0_m: f64, mu_d: f64, steps: u32) -> (f64
     let ll = (l * (l + 1)) as f64;
     let expected = sigma * h0_m.powi(3) * ll * ll / (6.0 * mu_d * r.powi(4));
     let mut f = flow(n, p, |d| h0_m * (1.0 + 0.01 * legendre(l, d.z).0));
-    let pattern: Vec<f64> = f
-        .grid()
-        .centres()
-        .iter()
-        .map(|d| legendre(l, d.z).0)
-        .collect();
+    let pattern = zonal_cell_pattern(&f, l);
     let areas = f.grid().areas_sr().to_vec();
     let amplitude = |f: &FilmFlow| {
         let dev: Vec<f64> = f.thickness_m().iter().map(|h| h / h0_m - 1.0).collect();

@@ -13,6 +13,7 @@
 //! keep the exact law. Fluxes that sum to zero keep liquid conserved to rounding, each
 //! donor limited to half its content keeps h ≥ 0.
 
+use super::flow::{apply_fluxes, limit_outflow};
 use super::grid::CubeSphere;
 
 /// Most explicit sub-steps a film step spends on capillary smoothing.
@@ -133,23 +134,6 @@ fn substep(grid: &CubeSphere, radius_m: f64, dt_s: f64, h_m: &mut [f64], s: &mut
             m * rise / (d * radius_m) * l * dt_s / radius_m
         }));
     // Each donor gives at most half its content: h stays ≥ 0.
-    s.outflow.clear();
-    s.outflow.resize(grid.cells(), 0.0);
-    for ([a, b], f) in ea.cells.iter().zip(&s.flux) {
-        let donor = if *f >= 0.0 { *a } else { *b } as usize;
-        s.outflow[donor] += f.abs();
-    }
-    let areas = grid.areas_sr();
-    for ([a, b], f) in ea.cells.iter().zip(s.flux.iter_mut()) {
-        let donor = if *f >= 0.0 { *a } else { *b } as usize;
-        let budget = 0.5 * areas[donor] * h_m[donor];
-        if s.outflow[donor] > budget {
-            *f *= budget / s.outflow[donor];
-        }
-    }
-    for ([a, b], f) in ea.cells.iter().zip(&s.flux) {
-        let (a, b) = (*a as usize, *b as usize);
-        h_m[a] -= f / areas[a];
-        h_m[b] += f / areas[b];
-    }
+    limit_outflow(grid, &mut s.flux, 1.0, h_m, &mut s.outflow);
+    apply_fluxes(grid, &s.flux, 1.0, h_m);
 }
