@@ -38,7 +38,8 @@ impl FilmFlow {
         }
     }
 
-    /// The largest fraction of a cell's width any edge's speed carries over `dt_s`.
+    /// The largest fraction of a cell's width any edge's characteristic speed, `|u|` plus
+    /// the drainage's `3|c|h²`, carries over `dt_s`.
     fn courant_number(&self, drain_rate: &[f64], dt_s: f64) -> f64 {
         let ea = self.grid.edge_arrays();
         let edges = ea
@@ -49,8 +50,8 @@ impl FilmFlow {
         let fastest = edges
             .zip(&self.u_m_per_s)
             .map(|((([a, b], per_area), &c), &u)| {
-                let v = edge_speed(u, c, self.h_m[*a as usize], self.h_m[*b as usize]);
-                v.abs() * per_area
+                let h = self.h_m[*a as usize].max(self.h_m[*b as usize]);
+                (u.abs() + 3.0 * c.abs() * h * h) * per_area
             })
             .fold(0.0, f64::max);
         fastest * dt_s / self.params.radius_m
@@ -117,30 +118,31 @@ impl FilmFlow {
         let edges = ea.cells.iter().zip(&ea.reach).zip(&ea.length);
         let speeds = self.u_m_per_s.iter().zip(&s.drain_rate);
         for ((&u, &c), (([a, b], reach), l)) in speeds.zip(edges) {
-            let (ha, hb) = (self.h_m[*a as usize], self.h_m[*b as usize]);
-            let v = edge_speed(u, c, ha, hb);
-            let (up, down, to_edge) = if v >= 0.0 {
-                (*a, *b, reach[0])
-            } else {
-                (*b, *a, reach[1])
+            let (a, b) = (*a as usize, *b as usize);
+            let face = |forward: bool| {
+                let (up, down, to_edge) = if forward {
+                    (a, b, reach[0])
+                } else {
+                    (b, a, reach[1])
+                };
+                let (h_up, h_down) = (self.h_m[up], self.h_m[down]);
+                let reach = gradient[up].dot(to_edge);
+                (h_up + reach).clamp(h_up.min(h_down), h_up.max(h_down))
             };
-            let (up, down) = (up as usize, down as usize);
-            let (h_up, h_down) = (self.h_m[up], self.h_m[down]);
-            let reach = gradient[up].dot(to_edge);
-            let h_face = (h_up + reach).clamp(h_up.min(h_down), h_up.max(h_down));
-            let f = h_face * v * l * dt_per_r;
+            // Each part upwind along its own characteristic: the surfaces carry h at u,
+            // the drainage flux c·h³ travels at 3c·h², the sign of c. One upwind choice by
+            // the sign of the summed speed runs downwind wherever the surfaces move up
+            // against a film that drains down, and grew odd-even stripes there.
+            let h_plug = face(u >= 0.0);
+            let h_drain = if (c >= 0.0) == (u >= 0.0) {
+                h_plug
+            } else {
+                face(c >= 0.0)
+            };
+            let f = (u * h_plug + c * h_drain * h_drain * h_drain) * l * dt_per_r;
             volume.push(f);
-            let donor = if f >= 0.0 { *a } else { *b } as usize;
+            let donor = if f >= 0.0 { a } else { b };
             outflow[donor] += f.abs();
         }
     }
-}
-
-/// An edge's transport speed: the surfaces' `u` plus the drainage `c·h_up²`, the upwind
-/// cell chosen by the sign of the speed at the mean thickness.
-#[inline(always)]
-fn edge_speed(u: f64, c: f64, ha: f64, hb: f64) -> f64 {
-    let mean = 0.5 * (ha + hb);
-    let h = if u + c * mean * mean >= 0.0 { ha } else { hb };
-    u + c * h * h
 }
