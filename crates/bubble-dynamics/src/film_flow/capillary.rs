@@ -44,7 +44,6 @@ pub(crate) struct CapillaryScratch {
     /// depends on the grid alone).
     laplacian_norm: Option<(usize, f64)>,
     laplacian: Vec<f64>,
-    mobility: Vec<f64>,
     flux: Vec<f64>,
     outflow: Vec<f64>,
 }
@@ -57,13 +56,8 @@ pub(crate) fn smooth_thickness(
     h_m: &mut [f64],
     s: &mut CapillaryScratch,
 ) {
-    let ea = grid.edge_arrays();
-    // Per edge: h³/(3μ_d) at the mean thickness, times σ/2 (the pressure's factor).
-    s.mobility.clear();
-    s.mobility.extend(ea.cells.iter().map(|[a, b]| {
-        let h = 0.5 * (h_m[*a as usize] + h_m[*b as usize]);
-        0.5 * c.sigma_n_per_m * h * h * h / (3.0 * c.drainage_viscosity_pa_s)
-    }));
+    // h³/(3μ_d) times σ/2 (the pressure's factor), per m³ of h³.
+    let per_cubed = 0.5 * c.sigma_n_per_m / (3.0 * c.drainage_viscosity_pa_s);
     // Gershgorin: |∇·(M∇)| ≤ max M · |∇²| and |∇²| ≤ 2 max Σ l/(d A R²).
     let norm = match s.laplacian_norm {
         Some((cells, norm)) if cells == grid.cells() => norm,
@@ -73,7 +67,8 @@ pub(crate) fn smooth_thickness(
             norm
         }
     };
-    let max_mobility = s.mobility.iter().copied().fold(0.0, f64::max);
+    let thickest = h_m.iter().copied().fold(0.0, f64::max);
+    let max_mobility = per_cubed * thickest * thickest * thickest;
     let rate = max_mobility * (norm / (c.radius_m * c.radius_m)).powi(2);
     if rate * dt_s < 1e-3 {
         return; // a smoothing the step cannot see (every film of the optics' range)
@@ -82,13 +77,11 @@ pub(crate) fn smooth_thickness(
         .ceil()
         .min(f64::from(MAX_SUBSTEPS));
     let sub_dt = dt_s / substeps;
-    if rate * sub_dt > STABLE_RATE_DT {
-        // Cap the mobility where the sub-steps cannot resolve the rate.
-        let cap = max_mobility * STABLE_RATE_DT / (rate * sub_dt);
-        s.mobility.iter_mut().for_each(|m| *m = m.min(cap));
-    }
+    // Cap the mobility where the sub-steps cannot resolve the rate.
+    let cap = max_mobility * (STABLE_RATE_DT / (rate * sub_dt)).min(1.0);
+    let mobility = Mobility { per_cubed, cap };
     for _ in 0..substeps as u32 {
-        substep(grid, c.radius_m, sub_dt, h_m, s);
+        substep(grid, c.radius_m, mobility, sub_dt, h_m, s);
     }
 }
 
@@ -108,8 +101,22 @@ fn laplacian_norm(grid: &CubeSphere) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// One forward-Euler sub-step of `∂h/∂t = −∇·(M ∇(−∇²h))` with `s.mobility` as M.
-fn substep(grid: &CubeSphere, radius_m: f64, dt_s: f64, h_m: &mut [f64], s: &mut CapillaryScratch) {
+/// An edge's mobility `M = per_cubed·h³` at its donor's thickness, at most `cap`.
+#[derive(Clone, Copy, Debug)]
+struct Mobility {
+    per_cubed: f64,
+    cap: f64,
+}
+
+/// One forward-Euler sub-step of `∂h/∂t = −∇·(M ∇(−∇²h))`.
+fn substep(
+    grid: &CubeSphere,
+    radius_m: f64,
+    mobility: Mobility,
+    dt_s: f64,
+    h_m: &mut [f64],
+    s: &mut CapillaryScratch,
+) {
     let ea = grid.edge_arrays();
     let r2 = radius_m * radius_m;
     s.laplacian.clear();
@@ -126,13 +133,21 @@ fn substep(grid: &CubeSphere, radius_m: f64, dt_s: f64, h_m: &mut [f64], s: &mut
     // Volume from a to b over the sub-step, per R² (m·sr): the flux runs down the
     // pressure −(σ/2)∇²h, i.e. up the gradient of ∇²h (the ½σ is in the mobility), so
     // out of a bump, whose top has the lowest ∇²h.
+    //
+    // The mobility is the donor's h³ (the cell the liquid leaves), not the edge's mean:
+    // the fourth-order flow has no maximum principle, and beside a pool tens of µm thick
+    // a mean-thickness mobility drew liquid out of the thin film one cell further at the
+    // pool's rate, emptying it in a step (bubbles resting on the ground burst within a
+    // second). At the donor's, a thin cell gives at its own slow rate.
     s.flux.clear();
     let edges = ea.cells.iter().zip(&ea.length).zip(&ea.dual_length);
-    s.flux
-        .extend(edges.zip(&s.mobility).map(|((([a, b], l), d), m)| {
-            let rise = s.laplacian[*b as usize] - s.laplacian[*a as usize];
-            m * rise / (d * radius_m) * l * dt_s / radius_m
-        }));
+    s.flux.extend(edges.map(|(([a, b], l), d)| {
+        let (a, b) = (*a as usize, *b as usize);
+        let rise = s.laplacian[b] - s.laplacian[a];
+        let donor = h_m[if rise >= 0.0 { a } else { b }];
+        let m = (mobility.per_cubed * donor * donor * donor).min(mobility.cap);
+        m * rise / (d * radius_m) * l * dt_s / radius_m
+    }));
     // Each donor gives at most half its content: h stays ≥ 0.
     limit_outflow(grid, &mut s.flux, 1.0, h_m, &mut s.outflow);
     apply_fluxes(grid, &s.flux, 1.0, h_m);

@@ -130,6 +130,10 @@ pub(super) struct Scratch {
     pub(super) stiffness: Vec<f64>,
     pub(super) guess: Vec<f64>,
     pub(super) gradient: Vec<DVec3>,
+    /// Per cell: the least and greatest thickness of the cell and its edge neighbours.
+    pub(super) neighbour_range: Vec<[f64; 2]>,
+    /// Per cell: the factor its thickness gradient is limited by.
+    pub(super) limiter: Vec<f64>,
     pub(super) drag: Vec<f64>,
     /// Per edge: the drainage speed's coefficient over `h²`, s⁻¹·m⁻¹.
     pub(super) drain_rate: Vec<f64>,
