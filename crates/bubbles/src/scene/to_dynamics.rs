@@ -119,9 +119,23 @@ impl Scene {
     }
 }
 
+/// A scene bubble's film-flow grid when its entry gives none: every bubble's film flows
+/// unless its scene says `film_grid = 0`. 6 × 32² cells resolve a 5 cm bubble's film at
+/// 2.5 mm, and a step costs about a sixth of n = 64's (docs/dynamics.md, "Film flow").
+pub(crate) const SCENE_FILM_GRID: u32 = 32;
+
+/// A flowing film's drainage viscosity when its entry gives none, Pa·s. The per-vertex
+/// film's 5e-8 stands for the whole film sliding down, its surfaces too; the flow moves
+/// the surfaces itself, so only the liquid's drainage between them is left. At 5e-8 the
+/// flow drained every scene bubble's liquid into a pool tens of µm thick at its bottom
+/// within two seconds, and its steps then ran at their sub-step limits (8 s of `paper`
+/// took 49 s, against 6 s at this value); `swirl`'s colour bands drain at it over its 12 s.
+pub(crate) const FLOW_DRAINAGE_VISCOSITY_PA_S: f64 = 1e-6;
+
 /// The solver's parameters for one bubble of the scene file.
 pub(crate) fn bubble_params(spec: &BubbleSpec) -> BubbleParams {
     let defaults = BubbleParams::default();
+    let film_grid = spec.film_grid.map_or(SCENE_FILM_GRID, |v| v.get());
     BubbleParams {
         center_m: dvec(spec.center_m.get()),
         velocity_m_per_s: dvec(spec.velocity_m_per_s.get()),
@@ -141,7 +155,11 @@ pub(crate) fn bubble_params(spec: &BubbleSpec) -> BubbleParams {
         ),
         drainage_viscosity_pa_s: or(
             spec.drainage_viscosity_pa_s.map(|v| v.get()),
-            defaults.drainage_viscosity_pa_s,
+            if film_grid > 0 {
+                FLOW_DRAINAGE_VISCOSITY_PA_S
+            } else {
+                defaults.drainage_viscosity_pa_s
+            },
         ),
         rupture_thickness_nm: or(
             spec.rupture_thickness_nm.map(|v| v.get()),
@@ -166,7 +184,7 @@ pub(crate) fn bubble_params(spec: &BubbleSpec) -> BubbleParams {
         initial_scale: spec
             .initial_scale
             .map_or(defaults.initial_scale, |v| dvec(v.get())),
-        film_grid: spec.film_grid.map_or(defaults.film_grid, |v| v.get()),
+        film_grid,
         film_viscosity_pa_s: or(
             spec.film_viscosity_pa_s.map(|v| v.get()),
             defaults.film_viscosity_pa_s,
