@@ -72,10 +72,16 @@ fn export_film_writes_the_cube_map_field_of_each_frame() {
 #[test]
 fn export_film_without_a_film_flow_exits_2_naming_film_grid() {
     let dir = tempfile::tempdir().unwrap();
+    // Scene bubbles flow by default; this one asks for the per-vertex film.
+    std::fs::write(
+        dir.path().join("still.toml"),
+        SCENE.replace("film_grid = 16", "film_grid = 0"),
+    )
+    .unwrap();
     let out = bubbles(
         &[
             "simulate",
-            "paper",
+            "still.toml",
             "--seconds",
             "0.1",
             "--export-film",

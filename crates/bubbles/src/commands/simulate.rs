@@ -27,7 +27,8 @@ const ABOUT_OUTPUT: &str = "Simulates the scene's bubbles (seed 000 §3: film te
     each vertex line is `v x y z r g b` with r = g = b = thickness / 4000 nm (clamped to 1), the \
     vertex-colour extension that Blender, MeshLab and most OBJ readers import as a colour \
     attribute, and the exact thicknesses follow as `#thickness_nm` comment lines, in vertex \
-    order. Files are written to a temporary name in DIR, then renamed.\n\n\
+    order (with a film flow, its field sampled where each vertex sits, as the renderers \
+    sample it). Files are written to a temporary name in DIR, then renamed.\n\n\
     --export-film DIR writes, at the same frames, DIR/film_<id>_00000.exr, … for every bubble \
     with a film flow (`film_grid` > 0): the film's cube-sphere grid as a 32-bit float EXR of \
     6n × n pixels, the faces side by side in OpenGL cube-map order (+X, −X, +Y, −Y, +Z, −Z; \
@@ -231,9 +232,23 @@ pub fn obj_text(world: &World, frame: usize) -> String {
     out
 }
 
+/// Each vertex's film thickness, nm: with a film flow, its field where the vertex sits
+/// (as the renderers sample it, stretch included); else the per-vertex film's.
+fn vertex_thickness_nm(bubble: &Bubble) -> Vec<f64> {
+    match crate::scene::bubble_film(bubble) {
+        Some(film) => film
+            .material_dirs
+            .iter()
+            .map(|d| f64::from(film.field.sample(*d).thickness_nm))
+            .collect(),
+        None => bubble.thickness_nm().to_vec(),
+    }
+}
+
 fn write_bubble(out: &mut String, bubble: &Bubble, base: usize) {
     let _ = writeln!(out, "o bubble_{}", bubble.id());
-    for (x, d) in bubble.positions_m().iter().zip(bubble.thickness_nm()) {
+    let thickness_nm = vertex_thickness_nm(bubble);
+    for (x, d) in bubble.positions_m().iter().zip(&thickness_nm) {
         let c = (d / OBJ_FULL_SCALE_NM).min(1.0);
         let _ = writeln!(
             out,
@@ -244,7 +259,7 @@ fn write_bubble(out: &mut String, bubble: &Bubble, base: usize) {
     for n in bubble.vertex_normals() {
         let _ = writeln!(out, "vn {:.6} {:.6} {:.6}", n.x, n.y, n.z);
     }
-    for chunk in bubble.thickness_nm().chunks(16) {
+    for chunk in thickness_nm.chunks(16) {
         let values: Vec<String> = chunk.iter().map(|d| format!("{d:.4}")).collect();
         let _ = writeln!(out, "#thickness_nm {}", values.join(" "));
     }

@@ -6,6 +6,7 @@ mod film;
 pub mod schema;
 mod to_dynamics;
 mod to_raster;
+pub(crate) use to_raster::bubble_film;
 mod to_reference;
 mod to_water;
 pub mod values;

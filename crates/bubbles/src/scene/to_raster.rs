@@ -174,7 +174,7 @@ pub fn bubble_meshes(world: &World) -> Vec<BubbleMesh> {
 /// The renderers' view of a bubble's film flow: its grid as a cube-map field (thickness
 /// clamped to the field's range, as the film tables clamp it) and each vertex's material
 /// direction.
-fn bubble_film(b: &bubble_dynamics::Bubble) -> Option<BubbleFilm> {
+pub(crate) fn bubble_film(b: &bubble_dynamics::Bubble) -> Option<BubbleFilm> {
     let field = b.film_field()?;
     let dirs = b.material_dirs()?;
     let max = raster::MAX_FILM_THICKNESS_NM;
