@@ -213,7 +213,7 @@ fn figures() -> bool {
 }
 
 /// The swirl scene's burst in slow motion (docs/gallery.md): an animated PNG 200× slower
-/// than real time from just before the hole opens (t = 12.4333 s) until the bubble is
+/// than real time from just before the hole opens (t = 12.4833 s) until the bubble is
 /// gone, and two larger stills 1 ms apart taken as the frames of a second animation.
 fn swirl_burst(dir: &str, bubbles: &dyn Fn(&[&str]) -> bool) -> bool {
     let movie = format!("{dir}/swirl_burst.apng");
@@ -221,7 +221,7 @@ fn swirl_burst(dir: &str, bubbles: &dyn Fn(&[&str]) -> bool) -> bool {
         "animate",
         "swirl",
         "--start-s",
-        "12.433",
+        "12.483",
         "--seconds",
         "0.008",
         "--fps",
@@ -243,7 +243,7 @@ fn swirl_burst(dir: &str, bubbles: &dyn Fn(&[&str]) -> bool) -> bool {
         "animate",
         "swirl",
         "--start-s",
-        "12.435",
+        "12.485",
         "--seconds",
         "0.002",
         "--fps",
@@ -257,7 +257,7 @@ fn swirl_burst(dir: &str, bubbles: &dyn Fn(&[&str]) -> bool) -> bool {
         "--height",
         "480",
     ]);
-    for (k, time_s) in [(0, "12.435"), (1, "12.436")] {
+    for (k, time_s) in [(0, "12.485"), (1, "12.486")] {
         let from = frames.join(format!("frame_{k:05}.png"));
         let to = root.join(format!("{dir}/swirl_burst_t{time_s}.png"));
         ok &= std::fs::copy(from, to).is_ok();
