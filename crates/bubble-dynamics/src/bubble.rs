@@ -214,12 +214,6 @@ impl Bubble {
         self.grid_film.as_ref().map(|g| &g.flow)
     }
 
-    /// Wall time this bubble's film flow has spent in its steps so far, s (0 without a
-    /// film flow): a measurement for benches; the simulation never reads it.
-    pub fn film_step_time_s(&self) -> f64 {
-        self.grid_film.as_ref().map_or(0.0, |g| g.step_time_s)
-    }
-
     /// The film's thickness field for renderers, when the bubble has a film flow.
     pub fn film_field(&self) -> Option<FilmField> {
         self.grid_film.as_ref().map(|g| FilmField {

@@ -67,6 +67,9 @@ pub struct World {
     failed: Option<SimError>,
     /// The id the next added bubble gets (ids are never reused).
     next_id: u64,
+    /// Wall time of the steps' film stages while some bubble's film flows, s: a
+    /// measurement for `bubbles bench`, never read by the simulation.
+    film_wall_s: f64,
 }
 
 impl Clone for World {
@@ -84,6 +87,7 @@ impl Clone for World {
             last_substeps: self.last_substeps,
             failed: self.failed.clone(),
             next_id: self.next_id,
+            film_wall_s: self.film_wall_s,
         }
     }
 }
@@ -135,6 +139,7 @@ impl World {
             last_substeps: 0,
             failed: None,
             next_id,
+            film_wall_s: 0.0,
         })
     }
 
@@ -156,6 +161,12 @@ impl World {
     /// The fixed step, s.
     pub fn dt_s(&self) -> f64 {
         self.params.dt_s
+    }
+
+    /// Wall time the steps' film stages have taken while some bubble's film flows, s
+    /// (the bubbles' films step in parallel: this is what they add to a step).
+    pub fn film_wall_time_s(&self) -> f64 {
+        self.film_wall_s
     }
 
     /// Substeps the last step used.
@@ -295,7 +306,9 @@ impl World {
                 )
             })
             .collect();
-        let parallel = parallel || self.bubbles.iter().any(|b| b.grid_film.is_some());
+        let flowing = self.bubbles.iter().any(|b| b.grid_film.is_some());
+        let parallel = parallel || flowing;
+        let film_start = std::time::Instant::now();
         for_each_bubble(&mut self.bubbles, &mut slots, parallel, |b, (v0, air)| {
             let acceleration = (b.velocity_m_per_s() - *v0) / dt;
             match b.grid_film.as_mut() {
@@ -310,6 +323,9 @@ impl World {
                 None => b.transport_film(gravity - acceleration, dt, t0),
             }
         });
+        if flowing {
+            self.film_wall_s += film_start.elapsed().as_secs_f64();
+        }
         Ok(self.remove_burst(step))
     }
 

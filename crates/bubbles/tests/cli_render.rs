@@ -255,6 +255,13 @@ fn bench_shows_the_film_steps_and_the_bake_as_their_own_columns() {
     std::fs::write(dir.path().join("still.toml"), paper).unwrap();
     let (_, film_free, bake_meshes) = column("still.toml");
     assert_eq!(film_free, 0.0);
+    // Two bubbles' films step in parallel: the column is their wall time, within the
+    // simulation's (a sum of each bubble's time exceeded it on two threads).
+    let (sim, film, _) = column("paper");
+    assert!(
+        film > 0.0 && film <= sim,
+        "paper: film {film} ms, simulation {sim} ms"
+    );
     let (sim, film, bake_field) = column("swirl");
     assert!(
         film > 0.0 && film <= sim,

@@ -23,9 +23,6 @@ pub(crate) struct GridFilm {
     pending_forcing: Forcing,
     /// How far into the world step under way the rims have been advanced, s.
     rim_ahead_s: f64,
-    /// Wall time spent in the flow's steps so far, s: a measurement for `bubbles bench`,
-    /// never read by the simulation.
-    pub(crate) step_time_s: f64,
 }
 
 impl GridFilm {
@@ -51,7 +48,6 @@ impl GridFilm {
             pending_s: 0.0,
             pending_forcing: Forcing::default(),
             rim_ahead_s: 0.0,
-            step_time_s: 0.0,
         }
     }
 
@@ -71,9 +67,7 @@ impl GridFilm {
                 g_eff_m_per_s2: self.pending_forcing.g_eff_m_per_s2 / t,
                 air_m_per_s: self.pending_forcing.air_m_per_s / t,
             };
-            let start = std::time::Instant::now();
             self.flow.step(t, &mean);
-            self.step_time_s += start.elapsed().as_secs_f64();
             self.pending_s = 0.0;
             self.pending_forcing = Forcing::default();
         }

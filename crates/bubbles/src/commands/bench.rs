@@ -101,8 +101,7 @@ fn time_frames(job: &mut FrameJob, frames: u32) -> Result<Breakdown, CliError> {
         let start = Instant::now();
         job.step()?;
         let sim = start.elapsed().as_secs_f64();
-        // A bubble that burst this frame takes its clock with it: never below zero.
-        sum.film_s += (film_step_time_s(job) - film_before).max(0.0);
+        sum.film_s += film_step_time_s(job) - film_before;
         let t = job.render()?.timings;
         let total = start.elapsed().as_secs_f64();
         let bake = job.last_bake_s();
@@ -127,13 +126,11 @@ fn time_frames(job: &mut FrameJob, frames: u32) -> Result<Breakdown, CliError> {
     })
 }
 
-/// Wall time all living bubbles' film flows have spent stepping, s.
+/// Wall time the world's film stages have taken, s (its bubbles' flows step in
+/// parallel: summing each bubble's own time counted them twice on two threads, and the
+/// column then exceeded the simulation it is part of).
 fn film_step_time_s(job: &FrameJob) -> f64 {
-    job.world()
-        .bubbles()
-        .iter()
-        .map(|b| b.film_step_time_s())
-        .sum()
+    job.world().film_wall_time_s()
 }
 
 fn parse_size(s: &str) -> Result<(usize, usize), String> {
