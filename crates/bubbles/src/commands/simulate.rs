@@ -405,7 +405,7 @@ impl Report {
             );
         }
         if self.frames_written > 0 {
-            let _ = writeln!(out, "wrote {} OBJ frames", self.frames_written);
+            let _ = writeln!(out, "wrote {} export frames", self.frames_written);
         }
         out
     }
