@@ -269,11 +269,11 @@ impl FrameJob {
 
     /// The scene's first bubble (a template for blowing new ones), if it has any.
     pub fn bubble_template(&self) -> Option<BubbleParams> {
-        self.scene
-            .file
-            .bubbles
+        let bubbles = &self.scene.file.bubbles;
+        let grid = crate::scene::default_film_grid(bubbles);
+        bubbles
             .first()
-            .map(crate::scene::bubble_params)
+            .map(|b| crate::scene::bubble_params(b, grid))
     }
 
     /// The camera in force.

@@ -15,8 +15,8 @@ use crate::error::CliError;
 pub use check::{check_memory, check_spectrum_file};
 use schema::SceneFile;
 use std::path::{Path, PathBuf};
-pub(crate) use to_dynamics::bubble_params;
 pub use to_dynamics::sim_error;
+pub(crate) use to_dynamics::{bubble_params, default_film_grid};
 pub use to_raster::bubble_meshes;
 
 /// Built-in scenes, by name, with their TOML source.

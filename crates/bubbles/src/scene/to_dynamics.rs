@@ -12,7 +12,13 @@ impl Scene {
     /// Builds the solver's world: the bubbles, the ground, box/sphere objects and the
     /// water's rest plane as colliders.
     pub fn dynamics_world(&self) -> Result<World, CliError> {
-        let bubbles = self.file.bubbles.iter().map(bubble_params).collect();
+        let grid = default_film_grid(&self.file.bubbles);
+        let bubbles = self
+            .file
+            .bubbles
+            .iter()
+            .map(|b| bubble_params(b, grid))
+            .collect();
         World::try_new(self.world_params()?, bubbles).map_err(|e| {
             let message = scene_names(&e.to_string(), &self.collider_names());
             CliError::input(format!("{}: {message}", self.origin))
@@ -132,10 +138,31 @@ pub(crate) const SCENE_FILM_GRID: u32 = 32;
 /// took 49 s, against 6 s at this value); `swirl`'s colour bands drain at it over its 12 s.
 pub(crate) const FLOW_DRAINAGE_VISCOSITY_PA_S: f64 = 1e-6;
 
-/// The solver's parameters for one bubble of the scene file.
-pub(crate) fn bubble_params(spec: &BubbleSpec) -> BubbleParams {
+/// The film grid of the scene's bubbles that give none: [`SCENE_FILM_GRID`], or the
+/// largest of 16 and 8 that keeps the scene's film cells (those given included) within
+/// the limit, or 0 (the per-vertex film) when even 8 would not. A scene of many bubbles
+/// written before films flowed then still loads: at 32 a 257-bubble scene would
+/// have gone over the limit.
+pub(crate) fn default_film_grid(bubbles: &[BubbleSpec]) -> u32 {
+    let cells = |n: u32| 6 * (n as usize).pow(2);
+    let given: usize = bubbles
+        .iter()
+        .filter_map(|b| b.film_grid)
+        .map(|n| cells(n.get()))
+        .sum();
+    let defaulted = bubbles.iter().filter(|b| b.film_grid.is_none()).count();
+    let room = crate::limits::MAX_FILM_CELLS.saturating_sub(given);
+    [SCENE_FILM_GRID, 16, 8]
+        .into_iter()
+        .find(|&n| defaulted * cells(n) <= room)
+        .unwrap_or(0)
+}
+
+/// The solver's parameters for one bubble of the scene file, `default_grid` its film
+/// grid if it gives none ([`default_film_grid`]).
+pub(crate) fn bubble_params(spec: &BubbleSpec, default_grid: u32) -> BubbleParams {
     let defaults = BubbleParams::default();
-    let film_grid = spec.film_grid.map_or(SCENE_FILM_GRID, |v| v.get());
+    let film_grid = spec.film_grid.map_or(default_grid, |v| v.get());
     BubbleParams {
         center_m: dvec(spec.center_m.get()),
         velocity_m_per_s: dvec(spec.velocity_m_per_s.get()),
@@ -281,6 +308,49 @@ pub fn sim_error(scene: &Scene, error: SimError) -> CliError {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A scene of `count` bubbles 12 cm apart on a row, `extra` added to each entry.
+    fn row_of_bubbles(count: usize, extra: &str) -> Scene {
+        let mut text =
+            String::from("[camera]\neye_m = [0.0, 0.5, 2.0]\ntarget_m = [0.0, 0.5, 0.0]\n");
+        for k in 0..count {
+            text.push_str(&format!(
+                "[[bubbles]]\ncenter_m = [{}, 0.5, 0.0]\nradius_m = 0.05\n{extra}\n",
+                0.12 * k as f64
+            ));
+        }
+        Scene::from_toml_str(&text, "test", std::path::Path::new(".")).unwrap()
+    }
+
+    /// Regression: at a fixed default of 32, a scene of 257 or more bubbles that gives no
+    /// film grid, valid before films flowed, would hold more film cells than the limit.
+    #[test]
+    fn many_bubbles_without_a_film_grid_get_a_coarser_one_within_the_limit() {
+        let grid = |count: usize, extra: &str| {
+            default_film_grid(&row_of_bubbles(count, extra).file.bubbles)
+        };
+        assert_eq!(grid(2, ""), SCENE_FILM_GRID);
+        assert_eq!(grid(256, ""), 32);
+        assert_eq!(grid(257, ""), 16);
+        assert_eq!(grid(1000, ""), 16);
+        // Grids given count against the limit first: three at 256 leave room for 300
+        // bubbles at 8 but not at 16; four leave none.
+        let mixed = |given: usize| {
+            let mut bubbles = row_of_bubbles(given, "film_grid = 256").file.bubbles;
+            bubbles.extend(row_of_bubbles(300, "").file.bubbles);
+            default_film_grid(&bubbles)
+        };
+        assert_eq!(mixed(3), 8);
+        assert_eq!(mixed(4), 0);
+        let world = row_of_bubbles(300, "").dynamics_world().unwrap();
+        let cells: usize = world
+            .bubbles()
+            .iter()
+            .map(|b| b.film_flow().map_or(0, |f| f.grid().cells()))
+            .sum();
+        assert!(cells <= crate::limits::MAX_FILM_CELLS, "{cells} film cells");
+        assert!(cells > 0, "no bubble's film flows");
+    }
 
     #[test]
     fn solver_names_become_the_scene_names() {
