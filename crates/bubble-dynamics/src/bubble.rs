@@ -254,7 +254,9 @@ impl Bubble {
         &self.topology
     }
 
-    /// Film thickness at each vertex, nm, as of the end of the last step.
+    /// Film thickness at each vertex, nm, as of the end of the last step: the per-vertex
+    /// film's. A bubble with a film flow keeps this as its flow started it (stretched
+    /// with the mesh); its flowing film is [`Bubble::film_field`].
     pub fn thickness_nm(&self) -> &[f64] {
         &self.thickness_nm
     }

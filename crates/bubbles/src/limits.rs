@@ -45,6 +45,11 @@ pub const MAX_BUBBLE_VERTICES: usize = 1_000_000;
 /// multigrid levels and the scratch: 0.6 GB at the limit).
 pub const MAX_FILM_CELLS: usize = 6 * 512 * 512;
 
+/// Film-flow cells of one bubble's grid of `film_grid` cells a face side.
+pub fn film_cells(film_grid: u32) -> usize {
+    6 * (film_grid as usize).pow(2)
+}
+
 /// Opaque objects (spheres, boxes, meshes) in one scene.
 pub const MAX_OBJECTS: usize = 1000;
 

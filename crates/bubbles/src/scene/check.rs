@@ -30,12 +30,7 @@ impl Scene {
                 limits::MAX_BUBBLE_VERTICES
             )));
         }
-        let film_cells: usize = f
-            .bubbles
-            .iter()
-            .filter_map(|b| b.film_grid)
-            .map(|n| 6 * (n.get() as usize).pow(2))
-            .sum();
+        let film_cells = super::to_dynamics::given_film_cells(&f.bubbles);
         if film_cells > limits::MAX_FILM_CELLS {
             return Err(self.error(format!(
                 "the bubbles' film grids have {film_cells} cells in all, above the limit of {} (lower film_grid; see --help)",

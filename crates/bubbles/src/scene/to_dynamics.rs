@@ -4,6 +4,7 @@ use super::Scene;
 use super::schema::{BubbleSpec, ObjectSpec};
 use super::values::{numbers, plain};
 use crate::error::CliError;
+use crate::limits;
 use bubble_dynamics::{
     BubbleParams, Collider, DVec3, Gusts, Integrator, SimError, Wind, World, WorldParams,
 };
@@ -144,18 +145,21 @@ pub(crate) const FLOW_DRAINAGE_VISCOSITY_PA_S: f64 = 1e-6;
 /// written before films flowed then still loads: at 32 a 257-bubble scene would
 /// have gone over the limit.
 pub(crate) fn default_film_grid(bubbles: &[BubbleSpec]) -> u32 {
-    let cells = |n: u32| 6 * (n as usize).pow(2);
-    let given: usize = bubbles
-        .iter()
-        .filter_map(|b| b.film_grid)
-        .map(|n| cells(n.get()))
-        .sum();
     let defaulted = bubbles.iter().filter(|b| b.film_grid.is_none()).count();
-    let room = crate::limits::MAX_FILM_CELLS.saturating_sub(given);
+    let room = limits::MAX_FILM_CELLS.saturating_sub(given_film_cells(bubbles));
     [SCENE_FILM_GRID, 16, 8]
         .into_iter()
-        .find(|&n| defaulted * cells(n) <= room)
+        .find(|&n| defaulted * limits::film_cells(n) <= room)
         .unwrap_or(0)
+}
+
+/// Film-flow cells of the bubbles that give their `film_grid`, summed.
+pub(crate) fn given_film_cells(bubbles: &[BubbleSpec]) -> usize {
+    bubbles
+        .iter()
+        .filter_map(|b| b.film_grid)
+        .map(|n| limits::film_cells(n.get()))
+        .sum()
 }
 
 /// The solver's parameters for one bubble of the scene file, `default_grid` its film
@@ -348,7 +352,7 @@ mod tests {
             .iter()
             .map(|b| b.film_flow().map_or(0, |f| f.grid().cells()))
             .sum();
-        assert!(cells <= crate::limits::MAX_FILM_CELLS, "{cells} film cells");
+        assert!(cells <= limits::MAX_FILM_CELLS, "{cells} film cells");
         assert!(cells > 0, "no bubble's film flows");
     }
 
