@@ -7,7 +7,7 @@ use std::f64::consts::TAU;
 use glam::DVec3;
 
 use crate::bubble::{Bubble, Scratch};
-use crate::geometry::double_area_vector;
+use crate::geometry::face_areas_into;
 use crate::params::BubbleParams;
 use crate::rng::SplitMix64;
 
@@ -244,15 +244,6 @@ impl Bubble {
             *m = (*m - rate * a * dt_s).max(0.0);
         }
     }
-}
-
-/// Face areas, m², into `out`.
-fn face_areas_into(positions: &[DVec3], triangles: &[[u32; 3]], out: &mut Vec<f64>) {
-    out.clear();
-    out.extend(triangles.iter().map(|t| {
-        let [a, b, c] = t.map(|i| positions[i as usize]);
-        0.5 * double_area_vector(a, b, c).length()
-    }));
 }
 
 /// Barycentric vertex areas from face areas into `out`: a third of each face to each

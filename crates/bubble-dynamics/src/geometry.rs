@@ -23,13 +23,18 @@ pub fn triangle_area_gradient(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
 
 /// Area of each triangle in m².
 pub fn face_areas_m2(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<f64> {
-    triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| positions[i as usize]);
-            0.5 * double_area_vector(a, b, c).length()
-        })
-        .collect()
+    let mut out = Vec::with_capacity(triangles.len());
+    face_areas_into(positions, triangles, &mut out);
+    out
+}
+
+/// Area of each triangle in m², into `out` (its buffer reused).
+pub(crate) fn face_areas_into(positions: &[DVec3], triangles: &[[u32; 3]], out: &mut Vec<f64>) {
+    out.clear();
+    out.extend(triangles.iter().map(|t| {
+        let [a, b, c] = t.map(|i| positions[i as usize]);
+        0.5 * double_area_vector(a, b, c).length()
+    }));
 }
 
 /// Total area of the mesh in m².
