@@ -7,7 +7,7 @@ use glam::DVec3;
 
 use crate::film::Slosh;
 use crate::film_flow::on_bubble::GridFilm;
-use crate::film_flow::{BurstParams, FilmFlow, FlowParams};
+use crate::film_flow::{BurstParams, FilmFlow, FlowParams, ThermalParams};
 use crate::geometry::{self, barycentric_vertex_areas_m2, enclosed_volume_m3, surface_area_m2};
 use crate::params::{BubbleParams, GAS_CONSTANT_J_PER_MOL_K, MassDistribution, WorldParams};
 use crate::rng::SphereField;
@@ -444,6 +444,11 @@ fn grid_film(
             black_film_nm: params.black_film_nm,
             rupture_thickness_nm: params.rupture_thickness_nm,
             nucleation_per_m2_s: params.nucleation_per_m2_s,
+        },
+        thermal: ThermalParams {
+            bottom_warming_k: params.bottom_warming_k,
+            ambient_k: params.gas_temperature_k,
+            ..ThermalParams::isothermal()
         },
         seed: params.seed,
     };

@@ -138,6 +138,9 @@ impl WorldParams {
 
 /// Largest film-flow grid: 6·512² cells, 1.6 M.
 pub const MAX_FILM_GRID: usize = 512;
+/// Largest `bottom_warming_k`, K: the film's temperature stays within tens of kelvin of
+/// room temperature, where its constants (dσ/dθ, the vapour pressure's slope) hold.
+pub const MAX_WARMING_K: f64 = 30.0;
 
 /// Parameters of one bubble.
 #[derive(Clone, Debug, PartialEq)]
@@ -196,6 +199,9 @@ pub struct BubbleParams {
     pub black_film_nm: f64,
     /// Rate of spontaneous holes per area of black film, 1/(m²·s) (film flow only).
     pub nucleation_per_m2_s: f64,
+    /// How much warmer the air at the bubble's bottom is than at its top, K (film flow
+    /// only; 0: isothermal). Drives thermal convection (docs/dynamics.md).
+    pub bottom_warming_k: f64,
 }
 
 impl Default for BubbleParams {
@@ -227,6 +233,7 @@ impl Default for BubbleParams {
             black_threshold_nm: 30.0,
             black_film_nm: 12.0,
             nucleation_per_m2_s: 0.0,
+            bottom_warming_k: 0.0,
         }
     }
 }
@@ -298,6 +305,13 @@ impl BubbleParams {
             ));
         }
         non_negative("nucleation_per_m2_s", self.nucleation_per_m2_s)?;
+        if !(self.bottom_warming_k.is_finite() && self.bottom_warming_k.abs() <= MAX_WARMING_K) {
+            return Err(ParamError::new(
+                "bottom_warming_k",
+                self.bottom_warming_k,
+                format!("must lie in [-{MAX_WARMING_K}, {MAX_WARMING_K}] K"),
+            ));
+        }
         if self.initial_scale.min_element() <= 0.0 {
             return Err(ParamError::new(
                 "initial_scale",

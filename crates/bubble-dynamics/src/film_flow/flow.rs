@@ -20,6 +20,7 @@ use super::burst::{BurstParams, BurstState, Hole};
 use super::capillary::{Capillary, CapillaryScratch, smooth_thickness};
 use super::grid::CubeSphere;
 use super::solve::{Hierarchy, SolveReport, Work};
+use super::thermal::{ThermalParams, up_from};
 use super::viscosity::viscous_bound;
 
 /// Thickness floor of the Marangoni coefficient `E_f/(ρh)`, m: a hole or a Newton black
@@ -57,6 +58,8 @@ pub struct FlowParams {
     pub air_density_kg_per_m3: f64,
     /// Black film and rupture.
     pub burst: BurstParams,
+    /// The film's temperature: the warming it sees and how it answers.
+    pub thermal: ThermalParams,
     /// Seed of the spontaneous rupture.
     pub seed: u64,
 }
@@ -82,6 +85,7 @@ impl FlowParams {
                 rupture_thickness_nm: 5.0,
                 nucleation_per_m2_s: 0.0,
             },
+            thermal: ThermalParams::isothermal(),
             seed: 0,
         }
     }
@@ -110,6 +114,8 @@ pub struct FilmFlow {
     pub(crate) h_m: Vec<f64>,
     pub(crate) gamma: Vec<f64>,
     pub(crate) u_m_per_s: Vec<f64>,
+    /// The film's temperature excess over the ambient per cell, K (empty when isothermal).
+    pub(super) temperature_k: Vec<f64>,
     /// The last Marangoni solve's change of Γ (empty before the first): the next solve's
     /// first guess.
     pub(super) surfactant_change: Vec<f64>,
@@ -167,6 +173,11 @@ impl FilmFlow {
             h_m: h,
             gamma: vec![1.0; cells],
             u_m_per_s: vec![0.0; edges],
+            temperature_k: if params.thermal.is_active() {
+                vec![0.0; cells]
+            } else {
+                Vec::new()
+            },
             surfactant_change: Vec::new(),
             hierarchy,
             grid,
@@ -192,6 +203,11 @@ impl FilmFlow {
     /// Surfactant concentration of each cell, relative to the rest value.
     pub fn surfactant(&self) -> &[f64] {
         &self.gamma
+    }
+
+    /// The film's temperature excess over the ambient per cell, K (empty: isothermal).
+    pub fn temperature_excess_k(&self) -> &[f64] {
+        &self.temperature_k
     }
 
     /// Surface velocity normal to each edge (along the edge's normal), m/s.
@@ -287,17 +303,14 @@ impl FilmFlow {
         let mut s = std::mem::take(&mut self.scratch);
         s.u_start.clear();
         s.u_start.extend_from_slice(&self.u_m_per_s);
+        let up = up_from(forcing.g_eff_m_per_s2);
+        self.exchange_heat(&s.u_start, &mut s.cell, dt_s, up);
         self.momentum_explicit(&mut s, dt_s, forcing);
         self.air_shear(&mut s, dt_s, forcing.air_m_per_s);
         let report = self.marangoni_implicit(&mut s, dt_s);
         self.transport_thickness(&mut s, dt_s, forcing.g_eff_m_per_s2);
         self.capillary_smoothing(&mut s, dt_s);
-        let evaporated = self.params.evaporation_nm_per_s * 1e-9 * dt_s;
-        if evaporated > 0.0 {
-            self.h_m
-                .iter_mut()
-                .for_each(|h| *h = (*h - evaporated).max(0.0));
-        }
+        self.evaporate(dt_s);
         if let Some(mut burst) = self.burst.take() {
             burst.step(self, dt_s);
             self.burst = Some(burst);
@@ -306,7 +319,26 @@ impl FilmFlow {
         report
     }
 
-    /// `u ← u + dt (−u·∇u + g_t + viscous)`.
+    /// Thins every cell by the evaporation rate, scaled by its temperature's vapour
+    /// pressure where the film has a temperature.
+    fn evaporate(&mut self, dt_s: f64) {
+        let evaporated = self.params.evaporation_nm_per_s * 1e-9 * dt_s;
+        if evaporated <= 0.0 {
+            return;
+        }
+        if self.temperature_k.is_empty() {
+            self.h_m
+                .iter_mut()
+                .for_each(|h| *h = (*h - evaporated).max(0.0));
+            return;
+        }
+        let th = self.params.thermal;
+        for (h, theta) in self.h_m.iter_mut().zip(&self.temperature_k) {
+            *h = (*h - evaporated * th.evaporation_factor(*theta)).max(0.0);
+        }
+    }
+
+    /// `u ← u + dt (−u·∇u + g_t + thermal Marangoni + viscous)`.
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn momentum_explicit(&mut self, s: &mut Scratch, dt_s: f64, forcing: &Forcing) {
         let r = self.params.radius_m;
@@ -326,6 +358,7 @@ impl FilmFlow {
         for (u, c) in self.u_m_per_s.iter_mut().zip(slope) {
             *u += dt_s * g.dot(*c);
         }
+        self.thermal_stress(dt_s);
         let nu = self.params.viscosity_pa_s / self.params.density_kg_per_m3;
         if nu > 0.0 {
             self.viscous_step(s, nu, dt_s);

@@ -11,6 +11,7 @@ pub mod grid;
 mod marangoni;
 pub(crate) mod on_bubble;
 pub mod solve;
+mod thermal;
 mod transport;
 mod viscosity;
 
@@ -19,3 +20,4 @@ pub use cell_map::CellMap;
 pub use flow::{FilmFlow, FlowParams, Forcing};
 pub use grid::CubeSphere;
 pub use solve::{Hierarchy, SolveLimits, SolveReport};
+pub use thermal::ThermalParams;

@@ -10,7 +10,7 @@ use super::values::{
     InitialScale, Intensity, LightRadius, Luminance, LutAngleSamples, LutThicknessSamples,
     MeshScale, MolarMass, NucleationRate, Num, Num3, ObjectRadius, PatternScale, Radiance,
     Reflectance, RuptureThickness, Samples, Seconds, Shininess, SloshSpeed, Speed, Subdivisions,
-    SurfaceTension, TimeStep, Variation, Viscosity, WaterDepth, WaterIndex, WaterSlices,
+    SurfaceTension, TimeStep, Variation, Viscosity, Warming, WaterDepth, WaterIndex, WaterSlices,
     WaveAmplitude, Wavelength, exact,
 };
 use serde::Deserialize;
@@ -456,6 +456,10 @@ pub struct BubbleSpec {
     /// Rate of spontaneous holes per area of black film, 1/(m²·s).
     #[serde(default)]
     pub nucleation_per_m2_s: Option<Num<NucleationRate>>,
+    /// How much warmer the air at the bubble's bottom is than at its top, K (film flow:
+    /// thermal convection).
+    #[serde(default)]
+    pub bottom_warming_k: Option<Num<Warming>>,
 }
 
 fn mean_thickness() -> Num<FilmThickness> {

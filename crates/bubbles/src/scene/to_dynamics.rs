@@ -229,6 +229,10 @@ pub(crate) fn bubble_params(spec: &BubbleSpec, default_grid: u32) -> BubbleParam
             spec.nucleation_per_m2_s.map(|v| v.get()),
             defaults.nucleation_per_m2_s,
         ),
+        bottom_warming_k: or(
+            spec.bottom_warming_k.map(|v| v.get()),
+            defaults.bottom_warming_k,
+        ),
         ..defaults
     }
 }

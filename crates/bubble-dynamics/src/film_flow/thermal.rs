@@ -1,0 +1,173 @@
+//! Thermal convection: the film's temperature, and the two ways it moves the film.
+//!
+//! The air around the bubble is warmer at its bottom than at its top by
+//! `bottom_warming_k` (a bubble over a warm floor or a hand; Seychelles et al. 2008, "Thermal
+//! convection and emergence of isolated vortices in soap bubbles", PRL 101, 144501, heated
+//! a half bubble at its equator), linearly in height. The film's temperature excess θ
+//! over the ambient (the air at the top) moves with the surfaces and relaxes towards the
+//! air's through both faces, `∂θ/∂t + u·∇θ = (2 h_c/(ρ c_p h)) (θ_air − θ)`: a 600 nm film
+//! follows the air within a quarter second, so a film carried up keeps its warmth for a
+//! centimetre or so.
+//!
+//! Warm film is weaker, `T = T₀ − E_f ln Γ + 2 (dσ/dθ) θ`: the thermal Marangoni stress
+//! pulls the surfaces from the warm bottom towards the cold top, stretching and thinning
+//! the film there. Warm film also evaporates faster, as the water's vapour pressure,
+//! `e(θ) = e₀ exp((L M/R)(1/T_a − 1/(T_a + θ)))` (Clausius–Clapeyron; 6 % a kelvin at
+//! 20 °C). Both make thin film at the bottom, and thin film is light: the tension that
+//! holds the film against gravity, a gradient, lifts a thin patch faster than its weight
+//! pulls it down. Thin film below thick film is the unstable stratification of
+//! Rayleigh–Bénard convection in two dimensions; plumes of thin film rise and roll up
+//! into vortices, the swirls of a real bubble.
+//!
+//! Left out: the evaporation's latent heat (the scene's rate is taken as the net rate at
+//! the ambient temperature) and conduction along the film (10⁻⁷ m²/s, far below the
+//! upwind transport's own smoothing).
+
+use glam::DVec3;
+
+use super::flow::{FilmFlow, H_FLOOR_M};
+
+/// Specific heat of the film liquid (water), J/(kg·K).
+pub const LIQUID_HEAT_CAPACITY_J_PER_KG_K: f64 = 4186.0;
+/// Latent heat of vaporisation of water at 20 °C, J/kg.
+pub const LATENT_HEAT_J_PER_KG: f64 = 2.454e6;
+/// Molar mass of water, kg/mol.
+pub const WATER_MOLAR_MASS_KG_PER_MOL: f64 = 0.018_015;
+/// The gas constant, J/(mol·K).
+const GAS_CONSTANT_J_PER_MOL_K: f64 = 8.314_462_618;
+/// Most sub-steps the temperature's transport takes in one step.
+const MAX_SUBSTEPS: u32 = 64;
+/// Largest fraction of a cell's temperature difference one edge's inflow brings in a
+/// sub-step: with four edges a cell the new value is then a convex mix of the old ones.
+const MAX_INFLOW_FRACTION: f64 = 0.25;
+
+/// What the film's temperature does: the warming it sees and how it answers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThermalParams {
+    /// How much warmer the air at the bubble's bottom is than at its top, K (0: an
+    /// isothermal film, no thermal effects and no temperature field).
+    pub bottom_warming_k: f64,
+    /// Temperature of the air at the bubble's top (the ambient), K.
+    pub ambient_k: f64,
+    /// `dσ/dθ` of one surface, N/(m·K): negative, warm film is weaker.
+    pub tension_per_kelvin_n_per_m_k: f64,
+    /// Heat transfer coefficient between the film and the air on each face, W/(m²·K).
+    pub heat_transfer_w_per_m2_k: f64,
+}
+
+impl ThermalParams {
+    /// No warming: water's `dσ/dθ` (−1.5e-4 N/(m·K)), 5 W/(m²·K) a face (free convection
+    /// about a sphere of a few cm in still air), 20 °C.
+    pub fn isothermal() -> Self {
+        Self {
+            bottom_warming_k: 0.0,
+            ambient_k: 293.15,
+            tension_per_kelvin_n_per_m_k: -1.5e-4,
+            heat_transfer_w_per_m2_k: 5.0,
+        }
+    }
+
+    /// Whether the film has a temperature field at all.
+    pub fn is_active(&self) -> bool {
+        self.bottom_warming_k != 0.0
+    }
+
+    /// The air's temperature excess over the ambient at direction `d` (unit), K, with
+    /// `up` the unit direction against gravity: `bottom_warming_k` at the bottom, 0 at
+    /// the top, linear in height between.
+    pub fn air_excess_k(&self, d: DVec3, up: DVec3) -> f64 {
+        0.5 * self.bottom_warming_k * (1.0 - d.dot(up))
+    }
+
+    /// The evaporation rate of film `excess_k` warmer than the ambient over the
+    /// ambient's (Clausius–Clapeyron).
+    pub fn evaporation_factor(&self, excess_k: f64) -> f64 {
+        let per_kelvin_inverse =
+            LATENT_HEAT_J_PER_KG * WATER_MOLAR_MASS_KG_PER_MOL / GAS_CONSTANT_J_PER_MOL_K;
+        let t = self.ambient_k;
+        (per_kelvin_inverse * (1.0 / t - 1.0 / (t + excess_k))).exp()
+    }
+
+    /// The rate at which a film `h_m` thick relaxes towards the air's temperature, 1/s.
+    pub fn relaxation_per_s(&self, h_m: f64, density_kg_per_m3: f64) -> f64 {
+        let heat_per_kelvin = density_kg_per_m3 * LIQUID_HEAT_CAPACITY_J_PER_KG_K * h_m;
+        2.0 * self.heat_transfer_w_per_m2_k / heat_per_kelvin.max(f64::MIN_POSITIVE)
+    }
+}
+
+/// The unit direction against `g` (+Y where there is no gravity).
+pub(super) fn up_from(g_eff_m_per_s2: DVec3) -> DVec3 {
+    (-g_eff_m_per_s2).try_normalize().unwrap_or(DVec3::Y)
+}
+
+impl FilmFlow {
+    /// Moves the temperature with the surfaces' starting velocity (upwind, in sub-steps
+    /// of Courant ≤ ½ an edge), then relaxes it towards the air's, implicitly per cell.
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
+    pub(super) fn exchange_heat(
+        &mut self,
+        u_start: &[f64],
+        scratch: &mut Vec<f64>,
+        dt_s: f64,
+        up: DVec3,
+    ) {
+        if self.temperature_k.is_empty() {
+            return;
+        }
+        self.advect_temperature(u_start, scratch, dt_s);
+        let th = self.params.thermal;
+        let rho = self.params.density_kg_per_m3;
+        let cells = self.temperature_k.iter_mut().zip(&self.h_m);
+        for ((theta, h), d) in cells.zip(self.grid.centres()) {
+            let r = dt_s * th.relaxation_per_s(h.max(H_FLOOR_M), rho);
+            *theta = (*theta + r * th.air_excess_k(*d, up)) / (1.0 + r);
+        }
+    }
+
+    /// `∂θ/∂t + u·∇θ = 0`, upwind: each cell takes `(θ_up − θ)` times what flows in.
+    fn advect_temperature(&mut self, u: &[f64], before: &mut Vec<f64>, dt_s: f64) {
+        let ea = self.grid.edge_arrays();
+        let per_area = self.grid.inverse_areas_per_sr();
+        let fastest = u
+            .iter()
+            .zip(&ea.length_per_smaller_area)
+            .map(|(u, per)| u.abs() * per)
+            .fold(0.0, f64::max);
+        let courant = fastest * dt_s / self.params.radius_m;
+        if courant == 0.0 {
+            return;
+        }
+        let substeps = (courant / MAX_INFLOW_FRACTION)
+            .ceil()
+            .clamp(1.0, f64::from(MAX_SUBSTEPS)) as u32;
+        let scale = dt_s / (self.params.radius_m * f64::from(substeps));
+        for _ in 0..substeps {
+            before.clear();
+            before.extend_from_slice(&self.temperature_k);
+            for (([a, b], l), &u) in ea.cells.iter().zip(&ea.length).zip(u) {
+                let (a, b) = (*a as usize, *b as usize);
+                let (from, to) = if u >= 0.0 { (a, b) } else { (b, a) };
+                let inflow = (scale * u.abs() * l * per_area[to]).min(MAX_INFLOW_FRACTION);
+                self.temperature_k[to] += inflow * (before[from] - before[to]);
+            }
+        }
+    }
+
+    /// `u += dt·2(dσ/dθ)∇θ/(ρh)` on every edge: the thermal Marangoni stress.
+    pub(super) fn thermal_stress(&mut self, dt_s: f64) {
+        if self.temperature_k.is_empty() {
+            return;
+        }
+        let p = &self.params;
+        let per = 2.0 * p.thermal.tension_per_kelvin_n_per_m_k * dt_s
+            / (p.density_kg_per_m3 * p.radius_m);
+        let ea = self.grid.edge_arrays();
+        let (theta, h) = (&self.temperature_k, &self.h_m);
+        let edges = ea.cells.iter().zip(&ea.inverse_dual_length);
+        for (u, ([a, b], id)) in self.u_m_per_s.iter_mut().zip(edges) {
+            let (a, b) = (*a as usize, *b as usize);
+            let h_edge = (0.5 * (h[a] + h[b])).max(H_FLOOR_M);
+            *u += per * (theta[b] - theta[a]) * id / h_edge;
+        }
+    }
+}
