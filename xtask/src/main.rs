@@ -213,7 +213,7 @@ fn figures() -> bool {
 }
 
 /// The swirl scene's burst in slow motion (docs/gallery.md): an animated PNG 200× slower
-/// than real time from just before the hole opens (t = 12.4833 s) until the bubble is
+/// than real time from just before the hole opens (t = 11.4667 s) until the bubble is
 /// gone, and two larger stills 1 ms apart taken as the frames of a second animation.
 fn swirl_burst(dir: &str, bubbles: &dyn Fn(&[&str]) -> bool) -> bool {
     let movie = format!("{dir}/swirl_burst.apng");
@@ -221,9 +221,9 @@ fn swirl_burst(dir: &str, bubbles: &dyn Fn(&[&str]) -> bool) -> bool {
         "animate",
         "swirl",
         "--start-s",
-        "12.483",
+        "11.466",
         "--seconds",
-        "0.008",
+        "0.007",
         "--fps",
         "30",
         "--slow-motion",
@@ -243,7 +243,7 @@ fn swirl_burst(dir: &str, bubbles: &dyn Fn(&[&str]) -> bool) -> bool {
         "animate",
         "swirl",
         "--start-s",
-        "12.485",
+        "11.468",
         "--seconds",
         "0.002",
         "--fps",
@@ -257,7 +257,7 @@ fn swirl_burst(dir: &str, bubbles: &dyn Fn(&[&str]) -> bool) -> bool {
         "--height",
         "480",
     ]);
-    for (k, time_s) in [(0, "12.485"), (1, "12.486")] {
+    for (k, time_s) in [(0, "11.468"), (1, "11.469")] {
         let from = frames.join(format!("frame_{k:05}.png"));
         let to = root.join(format!("{dir}/swirl_burst_t{time_s}.png"));
         ok &= std::fs::copy(from, to).is_ok();
@@ -278,7 +278,7 @@ fn gallery() -> bool {
         ("bubble-collision", "0.12", "1", "20"),
         ("demo", "0.5", "2", "10"),
         ("pond", "1", "2", "10"),
-        ("swirl", "5", "12.5", "8"),
+        ("swirl", "5", "11.5", "8"),
     ];
     let dir = "docs/figures/gallery";
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
@@ -314,7 +314,7 @@ fn gallery() -> bool {
         ]);
     }
     // The swirl scene's film at three ages, full size (docs/gallery.md).
-    for time_s in ["0.5", "5", "11.5"] {
+    for time_s in ["0.5", "5", "10.5"] {
         let still = format!("{dir}/swirl_t{time_s}.png");
         ok &= bubbles(&["render", "swirl", "--out", &still, "--time-s", time_s]);
     }

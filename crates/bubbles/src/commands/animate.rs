@@ -42,8 +42,8 @@ pub const MANIFEST: &str = "animation.txt";
     frames for its --seconds of simulated time (T + seconds <= 3600). With K other than \
     1 each frame shows the solver step at or before its t, and the holes of a bursting \
     film exactly at t (their rims move between steps, half a film cell at a time), so \
-    `swirl --start-s 12.483 --seconds 0.008 --fps 30 --slow-motion 200` shows that \
-    scene's burst (a hole opens at t = 12.483 s) in 48 frames, as high-speed video \
+    `swirl --start-s 11.466 --seconds 0.007 --fps 30 --slow-motion 200` shows that \
+    scene's burst (a hole opens at t = 11.467 s) in 42 frames, as high-speed video \
     does.\n\n\
     --out DIR writes DIR/frame_00000.png, … each through a temporary file renamed into \
     place, so an interrupted run leaves only whole frames, and DIR/animation.txt records \
