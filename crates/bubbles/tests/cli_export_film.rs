@@ -56,6 +56,7 @@ fn export_film_writes_the_cube_map_field_of_each_frame() {
         for p in image.pixels() {
             assert!(p[0].is_finite() && p[0] > 0.0, "{name}: thickness {}", p[0]);
             assert_eq!(p[1], 1.0, "{name}: no hole, full coverage");
+            assert_eq!(p[2], 0.0, "{name}: an isothermal film's temperature");
             sum += f64::from(p[0]);
             count += 1;
         }
@@ -67,6 +68,45 @@ fn export_film_writes_the_cube_map_field_of_each_frame() {
             "{name}: mean cell thickness {mean} nm"
         );
     }
+}
+
+/// With `bottom_warming_k` the blue channel is the film's temperature above the ambient:
+/// after 1 s (four relaxation times of the 400 nm film) the −Y face is near the air's
+/// 4 K bottom and the +Y face near its cold top, every cell within [0, 4] K.
+#[test]
+fn export_film_carries_the_warmed_films_temperature_in_blue() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = format!("{SCENE}bottom_warming_k = 4.0\n");
+    std::fs::write(dir.path().join("film.toml"), scene).unwrap();
+    let args = [
+        "simulate",
+        "film.toml",
+        "--seconds",
+        "1",
+        "--fps",
+        "1",
+        "--export-film",
+        "film",
+    ];
+    let out = bubbles(&args, dir.path());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let image = image::open(dir.path().join("film/film_0_00001.exr"))
+        .unwrap()
+        .to_rgb32f();
+    let face_mean = |face: u32| {
+        let texels = (0..16).flat_map(|y| (0..16).map(move |x| (face * 16 + x, y)));
+        texels
+            .map(|(x, y)| f64::from(image.get_pixel(x, y)[2]))
+            .sum::<f64>()
+            / 256.0
+    };
+    let (top, bottom) = (face_mean(2), face_mean(3));
+    eprintln!("film temperature: +Y face {top:.3} K, −Y face {bottom:.3} K");
+    assert!(
+        bottom > 3.0 && top < 1.0,
+        "+Y face {top:.3} K, −Y face {bottom:.3} K"
+    );
+    assert!(image.pixels().all(|p| (0.0..=4.0).contains(&p[2])));
 }
 
 #[test]

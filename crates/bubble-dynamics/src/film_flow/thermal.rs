@@ -102,7 +102,8 @@ pub(super) fn up_from(g_eff_m_per_s2: DVec3) -> DVec3 {
 
 impl FilmFlow {
     /// Moves the temperature with the surfaces' starting velocity (upwind, in sub-steps
-    /// of Courant ≤ ½ an edge), then relaxes it towards the air's, implicitly per cell.
+    /// of at most a quarter of a cell an edge), then relaxes it towards the air's,
+    /// implicitly per cell.
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     pub(super) fn exchange_heat(
         &mut self,

@@ -34,7 +34,8 @@ const ABOUT_OUTPUT: &str = "Simulates the scene's bubbles (seed 000 §3: film te
     6n × n pixels, the faces side by side in OpenGL cube-map order (+X, −X, +Y, −Y, +Z, −Z; \
     each face's rows top to bottom, its texel (x, y) at s = (x + ½)·2/n − 1, t likewise), \
     R = thickness in nm (stretched by the mesh's deformation, as renderers draw it), \
-    G = coverage (1 film, 0 burst hole), B = 0.";
+    G = coverage (1 film, 0 burst hole), B = the film's temperature above the ambient in K \
+    (0 unless the bubble has `bottom_warming_k`).";
 
 /// Arguments of `bubbles simulate`.
 #[derive(Debug, clap::Args)]
@@ -276,11 +277,13 @@ fn write_films(world: &World, dir: &Path, frame: usize) -> CliResult {
             continue;
         };
         let n = field.face_size;
+        let warmth = b.film_flow().map_or(&[][..], |f| f.temperature_excess_k());
         let mut rgb = vec![[0.0f32; 3]; 6 * n * n];
         for (cell, (h, c)) in field.thickness_nm.iter().zip(&field.coverage).enumerate() {
             let (face, rest) = (cell / (n * n), cell % (n * n));
             let (y, x) = (rest / n, rest % n);
-            rgb[y * 6 * n + face * n + x] = [*h as f32, *c as f32, 0.0];
+            let kelvin = warmth.get(cell).copied().unwrap_or(0.0);
+            rgb[y * 6 * n + face * n + x] = [*h as f32, *c as f32, kelvin as f32];
         }
         let image = raster::Frame::try_from_rgb(6 * n, n, rgb)
             .ok_or_else(|| CliError::runtime(format!("film grid of face size {n} has no image")))?;
