@@ -85,6 +85,20 @@ pub struct BurstState {
     /// Whether the rims are advanced from outside (by the world, every world step and
     /// between them) rather than within [`BurstState::step`].
     rims_driven_outside: bool,
+    /// The black film's per-cell buffers, kept from step to step (three cell arrays a
+    /// step were a malloc and free each, 200 kB apiece at n = 64).
+    black: BlackScratch,
+}
+
+/// Buffers of [`BurstState::blacken`].
+#[derive(Clone, Debug, Default)]
+struct BlackScratch {
+    /// Per cell: whether it is thick film.
+    thick: Vec<bool>,
+    /// Per cell: the length of its boundary that borders thick film, rad.
+    thick_sides: Vec<f64>,
+    /// Per cell: the thickness it gives away this step, m.
+    excess: Vec<f64>,
 }
 
 impl BurstState {
@@ -98,6 +112,7 @@ impl BurstState {
             burst_volume_m3: 0.0,
             first_hole_thickness_m: None,
             rims_driven_outside: false,
+            black: BlackScratch::default(),
         }
     }
 
@@ -203,7 +218,7 @@ impl BurstState {
 
     /// Thins black cells towards the black film, their liquid shared among the
     /// neighbours above the threshold in proportion to edge length.
-    fn blacken(&self, flow: &mut FilmFlow, dt_s: f64) {
+    fn blacken(&mut self, flow: &mut FilmFlow, dt_s: f64) {
         let p = &self.params;
         if p.black_threshold_nm <= 0.0 {
             return;
@@ -212,15 +227,22 @@ impl BurstState {
         let fraction = 1.0 - (-dt_s / BLACK_RELAX_S).exp();
         let grid = std::sync::Arc::clone(&flow.grid);
         let areas = grid.areas_sr();
+        let BlackScratch {
+            thick,
+            thick_sides,
+            excess,
+        } = &mut self.black;
         // Judged once, before anything moves: which cells are thick film, and how much of
         // each cell's boundary borders them.
-        let thick: Vec<bool> = flow
-            .h_m
-            .iter()
-            .zip(&self.coverage)
-            .map(|(&h, &c)| h >= threshold && c > 0.0)
-            .collect();
-        let mut thick_sides = vec![0.0; grid.cells()];
+        thick.clear();
+        thick.extend(
+            flow.h_m
+                .iter()
+                .zip(&self.coverage)
+                .map(|(&h, &c)| h >= threshold && c > 0.0),
+        );
+        thick_sides.clear();
+        thick_sides.resize(grid.cells(), 0.0);
         for e in grid.edges() {
             let (a, b) = (e.a as usize, e.b as usize);
             if thick[b] {
@@ -230,18 +252,14 @@ impl BurstState {
                 thick_sides[b] += e.length;
             }
         }
-        let excess: Vec<f64> = flow
-            .h_m
-            .iter()
-            .zip(&thick_sides)
-            .map(|(&h, &sides)| {
-                if h < threshold && h > black && sides > 0.0 {
-                    (h - black) * fraction
-                } else {
-                    0.0
-                }
-            })
-            .collect();
+        excess.clear();
+        excess.extend(flow.h_m.iter().zip(thick_sides.iter()).map(|(&h, &sides)| {
+            if h < threshold && h > black && sides > 0.0 {
+                (h - black) * fraction
+            } else {
+                0.0
+            }
+        }));
         for e in grid.edges() {
             let (a, b) = (e.a as usize, e.b as usize);
             for (from, to) in [(a, b), (b, a)] {

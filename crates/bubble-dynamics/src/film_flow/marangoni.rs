@@ -3,8 +3,8 @@
 //! fluxes that sum to zero.
 //!
 //! First the surfactant moves upwind with the step's starting velocity, in sub-steps of
-//! its own (`transport_surfactant`). Then the edges are walked three times: the fluxes'
-//! central part with the system's edge weights; the right-hand side; the velocity
+//! its own (`transport_surfactant`). Then the edges are walked twice: the fluxes'
+//! central part with the system's edge weights and right-hand side; the velocity
 //! correction with the surfactant's move (into a copy, so the correction still reads the
 //! surfactant the solve started from and the rare redo needs no restore).
 
@@ -21,8 +21,7 @@ impl FilmFlow {
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     pub(super) fn marangoni_implicit(&mut self, s: &mut Scratch, dt_s: f64) -> SolveReport {
         self.transport_surfactant(s, dt_s);
-        self.transport_fluxes_and_weights(s, dt_s);
-        self.right_hand_side(s, dt_s);
+        self.fluxes_weights_and_right_hand_side(s, dt_s);
         let report = self.solve_surfactant(s);
         self.correct_velocity_and_move_surfactant(s, dt_s);
         report
@@ -72,39 +71,33 @@ impl FilmFlow {
     /// upwind flux there would diffuse Γ at |g dt| and no gradient could hold a film at
     /// rest); `dt·E/(ρh)/(1 + dt k)` into `s.stiffness` (the weights and the velocity
     /// correction both use it) and the system's weight `dt² E l/(ρ h d R²)/(1 + dt k)`
-    /// into `s.weight`.
-    fn transport_fluxes_and_weights(&self, s: &mut Scratch, dt_s: f64) {
+    /// into `s.weight`; and, in the same pass over the edges, the system's right-hand
+    /// side `A Γ − dt Σ F/R` (rows divided by R²) into `s.rhs`.
+    fn fluxes_weights_and_right_hand_side(&self, s: &mut Scratch, dt_s: f64) {
         let p = &self.params;
         let per_r2 = 1.0 / (p.radius_m * p.radius_m);
+        let dt_per_r = dt_s / p.radius_m;
         let g = &self.grid;
         let ea = g.edge_arrays();
         let (gamma, h) = (&self.gamma, &self.h_m);
         s.edge.clear();
         s.stiffness.clear();
         s.weight.clear();
+        let rhs = &mut s.rhs;
+        rhs.clear();
+        rhs.extend(g.areas_sr().iter().zip(gamma).map(|(a, gm)| a * gm));
         let velocities = self.u_m_per_s.iter().zip(&s.u_start).zip(&s.drag);
         let lengths = ea.length.iter().zip(&ea.inverse_dual_length);
         for (((&u, &u0), drag), ([a, b], (l, id))) in velocities.zip(ea.cells.iter().zip(lengths)) {
             let (a, b) = (*a as usize, *b as usize);
-            s.edge.push(0.5 * (gamma[a] + gamma[b]) * (u - u0) * l);
+            let f = 0.5 * (gamma[a] + gamma[b]) * (u - u0) * l;
+            s.edge.push(f);
+            rhs[a] -= dt_per_r * f;
+            rhs[b] += dt_per_r * f;
             let h_edge = (0.5 * (h[a] + h[b])).max(H_FLOOR_M);
             let k = dt_s * p.elasticity_n_per_m / (p.density_kg_per_m3 * h_edge) * drag;
             s.stiffness.push(k);
             s.weight.push(dt_s * k * l * id * per_r2);
-        }
-    }
-
-    /// The system's right-hand side `A Γ − dt Σ F/R` (rows divided by R²) into `s.rhs`.
-    fn right_hand_side(&self, s: &mut Scratch, dt_s: f64) {
-        let dt_per_r = dt_s / self.params.radius_m;
-        let g = &self.grid;
-        let (ea, areas, gamma) = (g.edge_arrays(), g.areas_sr(), &self.gamma);
-        let rhs = &mut s.rhs;
-        rhs.clear();
-        rhs.extend(areas.iter().zip(gamma).map(|(a, gm)| a * gm));
-        for (f, [a, b]) in s.edge.iter().zip(&ea.cells) {
-            rhs[*a as usize] -= dt_per_r * f;
-            rhs[*b as usize] += dt_per_r * f;
         }
     }
 

@@ -304,10 +304,9 @@ impl Hierarchy {
                     .map(|(w, a)| 1.0 / (a + w[0] + w[1] + w[2] + w[3])),
             );
         }
-        work.coarse_factor.clear();
         let last = self.levels.len() - 1;
-        work.coarse_factor =
-            dense_cholesky(&self.levels[last], &work.alpha[last], &work.weight[last]);
+        let (level, alpha, weight) = (&self.levels[last], &work.alpha[last], &work.weight[last]);
+        dense_cholesky(level, alpha, weight, &mut work.coarse_factor);
     }
 
     /// One symmetric V-cycle on level `k` for residual `r`, result in `z`.
@@ -559,10 +558,12 @@ fn restrict_residual(
     }
 }
 
-/// The lower Cholesky factor of the coarsest level's matrix, row-major.
-fn dense_cholesky(level: &Level, alpha: &[f64], weight: &[f64]) -> Vec<f64> {
+/// The lower Cholesky factor of the coarsest level's matrix, row-major, into `m` (a
+/// buffer kept from step to step: a fresh 74 kB one each step was a malloc and free).
+fn dense_cholesky(level: &Level, alpha: &[f64], weight: &[f64], m: &mut Vec<f64>) {
     let n = level.cells;
-    let mut m = vec![0.0; n * n];
+    m.clear();
+    m.resize(n * n, 0.0);
     for i in 0..n {
         m[i * n + i] = alpha[i];
     }
@@ -588,7 +589,6 @@ fn dense_cholesky(level: &Level, alpha: &[f64], weight: &[f64]) -> Vec<f64> {
             m[i * n + j] = s / d;
         }
     }
-    m
 }
 
 fn dense_solve(l: &[f64], n: usize, b: &[f64], x: &mut [f64]) {

@@ -3,8 +3,8 @@
 //! the upwind cell's Barth–Jespersen-limited gradient), in sub-steps under a Courant
 //! bound, each donor's outflow limited to a fraction of its content.
 //!
-//! A sub-step walks the edges five times (the cells' gradients; their neighbours' range;
-//! the gradients' limits; the volumes and each donor's outflow; the limited volumes
+//! A sub-step walks the edges four times (the cells' gradients and their neighbours'
+//! range; the gradients' limits; the volumes and each donor's outflow; the limited volumes
 //! applied): the edge speeds are computed where the volumes are, from the thickness the
 //! sub-step starts with, so no pass stores them.
 
@@ -66,8 +66,8 @@ impl FilmFlow {
     /// midpoint and clamped between the two cells' values), outflow-limited.
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn upwind_substep(&mut self, s: &mut Scratch, dt_s: f64) {
-        self.thickness_gradients(&mut s.gradient);
-        self.limit_gradients(&mut s.gradient, &mut s.neighbour_range, &mut s.limiter);
+        self.gradients_and_ranges(&mut s.gradient, &mut s.neighbour_range);
+        self.limit_gradients(&mut s.gradient, &s.neighbour_range, &mut s.limiter);
         self.upwind_volumes(s, dt_s);
         let areas = self.grid.areas_sr();
         // Each donor's factor `budget/outflow` where it would give more than its budget
@@ -92,17 +92,23 @@ impl FilmFlow {
     }
 
     /// Each cell's Green–Gauss gradient of `h` on the unit sphere, per radian, projected
-    /// onto the sphere's tangent plane.
-    fn thickness_gradients(&self, gradient: &mut Vec<DVec3>) {
+    /// onto the sphere's tangent plane, and the least and greatest `h` of the cell and its
+    /// edge neighbours (one pass: both read the same two cells of each edge).
+    fn gradients_and_ranges(&self, gradient: &mut Vec<DVec3>, range: &mut Vec<[f64; 2]>) {
         let g = &self.grid;
         gradient.clear();
         gradient.resize(g.cells(), DVec3::ZERO);
+        range.clear();
+        range.extend(self.h_m.iter().map(|h| [*h, *h]));
         let ea = g.edge_arrays();
         for (([a, b], normal), l) in ea.cells.iter().zip(&ea.normal).zip(&ea.length) {
             let (a, b) = (*a as usize, *b as usize);
-            let flux = *normal * (0.5 * (self.h_m[a] + self.h_m[b]) * l);
+            let (ha, hb) = (self.h_m[a], self.h_m[b]);
+            let flux = *normal * (0.5 * (ha + hb) * l);
             gradient[a] += flux;
             gradient[b] -= flux;
+            range[a] = [range[a][0].min(hb), range[a][1].max(hb)];
+            range[b] = [range[b][0].min(ha), range[b][1].max(ha)];
         }
         let per_area = g.inverse_areas_per_sr();
         for ((grad, ia), c) in gradient.iter_mut().zip(per_area).zip(g.centres()) {
@@ -120,21 +126,8 @@ impl FilmFlow {
     /// was then hundreds of times its content: the outflow limit let it give half of what
     /// it had in each of up to 64 sub-steps, so film beside the pooled bottom of a bubble
     /// resting on the ground emptied to under a nanometre and burst within a second.
-    fn limit_gradients(
-        &self,
-        gradient: &mut [DVec3],
-        range: &mut Vec<[f64; 2]>,
-        phi: &mut Vec<f64>,
-    ) {
+    fn limit_gradients(&self, gradient: &mut [DVec3], range: &[[f64; 2]], phi: &mut Vec<f64>) {
         let ea = self.grid.edge_arrays();
-        range.clear();
-        range.extend(self.h_m.iter().map(|h| [*h, *h]));
-        for [a, b] in &ea.cells {
-            let (a, b) = (*a as usize, *b as usize);
-            let (ha, hb) = (self.h_m[a], self.h_m[b]);
-            range[a] = [range[a][0].min(hb), range[a][1].max(hb)];
-            range[b] = [range[b][0].min(ha), range[b][1].max(ha)];
-        }
         let allowed = |h: f64, [lo, hi]: [f64; 2], rise: f64| {
             if rise > 0.0 {
                 ((hi - h) / rise).min(1.0)
