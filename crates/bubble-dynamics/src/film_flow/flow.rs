@@ -140,6 +140,9 @@ pub(super) struct Scratch {
     pub(super) neighbour_range: Vec<[f64; 2]>,
     /// Per cell: the factor its thickness gradient is limited by.
     pub(super) limiter: Vec<f64>,
+    /// Per edge: how far cell `a`'s and cell `b`'s unlimited gradients carry their
+    /// thickness to the edge midpoint, m.
+    pub(super) rise: Vec<[f64; 2]>,
     pub(super) drag: Vec<f64>,
     /// Per edge: the drainage speed's coefficient over `h²`, s⁻¹·m⁻¹.
     pub(super) drain_rate: Vec<f64>,
