@@ -10,17 +10,44 @@
 use super::grid::{CubeSphere, parent_cell};
 
 /// Sides of every cell: each level is itself a cube-sphere, whose cells all have four
-/// neighbours, so the stencils are fixed-size arrays (no per-cell loop bounds to load).
+/// neighbours, so the stencils have four sides everywhere (no per-cell loop bounds).
 const SIDES: usize = 4;
+
+/// Per side `k`: each cell's weight of the edge to its `k`-th neighbour (one array a side,
+/// so a run of cells reads each side's weights contiguously and the loop vectorises).
+type Stencil = [Vec<f64>; SIDES];
+
+/// Shortest run of cells with a shared neighbour pattern taken as a [`Segment::Run`].
+const MIN_RUN: usize = 4;
+
+/// A stretch of consecutive cells, in the level's numbering, that a sweep visits in turn.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Segment {
+    /// Cells `start..end`, each read through its own neighbour list.
+    Cells { start: usize, end: usize },
+    /// Cells `start..end` whose `k`-th neighbours are the cells `from[k]..` in the same
+    /// order, all outside the run (on the other colour): the face interiors' rows in the
+    /// chequered numbering. Their updates do not read one another, so a run is relaxed
+    /// as slices, with no neighbour indices to load or bounds to check, and the same
+    /// results.
+    Run {
+        start: usize,
+        end: usize,
+        from: [usize; SIDES],
+    },
+}
 
 /// A level's cells and edges (`a`, `b` cell indices), with per-cell neighbour lists.
 #[derive(Clone, Debug)]
 struct Level {
     cells: usize,
     edges: Vec<(u32, u32)>,
-    /// The four neighbours of each cell, and the edges to them, in matching order.
+    /// The four neighbours of each cell in increasing order, and the edges to them, in
+    /// matching order (increasing, so a face interior's cells share one pattern).
     neighbours: Vec<[u32; SIDES]>,
     neighbour_edges: Vec<[u32; SIDES]>,
+    /// The cells as runs and stretches of single cells, in order.
+    segments: Vec<Segment>,
     /// Fine cell → this level's cell, for the level below (finer) this one.
     parent_of_fine: Vec<u32>,
     /// Fine edge → coarse edge it lies along (`u32::MAX` inside a coarse cell).
@@ -59,7 +86,7 @@ pub struct Work {
     /// Per level: each cell's inverse diagonal, and its four edge weights in neighbour
     /// order (the smoother and the operator then read one cell's numbers contiguously).
     inv_diag: Vec<Vec<f64>>,
-    stencil: Vec<Vec<[f64; SIDES]>>,
+    stencil: Vec<Stencil>,
     residual: Vec<Vec<f64>>,
     correction: Vec<Vec<f64>>,
     r: Vec<f64>,
@@ -284,24 +311,23 @@ impl Hierarchy {
             }
         }
         work.inv_diag.resize(count, Vec::new());
-        work.stencil.resize(count, Vec::new());
+        work.stencil.resize(count, Stencil::default());
         for (k, level) in self.levels.iter().enumerate() {
             let (weight, alpha) = (&work.weight[k], &work.alpha[k]);
             let stencil = &mut work.stencil[k];
-            stencil.clear();
-            stencil.extend(
-                level
-                    .neighbour_edges
-                    .iter()
-                    .map(|es| es.map(|e| weight[e as usize])),
-            );
+            for (side, w) in stencil.iter_mut().enumerate() {
+                w.clear();
+                let edges = level.neighbour_edges.iter();
+                w.extend(edges.map(|es| weight[es[side] as usize]));
+            }
             let inv_diag = &mut work.inv_diag[k];
             inv_diag.clear();
+            let [w0, w1, w2, w3] = &*stencil;
+            let sides = w0.iter().zip(w1).zip(w2.iter().zip(w3));
             inv_diag.extend(
-                stencil
-                    .iter()
+                sides
                     .zip(alpha)
-                    .map(|(w, a)| 1.0 / (a + w[0] + w[1] + w[2] + w[3])),
+                    .map(|(((w0, w1), (w2, w3)), a)| 1.0 / (a + w0 + w1 + w2 + w3)),
             );
         }
         let last = self.levels.len() - 1;
@@ -364,9 +390,19 @@ impl Level {
             count.iter().all(|&k| k == SIDES),
             "a cell has under {SIDES} sides"
         );
+        for (nb, es) in neighbours.iter_mut().zip(&mut neighbour_edges) {
+            let mut pairs = [0; SIDES].map(|_| (0u32, 0u32));
+            for k in 0..SIDES {
+                pairs[k] = (nb[k], es[k]);
+            }
+            pairs.sort_unstable();
+            *nb = pairs.map(|(n, _)| n);
+            *es = pairs.map(|(_, e)| e);
+        }
         Self {
             cells,
             edges,
+            segments: segments(&neighbours),
             neighbours,
             neighbour_edges,
             parent_of_fine: Vec::new(),
@@ -411,19 +447,49 @@ fn coarsen(fine: &Level, parent: &[u32], coarse_cells: usize) -> (Level, Vec<u32
 /// `out = (diag(alpha) + L_w) x`, as `αᵢxᵢ + Σ w (xᵢ − xⱼ)`: the differences keep the
 /// result accurate where the weights dwarf `α` and `x` is nearly uniform (a stiff step's
 /// surfactant), which `diag·xᵢ − Σ w xⱼ` would lose to cancellation.
-fn apply(level: &Level, alpha: &[f64], stencil: &[[f64; SIDES]], x: &[f64], out: &mut [f64]) {
-    let rows = out
-        .iter_mut()
-        .zip(alpha)
-        .zip(stencil)
-        .zip(&level.neighbours);
-    for (i, (((o, a), w), nb)) in rows.enumerate() {
-        let xi = x[i];
-        let mut sum = a * xi;
-        for k in 0..SIDES {
-            sum += w[k] * (xi - x[nb[k] as usize]);
+fn apply(level: &Level, alpha: &[f64], stencil: &Stencil, x: &[f64], out: &mut [f64]) {
+    for segment in &level.segments {
+        match *segment {
+            Segment::Cells { start, end } => {
+                for i in start..end {
+                    let xi = x[i];
+                    let mut sum = alpha[i] * xi;
+                    for k in 0..SIDES {
+                        sum += stencil[k][i] * (xi - x[level.neighbours[i][k] as usize]);
+                    }
+                    out[i] = sum;
+                }
+            }
+            Segment::Run { start, end, from } => {
+                apply_run(start..end, from, alpha, stencil, x, out)
+            }
         }
-        *o = sum;
+    }
+}
+
+/// [`apply`] on a [`Segment::Run`]: the same sums, read as slices.
+fn apply_run(
+    run: std::ops::Range<usize>,
+    from: [usize; SIDES],
+    alpha: &[f64],
+    stencil: &Stencil,
+    x: &[f64],
+    out: &mut [f64],
+) {
+    let len = run.len();
+    let (x0, x1) = (&x[from[0]..][..len], &x[from[1]..][..len]);
+    let (x2, x3) = (&x[from[2]..][..len], &x[from[3]..][..len]);
+    let (w0, w1) = (&stencil[0][run.clone()], &stencil[1][run.clone()]);
+    let (w2, w3) = (&stencil[2][run.clone()], &stencil[3][run.clone()]);
+    let (a, xs, out) = (&alpha[run.clone()], &x[run.clone()], &mut out[run]);
+    for i in 0..len {
+        let xi = xs[i];
+        let mut sum = a[i] * xi;
+        sum += w0[i] * (xi - x0[i]);
+        sum += w1[i] * (xi - x1[i]);
+        sum += w2[i] * (xi - x2[i]);
+        sum += w3[i] * (xi - x3[i]);
+        out[i] = sum;
     }
 }
 
@@ -432,33 +498,119 @@ fn apply(level: &Level, alpha: &[f64], stencil: &[[f64; SIDES]], x: &[f64], out:
 fn gauss_seidel(
     level: &Level,
     inv_diag: &[f64],
-    stencil: &[[f64; SIDES]],
+    stencil: &Stencil,
     r: &[f64],
     z: &mut [f64],
     back: bool,
 ) {
-    // Every row's numbers cut to the level's length once, so the loops index them
-    // without a bounds check per cell (only the neighbours' `z` keep theirs).
-    let cells = level.cells;
-    let (nb, stencil) = (&level.neighbours[..cells], &stencil[..cells]);
-    let (inv_diag, r, z) = (&inv_diag[..cells], &r[..cells], &mut z[..cells]);
+    let relax_segment = |segment: &Segment, z: &mut [f64]| match *segment {
+        Segment::Cells { start, end } => {
+            let relax_cell = |i: usize, z: &mut [f64]| {
+                let (nb, w) = (&level.neighbours[i], stencil);
+                let near = w[0][i] * z[nb[0] as usize] + w[1][i] * z[nb[1] as usize];
+                let far = w[2][i] * z[nb[2] as usize] + w[3][i] * z[nb[3] as usize];
+                z[i] = (r[i] + near + far) * inv_diag[i];
+            };
+            if back {
+                (start..end).rev().for_each(|i| relax_cell(i, z));
+            } else {
+                (start..end).for_each(|i| relax_cell(i, z));
+            }
+        }
+        Segment::Run { start, end, from } => relax_run(start..end, from, inv_diag, stencil, r, z),
+    };
     if back {
-        for i in (0..cells).rev() {
-            relax(i, &nb[i], &stencil[i], inv_diag[i], r[i], z);
-        }
+        level
+            .segments
+            .iter()
+            .rev()
+            .for_each(|s| relax_segment(s, z));
     } else {
-        for i in 0..cells {
-            relax(i, &nb[i], &stencil[i], inv_diag[i], r[i], z);
-        }
+        level.segments.iter().for_each(|s| relax_segment(s, z));
     }
 }
 
-/// Gauss–Seidel's update of cell `i`, inlined into both sweeps.
-#[inline(always)]
-fn relax(i: usize, nb: &[u32; SIDES], w: &[f64; SIDES], inv_diag: f64, r: f64, z: &mut [f64]) {
-    let near = w[0] * z[nb[0] as usize] + w[1] * z[nb[1] as usize];
-    let far = w[2] * z[nb[2] as usize] + w[3] * z[nb[3] as usize];
-    z[i] = (r + near + far) * inv_diag;
+/// Gauss–Seidel's update of a [`Segment::Run`]: no cell of it reads another, so the
+/// order within it does not matter (either sweep direction gives the same numbers) and
+/// it is computed as slices. Its neighbours all lie after it or all before it
+/// ([`segments`] takes no other), so `z` splits into the run and the cells it reads.
+fn relax_run(
+    run: std::ops::Range<usize>,
+    from: [usize; SIDES],
+    inv_diag: &[f64],
+    stencil: &Stencil,
+    r: &[f64],
+    z: &mut [f64],
+) {
+    let len = run.len();
+    let (cells, others, base) = if from[0] > run.start {
+        let (lo, hi) = z.split_at_mut(run.end);
+        (&mut lo[run.start..], &*hi, run.end)
+    } else {
+        let (lo, hi) = z.split_at_mut(run.start);
+        (hi, &*lo, 0)
+    };
+    let (z0, z1) = (
+        &others[from[0] - base..][..len],
+        &others[from[1] - base..][..len],
+    );
+    let (z2, z3) = (
+        &others[from[2] - base..][..len],
+        &others[from[3] - base..][..len],
+    );
+    let (w0, w1) = (&stencil[0][run.clone()], &stencil[1][run.clone()]);
+    let (w2, w3) = (&stencil[2][run.clone()], &stencil[3][run.clone()]);
+    let (inv_diag, r, cells) = (&inv_diag[run.clone()], &r[run], &mut cells[..len]);
+    for i in 0..len {
+        let near = w0[i] * z0[i] + w1[i] * z1[i];
+        let far = w2[i] * z2[i] + w3[i] * z3[i];
+        cells[i] = (r[i] + near + far) * inv_diag[i];
+    }
+}
+
+/// A level's cells as [`Segment`]s: maximal runs of at least [`MIN_RUN`] consecutive
+/// cells whose neighbours lie at the same offsets, all after the run or all before it,
+/// and the single cells between them.
+fn segments(neighbours: &[[u32; SIDES]]) -> Vec<Segment> {
+    let offsets = |i: usize| neighbours[i].map(|n| n as isize - i as isize);
+    let (cells, mut out, mut loose) = (neighbours.len(), Vec::new(), 0);
+    let mut i = 0;
+    while i < cells {
+        let d = offsets(i);
+        let one_side = d.iter().all(|&o| o > 0) || d.iter().all(|&o| o < 0);
+        let mut end = i + 1;
+        // Grown while every offset reaches past the run, so no cell of it reads another.
+        while one_side
+            && end < cells
+            && offsets(end) == d
+            && d.iter().all(|o| o.unsigned_abs() > end - i)
+        {
+            end += 1;
+        }
+        if end - i >= MIN_RUN {
+            if loose < i {
+                out.push(Segment::Cells {
+                    start: loose,
+                    end: i,
+                });
+            }
+            let from = neighbours[i].map(|n| n as usize);
+            out.push(Segment::Run {
+                start: i,
+                end,
+                from,
+            });
+            loose = end;
+        }
+        i = end;
+    }
+    if loose < cells {
+        out.push(Segment::Cells {
+            start: loose,
+            end: cells,
+        });
+    }
+    out
 }
 
 /// `out[i] = values[order[i]]`.
@@ -537,22 +689,18 @@ fn restrict_residual(
     level: &Level,
     parent_of_fine: &[u32],
     alpha: &[f64],
-    stencil: &[[f64; SIDES]],
+    stencil: &Stencil,
     r: &[f64],
     z: &[f64],
     rc: &mut [f64],
 ) {
     rc.iter_mut().for_each(|v| *v = 0.0);
-    let rows = alpha
-        .iter()
-        .zip(stencil)
-        .zip(&level.neighbours)
-        .zip(parent_of_fine);
-    for (i, (((a, w), nb), &parent)) in rows.enumerate() {
+    let rows = alpha.iter().zip(&level.neighbours).zip(parent_of_fine);
+    for (i, ((a, nb), &parent)) in rows.enumerate() {
         let zi = z[i];
         let mut mz = a * zi;
         for k in 0..SIDES {
-            mz += w[k] * (zi - z[nb[k] as usize]);
+            mz += stencil[k][i] * (zi - z[nb[k] as usize]);
         }
         rc[parent as usize] += r[i] - mz;
     }
@@ -711,6 +859,44 @@ mod tests {
             .map(|(p, q)| (p - q).abs())
             .fold(0.0, f64::max);
         assert!(worst < 1e-8, "error {worst}");
+    }
+
+    /// Gauss–Seidel sweeps (both ways) and the operator give bit for bit the same numbers
+    /// through the runs as cell by cell, and the runs cover most of the fine level.
+    #[test]
+    fn runs_relax_and_apply_exactly_as_single_cells_do() {
+        let h = Hierarchy::new(&CubeSphere::new(16));
+        for level in &h.levels[..2] {
+            let n = level.cells;
+            let value = |i: usize, k: usize| 1.0 + ((i * 7 + k * 13) % 17) as f64 / 3.0;
+            let stencil: Stencil = std::array::from_fn(|k| (0..n).map(|i| value(i, k)).collect());
+            let inv_diag: Vec<f64> = (0..n).map(|i| 1.0 / (10.0 + value(i, 5))).collect();
+            let r: Vec<f64> = (0..n).map(|i| value(i, 6) - 2.0).collect();
+            let mut single = level.clone();
+            single.segments = vec![Segment::Cells { start: 0, end: n }];
+            let (mut z_runs, mut z_cells) = (vec![0.0; n], vec![0.0; n]);
+            for back in [false, false, true, true] {
+                gauss_seidel(level, &inv_diag, &stencil, &r, &mut z_runs, back);
+                gauss_seidel(&single, &inv_diag, &stencil, &r, &mut z_cells, back);
+                assert_eq!(z_runs, z_cells);
+            }
+            let (mut by_runs, mut by_cells) = (vec![0.0; n], vec![0.0; n]);
+            apply(level, &inv_diag, &stencil, &z_runs, &mut by_runs);
+            apply(&single, &inv_diag, &stencil, &z_runs, &mut by_cells);
+            assert_eq!(by_runs, by_cells);
+        }
+        let in_runs: usize = h.levels[0]
+            .segments
+            .iter()
+            .map(|s| match *s {
+                Segment::Run { start, end, .. } => end - start,
+                Segment::Cells { .. } => 0,
+            })
+            .sum();
+        assert!(
+            in_runs * 4 > h.levels[0].cells * 3,
+            "{in_runs} cells in runs"
+        );
     }
 
     #[test]
