@@ -88,6 +88,8 @@ pub struct Work {
     inv_diag: Vec<Vec<f64>>,
     stencil: Vec<Stencil>,
     residual: Vec<Vec<f64>>,
+    /// A level's `M z` before its residual is restricted (the finest level's length).
+    operator: Vec<f64>,
     correction: Vec<Vec<f64>>,
     r: Vec<f64>,
     z: Vec<f64>,
@@ -348,15 +350,11 @@ impl Hierarchy {
         let coarse = &self.levels[k + 1];
         let mut rc = std::mem::take(&mut work.residual[k + 1]);
         rc.resize(coarse.cells, 0.0);
-        restrict_residual(
-            level,
-            &coarse.parent_of_fine,
-            &work.alpha[k],
-            &work.stencil[k],
-            r,
-            z,
-            &mut rc,
-        );
+        let mut mz = std::mem::take(&mut work.operator);
+        mz.resize(level.cells, 0.0);
+        apply(level, &work.alpha[k], &work.stencil[k], z, &mut mz);
+        restrict_residual(&coarse.parent_of_fine, r, &mz, &mut rc);
+        work.operator = mz;
         let mut zc = std::mem::take(&mut work.correction[k + 1]);
         zc.resize(coarse.cells, 0.0);
         self.v_cycle(work, k + 1, &rc, &mut zc);
@@ -683,26 +681,13 @@ fn update_and_norm2(step: f64, p: &[f64], q: &[f64], x: &mut [f64], r: &mut [f64
     dot(r, r)
 }
 
-/// `rc` = the residual `r − M z` of a level, restricted by summing each coarse cell's
-/// children (the equations are area-integrated), without storing the fine residual.
-fn restrict_residual(
-    level: &Level,
-    parent_of_fine: &[u32],
-    alpha: &[f64],
-    stencil: &Stencil,
-    r: &[f64],
-    z: &[f64],
-    rc: &mut [f64],
-) {
+/// `rc` = the residual `r − M z` of a level (`mz` = `M z`, from [`apply`], which takes
+/// the face interiors as vectorised runs), restricted by summing each coarse cell's
+/// children (the equations are area-integrated).
+fn restrict_residual(parent_of_fine: &[u32], r: &[f64], mz: &[f64], rc: &mut [f64]) {
     rc.iter_mut().for_each(|v| *v = 0.0);
-    let rows = alpha.iter().zip(&level.neighbours).zip(parent_of_fine);
-    for (i, ((a, nb), &parent)) in rows.enumerate() {
-        let zi = z[i];
-        let mut mz = a * zi;
-        for k in 0..SIDES {
-            mz += stencil[k][i] * (zi - z[nb[k] as usize]);
-        }
-        rc[parent as usize] += r[i] - mz;
+    for ((&parent, r), mz) in parent_of_fine.iter().zip(r).zip(mz) {
+        rc[parent as usize] += r - mz;
     }
 }
 
