@@ -47,18 +47,19 @@ pub(crate) struct AdvectionGeometry {
     /// `b`'s velocity vector (Perot's reconstruction `U_c = Σ ± l (m − x_c) u / A_c`,
     /// exact for a uniform field on a flat cell).
     to_cells: Vec<[DVec3; 2]>,
-    /// Per edge: the six other edges of its two cells, each with the weight of its normal
-    /// velocity in this edge's `ζ k×u` term (times the mean of the two edges'
-    /// vorticities). The weights are the reconstruction's `½ t·w` made antisymmetric
-    /// under the energy norm `Σ l d u²`, so the term does no work, as `ζ k×u ⊥ u` in the
-    /// continuum (with the reconstruction's own weights the advection alone lost 3.3e-4
-    /// of a rotating film's energy in 0.25 s: `tests::the_rotation_term_does_no_work`).
-    /// Indices and weights in two arrays (72 bytes an edge where `(u32, f64)` pairs
-    /// padded to 96), each weight times the ½ of the two vorticities' mean (exact: a
-    /// power of two).
-    coriolis_edges: Vec<[u32; 6]>,
-    /// The weights of [`AdvectionGeometry::coriolis_edges`], halved.
-    coriolis_weights: Vec<[f64; 6]>,
+    /// Per cell: its four edges.
+    cell_edges: Vec<[u32; 4]>,
+    /// Per cell, per edge `i` of it: the weights of the cell's three other edges (in
+    /// [`OTHERS`] order) in edge `i`'s `ζ k×u` term (times the mean of the two edges'
+    /// vorticities, and times the ½ of that mean: exact, a power of two). An edge's term
+    /// sums over the other edges of its two cells; the weights are the reconstruction's
+    /// `½ t·w` made antisymmetric under the energy norm `Σ l d u²`, so the term does no
+    /// work, as `ζ k×u ⊥ u` in the continuum (with the reconstruction's own weights the
+    /// advection alone lost 3.3e-4 of a rotating film's energy in 0.25 s:
+    /// `tests::the_rotation_term_does_no_work`). Taken cell by cell, each cell's four
+    /// edges are read once for the twelve terms among them, where edge by edge each
+    /// edge read six others through an index.
+    coriolis: Vec<[[f64; 3]; 4]>,
     /// The narrowest dual edge, rad.
     min_dual_length: f64,
 }
@@ -80,10 +81,12 @@ impl AdvectionGeometry {
             })
             .collect();
         let tangent: Vec<DVec3> = edges.iter().map(|e| e.midpoint.cross(e.normal)).collect();
-        let coriolis = coriolis_stencil(grid, &to_cells, &tangent);
+        let cell_edges = cell_edges(grid);
+        let stencil = coriolis_stencil(grid, &cell_edges, &to_cells, &tangent);
+        let coriolis = per_cell_weights(grid, &cell_edges, &stencil);
         Self {
-            coriolis_edges: coriolis.iter().map(|st| st.map(|(o, _)| o)).collect(),
-            coriolis_weights: coriolis.iter().map(|st| st.map(|(_, w)| 0.5 * w)).collect(),
+            cell_edges,
+            coriolis,
             to_cells,
             min_dual_length: edges
                 .iter()
@@ -93,18 +96,55 @@ impl AdvectionGeometry {
     }
 }
 
-/// The antisymmetric `ζ k×u` stencil (see [`AdvectionGeometry::coriolis_edges`]).
+/// For each of a cell's four edges, the other three, in increasing order.
+const OTHERS: [[usize; 3]; 4] = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]];
+
+/// Each cell's four edges, in increasing order.
+///
+/// # Panics
+/// If a cell does not have four edges.
+fn cell_edges(grid: &CubeSphere) -> Vec<[u32; 4]> {
+    let mut lists = vec![Vec::with_capacity(4); grid.cells()];
+    for (i, e) in grid.edges().iter().enumerate() {
+        lists[e.a as usize].push(i as u32);
+        lists[e.b as usize].push(i as u32);
+    }
+    let four = |(c, l): (usize, Vec<u32>)| {
+        <[u32; 4]>::try_from(l).unwrap_or_else(|l| panic!("cell {c} has {} edges", l.len()))
+    };
+    lists.into_iter().enumerate().map(four).collect()
+}
+
+/// The stencil's weights by cell: `stencil[e]` lists cell `a`'s other edges, then cell
+/// `b`'s, each in increasing order, as [`OTHERS`] does.
+fn per_cell_weights(
+    grid: &CubeSphere,
+    cell_edges: &[[u32; 4]],
+    stencil: &[[(u32, f64); 6]],
+) -> Vec<[[f64; 3]; 4]> {
+    let edges = grid.edges();
+    let weights = |(c, es): (usize, &[u32; 4])| {
+        std::array::from_fn(|i| {
+            let e = es[i] as usize;
+            let half = if edges[e].a as usize == c { 0 } else { 3 };
+            std::array::from_fn(|k| {
+                let (other, w) = stencil[e][half + k];
+                assert_eq!(other, es[OTHERS[i][k]], "edge {e}: stencil out of order");
+                0.5 * w
+            })
+        })
+    };
+    cell_edges.iter().enumerate().map(weights).collect()
+}
+
+/// The antisymmetric `ζ k×u` stencil (see [`AdvectionGeometry::coriolis`]).
 fn coriolis_stencil(
     grid: &CubeSphere,
+    cell_edges: &[[u32; 4]],
     to_cells: &[[DVec3; 2]],
     tangent: &[DVec3],
 ) -> Vec<[(u32, f64); 6]> {
     let edges = grid.edges();
-    let mut cell_edges = vec![Vec::with_capacity(4); grid.cells()];
-    for (i, e) in edges.iter().enumerate() {
-        cell_edges[e.a as usize].push(i);
-        cell_edges[e.b as usize].push(i);
-    }
     let centres = grid.centres();
     // M[e][e'] = l_e d_e · ½ t_e,c · w_c,e' for e' of shared cell c, with t_e,c the
     // edge's tangent in the cell's tangent plane (the reconstruction projects there).
@@ -122,7 +162,11 @@ fn coriolis_stencil(
             let mut out = [(0u32, 0.0); 6];
             let mut k = 0;
             for c in [ed.a as usize, ed.b as usize] {
-                for &other in cell_edges[c].iter().filter(|&&o| o != e) {
+                for other in cell_edges[c]
+                    .iter()
+                    .map(|&o| o as usize)
+                    .filter(|&o| o != e)
+                {
                     let a = 0.5 * (m(e, other, c) - m(other, e, c));
                     out[k] = (other as u32, a / (ed.length * ed.dual_length));
                     k += 1;
@@ -140,7 +184,7 @@ pub(crate) struct AdvectionScratch {
     cell_velocity: Vec<DVec3>,
     vorticity: Vec<f64>,
     /// Per edge: the mean vorticity of its two vertices, 1/s, and its velocity, m/s,
-    /// side by side (the stencil's six gathers then fetch one line each, not two).
+    /// side by side (each of a cell's four edges is then one read, not two).
     edge_vorticity_velocity: Vec<[f64; 2]>,
     rate: Vec<f64>,
     u0: Vec<f64>,
@@ -228,27 +272,24 @@ fn acceleration(
     let ea = grid.edge_arrays();
     let vorticity = &s.vorticity;
     let zeta_u = &mut s.edge_vorticity_velocity;
-    zeta_u.clear();
-    zeta_u.extend(
-        ea.vertices
-            .iter()
-            .zip(u)
-            .map(|([v0, v1], &u)| [0.5 * (vorticity[*v0 as usize] + vorticity[*v1 as usize]), u]),
-    );
+    zeta_u.resize(u.len(), [0.0; 2]);
+    for ((zu, [v0, v1]), &u) in zeta_u.iter_mut().zip(&ea.vertices).zip(u) {
+        *zu = [0.5 * (vorticity[*v0 as usize] + vorticity[*v1 as usize]), u];
+    }
     let zeta_u = &s.edge_vorticity_velocity;
-    let stencils = geo.coriolis_edges.iter().zip(&geo.coriolis_weights);
-    s.rate.clear();
-    s.rate
-        .extend(stencils.zip(zeta_u).map(|((others, weights), &[z, _])| {
-            others
-                .iter()
-                .zip(weights)
-                .map(|(&o, &w)| {
-                    let [z_o, u_o] = zeta_u[o as usize];
-                    w * (z + z_o) * u_o
-                })
-                .sum::<f64>()
-        }));
+    let rate = &mut s.rate;
+    rate.clear();
+    rate.resize(u.len(), 0.0);
+    for (es, weights) in geo.cell_edges.iter().zip(&geo.coriolis) {
+        let zu = es.map(|e| zeta_u[e as usize]);
+        for (i, (others, w)) in OTHERS.iter().zip(weights).enumerate() {
+            let term = |k: usize| {
+                let [z_o, u_o] = zu[others[k]];
+                w[k] * (zu[i][0] + z_o) * u_o
+            };
+            rate[es[i] as usize] += term(0) + term(1) + term(2);
+        }
+    }
 }
 
 /// The vorticity at each grid vertex, 1/s: the circulation `Σ u d` along its dual edges

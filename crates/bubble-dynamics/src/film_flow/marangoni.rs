@@ -80,24 +80,31 @@ impl FilmFlow {
         let g = &self.grid;
         let ea = g.edge_arrays();
         let (gamma, h) = (&self.gamma, &self.h_m);
-        s.edge.clear();
-        s.stiffness.clear();
-        s.weight.clear();
+        // Written in place through resized buffers: three pushes an edge each checked
+        // the capacity.
+        let n = ea.cells.len();
+        s.edge.resize(n, 0.0);
+        s.stiffness.resize(n, 0.0);
+        s.weight.resize(n, 0.0);
+        let outputs = s.edge.iter_mut().zip(&mut s.stiffness).zip(&mut s.weight);
         let rhs = &mut s.rhs;
         rhs.clear();
         rhs.extend(g.areas_sr().iter().zip(gamma).map(|(a, gm)| a * gm));
         let velocities = self.u_m_per_s.iter().zip(&s.u_start).zip(&s.drag);
         let lengths = ea.length.iter().zip(&ea.inverse_dual_length);
-        for (((&u, &u0), drag), ([a, b], (l, id))) in velocities.zip(ea.cells.iter().zip(lengths)) {
+        let edges = velocities.zip(ea.cells.iter().zip(lengths));
+        for ((((&u, &u0), drag), ([a, b], (l, id))), ((flux, stiffness), weight)) in
+            edges.zip(outputs)
+        {
             let (a, b) = (*a as usize, *b as usize);
             let f = 0.5 * (gamma[a] + gamma[b]) * (u - u0) * l;
-            s.edge.push(f);
+            *flux = f;
             rhs[a] -= dt_per_r * f;
             rhs[b] += dt_per_r * f;
             let h_edge = (0.5 * (h[a] + h[b])).max(H_FLOOR_M);
             let k = dt_s * p.elasticity_n_per_m / (p.density_kg_per_m3 * h_edge) * drag;
-            s.stiffness.push(k);
-            s.weight.push(dt_s * k * l * id * per_r2);
+            *stiffness = k;
+            *weight = dt_s * k * l * id * per_r2;
         }
     }
 

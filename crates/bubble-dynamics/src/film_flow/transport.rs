@@ -146,15 +146,15 @@ impl FilmFlow {
         let (phi, rises) = (&mut s.limiter, &mut s.rise);
         phi.clear();
         phi.resize(self.h_m.len(), 1.0);
-        rises.clear();
-        for ([a, b], reach) in ea.cells.iter().zip(&ea.reach) {
+        rises.resize(ea.cells.len(), [0.0; 2]);
+        for (([a, b], reach), kept) in ea.cells.iter().zip(&ea.reach).zip(rises.iter_mut()) {
             let (a, b) = (*a as usize, *b as usize);
             let rise = [gradient[a].dot(reach[0]), gradient[b].dot(reach[1])];
             let fa = allowed(self.h_m[a], range[a], rise[0]);
             let fb = allowed(self.h_m[b], range[b], rise[1]);
             phi[a] = phi[a].min(fa);
             phi[b] = phi[b].min(fb);
-            rises.push(rise);
+            *kept = rise;
         }
         for f in phi.iter_mut() {
             *f = f.max(0.0);
@@ -167,23 +167,14 @@ impl FilmFlow {
         let dt_per_r = dt_s / self.params.radius_m;
         let ea = self.grid.edge_arrays();
         let (volume, outflow, phi) = (&mut s.edge2, &mut s.cell, &s.limiter);
-        volume.clear();
+        volume.resize(ea.cells.len(), 0.0);
         outflow.clear();
         outflow.resize(self.grid.cells(), 0.0);
         let edges = ea.cells.iter().zip(&s.rise).zip(&ea.length);
         let speeds = self.u_m_per_s.iter().zip(&s.drain_rate);
-        for ((&u, &c), (([a, b], rise), l)) in speeds.zip(edges) {
+        for (((&u, &c), (([a, b], rise), l)), v) in speeds.zip(edges).zip(volume.iter_mut()) {
             let (a, b) = (*a as usize, *b as usize);
-            let face = |forward: bool| {
-                let (up, down, rise) = if forward {
-                    (a, b, rise[0])
-                } else {
-                    (b, a, rise[1])
-                };
-                let (h_up, h_down) = (self.h_m[up], self.h_m[down]);
-                let reach = rise * phi[up];
-                (h_up + reach).clamp(h_up.min(h_down), h_up.max(h_down))
-            };
+            let face = |forward: bool| face_thickness(&self.h_m, phi, [a, b], *rise, forward);
             // Each part upwind along its own characteristic: the surfaces carry h at u,
             // the drainage flux c·h³ travels at 3c·h², the sign of c. One upwind choice by
             // the sign of the summed speed runs downwind wherever the surfaces move up
@@ -195,9 +186,29 @@ impl FilmFlow {
                 face(c >= 0.0)
             };
             let f = (u * h_plug + c * h_drain * h_drain * h_drain) * l * dt_per_r;
-            volume.push(f);
+            *v = f;
             let donor = if f >= 0.0 { a } else { b };
             outflow[donor] += f.abs();
         }
     }
+}
+
+/// The thickness the upwind cell (`a` going `forward`, else `b`) carries to the edge: its
+/// own plus its limited rise, clamped between the two cells' values. A function, not a
+/// closure, so that it is inlined at both its calls.
+#[inline(always)]
+fn face_thickness(
+    h: &[f64],
+    phi: &[f64],
+    [a, b]: [usize; 2],
+    rise: [f64; 2],
+    forward: bool,
+) -> f64 {
+    let (up, down, rise) = if forward {
+        (a, b, rise[0])
+    } else {
+        (b, a, rise[1])
+    };
+    let (h_up, h_down) = (h[up], h[down]);
+    (h_up + rise * phi[up]).clamp(h_up.min(h_down), h_up.max(h_down))
 }
