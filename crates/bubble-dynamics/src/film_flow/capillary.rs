@@ -13,7 +13,7 @@
 //! keep the exact law. Fluxes that sum to zero keep liquid conserved to rounding, each
 //! donor limited to half its content keeps h ≥ 0.
 
-use super::flow::{apply_fluxes, limit_outflow};
+use super::flow::apply_limited_fluxes;
 use super::grid::CubeSphere;
 
 /// Most explicit sub-steps a film step spends on capillary smoothing.
@@ -149,6 +149,5 @@ fn substep(
         m * rise / (d * radius_m) * l * dt_s / radius_m
     }));
     // Each donor gives at most half its content: h stays ≥ 0.
-    limit_outflow(grid, &mut s.flux, 1.0, h_m, &mut s.outflow);
-    apply_fluxes(grid, &s.flux, 1.0, h_m);
+    apply_limited_fluxes(grid, &s.flux, 1.0, h_m, &mut s.outflow);
 }

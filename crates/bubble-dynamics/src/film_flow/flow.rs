@@ -425,37 +425,38 @@ impl FilmFlow {
     }
 }
 
-/// Moves `scale·flux_e` (per unit sphere area) from cell `a` to `b` of every edge.
-pub(super) fn apply_fluxes(g: &CubeSphere, flux: &[f64], scale: f64, values: &mut [f64]) {
-    for ([a, b], f) in g.edge_arrays().cells.iter().zip(flux) {
-        let (a, b) = (*a as usize, *b as usize);
-        let moved = scale * f;
-        values[a] -= moved / g.areas_sr()[a];
-        values[b] += moved / g.areas_sr()[b];
-    }
-}
-
-/// Scales each donor's outgoing fluxes so no cell gives more than
-/// [`MAX_OUTFLOW_FRACTION`] of its content in one step (`outflow` is scratch).
-pub(super) fn limit_outflow(
+/// Moves `scale·flux_e` (per unit sphere area) from cell `a` to `b` of every edge, each
+/// donor's outgoing fluxes scaled so that no cell gives more than
+/// [`MAX_OUTFLOW_FRACTION`] of its content in one step (`ratio` is scratch).
+///
+/// Two passes over the edges: each donor's outflow, then the limited fluxes moved. The
+/// limit is each donor's `budget/outflow`, taken once a cell from the values the step
+/// starts with (limiting the fluxes in a pass of their own, before moving them, took it
+/// once an edge and walked the edges three times).
+pub(super) fn apply_limited_fluxes(
     g: &CubeSphere,
-    flux: &mut [f64],
+    flux: &[f64],
     scale: f64,
-    values: &[f64],
-    outflow: &mut Vec<f64>,
+    values: &mut [f64],
+    ratio: &mut Vec<f64>,
 ) {
-    outflow.clear();
-    outflow.resize(g.cells(), 0.0);
+    ratio.clear();
+    ratio.resize(g.cells(), 0.0);
     let cells = &g.edge_arrays().cells;
-    for ([a, b], f) in cells.iter().zip(flux.iter()) {
+    for ([a, b], f) in cells.iter().zip(flux) {
         let donor = if *f >= 0.0 { *a } else { *b } as usize;
-        outflow[donor] += (scale * f).abs();
+        ratio[donor] += (scale * f).abs();
     }
-    for ([a, b], f) in cells.iter().zip(flux.iter_mut()) {
-        let donor = if *f >= 0.0 { *a } else { *b } as usize;
-        let budget = MAX_OUTFLOW_FRACTION * g.areas_sr()[donor] * values[donor];
-        if outflow[donor] > budget {
-            *f *= budget / outflow[donor];
-        }
+    for ((r, area), v) in ratio.iter_mut().zip(g.areas_sr()).zip(values.iter()) {
+        let budget = MAX_OUTFLOW_FRACTION * area * v;
+        *r = if *r > budget { budget / *r } else { 1.0 };
+    }
+    let areas = g.areas_sr();
+    for ([a, b], f) in cells.iter().zip(flux) {
+        let (a, b) = (*a as usize, *b as usize);
+        let donor = if *f >= 0.0 { a } else { b };
+        let moved = scale * (f * ratio[donor]);
+        values[a] -= moved / areas[a];
+        values[b] += moved / areas[b];
     }
 }

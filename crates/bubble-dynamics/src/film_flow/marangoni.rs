@@ -9,8 +9,7 @@
 //! surfactant the solve started from and the rare redo needs no restore).
 
 use super::flow::{
-    FilmFlow, H_FLOOR_M, SOLVE_MAX_ITERATIONS, SOLVE_TOLERANCE, Scratch, apply_fluxes,
-    limit_outflow,
+    FilmFlow, H_FLOOR_M, SOLVE_MAX_ITERATIONS, SOLVE_TOLERANCE, Scratch, apply_limited_fluxes,
 };
 use super::solve::{SolveLimits, SolveReport};
 
@@ -61,8 +60,7 @@ impl FilmFlow {
                 let up = if u0 >= 0.0 { *a } else { *b } as usize;
                 self.gamma[up] * u0 * l
             }));
-            limit_outflow(&g, flux, sub_dt_per_r, &self.gamma, &mut s.cell);
-            apply_fluxes(&g, flux, sub_dt_per_r, &mut self.gamma);
+            apply_limited_fluxes(&g, flux, sub_dt_per_r, &mut self.gamma, &mut s.cell);
         }
     }
 
@@ -182,7 +180,6 @@ impl FilmFlow {
             let up = if du >= 0.0 { *a } else { *b } as usize;
             self.gamma[up] * du * l
         }));
-        limit_outflow(&g, flux, scale, &self.gamma, &mut s.cell);
-        apply_fluxes(&g, flux, scale, &mut self.gamma);
+        apply_limited_fluxes(&g, flux, scale, &mut self.gamma, &mut s.cell);
     }
 }
