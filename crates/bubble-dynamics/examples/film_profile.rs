@@ -1,5 +1,6 @@
 //! Prints the film step's solver iterations, wall time, thinnest film and fastest edge
-//! for `film_profile [n] [air m/s] [g m/s²]` (the bench's film, for profiling with perf).
+//! for `film_profile [n] [air m/s] [g m/s²] [bottom warming K]` (the bench's film, for
+//! profiling with perf).
 
 #[path = "../benches/common/swirl_film.rs"]
 mod swirl_film;
@@ -7,7 +8,7 @@ mod swirl_film;
 use bubble_dynamics::DVec3;
 use bubble_dynamics::film_flow::Forcing;
 
-use swirl_film::swirl_film;
+use swirl_film::swirl_film_warmed;
 
 fn main() {
     let arg = |k: usize, d: f64| std::env::args().nth(k).map_or(d, |s| s.parse().unwrap());
@@ -16,7 +17,7 @@ fn main() {
         air_m_per_s: DVec3::new(arg(2, 0.3), 0.0, 0.0),
     };
     let n = arg(1, 64.0) as usize;
-    let mut f = swirl_film(n);
+    let mut f = swirl_film_warmed(n, arg(4, 0.0));
     for k in 0..40 {
         let t = std::time::Instant::now();
         let r = f.step(1.0 / 60.0, &forcing);

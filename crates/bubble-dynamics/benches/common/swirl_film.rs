@@ -1,13 +1,14 @@
 //! The film the film-step bench and the `film_profile` example both step: the `swirl`
 //! scene's film (drainage μ 1e-6 Pa·s, evaporation 40 nm/s) on a 5 cm bubble, 600 nm ± 5 %,
-//! with bursting off so it keeps flowing through a measurement.
+//! with bursting off so it keeps flowing through a measurement; the scene's warm bottom
+//! (thermal convection) is `swirl_film_warmed`'s.
 
 use std::sync::Arc;
 
-use bubble_dynamics::film_flow::{CubeSphere, FilmFlow, FlowParams, Hierarchy};
+use bubble_dynamics::film_flow::{CubeSphere, FilmFlow, FlowParams, Hierarchy, ThermalParams};
 
-/// That film on a grid of `n` cells a face.
-pub fn swirl_film(n: usize) -> FilmFlow {
+/// That film on a grid of `n` cells a face, the air `warming_k` warmer at its bottom.
+pub fn swirl_film_warmed(n: usize, warming_k: f64) -> FilmFlow {
     let grid = Arc::new(CubeSphere::new(n));
     let hierarchy = Arc::new(Hierarchy::new(&grid));
     let mut params = FlowParams {
@@ -17,6 +18,10 @@ pub fn swirl_film(n: usize) -> FilmFlow {
     };
     params.burst.rupture_thickness_nm = 0.0;
     params.burst.black_threshold_nm = 0.0;
+    params.thermal = ThermalParams {
+        bottom_warming_k: warming_k,
+        ..ThermalParams::isothermal()
+    };
     FilmFlow::new(grid, hierarchy, params, |d| {
         600e-9 * (1.0 + 0.05 * (4.0 * d.x + d.y).sin())
     })
