@@ -268,7 +268,7 @@ fn swirl_burst(dir: &str, bubbles: &dyn Fn(&[&str]) -> bool) -> bool {
 
 /// The gallery scenes of docs/gallery.md (seed 000 Figs. 5–7, the demo, seed 002's pond
 /// and the living film's swirl): a still and a short animated PNG of each, a GIF preview
-/// of the wind scene, the swirl at three ages, and the pond at two times for
+/// of the wind scene, the swirl at four ages, and the pond at two times for
 /// docs/water.md.
 fn gallery() -> bool {
     const GALLERY: [(&str, &str, &str, &str); 6] = [
@@ -313,8 +313,8 @@ fn gallery() -> bool {
             "150",
         ]);
     }
-    // The swirl scene's film at three ages, full size (docs/gallery.md).
-    for time_s in ["0.5", "5", "10.5"] {
+    // The swirl scene's film at four ages, full size (docs/gallery.md).
+    for time_s in ["0.5", "5", "8", "10.5"] {
         let still = format!("{dir}/swirl_t{time_s}.png");
         ok &= bubbles(&["render", "swirl", "--out", &still, "--time-s", time_s]);
     }
