@@ -104,6 +104,56 @@ fn thin_film_turns_black_and_pushes_its_liquid_into_the_rim() {
     );
 }
 
+/// Regression: black spots are uniform black film, their liquid in the thick film
+/// around them. A film at rest between 25 and 45 nm (no gravity, no flow): after 1 s (20
+/// relaxation times) every cell under the 30 nm threshold is black film (12 nm) and no
+/// grey cell is left alone inside black film. Each black cell used to push its liquid
+/// only into its own neighbours above the threshold, so the inside of a spot (no thick
+/// neighbour) stayed at its starting 25–30 nm and marginal cells were pushed up into
+/// grey islands: the `swirl` film's black region was a cell-by-cell checkerboard.
+#[test]
+fn black_film_spreads_as_uniform_spots_not_a_checkerboard() {
+    let p = FlowParams::water_film(0.03);
+    let mut f = flow(32, p, |d| {
+        35e-9 + 10e-9 * (3.0 * d.x + 2.0 * d.y).sin() * (2.0 * d.z).cos()
+    });
+    let v0 = f.liquid_volume_m3();
+    for _ in 0..60 {
+        f.step(1.0 / 60.0, &Forcing::default());
+    }
+    let h = f.thickness_m();
+    let black: Vec<bool> = h.iter().map(|h| *h < 30e-9).collect();
+    let thickest_black = h
+        .iter()
+        .zip(&black)
+        .filter(|(_, b)| **b)
+        .map(|(h, _)| *h)
+        .fold(0.0, f64::max);
+    let mut grey_neighbours = vec![0u32; h.len()];
+    for e in f.grid().edges() {
+        let (a, b) = (e.a as usize, e.b as usize);
+        grey_neighbours[a] += u32::from(!black[b]);
+        grey_neighbours[b] += u32::from(!black[a]);
+    }
+    let islands = (0..h.len())
+        .filter(|&k| !black[k] && grey_neighbours[k] == 0)
+        .count();
+    let black_cells = black.iter().filter(|b| **b).count();
+    let dv = (f.liquid_volume_m3() - v0) / v0;
+    eprintln!(
+        "{black_cells} black cells, thickest {:.3} nm; grey islands {islands}; drift {dv:.1e}",
+        thickest_black * 1e9
+    );
+    assert!(black_cells > 100, "the film has {black_cells} black cells");
+    assert!(
+        thickest_black < 12.5e-9,
+        "a black cell is {:.2} nm, not black film",
+        thickest_black * 1e9
+    );
+    assert_eq!(islands, 0, "grey cells alone inside black film");
+    assert!(dv.abs() < 1e-12, "black film lost or made liquid: {dv:e}");
+}
+
 #[test]
 fn a_film_under_the_rupture_thickness_bursts_and_the_world_removes_the_bubble() {
     let bubble = BubbleParams {

@@ -93,12 +93,24 @@ pub struct BurstState {
 /// Buffers of [`BurstState::blacken`].
 #[derive(Clone, Debug, Default)]
 struct BlackScratch {
-    /// Per cell: whether it is thick film.
-    thick: Vec<bool>,
-    /// Per cell: the length of its boundary that borders thick film, rad.
-    thick_sides: Vec<f64>,
-    /// Per cell: the thickness it gives away this step, m.
-    excess: Vec<f64>,
+    /// Per cell: its black spot's root cell (union–find), or itself where not black.
+    spot: Vec<u32>,
+    /// Per root cell: the volume its spot expels this step, m³ per R².
+    expelled: Vec<f64>,
+    /// Per root cell: the summed weight of the thick film bordering its spot.
+    border_weight: Vec<f64>,
+    /// Per cell: the thickness the spots around it give it this step, m.
+    gain: Vec<f64>,
+}
+
+/// The root of `cell`'s spot, halving the path to it on the way.
+fn spot_root(spot: &mut [u32], mut cell: usize) -> usize {
+    while spot[cell] as usize != cell {
+        let parent = spot[cell] as usize;
+        spot[cell] = spot[parent];
+        cell = parent;
+    }
+    cell
 }
 
 impl BurstState {
@@ -216,59 +228,98 @@ impl BurstState {
         }
     }
 
-    /// Thins black cells towards the black film, their liquid shared among the
-    /// neighbours above the threshold in proportion to edge length.
+    /// Thins black cells towards the black film; each black spot's expelled liquid goes
+    /// to the thick film around the spot, each bordering cell in proportion to its edge's
+    /// length times its thickness above the threshold.
+    ///
+    /// Why by spot, and weighted so: each black cell used to push its liquid into its own
+    /// neighbours above the threshold. Marginal neighbours (a few nm above it) were pushed
+    /// up and stayed grey while the cells beyond them went black, and a cell under the
+    /// threshold with no thick neighbour kept its liquid: the `swirl` film's black region
+    /// became a cell-by-cell checkerboard of 13–16 nm and 34–41 nm cells with some stuck
+    /// near 21 nm, drawn as blocks in the renders
+    /// (`black_film_spreads_as_uniform_spots_not_a_checkerboard`). Real black spots are
+    /// uniform and gather their liquid into a rim in the thicker film around them.
     fn blacken(&mut self, flow: &mut FilmFlow, dt_s: f64) {
         let p = &self.params;
         if p.black_threshold_nm <= 0.0 {
             return;
         }
         let (threshold, black) = (p.black_threshold_nm * 1e-9, p.black_film_nm * 1e-9);
-        let fraction = 1.0 - (-dt_s / BLACK_RELAX_S).exp();
-        let grid = std::sync::Arc::clone(&flow.grid);
-        let areas = grid.areas_sr();
-        let BlackScratch {
-            thick,
-            thick_sides,
-            excess,
-        } = &mut self.black;
-        // Judged once, before anything moves: which cells are thick film, and how much of
-        // each cell's boundary borders them.
-        thick.clear();
-        thick.extend(
-            flow.h_m
-                .iter()
-                .zip(&self.coverage)
-                .map(|(&h, &c)| h >= threshold && c > 0.0),
-        );
-        thick_sides.clear();
-        thick_sides.resize(grid.cells(), 0.0);
-        for e in grid.edges() {
-            let (a, b) = (e.a as usize, e.b as usize);
-            if thick[b] {
-                thick_sides[a] += e.length;
-            }
-            if thick[a] {
-                thick_sides[b] += e.length;
-            }
-        }
-        excess.clear();
-        excess.extend(flow.h_m.iter().zip(thick_sides.iter()).map(|(&h, &sides)| {
-            if h < threshold && h > black && sides > 0.0 {
-                (h - black) * fraction
+        let coverage = &self.coverage;
+        let is_black = |h: &[f64], k: usize| h[k] < threshold && coverage[k] > 0.0;
+        // How far a cell's film stands above the threshold, at most the threshold again
+        // (0: black, a hole; small: marginal film). The cap keeps a cell that has taken
+        // liquid from drawing ever more: uncapped, a few cells inside a growing spot took
+        // all of it and stood as bright dots in the black film.
+        let above = |h: &[f64], k: usize| {
+            if coverage[k] > 0.0 {
+                (h[k] - threshold).clamp(0.0, threshold)
             } else {
                 0.0
             }
-        }));
-        for e in grid.edges() {
-            let (a, b) = (e.a as usize, e.b as usize);
+        };
+        if !(0..flow.h_m.len()).any(|k| is_black(&flow.h_m, k)) {
+            return;
+        }
+        let fraction = 1.0 - (-dt_s / BLACK_RELAX_S).exp();
+        let grid = std::sync::Arc::clone(&flow.grid);
+        let ea = grid.edge_arrays();
+        let areas = grid.areas_sr();
+        let h = &mut flow.h_m;
+        let BlackScratch {
+            spot,
+            expelled,
+            border_weight,
+            gain,
+        } = &mut self.black;
+        // Judged once, before anything moves: the spots and the thick film around each.
+        spot.clear();
+        spot.extend(0..grid.cells() as u32);
+        border_weight.clear();
+        border_weight.resize(grid.cells(), 0.0);
+        for [a, b] in &ea.cells {
+            let (a, b) = (*a as usize, *b as usize);
+            if is_black(h, a) && is_black(h, b) {
+                let (ra, rb) = (spot_root(spot, a), spot_root(spot, b));
+                spot[ra.max(rb)] = ra.min(rb) as u32;
+            }
+        }
+        for ([a, b], l) in ea.cells.iter().zip(&ea.length) {
+            let (a, b) = (*a as usize, *b as usize);
             for (from, to) in [(a, b), (b, a)] {
-                if excess[from] > 0.0 && thick[to] {
-                    let volume = excess[from] * areas[from] * e.length / thick_sides[from];
-                    flow.h_m[from] -= volume / areas[from];
-                    flow.h_m[to] += volume / areas[to];
+                if is_black(h, from) {
+                    border_weight[spot_root(spot, from)] += l * above(h, to);
                 }
             }
+        }
+        // Each black cell of a spot with thick film around it thins; a spot with none
+        // (it covers all the film there is) has nowhere to put its liquid and waits.
+        expelled.clear();
+        expelled.resize(grid.cells(), 0.0);
+        for k in 0..h.len() {
+            let root = spot_root(spot, k);
+            if is_black(h, k) && h[k] > black && border_weight[root] > 0.0 {
+                let give = (h[k] - black) * fraction;
+                expelled[root] += give * areas[k];
+                h[k] -= give;
+            }
+        }
+        // The expelled liquid into the thick film around each spot, by edge length times
+        // thickness above the threshold (judged before any arrives).
+        gain.clear();
+        gain.resize(grid.cells(), 0.0);
+        for ([a, b], l) in ea.cells.iter().zip(&ea.length) {
+            let (a, b) = (*a as usize, *b as usize);
+            for (from, to) in [(a, b), (b, a)] {
+                let root = spot_root(spot, from);
+                if is_black(h, from) && expelled[root] > 0.0 {
+                    gain[to] += expelled[root] * l * above(h, to) / border_weight[root];
+                }
+            }
+        }
+        for ((h, g), a) in h.iter_mut().zip(gain.iter()).zip(areas) {
+            *h += g / a;
         }
     }
 
