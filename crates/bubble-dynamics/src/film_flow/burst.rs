@@ -22,7 +22,7 @@
 use glam::DVec3;
 
 use super::FilmFlow;
-use super::grid::arc;
+use super::grid::{CubeSphere, arc};
 use crate::rng::SplitMix64;
 
 /// Time for a film that fell under the black threshold to reach the black film, s.
@@ -111,6 +111,94 @@ fn spot_root(spot: &mut [u32], mut cell: usize) -> usize {
         cell = parent;
     }
     cell
+}
+
+/// The black film's threshold model over one step's film.
+struct BlackFilm<'a> {
+    /// Thickness under which film is black, m.
+    threshold: f64,
+    /// Thickness of the common black film, m.
+    black: f64,
+    /// Per cell: 1 where film is, 0 in a hole.
+    coverage: &'a [f64],
+}
+
+impl BlackFilm<'_> {
+    /// Whether cell `k` of `h` is black film.
+    fn is_black(&self, h: &[f64], k: usize) -> bool {
+        h[k] < self.threshold && self.coverage[k] > 0.0
+    }
+
+    /// How far cell `k`'s film stands above the threshold, at most the threshold again
+    /// (0: black, a hole; small: marginal film). The cap keeps a cell that has taken
+    /// liquid from drawing ever more: uncapped, a few cells inside a growing spot took
+    /// all of it and stood as bright dots in the black film.
+    fn above(&self, h: &[f64], k: usize) -> f64 {
+        if self.coverage[k] > 0.0 {
+            (h[k] - self.threshold).clamp(0.0, self.threshold)
+        } else {
+            0.0
+        }
+    }
+
+    /// Joins touching black cells into spots (union–find; a root is its spot's smallest
+    /// cell) and sums each spot's border weight, judged before anything moves.
+    fn find_spots(&self, grid: &CubeSphere, h: &[f64], s: &mut BlackScratch) {
+        let ea = grid.edge_arrays();
+        s.spot.clear();
+        s.spot.extend(0..grid.cells() as u32);
+        for [a, b] in &ea.cells {
+            let (a, b) = (*a as usize, *b as usize);
+            if self.is_black(h, a) && self.is_black(h, b) {
+                let (ra, rb) = (spot_root(&mut s.spot, a), spot_root(&mut s.spot, b));
+                s.spot[ra.max(rb)] = ra.min(rb) as u32;
+            }
+        }
+        s.border_weight.clear();
+        s.border_weight.resize(grid.cells(), 0.0);
+        for ([a, b], l) in ea.cells.iter().zip(&ea.length) {
+            let (a, b) = (*a as usize, *b as usize);
+            for (from, to) in [(a, b), (b, a)] {
+                if self.is_black(h, from) {
+                    s.border_weight[spot_root(&mut s.spot, from)] += l * self.above(h, to);
+                }
+            }
+        }
+    }
+
+    /// Thins each black cell of a spot with thick film around it by `fraction` of its
+    /// excess over the black film, and puts the spot's liquid into the cells bordering
+    /// it by edge length times thickness above the threshold (judged before any
+    /// arrives). A spot with no thick film around it (it covers all the film there is)
+    /// has nowhere to put its liquid and waits.
+    fn expel(&self, grid: &CubeSphere, fraction: f64, h: &mut [f64], s: &mut BlackScratch) {
+        let (ea, areas) = (grid.edge_arrays(), grid.areas_sr());
+        s.expelled.clear();
+        s.expelled.resize(grid.cells(), 0.0);
+        for k in 0..h.len() {
+            let root = spot_root(&mut s.spot, k);
+            if self.is_black(h, k) && h[k] > self.black && s.border_weight[root] > 0.0 {
+                let give = (h[k] - self.black) * fraction;
+                s.expelled[root] += give * areas[k];
+                h[k] -= give;
+            }
+        }
+        s.gain.clear();
+        s.gain.resize(grid.cells(), 0.0);
+        for ([a, b], l) in ea.cells.iter().zip(&ea.length) {
+            let (a, b) = (*a as usize, *b as usize);
+            for (from, to) in [(a, b), (b, a)] {
+                let root = spot_root(&mut s.spot, from);
+                if self.is_black(h, from) && s.expelled[root] > 0.0 {
+                    let share = l * self.above(h, to) / s.border_weight[root];
+                    s.gain[to] += s.expelled[root] * share;
+                }
+            }
+        }
+        for ((h, g), a) in h.iter_mut().zip(&s.gain).zip(areas) {
+            *h += g / a;
+        }
+    }
 }
 
 impl BurstState {
@@ -245,82 +333,18 @@ impl BurstState {
         if p.black_threshold_nm <= 0.0 {
             return;
         }
-        let (threshold, black) = (p.black_threshold_nm * 1e-9, p.black_film_nm * 1e-9);
-        let coverage = &self.coverage;
-        let is_black = |h: &[f64], k: usize| h[k] < threshold && coverage[k] > 0.0;
-        // How far a cell's film stands above the threshold, at most the threshold again
-        // (0: black, a hole; small: marginal film). The cap keeps a cell that has taken
-        // liquid from drawing ever more: uncapped, a few cells inside a growing spot took
-        // all of it and stood as bright dots in the black film.
-        let above = |h: &[f64], k: usize| {
-            if coverage[k] > 0.0 {
-                (h[k] - threshold).clamp(0.0, threshold)
-            } else {
-                0.0
-            }
+        let film = BlackFilm {
+            threshold: p.black_threshold_nm * 1e-9,
+            black: p.black_film_nm * 1e-9,
+            coverage: &self.coverage,
         };
-        if !(0..flow.h_m.len()).any(|k| is_black(&flow.h_m, k)) {
+        if !(0..flow.h_m.len()).any(|k| film.is_black(&flow.h_m, k)) {
             return;
         }
         let fraction = 1.0 - (-dt_s / BLACK_RELAX_S).exp();
         let grid = std::sync::Arc::clone(&flow.grid);
-        let ea = grid.edge_arrays();
-        let areas = grid.areas_sr();
-        let h = &mut flow.h_m;
-        let BlackScratch {
-            spot,
-            expelled,
-            border_weight,
-            gain,
-        } = &mut self.black;
-        // Judged once, before anything moves: the spots and the thick film around each.
-        spot.clear();
-        spot.extend(0..grid.cells() as u32);
-        border_weight.clear();
-        border_weight.resize(grid.cells(), 0.0);
-        for [a, b] in &ea.cells {
-            let (a, b) = (*a as usize, *b as usize);
-            if is_black(h, a) && is_black(h, b) {
-                let (ra, rb) = (spot_root(spot, a), spot_root(spot, b));
-                spot[ra.max(rb)] = ra.min(rb) as u32;
-            }
-        }
-        for ([a, b], l) in ea.cells.iter().zip(&ea.length) {
-            let (a, b) = (*a as usize, *b as usize);
-            for (from, to) in [(a, b), (b, a)] {
-                if is_black(h, from) {
-                    border_weight[spot_root(spot, from)] += l * above(h, to);
-                }
-            }
-        }
-        // Each black cell of a spot with thick film around it thins; a spot with none
-        // (it covers all the film there is) has nowhere to put its liquid and waits.
-        expelled.clear();
-        expelled.resize(grid.cells(), 0.0);
-        for k in 0..h.len() {
-            let root = spot_root(spot, k);
-            if is_black(h, k) && h[k] > black && border_weight[root] > 0.0 {
-                let give = (h[k] - black) * fraction;
-                expelled[root] += give * areas[k];
-                h[k] -= give;
-            }
-        }
-        // The expelled liquid into the thick film around each spot, by edge length times
-        // thickness above the threshold (judged before any arrives).
-        gain.clear();
-        gain.resize(grid.cells(), 0.0);
-        for ([a, b], l) in ea.cells.iter().zip(&ea.length) {
-            let (a, b) = (*a as usize, *b as usize);
-            for (from, to) in [(a, b), (b, a)] {
-                let root = spot_root(spot, from);
-                if is_black(h, from) && expelled[root] > 0.0 {
-                    gain[to] += expelled[root] * l * above(h, to) / border_weight[root];
-                }
-            }
-        }
-        for ((h, g), a) in h.iter_mut().zip(gain.iter()).zip(areas) {
-            *h += g / a;
-        }
+        film.find_spots(&grid, &flow.h_m, &mut self.black);
+        film.expel(&grid, fraction, &mut flow.h_m, &mut self.black);
     }
 
     /// Opens holes where the film is under the rupture thickness, and at random on black
