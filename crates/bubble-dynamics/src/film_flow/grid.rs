@@ -209,6 +209,17 @@ impl CubeSphere {
         &self.edge_arrays
     }
 
+    /// The largest `|u|·length/min(area_a, area_b)` over the edges, for edge speeds `u`
+    /// (m/s): times a step over the radius, the largest fraction of a cell any edge
+    /// carries (a Courant number).
+    pub fn fastest_crossing(&self, u_m_per_s: &[f64]) -> f64 {
+        u_m_per_s
+            .iter()
+            .zip(&self.edge_arrays.length_per_smaller_area)
+            .map(|(u, per_area)| u.abs() * per_area)
+            .fold(0.0, f64::max)
+    }
+
     /// Dual area of each grid vertex (a quarter of each cell around it), sr.
     pub fn vertex_areas_sr(&self) -> &[f64] {
         &self.vertex_areas_sr

@@ -41,12 +41,7 @@ impl FilmFlow {
         let dt_per_r = dt_s / self.params.radius_m;
         let g = std::sync::Arc::clone(&self.grid);
         let ea = g.edge_arrays();
-        let fastest = s
-            .u_start
-            .iter()
-            .zip(&ea.length_per_smaller_area)
-            .map(|(u0, per_area)| u0.abs() * per_area)
-            .fold(0.0, f64::max);
+        let fastest = g.fastest_crossing(&s.u_start);
         if fastest == 0.0 {
             return;
         }

@@ -129,12 +129,7 @@ impl FilmFlow {
     fn advect_temperature(&mut self, u: &[f64], before: &mut Vec<f64>, dt_s: f64) {
         let ea = self.grid.edge_arrays();
         let per_area = self.grid.inverse_areas_per_sr();
-        let fastest = u
-            .iter()
-            .zip(&ea.length_per_smaller_area)
-            .map(|(u, per)| u.abs() * per)
-            .fold(0.0, f64::max);
-        let courant = fastest * dt_s / self.params.radius_m;
+        let courant = self.grid.fastest_crossing(u) * dt_s / self.params.radius_m;
         if courant == 0.0 {
             return;
         }
