@@ -43,7 +43,7 @@ pub use collider::{Collider, DEFAULT_FRICTION, DEFAULT_RESTITUTION};
 pub use error::{Divergence, ParamError, SimError};
 pub use params::{
     AIR_MOLAR_MASS_KG_PER_MOL, BubbleParams, GAS_CONSTANT_J_PER_MOL_K, Integrator, MAX_FILM_GRID,
-    MassDistribution, STANDARD_GRAVITY_M_PER_S2, STANDARD_PRESSURE_PA, WorldParams,
+    MAX_WARMING_K, MassDistribution, STANDARD_GRAVITY_M_PER_S2, STANDARD_PRESSURE_PA, WorldParams,
 };
 pub use topology::{Edge, Topology};
 pub use wind::{Gusts, Wind, WindFn};

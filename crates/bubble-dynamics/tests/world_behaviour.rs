@@ -139,6 +139,22 @@ fn bad_parameters_are_rejected_by_name_and_value() {
         (
             WorldParams::default(),
             vec![BubbleParams {
+                bottom_warming_k: f64::NAN,
+                ..BubbleParams::default()
+            }],
+            "bubbles[0].bottom_warming_k = NaN",
+        ),
+        (
+            WorldParams::default(),
+            vec![BubbleParams {
+                bottom_warming_k: 31.0,
+                ..BubbleParams::default()
+            }],
+            "bubbles[0].bottom_warming_k = 31.0",
+        ),
+        (
+            WorldParams::default(),
+            vec![BubbleParams {
                 subdivisions: 12,
                 ..BubbleParams::default()
             }],

@@ -26,6 +26,7 @@
 use glam::DVec3;
 
 use super::flow::{FilmFlow, H_FLOOR_M};
+use crate::params::GAS_CONSTANT_J_PER_MOL_K;
 
 /// Specific heat of the film liquid (water), J/(kg·K).
 pub const LIQUID_HEAT_CAPACITY_J_PER_KG_K: f64 = 4186.0;
@@ -33,8 +34,6 @@ pub const LIQUID_HEAT_CAPACITY_J_PER_KG_K: f64 = 4186.0;
 pub const LATENT_HEAT_J_PER_KG: f64 = 2.454e6;
 /// Molar mass of water, kg/mol.
 pub const WATER_MOLAR_MASS_KG_PER_MOL: f64 = 0.018_015;
-/// The gas constant, J/(mol·K).
-const GAS_CONSTANT_J_PER_MOL_K: f64 = 8.314_462_618;
 /// Most sub-steps the temperature's transport takes in one step.
 const MAX_SUBSTEPS: u32 = 64;
 /// Largest fraction of a cell's temperature difference one edge's inflow brings in a

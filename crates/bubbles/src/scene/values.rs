@@ -330,7 +330,7 @@ bounds! {
     /// Evaporative thinning rate.
     Evaporation: 0.0, 1e4, "nm/s";
     /// How much warmer the air at a bubble's bottom is than at its top.
-    Warming: -30.0, 30.0, "K";
+    Warming: -bubble_dynamics::MAX_WARMING_K, bubble_dynamics::MAX_WARMING_K, "K";
     /// Molar mass of the gas inside.
     MolarMass: 1e-3, 1.0, "kg/mol";
     /// Film refractive index.
