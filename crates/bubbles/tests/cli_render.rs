@@ -115,6 +115,24 @@ fn bad_output_extension_is_exit_2_and_writes_nothing() {
 }
 
 #[test]
+fn cube_map_reuse_past_half_a_texel_is_exit_2_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    for bad in ["0.7", "-0.1", "NaN"] {
+        let flag = format!("--cube-map-reuse={bad}");
+        let out = bubbles(
+            &["bench", "--frames", "1", "--size", "8x8", &flag],
+            dir.path(),
+        );
+        assert_eq!(out.status.code(), Some(2), "{bad}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains("--cube-map-reuse") && stderr(&out).contains(bad),
+            "{}",
+            stderr(&out)
+        );
+    }
+}
+
+#[test]
 fn missing_output_directory_is_exit_2() {
     let dir = tempfile::tempdir().unwrap();
     let out = bubbles(&["render", "--out", "no/such/dir/x.png"], dir.path());

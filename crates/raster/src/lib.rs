@@ -20,12 +20,14 @@
 
 #![warn(missing_docs)]
 
+mod cube_reuse;
 pub mod gpu;
 mod passes;
 mod raster;
 mod renderer;
 mod strip;
 
+pub use cube_reuse::CubeMapReuse;
 pub use renderer::Renderer;
 
 pub use render_scene::{

@@ -18,6 +18,7 @@ use render_scene::{
     RenderSettings,
 };
 
+use crate::cube_reuse::{CubeMapReuse, CubeReuseState, bounds};
 use crate::passes::bubble::{BubbleCtx, setup_bubble_tris};
 use crate::passes::opaque::OpaqueCtx;
 use crate::passes::water::{WaterPass, setup_water};
@@ -57,6 +58,10 @@ pub struct Renderer {
     parallax: ReflectionParallax,
     /// Each bubble's centre, where its cube map was rendered from.
     centres: Vec<Vec3>,
+    /// When bubbles' cube maps may be kept from an earlier frame.
+    cube_reuse: CubeMapReuse,
+    cube_state: CubeReuseState,
+    cube_maps_rendered: usize,
 }
 
 impl Renderer {
@@ -82,6 +87,18 @@ impl Renderer {
     /// frame on (default: once per surface; per triangle is kept to measure it against).
     pub fn set_partial_shading(&mut self, partial: PartialShading) {
         self.partial = partial;
+    }
+
+    /// Lets a bubble's dynamic cube map be kept from an earlier frame while it lags a
+    /// fresh one by at most `reuse` (from the next frame on; default [`CubeMapReuse::OFF`]:
+    /// every map every frame, so a frame does not depend on the frames before it).
+    pub fn set_cube_map_reuse(&mut self, reuse: CubeMapReuse) {
+        self.cube_reuse = reuse;
+    }
+
+    /// How many bubbles' cube maps the last frame rendered afresh (the others were kept).
+    pub fn cube_maps_rendered(&self) -> usize {
+        self.cube_maps_rendered
     }
 
     /// The last rendered frame.
@@ -133,8 +150,15 @@ impl Renderer {
         self.centres
             .extend(scene.bubbles.iter().map(BubbleMesh::center));
         let t = Instant::now();
+        self.cube_maps_rendered = 0;
         if let ReflectionMode::DynamicCubeMap { face_size } = settings.reflection {
-            self.render_cube_maps(scene, &materials, face_size);
+            let bounds = bounds(&self.objects.positions);
+            let fresh = self
+                .cube_state
+                .plan(scene, face_size, self.cube_reuse, bounds);
+            self.centres.clone_from(&self.cube_state.centres);
+            self.cube_maps_rendered = fresh.iter().filter(|&&f| f).count();
+            self.render_cube_maps(scene, &materials, face_size, &fresh);
         }
         let mut cube_maps_s = t.elapsed().as_secs_f64();
         if let Some(w) = &scene.water {
@@ -272,9 +296,15 @@ impl Renderer {
         setup_bubble_tris(scene, view, &mut self.bubble_tris);
     }
 
-    /// Renders each bubble's six cube faces (the scene without bubbles or light spheres) from
-    /// its centre in `self.centres`.
-    fn render_cube_maps(&mut self, scene: &RenderScene, materials: &[&Material], face_size: usize) {
+    /// Renders the six cube faces (the scene without bubbles or light spheres) of each
+    /// bubble `fresh` marks, from its centre in `self.centres`.
+    fn render_cube_maps(
+        &mut self,
+        scene: &RenderScene,
+        materials: &[&Material],
+        face_size: usize,
+        fresh: &[bool],
+    ) {
         let n = scene.bubbles.len();
         self.cube_maps.truncate(n);
         for c in &mut self.cube_maps {
@@ -295,6 +325,7 @@ impl Renderer {
             .flat_map(|c| c.faces_mut())
             .zip(self.faces.iter_mut())
             .enumerate()
+            .filter(|(j, _)| fresh[j / 6])
             .collect();
         jobs.into_par_iter().for_each(|(j, (texels, scratch))| {
             let (major, s_axis, t_axis) = FACE_BASES[j % 6];
@@ -337,7 +368,11 @@ impl Renderer {
                 .enumerate()
                 .for_each(|(s, (color, depth))| ctx.render_strip(s, color, depth));
         });
-        self.cube_maps.par_iter_mut().for_each(CubeMap::build_mips);
+        self.cube_maps
+            .par_iter_mut()
+            .zip(fresh)
+            .filter(|(_, fresh)| **fresh)
+            .for_each(|(c, _)| c.build_mips());
     }
 
     /// Caches the environment's cube faces when it is procedural (cheap to compare);

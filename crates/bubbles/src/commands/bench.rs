@@ -31,6 +31,8 @@ struct Breakdown {
     /// Baking the solver's state for the renderer: meshes, film fields, water surface.
     bake_s: f64,
     cube_maps_s: f64,
+    /// Bubbles' cube maps rendered afresh per frame (CPU backend), the rest kept.
+    cube_maps: Option<f64>,
     opaque_s: f64,
     bubbles_s: f64,
     other_s: f64,
@@ -56,29 +58,32 @@ pub fn run(args: Args) -> CliResult {
         )));
     }
     let frames = args.frames;
-    let mut job = FrameJob::prepare(args.scene.as_deref(), &args.options)?;
+    let options = args.options.real_time();
+    let mut job = FrameJob::prepare(args.scene.as_deref(), &options)?;
     let mut report = String::new();
     report.push_str(&format!(
-        "backend: {}, threads: {}, samples: {}, reflection: {:?}, one solver step (dt = {:.6} s) per frame\n",
+        "backend: {}, threads: {}, samples: {}, reflection: {:?}, cube-map reuse: {} texel, one solver step (dt = {:.6} s) per frame\n",
         job.backend_name(),
         rayon::current_num_threads(),
         job.settings().samples,
         job.settings().reflection,
+        options.cube_map_reuse.unwrap_or(0.0),
         job.dt_s()
     ));
     report.push_str(
-        "size        sim_ms  film_ms  bake_ms  cube_ms  opaque_ms  bubbles_ms  other_ms  frame_ms     fps\n",
+        "size        sim_ms  film_ms  bake_ms  cube_ms  cubes  opaque_ms  bubbles_ms  other_ms  frame_ms     fps\n",
     );
     for (w, h) in sizes {
         job.set_size(w, h)?;
         let b = time_frames(&mut job, frames)?;
         report.push_str(&format!(
-            "{:<10} {:>7.3} {:>8.3} {:>8.3} {:>8.3} {:>10.3} {:>11.3} {:>9.3} {:>9.3} {:>7.1}\n",
+            "{:<10} {:>7.3} {:>8.3} {:>8.3} {:>8.3} {:>6} {:>10.3} {:>11.3} {:>9.3} {:>9.3} {:>7.1}\n",
             format!("{w}x{h}"),
             b.simulation_s * 1e3,
             b.film_s * 1e3,
             b.bake_s * 1e3,
             b.cube_maps_s * 1e3,
+            b.cube_maps.map_or("-".to_string(), |c| format!("{c:.2}")),
             b.opaque_s * 1e3,
             b.bubbles_s * 1e3,
             b.other_s * 1e3,
@@ -108,6 +113,9 @@ fn time_frames(job: &mut FrameJob, frames: u32) -> Result<Breakdown, CliError> {
         sum.simulation_s += sim;
         sum.bake_s += bake;
         sum.cube_maps_s += t.cube_maps_s;
+        if let Some(c) = job.cube_maps_rendered() {
+            *sum.cube_maps.get_or_insert(0.0) += c as f64;
+        }
         sum.opaque_s += t.opaque_s;
         sum.bubbles_s += t.bubbles_s;
         sum.other_s += total - sim - bake - t.cube_maps_s - t.opaque_s - t.bubbles_s;
@@ -119,6 +127,7 @@ fn time_frames(job: &mut FrameJob, frames: u32) -> Result<Breakdown, CliError> {
         film_s: sum.film_s / n,
         bake_s: sum.bake_s / n,
         cube_maps_s: sum.cube_maps_s / n,
+        cube_maps: sum.cube_maps.map(|c| c / n),
         opaque_s: sum.opaque_s / n,
         bubbles_s: sum.bubbles_s / n,
         other_s: sum.other_s / n,

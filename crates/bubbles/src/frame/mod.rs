@@ -14,17 +14,32 @@ use crate::scene::values::plain;
 use crate::scene::{Scene, bubble_meshes};
 use bubble_dynamics::{BubbleParams, Event, World};
 use lut::LutSet;
-use raster::{Camera, FilmTables, Frame, RenderScene, RenderSettings, Renderer};
+use raster::{Camera, CubeMapReuse, FilmTables, Frame, RenderScene, RenderSettings, Renderer};
 
-/// The CPU renderer with `--partial-shading` and `--reflection-origin` applied.
-fn renderer(options: &Options) -> Renderer {
+/// The CPU renderer with `--partial-shading`, `--reflection-origin` and
+/// `--cube-map-reuse` applied.
+fn renderer(options: &Options) -> Result<Renderer, CliError> {
     let mut renderer = Renderer::new();
+    renderer.set_cube_map_reuse(cube_map_reuse(options)?);
     renderer.set_reflection_parallax(options.reflection_origin.parallax());
     renderer.set_partial_shading(match options.partial_shading {
         PartialShading::PerSurface => raster::PartialShading::PerSurface,
         PartialShading::PerTriangle => raster::PartialShading::PerTriangle,
     });
-    renderer
+    Ok(renderer)
+}
+
+/// `--cube-map-reuse`, checked (off when not given).
+fn cube_map_reuse(options: &Options) -> Result<CubeMapReuse, CliError> {
+    let Some(texels) = options.cube_map_reuse else {
+        return Ok(CubeMapReuse::OFF);
+    };
+    CubeMapReuse::new(texels).ok_or_else(|| {
+        CliError::input(format!(
+            "--cube-map-reuse {texels} is outside 0..={} texels",
+            CubeMapReuse::MAX_TEXELS
+        ))
+    })
 }
 
 /// A scene ready to simulate and render, frame after frame.
@@ -92,7 +107,7 @@ impl FrameJob {
             world,
             render_scene,
             settings,
-            renderer: renderer(options),
+            renderer: renderer(options)?,
             water,
             bake_s: 0.0,
         })
@@ -125,6 +140,12 @@ impl FrameJob {
             (None, Some(_)) => "reference".to_string(),
             (None, None) => "cpu".to_string(),
         }
+    }
+
+    /// How many bubbles' dynamic cube maps the last CPU frame rendered afresh (the others
+    /// were kept, `--cube-map-reuse`); `None` for the other backends.
+    pub fn cube_maps_rendered(&self) -> Option<usize> {
+        (self.gpu.is_none() && self.film_spec.is_none()).then(|| self.renderer.cube_maps_rendered())
     }
 
     /// The render settings in force.

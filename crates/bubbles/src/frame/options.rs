@@ -41,6 +41,12 @@ pub struct Options {
     /// does (to compare the two backends like for like).
     #[arg(long, value_enum, default_value_t = PartialShading::PerSurface)]
     pub partial_shading: PartialShading,
+    /// CPU backend: keep a bubble's dynamic cube map from an earlier frame while what it
+    /// shows has moved by at most this many of its texels, 0..=0.5 (default: 0.25 in `bench`
+    /// and `view`, which run in real time; 0, a fresh map every frame, in `render` and
+    /// `animate`, so that each frame is the same however the run is split).
+    #[arg(long)]
+    pub cube_map_reuse: Option<f32>,
     /// Exposure multiplier applied before tone mapping (default: the scene's, else 1).
     #[arg(long)]
     pub exposure: Option<f64>,
@@ -49,10 +55,23 @@ pub struct Options {
     pub tonemap: Option<Tone>,
 }
 
+/// `--cube-map-reuse` of the real-time commands (`bench`, `view`) when none is given, in
+/// texels (docs/performance.md measures what it saves and the error it adds).
+pub const REAL_TIME_CUBE_MAP_REUSE: f32 = 0.25;
+
 impl Options {
     /// `--width` and `--height`, or 800 × 600.
     pub fn size(&self) -> (usize, usize) {
         (self.width.unwrap_or(800), self.height.unwrap_or(600))
+    }
+
+    /// These options with `--cube-map-reuse` defaulting to [`REAL_TIME_CUBE_MAP_REUSE`].
+    pub fn real_time(&self) -> Options {
+        let mut options = self.clone();
+        options
+            .cube_map_reuse
+            .get_or_insert(REAL_TIME_CUBE_MAP_REUSE);
+        options
     }
 }
 

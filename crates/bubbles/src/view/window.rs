@@ -47,7 +47,7 @@ pub fn run(mut args: Args) -> CliResult {
     if backend == Backend::Wgpu {
         args.options.backend = Backend::Cpu;
     }
-    let job = FrameJob::prepare(args.scene.as_deref(), &args.options)?;
+    let job = FrameJob::prepare(args.scene.as_deref(), &args.options.real_time())?;
     let event_loop =
         EventLoop::new().map_err(|e| CliError::input(format!("cannot open the display: {e}")))?;
     event_loop.set_control_flow(ControlFlow::Poll);
