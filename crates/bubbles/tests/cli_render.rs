@@ -256,6 +256,7 @@ fn bench_shows_the_film_steps_and_the_bake_as_their_own_columns() {
             "sim_ms",
             "bake_ms",
             "cube_ms",
+            "setup_ms",
             "opaque_ms",
             "bubbles_ms",
             "other_ms",

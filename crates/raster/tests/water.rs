@@ -265,3 +265,41 @@ fn a_lamp_shows_in_the_water_where_a_plane_mirror_puts_it() {
         plain[row * w + w / 2]
     );
 }
+
+#[test]
+fn a_large_wavy_pond_renders_the_same_at_any_thread_count() {
+    // 2·120² triangles: several of the set-up's parallel chunks, some clipped at the edges.
+    let mut water = flat_water(120, 1.5, Material::checker([0.8; 3], [0.2; 3], 0.1));
+    for (p, n) in water.positions.iter_mut().zip(&mut water.normals) {
+        let phase = 9.0 * p.x + 5.0 * p.z;
+        p.y = 0.01 * phase.sin();
+        *n = Vec3::new(-0.09 * phase.cos(), 1.0, -0.05 * phase.cos()).normalize();
+    }
+    let camera = Camera::look_at(
+        Vec3::new(0.2, 0.6, 1.2),
+        Vec3::new(0.0, 0.0, -0.3),
+        Vec3::Y,
+        60.0,
+    );
+    let mut scene = RenderScene::new(camera, Environment::Sky(Sky::default()));
+    scene.water = Some(water);
+    let frames: Vec<Vec<[f32; 3]>> = [1, 2, 3]
+        .iter()
+        .map(|&n| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .unwrap();
+            pool.install(|| render_scene(&scene, ReflectionMode::StaticEnvironment, (64, 48)))
+        })
+        .collect();
+    for (threads, frame) in [2, 3].iter().zip(&frames[1..]) {
+        let same = frame
+            .iter()
+            .zip(&frames[0])
+            .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits));
+        assert!(same, "{threads} threads differ from one");
+    }
+    let lit = frames[0].iter().filter(|c| c[0] > 0.0).count();
+    assert!(lit > 64 * 48 / 2, "only {lit} pixels drawn");
+}

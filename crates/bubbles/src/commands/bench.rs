@@ -33,6 +33,8 @@ struct Breakdown {
     cube_maps_s: f64,
     /// Bubbles' cube maps rendered afresh per frame (CPU backend), the rest kept.
     cube_maps: Option<f64>,
+    /// Triangle set-up and binning of the main view.
+    setup_s: f64,
     opaque_s: f64,
     bubbles_s: f64,
     other_s: f64,
@@ -71,19 +73,20 @@ pub fn run(args: Args) -> CliResult {
         job.dt_s()
     ));
     report.push_str(
-        "size        sim_ms  film_ms  bake_ms  cube_ms  cubes  opaque_ms  bubbles_ms  other_ms  frame_ms     fps\n",
+        "size        sim_ms  film_ms  bake_ms  cube_ms  cubes  setup_ms  opaque_ms  bubbles_ms  other_ms  frame_ms     fps\n",
     );
     for (w, h) in sizes {
         job.set_size(w, h)?;
         let b = time_frames(&mut job, frames)?;
         report.push_str(&format!(
-            "{:<10} {:>7.3} {:>8.3} {:>8.3} {:>8.3} {:>6} {:>10.3} {:>11.3} {:>9.3} {:>9.3} {:>7.1}\n",
+            "{:<10} {:>7.3} {:>8.3} {:>8.3} {:>8.3} {:>6} {:>9.3} {:>10.3} {:>11.3} {:>9.3} {:>9.3} {:>7.1}\n",
             format!("{w}x{h}"),
             b.simulation_s * 1e3,
             b.film_s * 1e3,
             b.bake_s * 1e3,
             b.cube_maps_s * 1e3,
             b.cube_maps.map_or("-".to_string(), |c| format!("{c:.2}")),
+            b.setup_s * 1e3,
             b.opaque_s * 1e3,
             b.bubbles_s * 1e3,
             b.other_s * 1e3,
@@ -116,9 +119,10 @@ fn time_frames(job: &mut FrameJob, frames: u32) -> Result<Breakdown, CliError> {
         if let Some(c) = job.cube_maps_rendered() {
             *sum.cube_maps.get_or_insert(0.0) += c as f64;
         }
+        sum.setup_s += t.setup_s;
         sum.opaque_s += t.opaque_s;
         sum.bubbles_s += t.bubbles_s;
-        sum.other_s += total - sim - bake - t.cube_maps_s - t.opaque_s - t.bubbles_s;
+        sum.other_s += total - sim - bake - t.cube_maps_s - t.setup_s - t.opaque_s - t.bubbles_s;
         sum.total_s += total;
     }
     let n = f64::from(frames);
@@ -128,6 +132,7 @@ fn time_frames(job: &mut FrameJob, frames: u32) -> Result<Breakdown, CliError> {
         bake_s: sum.bake_s / n,
         cube_maps_s: sum.cube_maps_s / n,
         cube_maps: sum.cube_maps.map(|c| c / n),
+        setup_s: sum.setup_s / n,
         opaque_s: sum.opaque_s / n,
         bubbles_s: sum.bubbles_s / n,
         other_s: sum.other_s / n,

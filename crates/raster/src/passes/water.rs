@@ -25,21 +25,62 @@ use super::opaque::OpaqueCtx;
 use crate::raster::{ClipVertex, SamplePattern, SetupTri, setup_triangle};
 use crate::strip::{Bins, STRIP_ROWS};
 
-/// Clips and sets up the water's triangles for `view`, tagged [`WATER`].
-pub(crate) fn setup_water(water: &WaterSurface, view: &View, out: &mut Vec<SetupTri>) {
-    for t in &water.triangles {
-        let tri = t.map(|i| {
-            let (p, n) = (water.positions[i as usize], water.normals[i as usize]);
-            let [x, y, w] = view.clip(p);
-            ClipVertex {
-                x,
-                y,
-                w,
-                attrs: [n.x, n.y, n.z, 0.0, 0.0, 0.0],
+/// Clips and sets up the water's triangles for `view`, tagged [`WATER`], appending them to
+/// `out` in the mesh's order; `chunks` holds each chunk's set-up between frames.
+///
+/// In parallel: the pond's 131 k triangles took a fifth of its frame on one thread. Chunks
+/// are set up apart and copied into `out` in chunk order, so the result does not depend
+/// on the thread count.
+pub(crate) fn setup_water(
+    water: &WaterSurface,
+    view: &View,
+    out: &mut Vec<SetupTri>,
+    chunks: &mut Vec<Vec<SetupTri>>,
+) {
+    chunks.resize_with(water.triangles.len().div_ceil(WATER_CHUNK), Vec::new);
+    water
+        .triangles
+        .par_chunks(WATER_CHUNK)
+        .zip(chunks.par_iter_mut())
+        .for_each(|(tris, chunk)| {
+            chunk.clear();
+            for t in tris {
+                setup_water_triangle(water, view, t, chunk);
             }
         });
-        setup_triangle(view, tri, WATER, 0.0, |s| out.push(s));
-    }
+    // Where each chunk starts in the concatenation; a binary search maps an index back.
+    let starts: Vec<usize> = chunks
+        .iter()
+        .scan(0, |at, c| {
+            let start = *at;
+            *at += c.len();
+            Some(start)
+        })
+        .collect();
+    let total = chunks.iter().map(Vec::len).sum::<usize>();
+    out.par_extend((0..total).into_par_iter().map(|i| {
+        let k = starts.partition_point(|&s| s <= i) - 1;
+        chunks[k][i - starts[k]]
+    }));
+}
+
+/// Water triangles set up per parallel task.
+const WATER_CHUNK: usize = 4096;
+
+/// Clips and sets up water triangle `t` (mesh indices) into `out`.
+#[inline]
+fn setup_water_triangle(water: &WaterSurface, view: &View, t: &[u32; 3], out: &mut Vec<SetupTri>) {
+    let tri = t.map(|i| {
+        let (p, n) = (water.positions[i as usize], water.normals[i as usize]);
+        let [x, y, w] = view.clip(p);
+        ClipVertex {
+            x,
+            y,
+            w,
+            attrs: [n.x, n.y, n.z, 0.0, 0.0, 0.0],
+        }
+    });
+    setup_triangle(view, tri, WATER, 0.0, |s| out.push(s));
 }
 
 /// One cube face's buffers, reused across frames.
