@@ -3,6 +3,7 @@
 //! screen-space planes that give perspective-correct attributes.
 
 use glam::Vec3;
+use rayon::prelude::*;
 use render_scene::camera::View;
 use render_scene::tessellate::Geometry;
 
@@ -220,6 +221,25 @@ fn clip_planes(view: &View) -> [[f32; 4]; 5] {
 #[inline]
 fn plane_distance(p: &[f32; 4], v: &ClipVertex) -> f32 {
     p[0] * v.x + p[1] * v.y + p[2] * v.w + p[3]
+}
+
+/// Appends `chunks` to `out` one after another, copying in parallel: the result is the
+/// serial concatenation whatever the thread count.
+pub(crate) fn append_in_order(out: &mut Vec<SetupTri>, chunks: &[Vec<SetupTri>]) {
+    // Where each chunk starts in the concatenation; a binary search maps an index back.
+    let starts: Vec<usize> = chunks
+        .iter()
+        .scan(0, |at, c| {
+            let start = *at;
+            *at += c.len();
+            Some(start)
+        })
+        .collect();
+    let total = chunks.iter().map(Vec::len).sum::<usize>();
+    out.par_extend((0..total).into_par_iter().map(|i| {
+        let k = starts.partition_point(|&s| s <= i) - 1;
+        chunks[k][i - starts[k]]
+    }));
 }
 
 /// Clips a triangle and sets up each resulting triangle, calling `emit` for every one

@@ -50,6 +50,8 @@ pub struct Renderer {
     water_chunks: Vec<Vec<SetupTri>>,
     opaque_bins: Bins,
     bubble_tris: Vec<SetupTri>,
+    /// Each bubble's triangles, set up in parallel before joining `bubble_tris`.
+    bubble_layers: Vec<Vec<SetupTri>>,
     bubble_bins: Bins,
     /// The environment rendered into cube faces, reused while the environment is unchanged
     /// (kept only for the cheap-to-compare procedural kinds).
@@ -297,7 +299,7 @@ impl Renderer {
     /// Sets up bubble triangles: bubbles far to near, each bubble's back faces then front faces.
     fn setup_bubbles(&mut self, scene: &RenderScene, view: &View) {
         self.bubble_tris.clear();
-        setup_bubble_tris(scene, view, &mut self.bubble_tris);
+        setup_bubble_tris(scene, view, &mut self.bubble_tris, &mut self.bubble_layers);
     }
 
     /// Renders the six cube faces (the scene without bubbles or light spheres) of each

@@ -12,10 +12,11 @@ use render_scene::reflection::Reflection;
 use render_scene::{FilmField, Light, PartialShading, ReflectionFilter, RenderScene};
 
 use crate::raster::{
-    ATTRS, NO_SURFACE, Plane, SamplePattern, SetupTri, clip_vertex, for_each_covered_in_row,
-    setup_triangle,
+    ATTRS, NO_SURFACE, Plane, SamplePattern, SetupTri, append_in_order, clip_vertex,
+    for_each_covered_in_row, setup_triangle,
 };
 use crate::strip::{Bins, STRIP_ROWS};
+use rayon::prelude::*;
 
 /// Everything the bubble pass reads.
 pub(crate) struct BubbleCtx<'a> {
@@ -335,36 +336,56 @@ impl BubbleCtx<'_> {
 /// point it was computed at: two points of one pixel are at most √2 pixels apart.
 const SHARE_MARGIN_PX: f32 = 2.0;
 
-/// Sets up bubble triangles: bubbles far to near, each bubble's back faces then front faces.
-pub(crate) fn setup_bubble_tris(scene: &RenderScene, view: &View, out: &mut Vec<SetupTri>) {
-    for k in far_to_near(&scene.bubbles, view.eye) {
-        let bubble = &scene.bubbles[k];
-        for front in [false, true] {
-            for t in &bubble.triangles {
-                if is_front_facing(bubble, *t, view.eye) == front {
-                    let tri = t.map(|i| {
-                        let i = i as usize;
-                        let n = bubble.normals[i];
-                        // With a film field the material direction replaces the thickness.
-                        let rest = match &bubble.film {
-                            Some(film) => film.material_dirs[i].to_array(),
-                            None => [bubble.thickness_nm[i], 0.0, 0.0],
-                        };
-                        let [a, b, c] = rest;
-                        clip_vertex(view, bubble.positions[i], [n.x, n.y, n.z, a, b, c])
-                    });
-                    let extra = reflection_rate(view, bubble, *t);
-                    // One surface per bubble and facing: the back layer, then the front.
-                    let surface = 2 * k as u32 + u32::from(front);
-                    setup_triangle(view, tri, k as u32, extra, |s| {
-                        out.push(SetupTri {
-                            surface,
-                            mesh_vertices: *t,
-                            ..s
-                        });
-                    });
-                }
+/// Sets up bubble triangles into `out`: bubbles far to near, each bubble's back faces then
+/// front faces. Bubbles are set up in parallel into `layers` (kept between frames) and
+/// joined in that order, so the result does not depend on the thread count.
+pub(crate) fn setup_bubble_tris(
+    scene: &RenderScene,
+    view: &View,
+    out: &mut Vec<SetupTri>,
+    layers: &mut Vec<Vec<SetupTri>>,
+) {
+    let order = far_to_near(&scene.bubbles, view.eye);
+    layers.resize_with(order.len(), Vec::new);
+    order
+        .par_iter()
+        .zip(layers.par_iter_mut())
+        .for_each(|(&k, layer)| {
+            layer.clear();
+            setup_bubble(scene, view, k, layer);
+        });
+    append_in_order(out, &layers[..order.len()]);
+}
+
+/// Sets up bubble `k`'s back faces, then its front faces, into `out`.
+fn setup_bubble(scene: &RenderScene, view: &View, k: usize, out: &mut Vec<SetupTri>) {
+    let bubble = &scene.bubbles[k];
+    for front in [false, true] {
+        for t in &bubble.triangles {
+            if is_front_facing(bubble, *t, view.eye) != front {
+                continue;
             }
+            let tri = t.map(|i| {
+                let i = i as usize;
+                let n = bubble.normals[i];
+                // With a film field the material direction replaces the thickness.
+                let rest = match &bubble.film {
+                    Some(film) => film.material_dirs[i].to_array(),
+                    None => [bubble.thickness_nm[i], 0.0, 0.0],
+                };
+                let [a, b, c] = rest;
+                clip_vertex(view, bubble.positions[i], [n.x, n.y, n.z, a, b, c])
+            });
+            let extra = reflection_rate(view, bubble, *t);
+            // One surface per bubble and facing: the back layer, then the front.
+            let surface = 2 * k as u32 + u32::from(front);
+            setup_triangle(view, tri, k as u32, extra, |s| {
+                out.push(SetupTri {
+                    surface,
+                    mesh_vertices: *t,
+                    ..s
+                });
+            });
         }
     }
 }

@@ -22,7 +22,7 @@ use render_scene::{CubeMap, ReflectionMode, RenderScene, RenderSettings, WaterSu
 
 use super::bubble::{BubbleCtx, setup_bubble_tris};
 use super::opaque::OpaqueCtx;
-use crate::raster::{ClipVertex, SamplePattern, SetupTri, setup_triangle};
+use crate::raster::{ClipVertex, SamplePattern, SetupTri, append_in_order, setup_triangle};
 use crate::strip::{Bins, STRIP_ROWS};
 
 /// Clips and sets up the water's triangles for `view`, tagged [`WATER`], appending them to
@@ -48,20 +48,7 @@ pub(crate) fn setup_water(
                 setup_water_triangle(water, view, t, chunk);
             }
         });
-    // Where each chunk starts in the concatenation; a binary search maps an index back.
-    let starts: Vec<usize> = chunks
-        .iter()
-        .scan(0, |at, c| {
-            let start = *at;
-            *at += c.len();
-            Some(start)
-        })
-        .collect();
-    let total = chunks.iter().map(Vec::len).sum::<usize>();
-    out.par_extend((0..total).into_par_iter().map(|i| {
-        let k = starts.partition_point(|&s| s <= i) - 1;
-        chunks[k][i - starts[k]]
-    }));
+    append_in_order(out, chunks);
 }
 
 /// Water triangles set up per parallel task.
@@ -89,6 +76,8 @@ struct FaceScratch {
     tris: Vec<SetupTri>,
     bins: Bins,
     bubble_tris: Vec<SetupTri>,
+    /// Each bubble's triangles, set up in parallel before joining `bubble_tris`.
+    layers: Vec<Vec<SetupTri>>,
     bubble_bins: Bins,
     depth: Vec<f32>,
 }
@@ -192,7 +181,7 @@ impl WaterPass {
             opaque_setup(&view, &mut scratch.tris);
             scratch.bins.build(&scratch.tris, strips);
             scratch.bubble_tris.clear();
-            setup_bubble_tris(scene, &view, &mut scratch.bubble_tris);
+            setup_bubble_tris(scene, &view, &mut scratch.bubble_tris, &mut scratch.layers);
             scratch.bubble_bins.build(&scratch.bubble_tris, strips);
             scratch.depth.resize(m * m, 0.0);
             let pattern = SamplePattern::new(1);
