@@ -95,12 +95,9 @@ impl Frame {
     /// Tone-mapped 8-bit sRGB, interleaved RGB, row-major.
     pub fn to_srgb8(&self, exposure_ev: f32, tonemap: ToneMap) -> Vec<u8> {
         let scale = exposure_ev.exp2();
-        let encoder = Srgb8Encoder::get();
-        let mut out = vec![0; self.rgb.len() * 3];
-        for (bytes, &px) in out.chunks_exact_mut(3).zip(&self.rgb) {
-            bytes.copy_from_slice(&encoder.pixel(px, scale, tonemap));
-        }
-        out
+        let mut out = vec![[0; 3]; self.rgb.len()];
+        Srgb8Encoder::get().encode_pixels(&mut out, &self.rgb, scale, tonemap, |px| px);
+        out.into_flattened()
     }
 
     /// Writes the tone-mapped image as an 8-bit sRGB PNG (temporary file, then rename).
@@ -173,11 +170,35 @@ fn write_atomically(
 
 /// Applies the tone curve to linear RGB, giving display-linear values in `[0, 1]`.
 pub fn tone_map(rgb: [f32; 3], tonemap: ToneMap) -> [f32; 3] {
-    let rgb = rgb.map(|c| if c.is_nan() { 0.0 } else { c.max(0.0) });
+    tone_map_lanes(rgb.map(|c| [c]), tonemap).map(|[c]| c)
+}
+
+/// [`tone_map`] of `N` pixels at once, channel-major (`rgb[channel][pixel]`). Every lane
+/// goes through the same operations in the same order as [`tone_map`] (which is this
+/// with one lane), so the results are identical; the layout lets the compiler run the
+/// lanes side by side in SIMD registers.
+#[inline]
+pub fn tone_map_lanes<const N: usize>(mut rgb: [[f32; N]; 3], tonemap: ToneMap) -> [[f32; N]; 3] {
+    for_lanes(&mut rgb, |c| if c.is_nan() { 0.0 } else { c.max(0.0) });
     match tonemap {
-        ToneMap::Clamp => rgb.map(|c| c.min(1.0)),
-        ToneMap::Reinhard => rgb.map(|c| if c.is_infinite() { 1.0 } else { c / (1.0 + c) }),
-        ToneMap::AcesFitted => aces_fitted(rgb),
+        ToneMap::Clamp => for_lanes(&mut rgb, |c| c.min(1.0)),
+        ToneMap::Reinhard => for_lanes(
+            &mut rgb,
+            |c| if c.is_infinite() { 1.0 } else { c / (1.0 + c) },
+        ),
+        ToneMap::AcesFitted => rgb = aces_fitted(rgb),
+    }
+    rgb
+}
+
+/// Applies `f` to every lane of every channel. Plain loops: `array::map` here was left as
+/// calls through `try_map`, not vectorised.
+#[inline(always)]
+fn for_lanes<const N: usize>(rgb: &mut [[f32; N]; 3], f: impl Fn(f32) -> f32) {
+    for channel in rgb.iter_mut() {
+        for c in channel.iter_mut() {
+            *c = f(*c);
+        }
     }
 }
 
@@ -211,21 +232,32 @@ pub const SRGB_OFFSET: f32 = 0.055;
 pub const SRGB_GAMMA: f32 = 2.4;
 
 /// Stephen Hill's ACES fit: sRGB → ACES AP1-ish input matrix, RRT+ODT rational fit, back.
-fn aces_fitted(rgb: [f32; 3]) -> [f32; 3] {
+#[inline(always)]
+fn aces_fitted<const N: usize>(mut rgb: [[f32; N]; 3]) -> [[f32; N]; 3] {
     let [a0, a1] = ACES_NUMERATOR;
     let [b0, b1, b2] = ACES_DENOMINATOR;
-    let rgb = rgb.map(|c| c.min(ACES_INPUT_MAX));
-    let v = mat3_mul(&ACES_FROM_SRGB, rgb);
-    let v = v.map(|x| {
+    for_lanes(&mut rgb, |c| c.min(ACES_INPUT_MAX));
+    let mut v = mat3_mul(&ACES_FROM_SRGB, &rgb);
+    for_lanes(&mut v, |x| {
         let a = x * (x + a0) - a1;
         let b = x * (b0 * x + b1) + b2;
         a / b
     });
-    mat3_mul(&SRGB_FROM_ACES, v).map(|c| c.clamp(0.0, 1.0))
+    let mut out = mat3_mul(&SRGB_FROM_ACES, &v);
+    for_lanes(&mut out, |c| c.clamp(0.0, 1.0));
+    out
 }
 
-fn mat3_mul(m: &[[f32; 3]; 3], v: [f32; 3]) -> [f32; 3] {
-    m.map(|row| row[0] * v[0] + row[1] * v[1] + row[2] * v[2])
+/// `m` times each lane's RGB vector.
+#[inline(always)]
+fn mat3_mul<const N: usize>(m: &[[f32; 3]; 3], v: &[[f32; N]; 3]) -> [[f32; N]; 3] {
+    let mut out = [[0.0; N]; 3];
+    for (row, channel) in m.iter().zip(&mut out) {
+        for (l, c) in channel.iter_mut().enumerate() {
+            *c = row[0] * v[0][l] + row[1] * v[1][l] + row[2] * v[2][l];
+        }
+    }
+    out
 }
 
 /// The sRGB encoding curve (IEC 61966-2-1) for one channel in `[0, 1]`.
@@ -243,6 +275,9 @@ pub fn linear_to_srgb(c: f32) -> f32 {
 pub fn linear_to_srgb8_reference(c: f32) -> u8 {
     (linear_to_srgb(c) * 255.0 + 0.5) as u8
 }
+
+/// Pixels [`Srgb8Encoder::encode_pixels`] tone-maps together: two SSE registers a channel.
+pub const TONE_MAP_LANES: usize = 8;
 
 /// The bits of 1.0. A non-negative f32's bits order like its value, so `[+0, 1]` is the
 /// bit range `[0, ONE_BITS]`.
@@ -300,6 +335,38 @@ impl Srgb8Encoder {
     #[inline]
     pub fn pixel(&self, rgb: [f32; 3], exposure_scale: f32, tonemap: ToneMap) -> [u8; 3] {
         tone_map(rgb.map(|c| c * exposure_scale), tonemap).map(|c| self.encode(c))
+    }
+
+    /// Tone-maps and encodes `rgb` (linear, times `exposure_scale`) into `out`, pixel for
+    /// pixel up to the shorter slice, `pack` making each output element from a pixel's
+    /// three codes. [`Srgb8Encoder::pixel`] for each pixel, [`TONE_MAP_LANES`] at a time.
+    #[inline]
+    pub fn encode_pixels<T>(
+        &self,
+        out: &mut [T],
+        rgb: &[[f32; 3]],
+        exposure_scale: f32,
+        tonemap: ToneMap,
+        pack: impl Fn([u8; 3]) -> T,
+    ) {
+        let mut out_chunks = out.chunks_exact_mut(TONE_MAP_LANES);
+        let mut rgb_chunks = rgb.chunks_exact(TONE_MAP_LANES);
+        for (slots, pixels) in (&mut out_chunks).zip(&mut rgb_chunks) {
+            let mut lanes = [[0.0; TONE_MAP_LANES]; 3];
+            for (l, px) in pixels.iter().enumerate() {
+                for (channel, c) in lanes.iter_mut().zip(px) {
+                    channel[l] = c * exposure_scale;
+                }
+            }
+            let [r, g, b] = tone_map_lanes(lanes, tonemap);
+            for (l, slot) in slots.iter_mut().enumerate() {
+                *slot = pack([r[l], g[l], b[l]].map(|c| self.encode(c)));
+            }
+        }
+        let rest = out_chunks.into_remainder().iter_mut();
+        for (slot, &px) in rest.zip(rgb_chunks.remainder()) {
+            *slot = pack(self.pixel(px, exposure_scale, tonemap));
+        }
     }
 
     /// The thresholds' bits, lowest first: `thresholds()[k]` is the first f32 (as bits)
@@ -481,6 +548,71 @@ mod tests {
             x ^= x >> 17;
             x ^= x << 5;
             assert!(srgb8_agrees(encoder, x), "{x:#x}");
+        }
+    }
+
+    /// `tone_map` as it was written before [`tone_map_lanes`], one pixel at a time.
+    fn tone_map_one_pixel(rgb: [f32; 3], tonemap: ToneMap) -> [f32; 3] {
+        let rgb = rgb.map(|c| if c.is_nan() { 0.0 } else { c.max(0.0) });
+        let mat3_mul = |m: &[[f32; 3]; 3], v: [f32; 3]| {
+            m.map(|row| row[0] * v[0] + row[1] * v[1] + row[2] * v[2])
+        };
+        let [a0, a1] = ACES_NUMERATOR;
+        let [b0, b1, b2] = ACES_DENOMINATOR;
+        match tonemap {
+            ToneMap::Clamp => rgb.map(|c| c.min(1.0)),
+            ToneMap::Reinhard => rgb.map(|c| if c.is_infinite() { 1.0 } else { c / (1.0 + c) }),
+            ToneMap::AcesFitted => {
+                let v = mat3_mul(&ACES_FROM_SRGB, rgb.map(|c| c.min(ACES_INPUT_MAX)));
+                let v = v.map(|x| (x * (x + a0) - a1) / (x * (b0 * x + b1) + b2));
+                mat3_mul(&SRGB_FROM_ACES, v).map(|c| c.clamp(0.0, 1.0))
+            }
+        }
+    }
+
+    #[test]
+    fn eight_lanes_tone_map_and_encode_as_one_pixel_at_a_time() {
+        let odd = [
+            f32::NAN,
+            -f32::NAN,
+            f32::INFINITY,
+            -1.0,
+            1e30,
+            1e-40,
+            -0.0,
+            0.5,
+        ];
+        let mut x = 0x2545_f491_u32;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            // Mostly [0, 4), some of the odd values.
+            if x % 29 == 0 {
+                odd[(x >> 8) as usize % odd.len()]
+            } else {
+                (x >> 8) as f32 / (1u32 << 22) as f32
+            }
+        };
+        let rgb: Vec<[f32; 3]> = (0..20_003).map(|_| [next(), next(), next()]).collect();
+        let encoder = Srgb8Encoder::get();
+        for tonemap in [ToneMap::Clamp, ToneMap::Reinhard, ToneMap::AcesFitted] {
+            let mut lanes = vec![[0; 3]; rgb.len()];
+            encoder.encode_pixels(&mut lanes, &rgb, 1.7, tonemap, |px| px);
+            for (i, (&px, got)) in rgb.iter().zip(&lanes).enumerate() {
+                let one =
+                    tone_map_one_pixel(px.map(|c| c * 1.7), tonemap).map(linear_to_srgb8_reference);
+                assert_eq!(*got, one, "{tonemap:?} pixel {i} {px:?}");
+            }
+            for chunk in rgb.chunks_exact(TONE_MAP_LANES).take(500) {
+                let lanes = std::array::from_fn(|ch| std::array::from_fn(|l| chunk[l][ch]));
+                let mapped: [[f32; TONE_MAP_LANES]; 3] = tone_map_lanes(lanes, tonemap);
+                for (l, &px) in chunk.iter().enumerate() {
+                    let one = tone_map_one_pixel(px, tonemap).map(f32::to_bits);
+                    assert_eq!(tone_map(px, tonemap).map(f32::to_bits), one, "{px:?}");
+                    assert_eq!(mapped.map(|ch| ch[l].to_bits()), one, "{tonemap:?} {px:?}");
+                }
+            }
         }
     }
 
