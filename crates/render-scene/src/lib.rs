@@ -55,7 +55,10 @@ pub use cubemap::{CubeMap, MAX_FACE_SIZE};
 pub use environment::{Environment, Sky};
 pub use error::RenderError;
 pub use film_field::{BubbleFilm, FilmField, FilmSample, MAX_FILM_THICKNESS_NM};
-pub use frame::{Frame, FrameTimings, linear_to_srgb, tone_map};
+pub use frame::{
+    Frame, FrameTimings, Srgb8Encoder, TONE_MAP_LANES, linear_to_srgb, linear_to_srgb8_reference,
+    tone_map, tone_map_lanes,
+};
 pub use glam::{Mat3, Vec3};
 pub use irradiance::Irradiance;
 pub use lut::Lut;

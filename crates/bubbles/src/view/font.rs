@@ -67,14 +67,13 @@ pub fn glyph(c: char) -> [u8; GLYPH_H] {
 /// returns nothing, clips at the buffer's edges.
 pub fn draw_text(buf: &mut [u32], width: usize, x: usize, y: usize, scale: usize, text: &str) {
     let height = buf.len() / width.max(1);
-    let lines: Vec<&str> = text.lines().collect();
     let (box_w, box_h) = text_box(text, scale);
     for row in y..(y + box_h).min(height) {
         for px in &mut buf[row * width + x.min(width)..row * width + (x + box_w).min(width)] {
             *px = (*px >> 2) & 0x003f_3f3f;
         }
     }
-    for (line_index, line) in lines.iter().enumerate() {
+    for (line_index, line) in text.lines().enumerate() {
         let top = y + (line_index * (GLYPH_H + 2) + 1) * scale;
         for (col, c) in line.chars().enumerate() {
             let left = x + (col * (GLYPH_W + 1) + 1) * scale;

@@ -5,8 +5,8 @@
 //! straight into the window's surface.
 
 use super::font;
-use super::pixels::{tone_map_into, upscale};
-use crate::error::{CliError, CliResult};
+use super::pixels::WindowPixels;
+use crate::error::CliError;
 use crate::frame::FrameJob;
 use raster::FrameTimings;
 use std::num::NonZeroU32;
@@ -27,10 +27,11 @@ pub(super) enum Presenter {
     Gpu(Box<super::gpu::GpuPresenter>),
 }
 
-/// The CPU presenter: the window's softbuffer surface and the tone-mapped frame's words.
+/// The CPU presenter: the window's softbuffer surface (on X11 a MIT-SHM segment where the
+/// server offers it, as Xvfb does) and what fills it.
 pub(super) struct CpuPresenter {
     surface: softbuffer::Surface<Arc<Window>, Arc<Window>>,
-    internal: Vec<u32>,
+    pixels: WindowPixels,
 }
 
 impl Presenter {
@@ -41,7 +42,7 @@ impl Presenter {
             softbuffer::Surface::new(&context, window.clone()).map_err(|e| e.to_string())?;
         Ok(Presenter::Cpu(CpuPresenter {
             surface,
-            internal: Vec::new(),
+            pixels: WindowPixels::default(),
         }))
     }
 
@@ -107,39 +108,31 @@ impl Presenter {
 }
 
 impl CpuPresenter {
+    /// Renders, fills the window's buffer (tone-mapped, upscaled if smaller), draws the
+    /// overlay and presents. Allocates nothing once the buffers have grown.
     fn draw(
         &mut self,
         job: &mut FrameJob,
         (w, h): (u32, u32),
         overlay: Option<&str>,
     ) -> Result<FrameTimings, CliError> {
-        let (ev, tone) = (job.settings().exposure_ev, job.settings().tonemap);
-        let (iw, ih) = (job.settings().width, job.settings().height);
+        let tone = (job.settings().exposure_ev, job.settings().tonemap);
+        let internal_size = (job.settings().width, job.settings().height);
+        let window_size = (w as usize, h as usize);
         let frame = job.render()?;
-        let timings = frame.timings;
-        tone_map_into(&mut self.internal, frame.rgb(), ev, tone);
-        self.present(iw, ih, (w as usize, h as usize), overlay)?;
-        Ok(timings)
-    }
-
-    fn present(
-        &mut self,
-        iw: usize,
-        ih: usize,
-        (w, h): (usize, usize),
-        overlay: Option<&str>,
-    ) -> CliResult {
+        // Waits for the X server to finish reading the last frame from the shared buffer.
         let mut buffer = self
             .surface
             .buffer_mut()
             .map_err(|e| CliError::runtime(format!("window buffer: {e}")))?;
-        upscale(&self.internal, iw, ih, &mut buffer, w, h);
+        (self.pixels).fill(&mut buffer, window_size, frame.rgb(), internal_size, tone);
         if let Some(text) = overlay {
             let (x, y) = OVERLAY_AT;
-            font::draw_text(&mut buffer, w, x, y, OVERLAY_SCALE, text);
+            font::draw_text(&mut buffer, window_size.0, x, y, OVERLAY_SCALE, text);
         }
         buffer
             .present()
-            .map_err(|e| CliError::runtime(format!("window present: {e}")))
+            .map_err(|e| CliError::runtime(format!("window present: {e}")))?;
+        Ok(frame.timings)
     }
 }

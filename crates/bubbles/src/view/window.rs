@@ -11,7 +11,9 @@ use crate::error::{CliError, CliResult};
 use crate::frame::{Backend, FrameJob, Options, Reflection};
 use bubble_dynamics::Event;
 use glam::Vec3;
+use raster::FrameTimings;
 use std::collections::VecDeque;
+use std::fmt::Write as _;
 use std::num::NonZeroU32;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -61,6 +63,8 @@ pub fn run(mut args: Args) -> CliResult {
 struct Gfx {
     window: Arc<Window>,
     presenter: Presenter,
+    /// The presenter's name for the overlay (kept: it does not change).
+    name: String,
     size: (u32, u32),
 }
 
@@ -92,6 +96,77 @@ struct QuitAfter {
     after_s: f64,
     first: Option<Instant>,
     frames: u64,
+    totals: FrameTotals,
+}
+
+/// Sums over the frames drawn, for `--quit-after-s`'s breakdown of the mean frame.
+#[derive(Default)]
+struct FrameTotals {
+    sim_s: f64,
+    bake_s: f64,
+    render_s: f64,
+    frame_s: f64,
+    steps: u64,
+    slow_motion_frames: u64,
+}
+
+impl Stats {
+    /// Folds one frame into the overlay's running averages (weight 0.1 for the new frame).
+    fn mix(&mut self, sim_s: f64, t: &FrameTimings, frame_s: f64) {
+        let mix = |old: &mut f64, new: f64| {
+            *old = if *old == 0.0 {
+                new
+            } else {
+                *old + 0.1 * (new - *old)
+            }
+        };
+        mix(&mut self.sim_s, sim_s);
+        mix(&mut self.cube_s, t.cube_maps_s);
+        mix(&mut self.opaque_s, t.opaque_s);
+        mix(&mut self.bubbles_s, t.bubbles_s);
+        mix(&mut self.setup_s, t.setup_s);
+        mix(&mut self.gpu_s, t.resolve_s);
+        mix(&mut self.frame_s, frame_s);
+    }
+}
+
+impl FrameTotals {
+    /// Adds one frame: its solver and bake times, render phases, whole time, solver steps
+    /// and whether it fell into slow motion.
+    fn add(
+        &mut self,
+        [sim_s, bake_s]: [f64; 2],
+        t: &FrameTimings,
+        frame_s: f64,
+        steps: u32,
+        slow: bool,
+    ) {
+        self.sim_s += sim_s;
+        self.bake_s += bake_s;
+        self.render_s += t.total_s();
+        self.frame_s += frame_s;
+        self.steps += u64::from(steps);
+        self.slow_motion_frames += u64::from(slow);
+    }
+
+    /// The mean frame on one line: solver, the solver's state baked for the renderer, the
+    /// render (its phases' sum) and the rest (tone mapping, upscaling, overlay, presenting).
+    fn summary(&self, frames: u64) -> String {
+        let n = frames.max(1) as f64;
+        let ms = |s: f64| s / n * 1e3;
+        format!(
+            "view: mean frame {:.1} ms: sim {:.1} ms ({:.1} steps, slow motion in {} of {frames} \
+             frames), bake {:.1} ms, render {:.1} ms, the rest {:.1} ms (tone map, upscale, \
+             overlay, present)",
+            ms(self.frame_s),
+            ms(self.sim_s),
+            self.steps as f64 / n,
+            self.slow_motion_frames,
+            ms(self.bake_s),
+            ms(self.render_s),
+            ms(self.frame_s - self.sim_s - self.bake_s - self.render_s)
+        )
+    }
 }
 
 struct App {
@@ -113,6 +188,8 @@ struct App {
     /// Keys pressed and not yet released.
     held_keys: std::collections::HashSet<PhysicalKey>,
     quit_after: Option<QuitAfter>,
+    /// The overlay's text, rewritten each frame into the same allocation.
+    overlay: String,
 }
 
 impl App {
@@ -146,7 +223,9 @@ impl App {
                 after_s,
                 first: None,
                 frames: 0,
+                totals: FrameTotals::default(),
             }),
+            overlay: String::new(),
         })
     }
 
@@ -297,15 +376,16 @@ impl App {
         Ok(())
     }
 
-    /// Steps the solver to catch up with the wall clock, at its fixed step.
-    fn simulate(&mut self, now: Instant) -> CliResult {
+    /// Steps the solver to catch up with the wall clock, at its fixed step; returns the
+    /// steps taken.
+    fn simulate(&mut self, now: Instant) -> Result<u32, CliError> {
         let elapsed = self
             .last_frame
             .map_or(0.0, |t| (now - t).as_secs_f64().min(MAX_FRAME_S));
         self.last_frame = Some(now);
         if self.state.paused {
             self.behind_s = 0.0;
-            return Ok(());
+            return Ok(0);
         }
         self.behind_s += elapsed;
         let dt = self.job.dt_s();
@@ -320,7 +400,7 @@ impl App {
         if self.stats.slow_motion {
             self.behind_s = 0.0;
         }
-        Ok(())
+        Ok(steps)
     }
 
     fn report(&mut self, events: &[Event]) {
@@ -342,38 +422,26 @@ impl App {
             return Ok(());
         };
         let start = Instant::now();
-        self.simulate(start)?;
+        let steps = self.simulate(start)?;
         let sim_s = start.elapsed().as_secs_f64();
         if let Some(camera) = self.state.orbit.camera() {
             self.job.set_camera(camera);
         }
         let (iw, ih) = self.scale.internal_size(win_w as usize, win_h as usize);
         self.job.set_size(iw, ih)?;
-        let overlay = self.overlay_text(iw, ih);
+        let has_overlay = self.write_overlay(iw, ih);
         let Some(gfx) = self.gfx.as_mut() else {
             return Ok(());
         };
-        let t = gfx
-            .presenter
-            .draw(&mut self.job, (win_w, win_h), overlay.as_deref())?;
+        let overlay = has_overlay.then_some(self.overlay.as_str());
+        let t = gfx.presenter.draw(&mut self.job, (win_w, win_h), overlay)?;
         self.scale.update(t.total_s() as f32);
         let frame_s = start.elapsed().as_secs_f64();
-        let k = 0.1;
-        let s = &mut self.stats;
-        let mix = |old: f64, new: f64| {
-            if old == 0.0 {
-                new
-            } else {
-                old + k * (new - old)
-            }
-        };
-        s.sim_s = mix(s.sim_s, sim_s);
-        s.cube_s = mix(s.cube_s, t.cube_maps_s);
-        s.opaque_s = mix(s.opaque_s, t.opaque_s);
-        s.bubbles_s = mix(s.bubbles_s, t.bubbles_s);
-        s.setup_s = mix(s.setup_s, t.setup_s);
-        s.gpu_s = mix(s.gpu_s, t.resolve_s);
-        s.frame_s = mix(s.frame_s, frame_s);
+        if let Some(q) = &mut self.quit_after {
+            let bake_s = self.job.last_bake_s();
+            (q.totals).add([sim_s, bake_s], &t, frame_s, steps, self.stats.slow_motion);
+        }
+        self.stats.mix(sim_s, &t, frame_s);
         Ok(())
     }
 
@@ -390,10 +458,7 @@ impl App {
         if elapsed_s < q.after_s {
             return;
         }
-        let presenter = self
-            .gfx
-            .as_ref()
-            .map_or(String::new(), |g| g.presenter.name());
+        let presenter = self.gfx.as_ref().map_or("", |g| g.name.as_str());
         let (iw, ih) = (self.job.settings().width, self.job.settings().height);
         // The first frame starts the clock, so `frames - 1` frames fill `elapsed_s`.
         eprintln!(
@@ -403,6 +468,7 @@ impl App {
             (q.frames - 1) as f64 / elapsed_s.max(1e-9),
             self.scale.scale() * 100.0
         );
+        eprintln!("{}", q.totals.summary(q.frames));
         event_loop.exit();
     }
 
@@ -424,78 +490,91 @@ impl App {
         }
     }
 
-    fn overlay_text(&mut self, iw: usize, ih: usize) -> Option<String> {
+    /// Writes the overlay's text into `self.overlay` (its allocation reused from frame to
+    /// frame); false when there is none to draw.
+    fn write_overlay(&mut self, iw: usize, ih: usize) -> bool {
         let now = Instant::now();
         self.events.retain(|(_, at)| now - *at < EVENT_LIFETIME);
-        let mut text = String::new();
+        let mut text = std::mem::take(&mut self.overlay);
+        text.clear();
         if let Some(why) = &self.fallback {
-            text += &format!("wgpu failed, drawing on the cpu: {why}\n");
+            let _ = writeln!(text, "wgpu failed, drawing on the cpu: {why}");
         }
         if self.state.overlay {
-            let s = self.stats;
-            let world = self.job.world();
-            let gpu = self.gfx.as_ref().is_some_and(|g| g.presenter.is_gpu());
-            let presenter = self
-                .gfx
-                .as_ref()
-                .map_or(String::new(), |g| g.presenter.name());
-            text += &format!(
-                "fps {:.1}  frame {:.1} ms\n",
-                1.0 / s.frame_s.max(1e-9),
-                s.frame_s * 1e3
-            );
-            text += &if gpu {
-                format!(
-                    "sim {:.1}  encode {:.1}  gpu {:.1} ms\n",
-                    s.sim_s * 1e3,
-                    s.setup_s * 1e3,
-                    s.gpu_s * 1e3
-                )
-            } else {
-                format!(
-                    "sim {:.1}  cube {:.1}  opaque {:.1}  bubbles {:.1} ms\n",
-                    s.sim_s * 1e3,
-                    s.cube_s * 1e3,
-                    s.opaque_s * 1e3,
-                    s.bubbles_s * 1e3
-                )
-            };
-            text += &format!(
-                "scale {:.0}% ({}) {iw}x{ih}{}\n",
-                self.scale.scale() * 100.0,
-                if self.scale.is_fixed() {
-                    "fixed"
-                } else {
-                    "adaptive"
-                },
-                if self.scale.scale() < 1.0 {
-                    " upscaled"
-                } else {
-                    ""
-                }
-            );
-            text += &format!(
-                "bubbles {}  t {:.2} s{}{}\n",
-                world.bubbles().len(),
-                world.time_s(),
-                if self.state.paused { "  paused" } else { "" },
-                if s.slow_motion { "  slow motion" } else { "" }
-            );
-            text += &format!(
-                "reflect {:?}  samples {}\n",
-                self.state.reflection,
-                self.state.samples()
-            );
-            text += &format!("backend {presenter}\n");
-            for (e, _) in &self.events {
-                text += e;
-                text.push('\n');
-            }
+            self.write_stats(&mut text, iw, ih);
         }
         if self.state.help {
             text += CONTROLS;
         }
-        (!text.is_empty()).then_some(text)
+        self.overlay = text;
+        !self.overlay.is_empty()
+    }
+
+    /// The F overlay: rate, frame-time breakdown, scale, bubbles, settings and events.
+    fn write_stats(&self, text: &mut String, iw: usize, ih: usize) {
+        let s = self.stats;
+        let world = self.job.world();
+        let (gpu, presenter) = self
+            .gfx
+            .as_ref()
+            .map_or((false, ""), |g| (g.presenter.is_gpu(), g.name.as_str()));
+        let _ = writeln!(
+            text,
+            "fps {:.1}  frame {:.1} ms",
+            1.0 / s.frame_s.max(1e-9),
+            s.frame_s * 1e3
+        );
+        let _ = if gpu {
+            writeln!(
+                text,
+                "sim {:.1}  encode {:.1}  gpu {:.1} ms",
+                s.sim_s * 1e3,
+                s.setup_s * 1e3,
+                s.gpu_s * 1e3
+            )
+        } else {
+            writeln!(
+                text,
+                "sim {:.1}  cube {:.1}  opaque {:.1}  bubbles {:.1} ms",
+                s.sim_s * 1e3,
+                s.cube_s * 1e3,
+                s.opaque_s * 1e3,
+                s.bubbles_s * 1e3
+            )
+        };
+        let _ = writeln!(
+            text,
+            "scale {:.0}% ({}) {iw}x{ih}{}",
+            self.scale.scale() * 100.0,
+            if self.scale.is_fixed() {
+                "fixed"
+            } else {
+                "adaptive"
+            },
+            if self.scale.scale() < 1.0 {
+                " upscaled"
+            } else {
+                ""
+            }
+        );
+        let _ = writeln!(
+            text,
+            "bubbles {}  t {:.2} s{}{}",
+            world.bubbles().len(),
+            world.time_s(),
+            if self.state.paused { "  paused" } else { "" },
+            if s.slow_motion { "  slow motion" } else { "" }
+        );
+        let _ = writeln!(
+            text,
+            "reflect {:?}  samples {}",
+            self.state.reflection,
+            self.state.samples()
+        );
+        let _ = writeln!(text, "backend {presenter}");
+        for (e, _) in &self.events {
+            let _ = writeln!(text, "{e}");
+        }
     }
 }
 
@@ -516,6 +595,7 @@ impl ApplicationHandler for App {
                 let presenter = self.presenter(&window)?;
                 Ok(Gfx {
                     window,
+                    name: presenter.name(),
                     presenter,
                     size: (0, 0),
                 })
