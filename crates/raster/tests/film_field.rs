@@ -5,7 +5,8 @@
 mod common;
 
 use common::{
-    bubble, draining, film_field, paper_scene, settings, synthetic_reflectivity, with_film,
+    bubble, draining, film_field, on_threads, paper_scene, settings, synthetic_reflectivity,
+    with_film,
 };
 use raster::{
     Camera, Environment, FilmTables, Frame, Material, Object, ReflectionMode, RenderScene,
@@ -255,13 +256,7 @@ fn film_fields_render_bit_identically_at_1_2_and_3_threads() {
     let st = settings(96, 72, 4, ReflectionMode::DynamicCubeMap { face_size: 24 });
     let frames: Vec<Vec<[u32; 3]>> = [1, 2, 3]
         .iter()
-        .map(|&n| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .unwrap();
-            bits(&pool.install(|| render(&scene, &tables, &st)))
-        })
+        .map(|&n| bits(&on_threads(n, || render(&scene, &tables, &st))))
         .collect();
     assert!(frames[1] == frames[0], "2 threads differ from 1");
     assert!(frames[2] == frames[0], "3 threads differ from 1");

@@ -5,7 +5,9 @@ mod common;
 
 use std::sync::Arc;
 
-use common::{bubble, draining, lossless_tables, paper_scene, settings, synthetic_reflectivity};
+use common::{
+    bubble, draining, lossless_tables, on_threads, paper_scene, settings, synthetic_reflectivity,
+};
 use proptest::prelude::*;
 use raster::{
     Camera, Environment, FilmTables, Frame, Ground, Light, Lut, Material, Object, PartialShading,
@@ -189,13 +191,7 @@ fn output_is_bit_identical_at_1_2_and_3_threads() {
     let st = settings(96, 72, 4, ReflectionMode::DynamicCubeMap { face_size: 24 });
     let frames: Vec<Frame> = [1, 2, 3]
         .iter()
-        .map(|&n| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .unwrap();
-            pool.install(|| render(&scene, &tables, &st))
-        })
+        .map(|&n| on_threads(n, || render(&scene, &tables, &st)))
         .collect();
     for (n, f) in [2, 3].iter().zip(&frames[1..]) {
         let same = f

@@ -1,6 +1,9 @@
 //! Water optics through the public API: seed 002's sphere-map coordinates, Snell's law,
 //! total internal reflection, and whole frames with a water surface.
 
+mod common;
+
+use common::on_threads;
 use proptest::prelude::*;
 use raster::{
     Camera, Environment, FilmTables, Light, Lut, Material, ReflectionMode, RenderScene,
@@ -286,11 +289,9 @@ fn a_large_wavy_pond_renders_the_same_at_any_thread_count() {
     let frames: Vec<Vec<[f32; 3]>> = [1, 2, 3]
         .iter()
         .map(|&n| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .unwrap();
-            pool.install(|| render_scene(&scene, ReflectionMode::StaticEnvironment, (64, 48)))
+            on_threads(n, || {
+                render_scene(&scene, ReflectionMode::StaticEnvironment, (64, 48))
+            })
         })
         .collect();
     for (threads, frame) in [2, 3].iter().zip(&frames[1..]) {
