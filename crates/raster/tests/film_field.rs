@@ -3,15 +3,16 @@
 //! unblurred, and its coverage blends the film in (0: as if the bubble were not there).
 
 mod common;
+mod threads;
 
 use common::{
-    bubble, draining, film_field, on_threads, paper_scene, settings, synthetic_reflectivity,
-    with_film,
+    bubble, draining, film_field, paper_scene, settings, synthetic_reflectivity, with_film,
 };
 use raster::{
     Camera, Environment, FilmTables, Frame, Material, Object, ReflectionMode, RenderScene,
     RenderSettings, Renderer, Sky, Vec3,
 };
+use threads::on_threads;
 
 fn render(scene: &RenderScene, tables: &FilmTables, settings: &RenderSettings) -> Frame {
     Renderer::new()

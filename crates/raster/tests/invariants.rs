@@ -2,17 +2,17 @@
 //! two-face blend, thread-count independence and NaN-freedom.
 
 mod common;
+mod threads;
 
 use std::sync::Arc;
 
-use common::{
-    bubble, draining, lossless_tables, on_threads, paper_scene, settings, synthetic_reflectivity,
-};
+use common::{bubble, draining, lossless_tables, paper_scene, settings, synthetic_reflectivity};
 use proptest::prelude::*;
 use raster::{
     Camera, Environment, FilmTables, Frame, Ground, Light, Lut, Material, Object, PartialShading,
     ReflectionMode, RenderScene, RenderSettings, Renderer, SphereMap, ToneMap, TriMesh, Vec3,
 };
+use threads::on_threads;
 
 fn render(scene: &RenderScene, tables: &FilmTables, settings: &RenderSettings) -> Frame {
     Renderer::new()

@@ -1,15 +1,15 @@
 //! Water optics through the public API: seed 002's sphere-map coordinates, Snell's law,
 //! total internal reflection, and whole frames with a water surface.
 
-mod common;
+mod threads;
 
-use common::on_threads;
 use proptest::prelude::*;
 use raster::{
     Camera, Environment, FilmTables, Light, Lut, Material, ReflectionMode, RenderScene,
     RenderSettings, Renderer, Sky, ToneMap, Vec3, WATER_IOR, WaterSurface, refract,
     sphere_map_direction, sphere_map_uv,
 };
+use threads::on_threads;
 
 /// Asserts `|got − want| <= tol`, printing the difference.
 fn assert_close(what: &str, got: f32, want: f32, tol: f32) {

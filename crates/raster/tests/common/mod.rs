@@ -261,12 +261,3 @@ pub fn box_downsample(hi: &Frame, factor: usize) -> Frame {
     }
     Frame::try_from_rgb(w, h, out).unwrap()
 }
-
-/// Runs `f` on a pool of `threads` rayon threads (the thread-count determinism tests).
-pub fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap()
-        .install(f)
-}
