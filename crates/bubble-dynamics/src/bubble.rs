@@ -451,6 +451,7 @@ fn grid_film(
             ..ThermalParams::isothermal()
         },
         seed: params.seed,
+        gradient: params.film_gradient,
     };
     let h0 = params.mean_thickness_nm * 1e-9;
     let variation = params.thickness_variation;

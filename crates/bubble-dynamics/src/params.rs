@@ -4,6 +4,7 @@ use glam::DVec3;
 
 use crate::collider::Collider;
 use crate::error::ParamError;
+use crate::film_flow::FilmGradient;
 use crate::icosphere::MAX_SUBDIVISIONS;
 use crate::validate::{finite_vec, non_negative, nonzero_vec, positive, unit_interval};
 use crate::wind::Wind;
@@ -202,6 +203,9 @@ pub struct BubbleParams {
     /// How much warmer the air at the bubble's bottom is than at its top, K (film flow
     /// only; 0: isothermal). Drives thermal convection (docs/dynamics.md).
     pub bottom_warming_k: f64,
+    /// The discrete gradient that drives the film flow (film flow only; default the
+    /// two-point one, [`FilmGradient`]).
+    pub film_gradient: FilmGradient,
 }
 
 impl Default for BubbleParams {
@@ -234,6 +238,7 @@ impl Default for BubbleParams {
             black_film_nm: 12.0,
             nucleation_per_m2_s: 0.0,
             bottom_warming_k: 0.0,
+            film_gradient: FilmGradient::TwoPoint,
         }
     }
 }

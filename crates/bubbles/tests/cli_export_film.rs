@@ -161,3 +161,39 @@ fn film_grids_above_the_cell_limit_exit_2_before_any_work() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("3145728 cells"), "{}", stderr(&out));
 }
+
+#[test]
+fn a_bad_film_gradient_exits_2_naming_the_key_and_the_value() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = format!("{SCENE}film_gradient = \"diagonal\"\n");
+    std::fs::write(dir.path().join("film.toml"), scene).unwrap();
+    let out = bubbles(&["simulate", "film.toml", "--seconds", "0.1"], dir.path());
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let msg = stderr(&out);
+    assert!(msg.contains("film_gradient"), "{msg}");
+    assert!(msg.contains("diagonal"), "{msg}");
+    assert!(msg.contains("two-point") && msg.contains("normal"), "{msg}");
+}
+
+/// The normal gradient, chosen in the scene, steps the film (`--export-film` reads it).
+#[test]
+fn the_normal_film_gradient_simulates() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = format!("{SCENE}film_gradient = \"normal\"\n");
+    std::fs::write(dir.path().join("film.toml"), scene).unwrap();
+    let out = bubbles(
+        &[
+            "simulate",
+            "film.toml",
+            "--seconds",
+            "0.25",
+            "--fps",
+            "4",
+            "--export-film",
+            "film",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(dir.path().join("film").read_dir().unwrap().count() > 0);
+}

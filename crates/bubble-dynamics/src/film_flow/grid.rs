@@ -9,7 +9,7 @@
 
 use std::collections::HashMap;
 
-use glam::{DVec3, IVec3};
+use glam::{DMat3, DVec3, IVec3};
 
 /// Major axis, `s` axis and `t` axis of each face (OpenGL cube-map order).
 pub const FACE_BASES: [(IVec3, IVec3, IVec3); 6] = [
@@ -60,12 +60,25 @@ pub struct EdgeArrays {
     pub inverse_length: Vec<f64>,
     /// `1/dual_length`, per rad.
     pub inverse_dual_length: Vec<f64>,
+    /// `1/(dual_length·cos θ)`, per rad, θ the angle between the line of centres and the
+    /// edge's normal (up to 30° near the cube's corners): the centre difference's weight
+    /// in the gradient along the normal, [`CubeSphere::normal_gradient`].
+    pub inverse_normal_dual_length: Vec<f64>,
+    /// `tan θ/length`, per rad: the weight of the difference along the edge (its head
+    /// vertex's value less its tail's) taken off that gradient, so that it is along the
+    /// normal and not along the line of centres.
+    pub cross_per_length: Vec<f64>,
     /// `length/min(area_a, area_b)`, per rad: a speed times this and a step, per R, is the
     /// fraction of the smaller cell's content the edge can carry (a Courant number).
     pub length_per_smaller_area: Vec<f64>,
     /// `(centre_b − centre_a)/dual_length`, per rad: `G·` this is the discrete gradient
-    /// across the edge of a linear potential `G·x` (gravity, the wind's potential flow).
+    /// across the edge of a linear potential `G·x` (gravity, the wind's potential flow)
+    /// with the two-point gradient ([`FilmGradient::TwoPoint`](super::FilmGradient::TwoPoint)).
     pub centre_gradient: Vec<DVec3>,
+    /// The normal gradient ([`CubeSphere::normal_gradient`]) of the cell centres, per
+    /// rad: the same with [`FilmGradient::Normal`](super::FilmGradient::Normal), so that a
+    /// discrete Marangoni gradient along the normal can balance it exactly.
+    pub centre_normal_gradient: Vec<DVec3>,
     /// Unit tangent normal to the edge at its midpoint, from `a` towards `b`.
     pub normal: Vec<DVec3>,
     /// `midpoint − centre_a` and `midpoint − centre_b`: how far a cell's value is carried
@@ -74,10 +87,19 @@ pub struct EdgeArrays {
 }
 
 impl EdgeArrays {
-    fn new(edges: &[GridEdge], centres: &[DVec3], areas_sr: &[f64]) -> Self {
+    fn new(
+        edges: &[GridEdge],
+        centres: &[DVec3],
+        areas_sr: &[f64],
+        to_vertices: &VertexInterpolation,
+    ) -> Self {
         let centre = |c: u32| centres[c as usize];
         let smaller_area = |e: &GridEdge| areas_sr[e.a as usize].min(areas_sr[e.b as usize]);
+        let skew: Vec<[f64; 2]> = edges.iter().map(|e| skew_weights(e, centres)).collect();
+        let at_vertex = |v: u32| to_vertices.apply_vec(v as usize, centres);
         Self {
+            inverse_normal_dual_length: skew.iter().map(|w| w[0]).collect(),
+            cross_per_length: skew.iter().map(|w| w[1]).collect(),
             length_per_smaller_area: edges.iter().map(|e| e.length / smaller_area(e)).collect(),
             cells: edges.iter().map(|e| [e.a, e.b]).collect(),
             vertices: edges.iter().map(|e| [e.v0, e.v1]).collect(),
@@ -88,6 +110,14 @@ impl EdgeArrays {
             centre_gradient: edges
                 .iter()
                 .map(|e| (centre(e.b) - centre(e.a)) / e.dual_length)
+                .collect(),
+            centre_normal_gradient: edges
+                .iter()
+                .zip(&skew)
+                .map(|(e, [along, cross])| {
+                    (centre(e.b) - centre(e.a)) * along
+                        - (at_vertex(e.v1) - at_vertex(e.v0)) * cross
+                })
                 .collect(),
             normal: edges.iter().map(|e| e.normal).collect(),
             reach: edges
@@ -114,6 +144,84 @@ pub struct CubeSphere {
     vertex_areas_sr: Vec<f64>,
     inverse_areas_per_sr: Vec<f64>,
     inverse_vertex_areas_per_sr: Vec<f64>,
+    to_vertices: VertexInterpolation,
+}
+
+/// Per grid vertex: the cells around it (three at a cube corner, the first repeated with
+/// weight 0) and weights summing to 1 that carry a field linear in the vertex's tangent
+/// plane to its value there (least-norm weights: ¼ each where the four centres form a
+/// parallelogram).
+#[derive(Clone, Debug, Default)]
+struct VertexInterpolation {
+    cells: Vec<[u32; 4]>,
+    weights: Vec<[f64; 4]>,
+}
+
+impl VertexInterpolation {
+    fn new(corners: &[[u32; 4]], centres: &[DVec3], vertices: &[DVec3]) -> Self {
+        let mut around: Vec<Vec<u32>> = vec![Vec::new(); vertices.len()];
+        for (cell, ids) in corners.iter().enumerate() {
+            for &v in ids {
+                around[v as usize].push(cell as u32);
+            }
+        }
+        let mut cells = Vec::with_capacity(vertices.len());
+        let mut weights = Vec::with_capacity(vertices.len());
+        for (v, ring) in vertices.iter().zip(&around) {
+            assert!(
+                (3..=4).contains(&ring.len()),
+                "a vertex of {} cells",
+                ring.len()
+            );
+            let w = linear_exact_weights(*v, ring, centres);
+            cells.push(std::array::from_fn(|k| ring[k.min(ring.len() - 1)]));
+            weights.push(std::array::from_fn(
+                |k| if k < ring.len() { w[k] } else { 0.0 },
+            ));
+        }
+        Self { cells, weights }
+    }
+
+    fn apply(&self, v: usize, values: &[f64]) -> f64 {
+        let (c, w) = (&self.cells[v], &self.weights[v]);
+        (0..4).map(|k| w[k] * values[c[k] as usize]).sum()
+    }
+
+    fn apply_vec(&self, v: usize, values: &[DVec3]) -> DVec3 {
+        let (c, w) = (&self.cells[v], &self.weights[v]);
+        (0..4).map(|k| w[k] * values[c[k] as usize]).sum()
+    }
+}
+
+/// Least-norm weights over the cells `ring` around vertex `v`, summing to 1, whose mix of
+/// the centres' gnomonic projections onto `v`'s tangent plane is `v` itself.
+fn linear_exact_weights(v: DVec3, ring: &[u32], centres: &[DVec3]) -> Vec<f64> {
+    let side = if v.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
+    let e1 = side.cross(v).normalize();
+    let e2 = v.cross(e1);
+    let rows: Vec<DVec3> = ring
+        .iter()
+        .map(|&c| {
+            let p = centres[c as usize] / centres[c as usize].dot(v) - v;
+            DVec3::new(1.0, p.dot(e1), p.dot(e2))
+        })
+        .collect();
+    // w = Mᵀ (M Mᵀ)⁻¹ (1, 0, 0) with M's columns the rows above.
+    let normal = rows.iter().fold(DMat3::ZERO, |m, r| {
+        m + DMat3::from_cols(*r * r.x, *r * r.y, *r * r.z)
+    });
+    let lambda = normal.inverse() * DVec3::X;
+    rows.iter().map(|r| r.dot(lambda)).collect()
+}
+
+/// `[1/(d cos θ), tan θ/l]` of edge `e`: θ the angle at its midpoint between the line of
+/// centres (its tangential part) and the normal, positive towards the head vertex.
+fn skew_weights(e: &GridEdge, centres: &[DVec3]) -> [f64; 2] {
+    let chord = centres[e.b as usize] - centres[e.a as usize];
+    let along = (chord - chord.dot(e.midpoint) * e.midpoint).normalize();
+    let tangent = e.midpoint.cross(e.normal);
+    let (cos, sin) = (along.dot(e.normal), along.dot(tangent));
+    [1.0 / (e.dual_length * cos), sin / cos / e.length]
 }
 
 impl CubeSphere {
@@ -165,7 +273,8 @@ impl CubeSphere {
             }
         }
         let edges = build_edges(&cell_corners, &centres, &vertex_dirs);
-        let edge_arrays = EdgeArrays::new(&edges, &centres, &areas_sr);
+        let to_vertices = VertexInterpolation::new(&cell_corners, &centres, &vertex_dirs);
+        let edge_arrays = EdgeArrays::new(&edges, &centres, &areas_sr, &to_vertices);
         let inverse = |areas: &[f64]| areas.iter().map(|a| 1.0 / a).collect();
         Self {
             n,
@@ -176,7 +285,27 @@ impl CubeSphere {
             edges,
             edge_arrays,
             vertex_areas_sr,
+            to_vertices,
         }
+    }
+
+    /// Each grid vertex's value of the cell field `values`, linear-exact, into `out`.
+    pub fn cells_to_vertices(&self, values: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        out.extend((0..self.vertex_areas_sr.len()).map(|v| self.to_vertices.apply(v, values)));
+    }
+
+    /// The gradient of the cell field `values` along edge `e`'s normal, per rad, from
+    /// its cells' values and its vertices' (`at_vertices`, from [`Self::cells_to_vertices`]):
+    /// `(φ_b − φ_a)/(d cos θ) − (tan θ/l)(φ_v1 − φ_v0)`. The two-point difference alone is
+    /// the gradient along the line of centres, up to 30° off the normal near the cube's
+    /// corners: an error that does not fall with the cells' size.
+    pub fn normal_gradient(&self, e: usize, values: &[f64], at_vertices: &[f64]) -> f64 {
+        let ea = &self.edge_arrays;
+        let ([a, b], [v0, v1]) = (ea.cells[e], ea.vertices[e]);
+        let across = values[b as usize] - values[a as usize];
+        let along = at_vertices[v1 as usize] - at_vertices[v0 as usize];
+        across * ea.inverse_normal_dual_length[e] - along * ea.cross_per_length[e]
     }
 
     /// Cells along a face edge.
@@ -352,6 +481,64 @@ mod tests {
         }
         for (a, b) in area.iter().zip(coarse.areas_sr()) {
             assert!((a - b).abs() < 1e-14, "{a} vs {b}");
+        }
+    }
+
+    /// Largest error, over the edges, of a gradient `gradient(edge, field, at_vertices)`
+    /// of the cell samples of `g·x` against `g·n` at the edge's midpoint, relative to |g|.
+    fn worst_gradient_error(
+        n: usize,
+        gradient: impl Fn(&CubeSphere, usize, &[f64], &[f64]) -> f64,
+    ) -> f64 {
+        let grid = CubeSphere::new(n);
+        let g = DVec3::new(0.3, -0.5, 0.8);
+        let field: Vec<f64> = grid.centres().iter().map(|c| g.dot(*c)).collect();
+        let mut at_vertices = Vec::new();
+        grid.cells_to_vertices(&field, &mut at_vertices);
+        grid.edges()
+            .iter()
+            .enumerate()
+            .map(|(k, e)| (gradient(&grid, k, &field, &at_vertices) - g.dot(e.normal)).abs())
+            .fold(0.0, f64::max)
+            / g.length()
+    }
+
+    #[test]
+    fn the_normal_gradient_of_a_linear_field_converges_where_the_two_point_one_does_not() {
+        let two_point = |g: &CubeSphere, k: usize, f: &[f64], _: &[f64]| {
+            let ([a, b], d) = (g.edge_arrays().cells[k], g.edge_arrays().dual_length[k]);
+            (f[b as usize] - f[a as usize]) / d
+        };
+        let normal = |g: &CubeSphere, k: usize, f: &[f64], v: &[f64]| g.normal_gradient(k, f, v);
+        let old: Vec<f64> = [8, 16, 32]
+            .map(|n| worst_gradient_error(n, two_point))
+            .to_vec();
+        let new: Vec<f64> = [8, 16, 32]
+            .map(|n| worst_gradient_error(n, normal))
+            .to_vec();
+        eprintln!("worst gradient error at n = 8, 16, 32: two-point {old:?}, normal {new:?}");
+        assert!(old[2] > 0.1, "the two-point gradient's skew error: {old:?}");
+        assert!(
+            new[1] / new[2] > 1.8,
+            "normal gradient not converging: {new:?}"
+        );
+        assert!(new[2] < 0.01, "normal gradient error at n = 32: {new:?}");
+    }
+
+    #[test]
+    fn the_centre_normal_gradient_is_the_normal_gradient_of_the_centres() {
+        let grid = CubeSphere::new(8);
+        let g = DVec3::new(-0.2, 0.7, 0.4);
+        let field: Vec<f64> = grid.centres().iter().map(|c| g.dot(*c)).collect();
+        let mut at_vertices = Vec::new();
+        grid.cells_to_vertices(&field, &mut at_vertices);
+        for (k, c) in grid.edge_arrays().centre_normal_gradient.iter().enumerate() {
+            let want = grid.normal_gradient(k, &field, &at_vertices);
+            assert!(
+                (g.dot(*c) - want).abs() < 1e-12,
+                "edge {k}: {} vs {want}",
+                g.dot(*c)
+            );
         }
     }
 }

@@ -17,7 +17,7 @@ mod viscosity;
 
 pub use burst::{BLACK_RELAX_S, BurstParams, Hole, RIM_CELLS_PER_SUBSTEP};
 pub use cell_map::CellMap;
-pub use flow::{FilmFlow, FlowParams, Forcing};
+pub use flow::{FilmFlow, FilmGradient, FlowParams, Forcing};
 pub use grid::CubeSphere;
 pub use solve::{Hierarchy, SolveLimits, SolveReport};
 pub use thermal::ThermalParams;

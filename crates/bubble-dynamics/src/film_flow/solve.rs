@@ -117,6 +117,9 @@ pub struct SolveReport {
     pub iterations: u32,
     /// Final residual norm relative to the starting guess's.
     pub relative_residual: f64,
+    /// The residual norm the tolerance is relative to: the starting `x`'s (not the
+    /// guess's, where one was taken).
+    pub start_residual: f64,
 }
 
 impl Hierarchy {
@@ -183,9 +186,27 @@ impl Hierarchy {
         guess: Option<&[f64]>,
         limits: SolveLimits,
     ) -> SolveReport {
+        self.prepare(work, alpha, weight);
+        self.solve_prepared(work, b, x, guess, limits)
+    }
+
+    /// As [`Hierarchy::solve_with_guess`] for the system the last solve prepared (same
+    /// `alpha` and weights), with a new right-hand side `b`: the restriction to the
+    /// coarse levels and the coarsest level's factorisation are not redone.
+    ///
+    /// # Panics
+    /// If a slice's length does not match the finest level, or no solve came before.
+    pub fn solve_prepared(
+        &self,
+        work: &mut Work,
+        b: &[f64],
+        x: &mut [f64],
+        guess: Option<&[f64]>,
+        limits: SolveLimits,
+    ) -> SolveReport {
         let nc = self.levels[0].cells;
         assert!(b.len() == nc && x.len() == nc, "system size mismatch");
-        self.prepare(work, alpha, weight);
+        assert!(!work.stencil.is_empty(), "no system prepared");
         let order = &self.fine_order;
         let (mut bo, mut xo, mut go) = (
             std::mem::take(&mut work.b),
@@ -251,6 +272,7 @@ impl Hierarchy {
         let mut report = SolveReport {
             iterations: 0,
             relative_residual: start_norm / b_norm,
+            start_residual: b_norm,
         };
         if report.relative_residual > tolerance {
             self.v_cycle(work, 0, &r, &mut z);

@@ -25,7 +25,7 @@
 
 use glam::DVec3;
 
-use super::flow::{FilmFlow, H_FLOOR_M};
+use super::flow::{FilmFlow, FilmGradient, H_FLOOR_M};
 use crate::params::GAS_CONSTANT_J_PER_MOL_K;
 
 /// Specific heat of the film liquid (water), J/(kg·K).
@@ -148,21 +148,37 @@ impl FilmFlow {
         }
     }
 
-    /// `u += dt·2(dσ/dθ)∇θ/(ρh)` on every edge: the thermal Marangoni stress.
-    pub(super) fn thermal_stress(&mut self, dt_s: f64) {
+    /// `u += dt·2(dσ/dθ)∇θ/(ρh)` on every edge: the thermal Marangoni stress, with the
+    /// film's gradient ([`FilmGradient`]: with the normal one the surfactant's gradient
+    /// can hold it; `at_vertex` is scratch).
+    pub(super) fn thermal_stress(&mut self, dt_s: f64, at_vertex: &mut Vec<f64>) {
         if self.temperature_k.is_empty() {
             return;
         }
         let p = &self.params;
         let per = 2.0 * p.thermal.tension_per_kelvin_n_per_m_k * dt_s
             / (p.density_kg_per_m3 * p.radius_m);
-        let ea = self.grid.edge_arrays();
+        let g = &self.grid;
+        let ea = g.edge_arrays();
         let (theta, h) = (&self.temperature_k, &self.h_m);
-        let edges = ea.cells.iter().zip(&ea.inverse_dual_length);
-        for (u, ([a, b], id)) in self.u_m_per_s.iter_mut().zip(edges) {
-            let (a, b) = (*a as usize, *b as usize);
-            let h_edge = (0.5 * (h[a] + h[b])).max(H_FLOOR_M);
-            *u += per * (theta[b] - theta[a]) * id / h_edge;
+        match p.gradient {
+            FilmGradient::TwoPoint => {
+                let edges = ea.cells.iter().zip(&ea.inverse_dual_length);
+                for (u, ([a, b], id)) in self.u_m_per_s.iter_mut().zip(edges) {
+                    let (a, b) = (*a as usize, *b as usize);
+                    let h_edge = (0.5 * (h[a] + h[b])).max(H_FLOOR_M);
+                    *u += per * (theta[b] - theta[a]) * id / h_edge;
+                }
+            }
+            FilmGradient::Normal => {
+                g.cells_to_vertices(theta, at_vertex);
+                let edges = self.u_m_per_s.iter_mut().zip(&ea.cells).enumerate();
+                for (e, (u, [a, b])) in edges {
+                    let (a, b) = (*a as usize, *b as usize);
+                    let h_edge = (0.5 * (h[a] + h[b])).max(H_FLOOR_M);
+                    *u += per * g.normal_gradient(e, theta, at_vertex) / h_edge;
+                }
+            }
         }
     }
 }

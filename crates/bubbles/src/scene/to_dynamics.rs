@@ -1,10 +1,11 @@
 //! Scene → `bubble_dynamics::World`.
 
 use super::Scene;
-use super::schema::{BubbleSpec, ObjectSpec};
+use super::schema::{BubbleSpec, FilmGradientSpec, ObjectSpec};
 use super::values::{numbers, plain};
 use crate::error::CliError;
 use crate::limits;
+use bubble_dynamics::film_flow::FilmGradient;
 use bubble_dynamics::{
     BubbleParams, Collider, DVec3, Gusts, Integrator, SimError, Wind, World, WorldParams,
 };
@@ -233,6 +234,12 @@ pub(crate) fn bubble_params(spec: &BubbleSpec, default_grid: u32) -> BubbleParam
             spec.bottom_warming_k.map(|v| v.get()),
             defaults.bottom_warming_k,
         ),
+        film_gradient: spec
+            .film_gradient
+            .map_or(defaults.film_gradient, |g| match g {
+                FilmGradientSpec::TwoPoint => FilmGradient::TwoPoint,
+                FilmGradientSpec::Normal => FilmGradient::Normal,
+            }),
         ..defaults
     }
 }
@@ -328,6 +335,20 @@ mod tests {
             ));
         }
         Scene::from_toml_str(&text, "test", std::path::Path::new(".")).unwrap()
+    }
+
+    #[test]
+    fn film_gradient_is_two_point_unless_the_bubble_asks_for_normal() {
+        let gradient = |extra: &str| {
+            let scene = row_of_bubbles(1, extra);
+            bubble_params(&scene.file.bubbles[0], SCENE_FILM_GRID).film_gradient
+        };
+        assert_eq!(gradient(""), FilmGradient::TwoPoint);
+        assert_eq!(
+            gradient("film_gradient = \"two-point\""),
+            FilmGradient::TwoPoint
+        );
+        assert_eq!(gradient("film_gradient = \"normal\""), FilmGradient::Normal);
     }
 
     /// Regression: at a fixed default of 32, a scene of 257 or more bubbles that gives no
