@@ -555,8 +555,11 @@ fn check_initial_overlaps(
                     format!("bubbles[{j}].center_m"),
                     bj.center_m.to_array(),
                     format!(
-                        "overlaps bubbles[{i}] (centres {gap:.4} m apart, reach {:.4} m)",
-                        reach(bi) + reach(bj)
+                        "overlaps bubbles[{i}] (centres {gap:.4} m apart, reach {:.4} m from \
+                         their radius_m {} and {} and initial stretch)",
+                        reach(bi) + reach(bj),
+                        bi.radius_m,
+                        bj.radius_m
                     ),
                 ));
             }
@@ -568,8 +571,10 @@ fn check_initial_overlaps(
                     format!("bubbles[{j}].center_m"),
                     bj.center_m.to_array(),
                     format!(
-                        "is {d:.4} m from colliders[{k}], closer than the bubble's reach {:.4} m",
-                        reach(bj)
+                        "is {d:.4} m from colliders[{k}], closer than the bubble's reach {:.4} m \
+                         (its radius_m {} and initial stretch)",
+                        reach(bj),
+                        bj.radius_m
                     ),
                 ));
             }

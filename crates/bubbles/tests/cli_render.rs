@@ -132,6 +132,30 @@ fn cube_map_reuse_past_half_a_texel_is_exit_2_naming_it() {
     }
 }
 
+/// Found by `cli_extreme_numbers`' proptest: a radius too large for its bubble's height
+/// was refused naming only the centre and the ground, not the radius that caused it.
+#[test]
+fn a_radius_too_large_for_its_height_is_refused_naming_radius_m() {
+    let dir = tempfile::tempdir().unwrap();
+    let paper =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/paper.toml"))
+            .unwrap()
+            // The first bubble's radius (the light before it has one too).
+            .replacen(
+                "radius_m = 0.05\nmean_thickness_nm",
+                "radius_m = 0.5\nmean_thickness_nm",
+                1,
+            );
+    std::fs::write(dir.path().join("s.toml"), paper).unwrap();
+    let out = bubbles(&["render", "s.toml", "--out", "x.png"], dir.path());
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let msg = stderr(&out);
+    assert!(
+        msg.contains("radius_m 0.5") && msg.contains("center_m"),
+        "{msg}"
+    );
+}
+
 #[test]
 fn missing_output_directory_is_exit_2() {
     let dir = tempfile::tempdir().unwrap();
