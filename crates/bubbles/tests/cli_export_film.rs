@@ -4,6 +4,7 @@
 mod common;
 
 use common::{bubbles, stderr};
+use std::path::Path;
 
 const SCENE: &str = r#"
 [camera]
@@ -19,24 +20,28 @@ thickness_variation = 0.1
 drainage_viscosity_pa_s = 1e-6
 "#;
 
+/// Writes `scene` to `dir/film.toml` and simulates it for `seconds`, exporting the film
+/// field at `fps` into `dir/film`; asserts it succeeded.
+fn export_film(dir: &Path, scene: &str, seconds: &str, fps: &str) {
+    std::fs::write(dir.join("film.toml"), scene).unwrap();
+    let args = [
+        "simulate",
+        "film.toml",
+        "--seconds",
+        seconds,
+        "--fps",
+        fps,
+        "--export-film",
+        "film",
+    ];
+    let out = bubbles(&args, dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
 #[test]
 fn export_film_writes_the_cube_map_field_of_each_frame() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("film.toml"), SCENE).unwrap();
-    let out = bubbles(
-        &[
-            "simulate",
-            "film.toml",
-            "--seconds",
-            "0.5",
-            "--fps",
-            "4",
-            "--export-film",
-            "film",
-        ],
-        dir.path(),
-    );
-    assert!(out.status.success(), "{}", stderr(&out));
+    export_film(dir.path(), SCENE, "0.5", "4");
     let mut names: Vec<String> = std::fs::read_dir(dir.path().join("film"))
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -77,19 +82,7 @@ fn export_film_writes_the_cube_map_field_of_each_frame() {
 fn export_film_carries_the_warmed_films_temperature_in_blue() {
     let dir = tempfile::tempdir().unwrap();
     let scene = format!("{SCENE}bottom_warming_k = 4.0\n");
-    std::fs::write(dir.path().join("film.toml"), scene).unwrap();
-    let args = [
-        "simulate",
-        "film.toml",
-        "--seconds",
-        "1",
-        "--fps",
-        "1",
-        "--export-film",
-        "film",
-    ];
-    let out = bubbles(&args, dir.path());
-    assert!(out.status.success(), "{}", stderr(&out));
+    export_film(dir.path(), &scene, "1", "1");
     let image = image::open(dir.path().join("film/film_0_00001.exr"))
         .unwrap()
         .to_rgb32f();
@@ -180,20 +173,6 @@ fn a_bad_film_gradient_exits_2_naming_the_key_and_the_value() {
 fn the_normal_film_gradient_simulates() {
     let dir = tempfile::tempdir().unwrap();
     let scene = format!("{SCENE}film_gradient = \"normal\"\n");
-    std::fs::write(dir.path().join("film.toml"), scene).unwrap();
-    let out = bubbles(
-        &[
-            "simulate",
-            "film.toml",
-            "--seconds",
-            "0.25",
-            "--fps",
-            "4",
-            "--export-film",
-            "film",
-        ],
-        dir.path(),
-    );
-    assert!(out.status.success(), "{}", stderr(&out));
+    export_film(dir.path(), &scene, "0.25", "4");
     assert!(dir.path().join("film").read_dir().unwrap().count() > 0);
 }
