@@ -145,6 +145,7 @@ impl BubbleCtx<'_> {
         let ya = (tri.bbox[1] as usize).max(y0);
         let yb = (tri.bbox[3] as usize).min(y0 + rows);
         let shares = tri.surface != NO_SURFACE && self.partial == PartialShading::PerSurface;
+        let mut batch = PixelBatch::EMPTY;
         for py in ya..yb {
             for_each_covered_in_row(tri, &self.pattern, py as i32, |px, mask| {
                 let pixel = (py - y0) * width + px as usize;
@@ -160,23 +161,39 @@ impl BubbleCtx<'_> {
                 if pass == 0 {
                     return;
                 }
-                let (t_rgb, add) = if mask == full {
-                    // Shade at the centre when the triangle covers the pixel.
-                    let (t_rgb, add, _) = self.shade(tri, px as f32 + 0.5, py as f32 + 0.5);
-                    (t_rgb, add)
-                } else {
-                    let at = (px as f32, py as f32);
-                    self.shade_partial(tri, at, mask, pass, shares, &mut shared[pixel])
-                };
-                for (s, c) in color[base..base + s_count].iter_mut().enumerate() {
-                    if pass & (1 << s) != 0 {
-                        for k in 0..3 {
-                            c[k] = c[k] * t_rgb[k] + add[k];
-                        }
+                if mask == full {
+                    // Shaded at the centre when the triangle covers the pixel, in lanes.
+                    batch.push((px as f32 + 0.5, py as f32 + 0.5), base, pass);
+                    if batch.len == LANES {
+                        self.blend_batch(tri, &mut batch, &mut color[..]);
                     }
+                    return;
                 }
+                let at = (px as f32, py as f32);
+                let (t_rgb, add) =
+                    self.shade_partial(tri, at, mask, pass, shares, &mut shared[pixel]);
+                blend(&mut color[base..base + s_count], pass, t_rgb, add);
             });
         }
+        // Every pixel is blended by each triangle once, so the order within it is free.
+        self.blend_batch(tri, &mut batch, color);
+    }
+
+    /// Shades the pixels of `batch` in lanes, blends them into `color` and empties it.
+    #[inline(always)]
+    fn blend_batch(&self, tri: &SetupTri, batch: &mut PixelBatch, color: &mut [[f32; 3]]) {
+        let s_count = self.pattern.count;
+        let shadings = self.shade_lanes::<LANES>(tri, &batch.at[..batch.len]);
+        for ((&base, &pass), (t_rgb, add, _)) in batch
+            .base
+            .iter()
+            .zip(&batch.pass)
+            .zip(shadings)
+            .take(batch.len)
+        {
+            blend(&mut color[base..base + s_count], pass, t_rgb, add);
+        }
+        batch.len = 0;
     }
 
     /// Shading of a pixel whose top-left corner is `at` and whose samples `mask` the
@@ -211,86 +228,184 @@ impl BubbleCtx<'_> {
     }
 
     /// Transmittance and added radiance of the film at pixel-space point `(px, py)`, and
-    /// whether they may be shared with the rest of the pixel: no light's highlight reaches
-    /// within [`SHARE_MARGIN_PX`] of it.
+    /// whether they may be shared with the rest of the pixel: [`BubbleCtx::shade_lanes`]
+    /// with one lane.
+    #[inline]
+    fn shade(&self, tri: &SetupTri, px: f32, py: f32) -> Shading {
+        let [one] = self.shade_lanes::<1>(tri, &[(px, py)]);
+        one
+    }
+
+    /// [`BubbleCtx::shade`] at each pixel-space point of `at` (at most `L`; the lanes past
+    /// it are left as holes), stage by stage across the lanes.
+    ///
+    /// Each pixel runs exactly the operations `shade` would, so the results are
+    /// bit-identical; only their order across pixels changes. One pixel's shading is a
+    /// chain of dependent loads (film field, tables, cube map) longer than the core's
+    /// reorder window, so pixels shaded one after the other barely overlap; a stage that
+    /// runs for all lanes before the next gives the core independent work to overlap.
     ///
     /// A bubble with a film field reads its thickness and coverage `c` from the field at
     /// the interpolated material direction (attributes 3..6) and blends the film in by
     /// `c`: `T' = 1 − c·(1 − T)`, `add' = c·add`. A hole (`c = 0`) is exactly no film.
+    /// Shadings are shareable when no light's highlight reaches within
+    /// [`SHARE_MARGIN_PX`] of the point.
     ///
     /// The vector arithmetic runs in `Vec3A` lanes: the same IEEE operations in the same
     /// order as `Vec3`'s (glam sums dot products x, y, then z in both), so results are
     /// bit-identical, in fewer instructions.
-    #[inline]
-    fn shade(&self, tri: &SetupTri, px: f32, py: f32) -> ([f32; 3], [f32; 3], bool) {
-        let (inv_w, a) = tri.interpolate(px, py);
-        let (thickness_nm, coverage) = match self.films[tri.tag as usize] {
-            None => (a[3].max(0.0), 1.0),
-            Some(field) => {
-                let film = field.sample(Vec3::new(a[3], a[4], a[5]));
-                if film.coverage <= 0.0 {
-                    return ([1.0; 3], [0.0; 3], true);
-                }
-                (film.thickness_nm, film.coverage)
-            }
-        };
-        let (ax, ay) = self.view.ray_coefficients(px, py);
-        let d = Vec3A::from(self.view.forward)
-            + Vec3A::from(self.view.right) * ax
-            + Vec3A::from(self.view.up) * ay;
-        let v = d.normalize_or(self.view.forward.into());
-        let mut n = Vec3A::new(a[0], a[1], a[2]).normalize_or(-v);
-        let mut c = v.dot(n);
-        // Face the film towards the viewer: back faces show the film from inside.
-        if c > 0.0 {
-            n = -n;
-            c = -c;
+    #[inline(always)]
+    fn shade_lanes<const L: usize>(&self, tri: &SetupTri, at: &[(f32, f32)]) -> [Shading; L] {
+        let at = &at[..at.len().min(L)];
+        let mut out = [HOLE; L];
+        let mut inv_w = [0.0f32; L];
+        let mut attrs = [[0.0f32; ATTRS]; L];
+        for ((&(px, py), w), a) in at.iter().zip(&mut inv_w).zip(&mut attrs) {
+            (*w, *a) = tri.interpolate(px, py);
         }
-        let cos_theta = (-c).min(1.0);
-        let r_rgb = self.reflectivity.sample(thickness_nm, cos_theta);
-        let t_rgb = match &self.transmittance {
-            Some(t) => t.sample(thickness_nm, cos_theta),
-            None => r_rgb.map(|r| 1.0 - r),
-        };
-        let reflected = v - n * (2.0 * c);
+        let films = self.film_lanes::<L>(tri, &attrs[..at.len()]);
+        let rays = self.ray_lanes::<L>(at, &attrs);
+        let mut r_rgb = [[0.0f32; 3]; L];
+        let mut t_rgb = [[0.0f32; 3]; L];
+        for i in 0..at.len() {
+            r_rgb[i] = self.reflectivity.sample(films[i].0, rays[i].cos_theta);
+        }
+        for i in 0..at.len() {
+            t_rgb[i] = match &self.transmittance {
+                Some(t) => t.sample(films[i].0, rays[i].cos_theta),
+                None => r_rgb[i].map(|r| 1.0 - r),
+            };
+        }
         let reflection = &self.reflections[tri.tag as usize];
-        let derivatives = if reflection.is_cube() && self.filter == ReflectionFilter::Footprint {
-            self.reflection_derivatives(tri, d, inv_w, a)
-        } else {
-            [Vec3::ZERO; 2]
-        };
-        let reflected = Vec3::from(reflected);
-        let p = self.view.eye + Vec3::from(d / inv_w);
-        let dir = self.parallax_dir(tri, p, reflected).unwrap_or(reflected);
-        let env = reflection.sample(dir, derivatives, self.filter);
-        let mut add = [r_rgb[0] * env[0], r_rgb[1] * env[1], r_rgb[2] * env[2]];
-        let mut shareable = true;
-        if !self.lights.is_empty() {
-            for (light, table) in self.lights.iter().zip(self.light_tables) {
-                // Beyond the widened reach the visibility below is exactly 0.
-                let sight = LightSight::new(light, p, reflected);
-                if !sight.within_reach(light, tri.extra, SHARE_MARGIN_PX) {
-                    continue;
+        let footprint = reflection.is_cube() && self.filter == ReflectionFilter::Footprint;
+        let mut derivatives = [[Vec3::ZERO; 2]; L];
+        let mut points = [(Vec3::ZERO, Vec3::ZERO); L];
+        let mut dirs = [Vec3::ZERO; L];
+        for i in 0..at.len() {
+            let ray = &rays[i];
+            if footprint {
+                derivatives[i] = self.reflection_derivatives(tri, ray.d, inv_w[i], attrs[i]);
+            }
+            let p = self.view.eye + Vec3::from(ray.d / inv_w[i]);
+            points[i] = (p, ray.reflected);
+            dirs[i] = self
+                .parallax_dir(tri, p, ray.reflected)
+                .unwrap_or(ray.reflected);
+        }
+        let mut env = [[0.0f32; 3]; L];
+        for i in 0..at.len() {
+            env[i] = reflection.sample(dirs[i], derivatives[i], self.filter);
+        }
+        for i in 0..at.len() {
+            let (thickness_nm, coverage) = films[i];
+            // A hole (no film) stays `HOLE`; NaN coverage is not a hole, as in one lane.
+            if coverage <= 0.0 {
+                continue;
+            }
+            let (r, e) = (r_rgb[i], env[i]);
+            let mut add = [r[0] * e[0], r[1] * e[1], r[2] * e[2]];
+            let (p, reflected) = points[i];
+            let shareable = self.add_highlights(tri, p, reflected, thickness_nm, rays[i], &mut add);
+            out[i] = if coverage < 1.0 {
+                (
+                    t_rgb[i].map(|t| 1.0 - coverage * (1.0 - t)),
+                    add.map(|a| coverage * a),
+                    shareable,
+                )
+            } else {
+                (t_rgb[i], add, shareable)
+            };
+        }
+        out
+    }
+
+    /// Per lane: the film's thickness (nm) and coverage at interpolated attributes
+    /// `attrs` (the material direction with a film field, else the thickness itself).
+    #[inline(always)]
+    fn film_lanes<const L: usize>(
+        &self,
+        tri: &SetupTri,
+        attrs: &[[f32; ATTRS]],
+    ) -> [(f32, f32); L] {
+        let mut films = [(0.0f32, 0.0f32); L];
+        match self.films[tri.tag as usize] {
+            None => {
+                for (f, a) in films.iter_mut().zip(attrs) {
+                    *f = (a[3].max(0.0), 1.0);
                 }
-                shareable = false;
-                let vis = sight.visibility(light, reflected, tri.extra);
-                if vis > 0.0 {
-                    let l = table.sample(thickness_nm, cos_theta);
-                    let gain = light.highlight_gain();
-                    for k in 0..3 {
-                        add[k] += l[k] * gain[k] * vis;
-                    }
+            }
+            Some(field) => {
+                for (f, a) in films.iter_mut().zip(attrs) {
+                    let film = field.sample(Vec3::new(a[3], a[4], a[5]));
+                    *f = (film.thickness_nm, film.coverage);
                 }
             }
         }
-        if coverage < 1.0 {
-            return (
-                t_rgb.map(|t| 1.0 - coverage * (1.0 - t)),
-                add.map(|a| coverage * a),
-                shareable,
-            );
+        films
+    }
+
+    /// Per lane: the view ray through pixel-space point `at` and the film's facing
+    /// normal there (interpolated attributes 0..3).
+    #[inline(always)]
+    fn ray_lanes<const L: usize>(
+        &self,
+        at: &[(f32, f32)],
+        attrs: &[[f32; ATTRS]; L],
+    ) -> [FilmRay; L] {
+        let mut rays = [FilmRay::ZERO; L];
+        for ((ray, &(px, py)), a) in rays.iter_mut().zip(at).zip(attrs) {
+            let (ax, ay) = self.view.ray_coefficients(px, py);
+            let d = Vec3A::from(self.view.forward)
+                + Vec3A::from(self.view.right) * ax
+                + Vec3A::from(self.view.up) * ay;
+            let v = d.normalize_or(self.view.forward.into());
+            let mut n = Vec3A::new(a[0], a[1], a[2]).normalize_or(-v);
+            let mut c = v.dot(n);
+            // Face the film towards the viewer: back faces show the film from inside.
+            if c > 0.0 {
+                n = -n;
+                c = -c;
+            }
+            *ray = FilmRay {
+                d,
+                reflected: Vec3::from(v - n * (2.0 * c)),
+                cos_theta: (-c).min(1.0),
+            };
         }
-        (t_rgb, add, shareable)
+        rays
+    }
+
+    /// Adds every light's highlight reaching film point `p` (seen along a ray reflected
+    /// to `reflected`) to `add`; returns whether none reaches within [`SHARE_MARGIN_PX`]
+    /// (the shading may then be shared within the pixel).
+    #[inline(always)]
+    fn add_highlights(
+        &self,
+        tri: &SetupTri,
+        p: Vec3,
+        reflected: Vec3,
+        thickness_nm: f32,
+        ray: FilmRay,
+        add: &mut [f32; 3],
+    ) -> bool {
+        let mut shareable = true;
+        for (light, table) in self.lights.iter().zip(self.light_tables) {
+            // Beyond the widened reach the visibility below is exactly 0.
+            let sight = LightSight::new(light, p, reflected);
+            if !sight.within_reach(light, tri.extra, SHARE_MARGIN_PX) {
+                continue;
+            }
+            shareable = false;
+            let vis = sight.visibility(light, reflected, tri.extra);
+            if vis > 0.0 {
+                let l = table.sample(thickness_nm, ray.cos_theta);
+                let gain = light.highlight_gain();
+                for k in 0..3 {
+                    add[k] += l[k] * gain[k] * vis;
+                }
+            }
+        }
+        shareable
     }
 
     /// The direction bubble `tri.tag` reads its dynamic cube map in for the ray from film
@@ -330,6 +445,75 @@ impl BubbleCtx<'_> {
         ];
         reflection_derivatives(d, dd, n_raw, dn_raw).map(Vec3::from)
     }
+}
+
+/// Pixels a triangle covers whole, shaded together ([`BubbleCtx::shade_lanes`]).
+const LANES: usize = 8;
+
+/// Whole pixels of one triangle waiting to be shaded: their centres, first sample index
+/// and the samples in front of the opaque scene.
+struct PixelBatch {
+    len: usize,
+    at: [(f32, f32); LANES],
+    base: [usize; LANES],
+    pass: [u32; LANES],
+}
+
+impl PixelBatch {
+    const EMPTY: Self = Self {
+        len: 0,
+        at: [(0.0, 0.0); LANES],
+        base: [0; LANES],
+        pass: [0; LANES],
+    };
+
+    /// Adds a pixel; the caller empties a full batch first.
+    #[inline(always)]
+    fn push(&mut self, at: (f32, f32), base: usize, pass: u32) {
+        self.at[self.len] = at;
+        self.base[self.len] = base;
+        self.pass[self.len] = pass;
+        self.len += 1;
+    }
+}
+
+/// Blends a film of transmittance `t_rgb` adding `add` over the samples `pass` of one
+/// pixel's `samples`.
+#[inline(always)]
+fn blend(samples: &mut [[f32; 3]], pass: u32, t_rgb: [f32; 3], add: [f32; 3]) {
+    for (s, c) in samples.iter_mut().enumerate() {
+        if pass & (1 << s) != 0 {
+            for k in 0..3 {
+                c[k] = c[k] * t_rgb[k] + add[k];
+            }
+        }
+    }
+}
+
+/// A shading: the film's transmittance, the radiance it adds, and whether it may be
+/// shared within its pixel.
+type Shading = ([f32; 3], [f32; 3], bool);
+
+/// The shading of a hole in the film: no film at all.
+const HOLE: Shading = ([1.0; 3], [0.0; 3], true);
+
+/// One pixel's view ray and what the film's facing normal makes of it.
+#[derive(Debug, Clone, Copy)]
+struct FilmRay {
+    /// The (unnormalised) view ray.
+    d: Vec3A,
+    /// The unit view ray mirrored in the film.
+    reflected: Vec3,
+    /// Cosine of the angle of incidence, in [0, 1].
+    cos_theta: f32,
+}
+
+impl FilmRay {
+    const ZERO: Self = Self {
+        d: Vec3A::ZERO,
+        reflected: Vec3::ZERO,
+        cos_theta: 0.0,
+    };
 }
 
 /// How far (in pixels of reflected-direction turn) a shading may be reused from the
