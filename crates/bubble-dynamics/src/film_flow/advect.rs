@@ -27,7 +27,7 @@
 //! the term does no work (`ζ k×u ⊥ u`), to the time scheme's error. The Marangoni step
 //! that follows absorbs the gradient part of what it adds (a solid rotation's
 //! centripetal push) only within its backward-Euler relaxation, which costs a rotating
-//! film energy at about (ω dt)² a step: 3.4 % of a 5 rad/s rotation's rate in 0.2 s of
+//! film energy at about (ω dt)² a step: 3.3 % of a 5 rad/s rotation's rate in 0.2 s of
 //! 1/240 s steps (`tests/film_flow_advection.rs`).
 
 use glam::DVec3;
