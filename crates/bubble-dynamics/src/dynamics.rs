@@ -56,13 +56,14 @@ impl Bubble {
         } else {
             &self.scratch.relative_velocity_m_per_s
         };
-        let six_volume = faces.accumulate::<STIFFNESS>(
-            &self.positions_m,
-            relative,
-            self.topology.triangles(),
-            &self.inv_rest_face_area,
-            &mut self.scratch.sums,
-        );
+        let mesh = (&self.positions_m[..], self.topology.triangles());
+        let (rest, sums) = (&self.inv_rest_face_area[..], &mut self.scratch.sums[..]);
+        // The drag switch picks a loop, so the loop body carries no branch for it.
+        let six_volume = if faces.drag.active {
+            faces.accumulate::<STIFFNESS, true>(mesh, relative, rest, sums)
+        } else {
+            faces.accumulate::<STIFFNESS, false>(mesh, relative, rest, sums)
+        };
         self.scratch.volume_m3 = six_volume / 6.0;
         if STIFFNESS {
             self.frequency_from_stiffness()
@@ -310,14 +311,14 @@ struct FaceForces {
 }
 
 impl FaceForces {
-    /// One pass over the triangles: tension, hydrostatics and drag into the forces, the
+    /// One pass over the triangles: tension, hydrostatics and (with `DRAG`, which must be
+    /// `self.drag.active`) drag into the forces, the
     /// volume gradient, the drag stiffness and (with `STIFFNESS`) the Gershgorin row sums
     /// of the tension Hessian. Returns six times the enclosed volume.
-    fn accumulate<const STIFFNESS: bool>(
+    fn accumulate<const STIFFNESS: bool, const DRAG: bool>(
         &self,
-        positions: &[DVec3],
+        (positions, triangles): (&[DVec3], &[[u32; 3]]),
         relative_velocities: &[DVec3],
-        triangles: &[[u32; 3]],
         inv_rest_face_area: &[f64],
         sums: &mut [VertexSums],
     ) -> f64 {
@@ -360,7 +361,7 @@ impl FaceForces {
             let centroid = (a + b + c) * (1.0 / 3.0) - self.origin;
             let mut common = share * self.hydro_g.dot(centroid);
             let mut drag_k = 0.0;
-            if self.drag.active {
+            if DRAG {
                 let v_face =
                     (relative_velocities[ia] + relative_velocities[ib] + relative_velocities[ic])
                         * (1.0 / 3.0);
