@@ -595,7 +595,8 @@ impl DragModel {
     }
 }
 
-#[cfg(test)]
+/// The AVX2 pass against the portable one (only x86-64 has both).
+#[cfg(all(test, target_arch = "x86_64"))]
 mod tests {
     use super::*;
     use crate::geometry::face_areas_m2;
@@ -637,7 +638,6 @@ mod tests {
     }
 
     /// Every bit of the sums and the volume after the portable and the AVX2 triangle pass.
-    #[cfg(target_arch = "x86_64")]
     fn both_passes<const STIFFNESS: bool>(positions: &[DVec3]) -> [Vec<u64>; 2] {
         let ((_, velocities, triangles, inv_rest), faces) = wobbling_mesh();
         let run = |avx2: bool| {
@@ -681,7 +681,6 @@ mod tests {
 
     /// The AVX2 triangle pass rounds exactly as the portable one (no FMA), so results do
     /// not depend on the CPU; also with degenerate faces (a corner moved onto another).
-    #[cfg(target_arch = "x86_64")]
     #[test]
     fn triangle_pass_gives_the_same_bits_with_and_without_avx2() {
         if !std::arch::is_x86_feature_detected!("avx2") {
