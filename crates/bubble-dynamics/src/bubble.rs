@@ -48,8 +48,9 @@ pub(crate) struct Scratch {
     pub(crate) volume_m3: f64,
     pub(crate) relative_velocity_m_per_s: Vec<DVec3>,
     pub(crate) solve: Vec<DVec3>,
-    pub(crate) face_area_m2: Vec<f64>,
     pub(crate) vertex_area_m2: Vec<f64>,
+    /// Twice the cotangent of every corner, `3·face + slot` (see `film::FilmGeometry`).
+    pub(crate) corner_cot2: Vec<f64>,
     pub(crate) film_thickness_m: Vec<f64>,
     pub(crate) stream_m2_per_s: Vec<f64>,
     pub(crate) flux_kg_per_s: Vec<f64>,

@@ -56,13 +56,14 @@ impl Bubble {
         } else {
             &self.scratch.relative_velocity_m_per_s
         };
-        let six_volume = faces.accumulate::<STIFFNESS>(
-            &self.positions_m,
-            relative,
-            self.topology.triangles(),
-            &self.inv_rest_face_area,
-            &mut self.scratch.sums,
-        );
+        let mesh = (&self.positions_m[..], self.topology.triangles());
+        let (rest, sums) = (&self.inv_rest_face_area[..], &mut self.scratch.sums[..]);
+        // The drag switch picks a loop, so the loop body carries no branch for it.
+        let six_volume = if faces.drag.active {
+            faces.accumulate::<STIFFNESS, true>(mesh, relative, rest, sums)
+        } else {
+            faces.accumulate::<STIFFNESS, false>(mesh, relative, rest, sums)
+        };
         self.scratch.volume_m3 = six_volume / 6.0;
         if STIFFNESS {
             self.frequency_from_stiffness()
@@ -309,47 +310,137 @@ struct FaceForces {
     drag: DragModel,
 }
 
+/// Faces per block of the triangle pass: a block's per-face values (7 KB) stay in L1.
+const BLOCK: usize = 32;
+
+/// Vectors of a block's faces, one array per coordinate, so the per-face arithmetic runs
+/// on two (SSE2) or four (AVX2) faces per instruction.
+#[derive(Default)]
+struct Lanes3 {
+    x: [f64; BLOCK],
+    y: [f64; BLOCK],
+    z: [f64; BLOCK],
+}
+
+impl Lanes3 {
+    #[inline(always)]
+    fn get(&self, k: usize) -> DVec3 {
+        DVec3::new(self.x[k], self.y[k], self.z[k])
+    }
+
+    #[inline(always)]
+    fn set(&mut self, k: usize, v: DVec3) {
+        (self.x[k], self.y[k], self.z[k]) = (v.x, v.y, v.z);
+    }
+}
+
+/// One block of faces: the corners and corner velocities gathered from the mesh, then
+/// everything each face adds to its corners' sums.
+#[derive(Default)]
+struct FaceBlock {
+    a: Lanes3,
+    b: Lanes3,
+    c: Lanes3,
+    /// Sum of the corners' velocities relative to the air.
+    v_sum: Lanes3,
+    /// The force on each corner.
+    force_a: Lanes3,
+    force_b: Lanes3,
+    force_c: Lanes3,
+    /// ∂V/∂x of each corner (the same for all three).
+    share: Lanes3,
+    /// (a − o)·n2: six times the face's tetrahedron from the origin.
+    six_volume: [f64; BLOCK],
+    /// |n2| = 2A; 0 marks a degenerate face.
+    double_area: [f64; BLOCK],
+    drag_k: [f64; BLOCK],
+    stiffness: [f64; BLOCK],
+}
+
 impl FaceForces {
-    /// One pass over the triangles: tension, hydrostatics and drag into the forces, the
-    /// volume gradient, the drag stiffness and (with `STIFFNESS`) the Gershgorin row sums
-    /// of the tension Hessian. Returns six times the enclosed volume.
-    fn accumulate<const STIFFNESS: bool>(
+    /// One pass over the triangles: tension, hydrostatics and (with `DRAG`, which must be
+    /// `self.drag.active`) drag into the forces, the volume gradient, the drag stiffness
+    /// and (with `STIFFNESS`) the Gershgorin row sums of the tension Hessian. Returns six
+    /// times the enclosed volume.
+    ///
+    /// Blocks of faces go through three loops: gather the corners, compute each face on
+    /// its own (vectorised across faces), scatter to the corners in face order. Every
+    /// value is the same expression as a face-at-a-time loop, summed in the same order.
+    fn accumulate<const STIFFNESS: bool, const DRAG: bool>(
         &self,
-        positions: &[DVec3],
+        mesh: (&[DVec3], &[[u32; 3]]),
         relative_velocities: &[DVec3],
-        triangles: &[[u32; 3]],
+        inv_rest_face_area: &[f64],
+        sums: &mut [VertexSums],
+    ) -> f64 {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2, checked just above.
+            return unsafe {
+                self.accumulate_avx2::<STIFFNESS, DRAG>(
+                    mesh,
+                    relative_velocities,
+                    inv_rest_face_area,
+                    sums,
+                )
+            };
+        }
+        self.accumulate_body::<STIFFNESS, DRAG>(mesh, relative_velocities, inv_rest_face_area, sums)
+    }
+
+    /// [`FaceForces::accumulate`] with four faces per instruction. AVX2 without FMA:
+    /// the same roundings as SSE2, so the same bits on any CPU.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn accumulate_avx2<const STIFFNESS: bool, const DRAG: bool>(
+        &self,
+        mesh: (&[DVec3], &[[u32; 3]]),
+        relative_velocities: &[DVec3],
+        inv_rest_face_area: &[f64],
+        sums: &mut [VertexSums],
+    ) -> f64 {
+        self.accumulate_body::<STIFFNESS, DRAG>(mesh, relative_velocities, inv_rest_face_area, sums)
+    }
+
+    /// The triangle pass itself, inlined into each of the above.
+    #[inline(always)]
+    fn accumulate_body<const STIFFNESS: bool, const DRAG: bool>(
+        &self,
+        (positions, triangles): (&[DVec3], &[[u32; 3]]),
+        relative_velocities: &[DVec3],
         inv_rest_face_area: &[f64],
         sums: &mut [VertexSums],
     ) -> f64 {
         let mut six_volume = 0.0;
-        let n = positions.len();
-        let (relative_velocities, sums) = (&relative_velocities[..n], &mut sums[..n]);
-        for (t, inv_rest_area) in triangles.iter().zip(inv_rest_face_area) {
-            let [ia, ib, ic] = t.map(|i| i as usize);
-            // One check here lets the compiler drop the nine at the accesses below.
-            assert!(
-                ia < n && ib < n && ic < n,
-                "triangle {t:?} beyond {n} vertices"
-            );
-            let (a, b, c) = (positions[ia], positions[ib], positions[ic]);
+        let mut block = FaceBlock::default();
+        for (faces, inv_rest) in triangles
+            .chunks(BLOCK)
+            .zip(inv_rest_face_area.chunks(BLOCK))
+        {
+            block.gather::<DRAG>(positions, relative_velocities, faces);
+            self.compute::<STIFFNESS, DRAG>(&mut block, inv_rest);
+            six_volume = block.scatter::<STIFFNESS>(faces, sums, six_volume);
+        }
+        six_volume
+    }
+
+    /// Every face's contributions in `block`, for the faces with an `inv_rest` entry.
+    #[inline(always)]
+    fn compute<const STIFFNESS: bool, const DRAG: bool>(
+        &self,
+        block: &mut FaceBlock,
+        inv_rest: &[f64],
+    ) {
+        for (k, inv_rest_area) in inv_rest.iter().enumerate().take(BLOCK) {
+            let (a, b, c) = (block.a.get(k), block.b.get(k), block.c.get(k));
             let (ab, bc, ca) = (b - a, c - b, a - c);
             // n2 = (b − a) × (c − a) = 2A n̂.
             let n2 = ca.cross(ab);
             // ∂V/∂x = A n̂ / 3 per corner; V = Σ (a − o)·n2 / 6 (tetrahedra from o).
             let share = n2 * (1.0 / 6.0);
-            six_volume += (a - self.origin).dot(n2);
+            block.six_volume[k] = (a - self.origin).dot(n2);
             let len = n2.length();
-            if len == 0.0 {
-                // No area gradient exists; the stiffness bound turns infinite and the
-                // substep count reports the broken mesh.
-                for i in [ia, ib, ic] {
-                    sums[i].volume_gradient_m2 += share;
-                    if STIFFNESS {
-                        sums[i].stiffness_n_per_m = f64::INFINITY;
-                    }
-                }
-                continue;
-            }
+            // A degenerate face (len = 0) computes garbage here; the scatter skips it.
             let inv_len = 1.0 / len;
             let tension = self.tension_0 + self.elasticity * (0.5 * len * inv_rest_area - 1.0);
             // −T ∂A/∂x with ∂A/∂a = ½ n̂ × (c − b) = n2 × (c − b) / (2|n2|), cyclically.
@@ -360,29 +451,100 @@ impl FaceForces {
             let centroid = (a + b + c) * (1.0 / 3.0) - self.origin;
             let mut common = share * self.hydro_g.dot(centroid);
             let mut drag_k = 0.0;
-            if self.drag.active {
-                let v_face =
-                    (relative_velocities[ia] + relative_velocities[ib] + relative_velocities[ic])
-                        * (1.0 / 3.0);
+            if DRAG {
+                let v_face = block.v_sum.get(k) * (1.0 / 3.0);
                 let (force, stiffness) = self.drag.face_force(n2, len, inv_len, v_face);
                 common += force;
                 drag_k = stiffness;
             }
-            let stiffness = if STIFFNESS {
+            if STIFFNESS {
                 // Gershgorin: (|T| + E)·Σ|e|²/(4A) bounds the row sums of this triangle's
                 // tension/elasticity Hessian at each corner.
                 let edges2 = ab.length_squared() + bc.length_squared() + ca.length_squared();
-                (tension.abs() + self.elasticity) * edges2 * 0.5 * inv_len
-            } else {
-                0.0
-            };
-            for (i, opposite) in [(ia, bc), (ib, ca), (ic, ab)] {
+                block.stiffness[k] = (tension.abs() + self.elasticity) * edges2 * 0.5 * inv_len;
+            }
+            block.force_a.set(k, n2.cross(bc) * coef + common);
+            block.force_b.set(k, n2.cross(ca) * coef + common);
+            block.force_c.set(k, n2.cross(ab) * coef + common);
+            block.share.set(k, share);
+            block.double_area[k] = len;
+            block.drag_k[k] = drag_k;
+        }
+    }
+}
+
+impl FaceBlock {
+    /// Loads the corners of `faces` (at most `BLOCK`) and, with `DRAG`, the sums of their
+    /// relative velocities.
+    #[inline(always)]
+    fn gather<const DRAG: bool>(
+        &mut self,
+        positions: &[DVec3],
+        relative_velocities: &[DVec3],
+        faces: &[[u32; 3]],
+    ) {
+        let n = positions.len();
+        let relative_velocities = &relative_velocities[..n];
+        for (k, t) in faces.iter().enumerate().take(BLOCK) {
+            let [ia, ib, ic] = t.map(|i| i as usize);
+            // One check here (`&`, not `&&`: a single branch) drops the six at the accesses below.
+            assert!(
+                (ia < n) & (ib < n) & (ic < n),
+                "triangle {t:?} beyond {n} vertices"
+            );
+            self.a.set(k, positions[ia]);
+            self.b.set(k, positions[ib]);
+            self.c.set(k, positions[ic]);
+            if DRAG {
+                self.v_sum.set(
+                    k,
+                    relative_velocities[ia] + relative_velocities[ib] + relative_velocities[ic],
+                );
+            }
+        }
+    }
+
+    /// Adds the block's contributions to the corners of `faces`, face by face; returns
+    /// `six_volume` plus the block's tetrahedra.
+    #[inline(always)]
+    fn scatter<const STIFFNESS: bool>(
+        &self,
+        faces: &[[u32; 3]],
+        sums: &mut [VertexSums],
+        mut six_volume: f64,
+    ) -> f64 {
+        let n = sums.len();
+        for (k, t) in faces.iter().enumerate().take(BLOCK) {
+            six_volume += self.six_volume[k];
+            let [ia, ib, ic] = t.map(|i| i as usize);
+            assert!(
+                (ia < n) & (ib < n) & (ic < n),
+                "triangle {t:?} beyond {n} vertices"
+            );
+            let share = self.share.get(k);
+            if self.double_area[k] == 0.0 {
+                // No area gradient exists; the stiffness bound turns infinite and the
+                // substep count reports the broken mesh.
+                for i in [ia, ib, ic] {
+                    sums[i].volume_gradient_m2 += share;
+                    if STIFFNESS {
+                        sums[i].stiffness_n_per_m = f64::INFINITY;
+                    }
+                }
+                continue;
+            }
+            let corners = [
+                (ia, &self.force_a),
+                (ib, &self.force_b),
+                (ic, &self.force_c),
+            ];
+            for (i, force) in corners {
                 let sum = &mut sums[i];
-                sum.force_n += n2.cross(opposite) * coef + common;
+                sum.force_n += force.get(k);
                 sum.volume_gradient_m2 += share;
-                sum.drag_n_s_per_m += drag_k;
+                sum.drag_n_s_per_m += self.drag_k[k];
                 if STIFFNESS {
-                    sum.stiffness_n_per_m += stiffness;
+                    sum.stiffness_n_per_m += self.stiffness[k];
                 }
             }
         }
@@ -430,5 +592,112 @@ impl DragModel {
             * len
             * (1.0 / 6.0);
         (force, stiffness)
+    }
+}
+
+/// The AVX2 pass against the portable one (only x86-64 has both).
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use super::*;
+    use crate::geometry::face_areas_m2;
+    use crate::icosphere::equilibrium_icosphere;
+
+    /// Positions, velocities, triangles and inverse rest areas (1/m²) of a mesh.
+    type Mesh = (Vec<DVec3>, Vec<DVec3>, Vec<[u32; 3]>, Vec<f64>);
+
+    /// A level-3 icosphere stretched and swirling, and its forces with drag and buoyancy.
+    fn wobbling_mesh() -> (Mesh, FaceForces) {
+        let mesh = equilibrium_icosphere(3);
+        let rest: Vec<DVec3> = mesh.positions.iter().map(|p| *p * 0.05).collect();
+        let inv_rest = face_areas_m2(&rest, &mesh.triangles)
+            .iter()
+            .map(|a| 1.0 / a)
+            .collect();
+        let positions: Vec<DVec3> = rest
+            .iter()
+            .enumerate()
+            .map(|(i, p)| *p * DVec3::new(1.1, 0.9, 1.0) * (1.0 + 0.01 * (i as f64).sin()))
+            .collect();
+        let velocities = positions
+            .iter()
+            .map(|p| DVec3::new(p.y, -p.x, 0.3 * p.z) * 20.0 + DVec3::X * 0.1)
+            .collect();
+        let faces = FaceForces {
+            tension_0: 0.05,
+            elasticity: 0.02,
+            hydro_g: DVec3::new(0.0, -0.5, 0.0),
+            origin: DVec3::new(0.001, -0.002, 0.0),
+            drag: DragModel {
+                active: true,
+                linear_pa_s_per_m: 0.003,
+                quadratic_kg_per_m3: 0.56,
+            },
+        };
+        let triangles = mesh.triangles.clone();
+        ((positions, velocities, triangles, inv_rest), faces)
+    }
+
+    /// Every bit of the sums and the volume after the portable and the AVX2 triangle pass.
+    fn both_passes<const STIFFNESS: bool>(positions: &[DVec3]) -> [Vec<u64>; 2] {
+        let ((_, velocities, triangles, inv_rest), faces) = wobbling_mesh();
+        let run = |avx2: bool| {
+            let mut sums = vec![VertexSums::default(); positions.len()];
+            let mesh = (positions, &triangles[..]);
+            let six_volume = if avx2 {
+                // SAFETY: the caller checked that the CPU supports AVX2.
+                unsafe {
+                    faces.accumulate_avx2::<STIFFNESS, true>(
+                        mesh,
+                        &velocities,
+                        &inv_rest,
+                        &mut sums,
+                    )
+                }
+            } else {
+                faces.accumulate_body::<STIFFNESS, true>(mesh, &velocities, &inv_rest, &mut sums)
+            };
+            let mut bits = vec![six_volume.to_bits()];
+            for s in &sums {
+                let [fx, fy, fz] = s.force_n.to_array();
+                let [gx, gy, gz] = s.volume_gradient_m2.to_array();
+                bits.extend(
+                    [
+                        fx,
+                        fy,
+                        fz,
+                        gx,
+                        gy,
+                        gz,
+                        s.drag_n_s_per_m,
+                        s.stiffness_n_per_m,
+                    ]
+                    .map(f64::to_bits),
+                );
+            }
+            bits
+        };
+        [run(false), run(true)]
+    }
+
+    /// The AVX2 triangle pass rounds exactly as the portable one (no FMA), so results do
+    /// not depend on the CPU; also with degenerate faces (a corner moved onto another).
+    #[test]
+    fn triangle_pass_gives_the_same_bits_with_and_without_avx2() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            return;
+        }
+        let ((mut positions, _, triangles, _), _) = wobbling_mesh();
+        let [portable, avx2] = both_passes::<true>(&positions);
+        assert!(portable == avx2, "first substep's pass differs");
+        let [portable, avx2] = both_passes::<false>(&positions);
+        assert!(portable == avx2, "later substeps' pass differs");
+        let [a, b, _] = triangles[0].map(|i| i as usize);
+        positions[b] = positions[a];
+        let [portable, avx2] = both_passes::<true>(&positions);
+        assert!(portable == avx2, "pass with a degenerate face differs");
+        assert!(
+            f64::from_bits(portable[1 + 8 * a + 7]).is_infinite(),
+            "the degenerate face's corner has no infinite stiffness"
+        );
     }
 }

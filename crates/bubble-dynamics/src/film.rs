@@ -7,9 +7,9 @@ use std::f64::consts::TAU;
 use glam::DVec3;
 
 use crate::bubble::{Bubble, Scratch};
-use crate::geometry::face_areas_into;
 use crate::params::BubbleParams;
 use crate::rng::SplitMix64;
+use crate::topology::Edge;
 
 /// Number of travelling waves in the swirl stream function.
 const SLOSH_WAVES: usize = 6;
@@ -93,13 +93,11 @@ impl Bubble {
     pub(crate) fn transport_film(&mut self, g_eff: DVec3, dt_s: f64, t_s: f64) {
         // The work buffers live in the bubble; take them so the bubble can be borrowed.
         let mut s = std::mem::take(&mut self.scratch);
-        let triangles = self.topology.triangles();
-        face_areas_into(&self.positions_m, triangles, &mut s.face_area_m2);
-        vertex_areas_into(
-            triangles,
-            &s.face_area_m2,
-            self.positions_m.len(),
+        film_geometry_into(
+            &self.positions_m,
+            self.topology.triangles(),
             &mut s.vertex_area_m2,
+            &mut s.corner_cot2,
         );
         let rho = self.film.density_kg_per_m3;
         s.film_thickness_m.clear();
@@ -114,17 +112,12 @@ impl Bubble {
             &s.stream_m2_per_s[..]
         });
         let mut flux = std::mem::take(&mut s.flux_kg_per_s);
-        self.edge_fluxes_kg_per_s(
-            g_eff,
-            swirl,
-            &s.film_thickness_m,
-            &s.face_area_m2,
-            &mut flux,
-        );
+        self.edge_fluxes_kg_per_s(g_eff, swirl, &s.film_thickness_m, &s.corner_cot2, &mut flux);
         s.flux_kg_per_s = flux;
         self.apply_fluxes(&mut s, dt_s);
-        self.evaporate(&s.vertex_area_m2, dt_s);
-        self.refresh_inertial_mass();
+        if self.evaporate(&s.vertex_area_m2, dt_s) {
+            self.refresh_inertial_mass();
+        }
         self.update_thickness_with_areas(&s.vertex_area_m2);
         self.scratch = s;
     }
@@ -146,33 +139,33 @@ impl Bubble {
         g_eff: DVec3,
         swirl: Option<&[f64]>,
         h: &[f64],
-        face_areas: &[f64],
+        corner_cot2: &[f64],
         out: &mut Vec<f64>,
     ) {
-        let x = &self.positions_m;
+        let n = self.positions_m.len();
+        let (x, h) = (&self.positions_m[..n], &h[..n]);
         let rho = self.film.density_kg_per_m3;
-        // ρ·ρ h³/(3μ) times g·e·(cot α + cot β)/2, and cot = u·v/(2A) at the corner
-        // opposite the edge.
+        // ρ·ρ h³/(3μ) times g·e·(cot α + cot β)/2, with 2 cot per corner at hand.
         let mobility = rho * rho / (12.0 * self.film.drainage_viscosity_pa_s);
-        let cot_times_2a = |k: usize, i: usize, j: usize| (x[i] - x[k]).dot(x[j] - x[k]);
         let edges = self.topology.edges();
         out.clear();
         out.extend(
             edges
                 .iter()
-                .zip(self.topology.opposite_vertices())
-                .map(|(e, k)| {
+                .zip(self.topology.opposite_corners())
+                .map(|(e, corners)| {
                     let [i, j] = e.vertices.map(|v| v as usize);
-                    let [ka, kb] = k.map(|v| v as usize);
+                    // One check here lets the compiler drop the six at the accesses below.
+                    assert!(i < n && j < n, "edge {:?} beyond {n} vertices", e.vertices);
+                    let [ca, cb] = corners.map(|c| c as usize);
                     // The sign of a flux is as good as random: select the index, not the branch.
                     let upwind = |q: f64| h[if q > 0.0 { i } else { j }];
-                    let [fa, fb] = e.faces.map(|f| f as usize);
                     let g_dot_e = g_eff.dot(x[j] - x[i]);
                     let hu = upwind(g_dot_e);
-                    let cot_sum = cot_times_2a(ka, i, j) / face_areas[fa]
-                        + cot_times_2a(kb, i, j) / face_areas[fb];
+                    let cot_sum = corner_cot2[ca] + corner_cot2[cb];
                     let mut q = mobility * g_dot_e * cot_sum * (hu * hu * hu);
                     if let Some(psi) = swirl {
+                        let [fa, fb] = e.faces.map(|f| f as usize);
                         let volume_rate = psi[fa] - psi[fb];
                         q += rho * volume_rate * upwind(volume_rate);
                     }
@@ -185,13 +178,14 @@ impl Bubble {
     /// film; the moved mass carries the donor's velocity (momentum is conserved).
     fn apply_fluxes(&mut self, s: &mut Scratch, dt_s: f64) {
         let edges = self.topology.edges();
+        let n = self.film_mass_kg.len();
         let flux = &s.flux_kg_per_s;
         // Outflow per donor, then turned in place into the donor's limiting factor.
         let limit = &mut s.outflow_kg;
         limit.clear();
-        limit.resize(self.film_mass_kg.len(), 0.0);
+        limit.resize(n, 0.0);
         for (e, q) in edges.iter().zip(flux) {
-            let donor = e.vertices[usize::from(*q <= 0.0)] as usize;
+            let (donor, _) = donor_and_receiver(e, *q, n);
             limit[donor] += q.abs() * dt_s;
         }
         for (l, m) in limit.iter_mut().zip(&self.film_mass_kg) {
@@ -210,16 +204,14 @@ impl Bubble {
                 .zip(&self.inertial_mass_kg)
                 .map(|(v, m)| *v * *m),
         );
+        let (mass, velocity) = (&mut self.film_mass_kg[..n], &self.velocities_m_per_s[..n]);
+        let (limit, momentum) = (&limit[..n], &mut momentum[..n]);
         for (e, q) in edges.iter().zip(flux) {
-            let forward = usize::from(*q <= 0.0);
-            let (donor, receiver) = (
-                e.vertices[forward] as usize,
-                e.vertices[1 - forward] as usize,
-            );
+            let (donor, receiver) = donor_and_receiver(e, *q, n);
             let dm = q.abs() * dt_s * limit[donor];
-            self.film_mass_kg[donor] -= dm;
-            self.film_mass_kg[receiver] += dm;
-            let dp = self.velocities_m_per_s[donor] * dm;
+            mass[donor] -= dm;
+            mass[receiver] += dm;
+            let dp = velocity[donor] * dm;
             momentum[donor] -= dp;
             momentum[receiver] += dp;
         }
@@ -234,32 +226,69 @@ impl Bubble {
         }
     }
 
-    /// Removes ρ·rate·area·dt of film per vertex (vapour leaves with the film's velocity).
-    fn evaporate(&mut self, areas: &[f64], dt_s: f64) {
+    /// Removes ρ·rate·area·dt of film per vertex (vapour leaves with the film's velocity);
+    /// false when the film does not evaporate and no mass changed.
+    fn evaporate(&mut self, areas: &[f64], dt_s: f64) -> bool {
         let rate = self.film.evaporation_nm_per_s * 1e-9 * self.film.density_kg_per_m3;
         if rate == 0.0 {
-            return;
+            return false;
         }
         for (m, a) in self.film_mass_kg.iter_mut().zip(areas) {
             *m = (*m - rate * a * dt_s).max(0.0);
         }
+        true
     }
 }
 
-/// Barycentric vertex areas from face areas into `out`: a third of each face to each
-/// corner.
-fn vertex_areas_into(
+/// The donor and the receiver of flux `q` along edge `e` (from `vertices[0]` when
+/// positive), both checked to be below `n` once so the caller's indexing needs no checks.
+#[inline]
+fn donor_and_receiver(e: &Edge, q: f64, n: usize) -> (usize, usize) {
+    let forward = usize::from(q <= 0.0);
+    let (donor, receiver) = (
+        e.vertices[forward] as usize,
+        e.vertices[1 - forward] as usize,
+    );
+    assert!(
+        (donor < n) & (receiver < n),
+        "edge {:?} beyond {n} vertices",
+        e.vertices
+    );
+    (donor, receiver)
+}
+
+/// One pass over the triangles: the barycentric vertex areas (a third of each face's
+/// area to each corner) into `vertex_areas`, and twice the
+/// cotangent of every corner (u·v/A for the corner's edge vectors u, v) into
+/// `corner_cot2` at `3·face + slot`, for the drainage's cotangent weights.
+///
+/// Each value is computed exactly as the separate passes did (the dot products of
+/// negated edge vectors are negated exactly), so the fusion changes no bit.
+fn film_geometry_into(
+    positions: &[DVec3],
     triangles: &[[u32; 3]],
-    face_areas: &[f64],
-    vertex_count: usize,
-    out: &mut Vec<f64>,
+    vertex_areas: &mut Vec<f64>,
+    corner_cot2: &mut Vec<f64>,
 ) {
-    out.clear();
-    out.resize(vertex_count, 0.0);
-    for (t, a) in triangles.iter().zip(face_areas) {
-        let third = a / 3.0;
-        for &i in t {
-            out[i as usize] += third;
+    let n = positions.len();
+    vertex_areas.clear();
+    vertex_areas.resize(n, 0.0);
+    corner_cot2.clear();
+    for t in triangles {
+        let [ia, ib, ic] = t.map(|i| i as usize);
+        // One check here (`&`, not `&&`: a single branch) drops the six at the accesses below.
+        assert!(
+            (ia < n) & (ib < n) & (ic < n),
+            "triangle {t:?} beyond {n} vertices"
+        );
+        let (a, b, c) = (positions[ia], positions[ib], positions[ic]);
+        let (ab, ac, bc) = (b - a, c - a, c - b);
+        let area = 0.5 * ab.cross(ac).length();
+        let third = area / 3.0;
+        for i in [ia, ib, ic] {
+            vertex_areas[i] += third;
         }
+        // At b the edge vectors are a − b = −ab and bc; at c, −ac and −bc.
+        corner_cot2.extend([ab.dot(ac) / area, -ab.dot(bc) / area, ac.dot(bc) / area]);
     }
 }

@@ -20,6 +20,8 @@ pub struct Topology {
     edges: Vec<Edge>,
     /// Per edge, the third vertex of `faces[0]` and of `faces[1]`.
     opposite_vertices: Vec<[u32; 2]>,
+    /// Per edge, the same two corners as `3·face + slot` (slot in `triangles[face]`).
+    opposite_corners: Vec<[u32; 2]>,
     vertex_face_offsets: Vec<u32>,
     vertex_faces: Vec<u32>,
     neighbor_offsets: Vec<u32>,
@@ -60,10 +62,18 @@ impl Topology {
                     .map(|f| third_vertex(triangles[f as usize], e.vertices))
             })
             .collect();
+        let opposite_corners = edges
+            .iter()
+            .map(|e| {
+                e.faces
+                    .map(|f| 3 * f + third_slot(triangles[f as usize], e.vertices))
+            })
+            .collect();
         let topology = Self {
             triangles,
             edges,
             opposite_vertices,
+            opposite_corners,
             vertex_face_offsets,
             vertex_faces,
             neighbor_offsets,
@@ -88,6 +98,12 @@ impl Topology {
     /// two faces, in the order of `Edge::faces`.
     pub fn opposite_vertices(&self) -> &[[u32; 2]] {
         &self.opposite_vertices
+    }
+
+    /// Per edge, the corners of [`Topology::opposite_vertices`] as `3·face + slot`, the
+    /// slot being the vertex's position in its triangle: an index into per-corner data.
+    pub fn opposite_corners(&self) -> &[[u32; 2]] {
+        &self.opposite_corners
     }
 
     /// Number of vertices.
@@ -117,6 +133,15 @@ impl Topology {
 fn third_vertex(triangle: [u32; 3], edge: [u32; 2]) -> u32 {
     let [a, b, c] = triangle;
     a + b + c - edge[0] - edge[1]
+}
+
+/// The position in `triangle` of the corner that is neither end of `edge`.
+fn third_slot(triangle: [u32; 3], edge: [u32; 2]) -> u32 {
+    let k = third_vertex(triangle, edge);
+    triangle
+        .iter()
+        .position(|&v| v == k)
+        .expect("a triangle's own corner") as u32
 }
 
 fn collect_edges(triangles: &[[u32; 3]], vertex_count: usize) -> Option<Vec<Edge>> {

@@ -20,8 +20,9 @@ use crate::wind::{Wind, WindField};
 mod interact;
 
 /// Fraction of the symplectic-Euler stability limit ω·dt < 2 that a substep may use.
-/// Measured: a violent two-bubble collision in gusts stays stable up to 1.5 with the
-/// Gershgorin bound below and blows up at 2; 0.75 leaves a factor 2 of margin.
+/// The Gershgorin bound below overestimates the fastest mode 1.4–2× (power iteration,
+/// `examples/fastest_mode.rs`), but at 1.5 the E = 10 N/m film diverges in its first
+/// step at the bound (`tests/stability_at_substep_bound.rs`; docs/dynamics.md, Substeps).
 const STABILITY_FRACTION: f64 = 0.75;
 /// A substep count, once chosen, is kept while the stability bound asks for no more and
 /// for at least 1/SUBSTEP_HYSTERESIS of it. A count that follows the bound exactly flips

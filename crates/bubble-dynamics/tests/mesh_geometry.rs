@@ -172,6 +172,31 @@ fn opposite_vertices_complete_each_edges_faces() {
     }
 }
 
+/// Each edge's opposite corners name, as `3·face + slot`, its opposite vertices.
+#[test]
+fn opposite_corners_index_the_opposite_vertices() {
+    let mesh = icosphere(2);
+    let n = mesh.positions.len();
+    let topology = Topology::try_new(mesh.triangles, n).expect("closed");
+    let corners: Vec<u32> = topology.triangles().iter().flatten().copied().collect();
+    for (e, (slots, opposite)) in topology.edges().iter().zip(
+        topology
+            .opposite_corners()
+            .iter()
+            .zip(topology.opposite_vertices()),
+    ) {
+        for ((f, slot), k) in e.faces.iter().zip(slots).zip(opposite) {
+            assert_eq!(
+                slot / 3,
+                *f,
+                "edge {:?}: corner in the wrong face",
+                e.vertices
+            );
+            assert_eq!(corners[*slot as usize], *k, "edge {:?}", e.vertices);
+        }
+    }
+}
+
 /// The rest mesh is a discrete equilibrium: one pressure balances the tension at every
 /// vertex. Its radii spread shrinks ~h² and its pressure tends to Laplace's 4σ/R.
 #[test]
