@@ -886,24 +886,31 @@ mod tests {
             .collect()
     }
 
-    /// A stiff system (weights 10⁴× the mass term, as a frame's Marangoni step gives)
-    /// converges to 1e-12 from zero in at most 20 iterations at n = 16 and 64 alike (the
-    /// multigrid preconditioner keeps the count from growing with the grid), and the
-    /// answer satisfies the system.
-    /// A system like `stiff_system_converges_in_few_iterations`'s, solved on this thread
-    /// with or without AVX2 (`portable`), to a loose tolerance so that it iterates.
-    fn solve_on_this_thread(n: usize, portable: bool) -> (Vec<f64>, SolveReport) {
-        PORTABLE_ONLY.set(portable);
+    /// The stiff test system at `n` cells a face: the grid, its hierarchy, the mass
+    /// term, the weights (10⁴× the mass term, as a frame's Marangoni step gives) and the
+    /// right-hand side `rhs(centre) · area`.
+    fn stiff_system(
+        n: usize,
+        rhs: impl Fn(glam::DVec3) -> f64,
+    ) -> (CubeSphere, Hierarchy, Vec<f64>, Vec<f64>, Vec<f64>) {
         let grid = CubeSphere::new(n);
         let h = Hierarchy::new(&grid);
         let alpha = grid.areas_sr().to_vec();
         let weight = stiff_weights(&grid, n);
-        let b: Vec<f64> = grid
+        let b = grid
             .centres()
             .iter()
             .zip(&alpha)
-            .map(|(c, a)| a * (2.0 * c.x - c.y * c.z).sin())
+            .map(|(c, a)| a * rhs(*c))
             .collect();
+        (grid, h, alpha, weight, b)
+    }
+
+    /// A stiff system solved on this thread with or without AVX2 (`portable`), to a
+    /// loose tolerance so that it iterates.
+    fn solve_on_this_thread(n: usize, portable: bool) -> (Vec<f64>, SolveReport) {
+        PORTABLE_ONLY.set(portable);
+        let (grid, h, alpha, weight, b) = stiff_system(n, |c| (2.0 * c.x - c.y * c.z).sin());
         let mut x = vec![0.0; grid.cells()];
         let limits = SolveLimits {
             tolerance: 1e-9,
@@ -929,19 +936,14 @@ mod tests {
         }
     }
 
+    /// A stiff system (weights 10⁴× the mass term, as a frame's Marangoni step gives)
+    /// converges to 1e-12 from zero in at most 20 iterations at n = 16 and 64 alike (the
+    /// multigrid preconditioner keeps the count from growing with the grid), and the
+    /// answer satisfies the system.
     #[test]
     fn stiff_system_converges_in_few_iterations() {
         for n in [16, 64] {
-            let grid = CubeSphere::new(n);
-            let h = Hierarchy::new(&grid);
-            let alpha = grid.areas_sr().to_vec();
-            let weight = stiff_weights(&grid, n);
-            let b: Vec<f64> = grid
-                .centres()
-                .iter()
-                .zip(&alpha)
-                .map(|(c, a)| a * (3.0 * c.x * c.y + c.z).exp())
-                .collect();
+            let (grid, h, alpha, weight, b) = stiff_system(n, |c| (3.0 * c.x * c.y + c.z).exp());
             let mut x = vec![0.0; grid.cells()];
             let mut work = Work::default();
             let limits = SolveLimits {
