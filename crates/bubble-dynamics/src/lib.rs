@@ -22,6 +22,7 @@
 //! assert!((b.pressure_excess_pa() - 4.0 * 0.025 / b.radius_m()).abs() < 0.05);
 //! ```
 
+mod avx2;
 mod bubble;
 mod collide;
 mod collider;

@@ -8,6 +8,7 @@
 //! Galerkin coarsening would double it and halve the coarse correction).
 
 use super::grid::{CubeSphere, parent_cell};
+use crate::avx2::with_avx2;
 
 /// Sides of every cell: each level is itself a cube-sphere, whose cells all have four
 /// neighbours, so the stencils have four sides everywhere (no per-cell loop bounds).
@@ -239,86 +240,75 @@ impl Hierarchy {
     ) -> SolveReport {
         with_avx2(
             #[inline(always)]
-            || self.solve_ordered_body(work, b, x, guess, limits),
-        )
-    }
-
-    /// [`Hierarchy::solve_ordered`]'s work.
-    #[inline(always)]
-    fn solve_ordered_body(
-        &self,
-        work: &mut Work,
-        b: &[f64],
-        x: &mut [f64],
-        guess: Option<&[f64]>,
-        limits: SolveLimits,
-    ) -> SolveReport {
-        let SolveLimits {
-            tolerance,
-            max_iterations,
-        } = limits;
-        let fine = &self.levels[0];
-        let nc = fine.cells;
-        work.r.resize(nc, 0.0);
-        work.z.resize(nc, 0.0);
-        work.p.resize(nc, 0.0);
-        work.q.resize(nc, 0.0);
-        let mut r = std::mem::take(&mut work.r);
-        let mut z = std::mem::take(&mut work.z);
-        let mut p = std::mem::take(&mut work.p);
-        let mut q = std::mem::take(&mut work.q);
-        apply(fine, &work.alpha[0], &work.stencil[0], x, &mut q);
-        for i in 0..nc {
-            r[i] = b[i] - q[i];
-        }
-        // Relative to the warm start's residual: the step's change, not the whole field.
-        let mut start_norm = dot(&r, &r).sqrt();
-        let b_norm = if start_norm > 0.0 { start_norm } else { 1.0 };
-        if let Some(guess) = guess.filter(|_| start_norm > 0.0) {
-            apply(fine, &work.alpha[0], &work.stencil[0], guess, &mut q);
-            for i in 0..nc {
-                z[i] = b[i] - q[i];
-            }
-            let guess_norm = dot(&z, &z).sqrt();
-            if guess_norm < start_norm {
-                x.copy_from_slice(guess);
-                r.copy_from_slice(&z);
-                start_norm = guess_norm;
-            }
-        }
-        let mut report = SolveReport {
-            iterations: 0,
-            relative_residual: start_norm / b_norm,
-            start_residual: b_norm,
-        };
-        if report.relative_residual > tolerance {
-            self.v_cycle(work, 0, &r, &mut z);
-            p.copy_from_slice(&z);
-            let mut rz = dot(&r, &z);
-            while report.iterations < max_iterations {
-                apply(fine, &work.alpha[0], &work.stencil[0], &p, &mut q);
-                let pq = dot(&p, &q);
-                if pq <= 0.0 || !pq.is_finite() {
-                    break;
-                }
-                let step = rz / pq;
-                let rr = update_and_norm2(step, &p, &q, x, &mut r);
-                report.iterations += 1;
-                report.relative_residual = rr.sqrt() / b_norm;
-                if report.relative_residual <= tolerance {
-                    break;
-                }
-                self.v_cycle(work, 0, &r, &mut z);
-                let rz_next = dot(&r, &z);
-                let beta = rz_next / rz;
-                rz = rz_next;
+            || {
+                let SolveLimits {
+                    tolerance,
+                    max_iterations,
+                } = limits;
+                let fine = &self.levels[0];
+                let nc = fine.cells;
+                work.r.resize(nc, 0.0);
+                work.z.resize(nc, 0.0);
+                work.p.resize(nc, 0.0);
+                work.q.resize(nc, 0.0);
+                let mut r = std::mem::take(&mut work.r);
+                let mut z = std::mem::take(&mut work.z);
+                let mut p = std::mem::take(&mut work.p);
+                let mut q = std::mem::take(&mut work.q);
+                apply(fine, &work.alpha[0], &work.stencil[0], x, &mut q);
                 for i in 0..nc {
-                    p[i] = z[i] + beta * p[i];
+                    r[i] = b[i] - q[i];
                 }
-            }
-        }
-        (work.r, work.z, work.p, work.q) = (r, z, p, q);
-        report
+                // Relative to the warm start's residual: the step's change, not the whole field.
+                let mut start_norm = dot(&r, &r).sqrt();
+                let b_norm = if start_norm > 0.0 { start_norm } else { 1.0 };
+                if let Some(guess) = guess.filter(|_| start_norm > 0.0) {
+                    apply(fine, &work.alpha[0], &work.stencil[0], guess, &mut q);
+                    for i in 0..nc {
+                        z[i] = b[i] - q[i];
+                    }
+                    let guess_norm = dot(&z, &z).sqrt();
+                    if guess_norm < start_norm {
+                        x.copy_from_slice(guess);
+                        r.copy_from_slice(&z);
+                        start_norm = guess_norm;
+                    }
+                }
+                let mut report = SolveReport {
+                    iterations: 0,
+                    relative_residual: start_norm / b_norm,
+                    start_residual: b_norm,
+                };
+                if report.relative_residual > tolerance {
+                    self.v_cycle(work, 0, &r, &mut z);
+                    p.copy_from_slice(&z);
+                    let mut rz = dot(&r, &z);
+                    while report.iterations < max_iterations {
+                        apply(fine, &work.alpha[0], &work.stencil[0], &p, &mut q);
+                        let pq = dot(&p, &q);
+                        if pq <= 0.0 || !pq.is_finite() {
+                            break;
+                        }
+                        let step = rz / pq;
+                        let rr = update_and_norm2(step, &p, &q, x, &mut r);
+                        report.iterations += 1;
+                        report.relative_residual = rr.sqrt() / b_norm;
+                        if report.relative_residual <= tolerance {
+                            break;
+                        }
+                        self.v_cycle(work, 0, &r, &mut z);
+                        let rz_next = dot(&r, &z);
+                        let beta = rz_next / rz;
+                        rz = rz_next;
+                        for i in 0..nc {
+                            p[i] = z[i] + beta * p[i];
+                        }
+                    }
+                }
+                (work.r, work.z, work.p, work.q) = (r, z, p, q);
+                report
+            },
+        )
     }
 
     /// Restricts the system's numbers to every level.
@@ -380,39 +370,35 @@ impl Hierarchy {
     fn v_cycle(&self, work: &mut Work, k: usize, r: &[f64], z: &mut [f64]) {
         with_avx2(
             #[inline(always)]
-            || self.v_cycle_body(work, k, r, z),
+            || {
+                let level = &self.levels[k];
+                z.iter_mut().for_each(|v| *v = 0.0);
+                if k + 1 == self.levels.len() {
+                    dense_solve(&work.coarse_factor, level.cells, r, z);
+                    return;
+                }
+                gauss_seidel(level, &work.inv_diag[k], &work.stencil[k], r, z, false);
+                gauss_seidel(level, &work.inv_diag[k], &work.stencil[k], r, z, false);
+                let coarse = &self.levels[k + 1];
+                let mut rc = std::mem::take(&mut work.residual[k + 1]);
+                rc.resize(coarse.cells, 0.0);
+                let mut mz = std::mem::take(&mut work.operator);
+                mz.resize(level.cells, 0.0);
+                apply(level, &work.alpha[k], &work.stencil[k], z, &mut mz);
+                restrict_residual(&coarse.parent_of_fine, r, &mz, &mut rc);
+                work.operator = mz;
+                let mut zc = std::mem::take(&mut work.correction[k + 1]);
+                zc.resize(coarse.cells, 0.0);
+                self.v_cycle(work, k + 1, &rc, &mut zc);
+                for c in 0..level.cells {
+                    z[c] += zc[coarse.parent_of_fine[c] as usize];
+                }
+                work.residual[k + 1] = rc;
+                work.correction[k + 1] = zc;
+                gauss_seidel(level, &work.inv_diag[k], &work.stencil[k], r, z, true);
+                gauss_seidel(level, &work.inv_diag[k], &work.stencil[k], r, z, true);
+            },
         )
-    }
-
-    /// [`Hierarchy::v_cycle`]'s work at level `k`.
-    #[inline(always)]
-    fn v_cycle_body(&self, work: &mut Work, k: usize, r: &[f64], z: &mut [f64]) {
-        let level = &self.levels[k];
-        z.iter_mut().for_each(|v| *v = 0.0);
-        if k + 1 == self.levels.len() {
-            dense_solve(&work.coarse_factor, level.cells, r, z);
-            return;
-        }
-        gauss_seidel(level, &work.inv_diag[k], &work.stencil[k], r, z, false);
-        gauss_seidel(level, &work.inv_diag[k], &work.stencil[k], r, z, false);
-        let coarse = &self.levels[k + 1];
-        let mut rc = std::mem::take(&mut work.residual[k + 1]);
-        rc.resize(coarse.cells, 0.0);
-        let mut mz = std::mem::take(&mut work.operator);
-        mz.resize(level.cells, 0.0);
-        apply(level, &work.alpha[k], &work.stencil[k], z, &mut mz);
-        restrict_residual(&coarse.parent_of_fine, r, &mz, &mut rc);
-        work.operator = mz;
-        let mut zc = std::mem::take(&mut work.correction[k + 1]);
-        zc.resize(coarse.cells, 0.0);
-        self.v_cycle(work, k + 1, &rc, &mut zc);
-        for c in 0..level.cells {
-            z[c] += zc[coarse.parent_of_fine[c] as usize];
-        }
-        work.residual[k + 1] = rc;
-        work.correction[k + 1] = zc;
-        gauss_seidel(level, &work.inv_diag[k], &work.stencil[k], r, z, true);
-        gauss_seidel(level, &work.inv_diag[k], &work.stencil[k], r, z, true);
     }
 }
 
@@ -571,14 +557,13 @@ fn gauss_seidel(
 #[inline(always)]
 fn relax_segment(
     level: &Level,
-    (inv_diag, stencil, r): (&[f64], &Stencil, &[f64]),
+    system: (&[f64], &Stencil, &[f64]),
     segment: &Segment,
     z: &mut [f64],
     back: bool,
 ) {
     match *segment {
         Segment::Cells { start, end } => {
-            let system = (inv_diag, stencil, r);
             if back {
                 for i in (start..end).rev() {
                     relax_cell(level, system, i, z);
@@ -589,7 +574,10 @@ fn relax_segment(
                 }
             }
         }
-        Segment::Run { start, end, from } => relax_run(start..end, from, inv_diag, stencil, r, z),
+        Segment::Run { start, end, from } => {
+            let (inv_diag, stencil, r) = system;
+            relax_run(start..end, from, inv_diag, stencil, r, z);
+        }
     }
 }
 
@@ -733,43 +721,6 @@ fn renumber(levels: &[Level], orders: &[Vec<u32>]) -> Vec<Level> {
 /// running sum waits on every add before it), in a fixed order, so results stay the same.
 const LANES: usize = 4;
 
-#[cfg(test)]
-thread_local! {
-    /// Whether [`with_avx2`] runs the portable code on this thread (tests compare the two).
-    static PORTABLE_ONLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
-
-/// Whether [`with_avx2`] must run the portable code (only tests ask it to).
-#[inline(always)]
-fn portable_only() -> bool {
-    #[cfg(test)]
-    return PORTABLE_ONLY.get();
-    #[cfg(not(test))]
-    false
-}
-
-/// Runs `f` compiled for AVX2 where the processor has it, else as built (SSE2).
-///
-/// The solve's loops are IEEE additions and multiplications in a fixed order (no fused
-/// multiply-add is enabled, and the compiler reorders no floating-point sum), so both
-/// give the same bits; AVX2 does four `f64` lanes an instruction where SSE2 does two.
-#[inline(always)]
-fn with_avx2<R>(f: impl FnOnce() -> R) -> R {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && !portable_only() {
-        // SAFETY: the processor supports AVX2, checked just above.
-        return unsafe { run_avx2(f) };
-    }
-    f()
-}
-
-/// `f()` compiled with AVX2 (what `f` inlines is compiled so too).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn run_avx2<R>(f: impl FnOnce() -> R) -> R {
-    f()
-}
-
 #[inline(always)]
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     let mut lanes = [0.0; LANES];
@@ -909,7 +860,7 @@ mod tests {
     /// A stiff system solved on this thread with or without AVX2 (`portable`), to a
     /// loose tolerance so that it iterates.
     fn solve_on_this_thread(n: usize, portable: bool) -> (Vec<f64>, SolveReport) {
-        PORTABLE_ONLY.set(portable);
+        crate::avx2::set_portable_only(portable);
         let (grid, h, alpha, weight, b) = stiff_system(n, |c| (2.0 * c.x - c.y * c.z).sin());
         let mut x = vec![0.0; grid.cells()];
         let limits = SolveLimits {
@@ -917,7 +868,7 @@ mod tests {
             max_iterations: 50,
         };
         let report = h.solve(&mut Work::default(), &alpha, &weight, &b, &mut x, limits);
-        PORTABLE_ONLY.set(false);
+        crate::avx2::set_portable_only(false);
         (x, report)
     }
 
