@@ -279,7 +279,7 @@ impl BubbleCtx<'_> {
         let reflection = &self.reflections[tri.tag as usize];
         let footprint = reflection.is_cube() && self.filter == ReflectionFilter::Footprint;
         let mut derivatives = [[Vec3::ZERO; 2]; L];
-        let mut points = [(Vec3::ZERO, Vec3::ZERO); L];
+        let mut points = [Vec3::ZERO; L];
         let mut dirs = [Vec3::ZERO; L];
         for i in 0..at.len() {
             let ray = &rays[i];
@@ -287,7 +287,7 @@ impl BubbleCtx<'_> {
                 derivatives[i] = self.reflection_derivatives(tri, ray.d, inv_w[i], attrs[i]);
             }
             let p = self.view.eye + Vec3::from(ray.d / inv_w[i]);
-            points[i] = (p, ray.reflected);
+            points[i] = p;
             dirs[i] = self
                 .parallax_dir(tri, p, ray.reflected)
                 .unwrap_or(ray.reflected);
@@ -304,8 +304,14 @@ impl BubbleCtx<'_> {
             }
             let (r, e) = (r_rgb[i], env[i]);
             let mut add = [r[0] * e[0], r[1] * e[1], r[2] * e[2]];
-            let (p, reflected) = points[i];
-            let shareable = self.add_highlights(tri, p, reflected, thickness_nm, rays[i], &mut add);
+            let (p, ray) = (points[i], &rays[i]);
+            let shareable = self.add_highlights(
+                tri,
+                p,
+                ray.reflected,
+                (thickness_nm, ray.cos_theta),
+                &mut add,
+            );
             out[i] = if coverage < 1.0 {
                 (
                     t_rgb[i].map(|t| 1.0 - coverage * (1.0 - t)),
@@ -376,7 +382,8 @@ impl BubbleCtx<'_> {
     }
 
     /// Adds every light's highlight reaching film point `p` (seen along a ray reflected
-    /// to `reflected`) to `add`; returns whether none reaches within [`SHARE_MARGIN_PX`]
+    /// to `reflected`, through a film of the given thickness at that angle's cosine) to
+    /// `add`; returns whether none reaches within [`SHARE_MARGIN_PX`]
     /// (the shading may then be shared within the pixel).
     #[inline(always)]
     fn add_highlights(
@@ -384,8 +391,7 @@ impl BubbleCtx<'_> {
         tri: &SetupTri,
         p: Vec3,
         reflected: Vec3,
-        thickness_nm: f32,
-        ray: FilmRay,
+        (thickness_nm, cos_theta): (f32, f32),
         add: &mut [f32; 3],
     ) -> bool {
         let mut shareable = true;
@@ -398,7 +404,7 @@ impl BubbleCtx<'_> {
             shareable = false;
             let vis = sight.visibility(light, reflected, tri.extra);
             if vis > 0.0 {
-                let l = table.sample(thickness_nm, ray.cos_theta);
+                let l = table.sample(thickness_nm, cos_theta);
                 let gain = light.highlight_gain();
                 for k in 0..3 {
                     add[k] += l[k] * gain[k] * vis;
