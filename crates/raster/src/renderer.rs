@@ -13,9 +13,8 @@ use render_scene::parallax::proxy_ground_height_m;
 use render_scene::reflection::Reflection;
 use render_scene::tessellate::{Geometry, tessellate};
 use render_scene::{
-    BubbleMesh, CubeMap, Environment, FilmField, FilmTables, Frame, FrameTimings, Material,
-    PartialShading, ReflectionFilter, ReflectionMode, ReflectionParallax, RenderError, RenderScene,
-    RenderSettings,
+    CubeMap, Environment, FilmField, FilmTables, Frame, FrameTimings, Material, PartialShading,
+    ReflectionFilter, ReflectionMode, ReflectionParallax, RenderError, RenderScene, RenderSettings,
 };
 
 use crate::cube_reuse::{CubeMapReuse, CubeReuseState, bounds};
@@ -150,9 +149,8 @@ impl Renderer {
         self.bubble_bins.build(&self.bubble_tris, strips);
         let setup_s = start.elapsed().as_secs_f64();
 
+        // Only dynamic cube maps have centres (the parallax correction reads them).
         self.centres.clear();
-        self.centres
-            .extend(scene.bubbles.iter().map(BubbleMesh::center));
         let t = Instant::now();
         self.cube_maps_rendered = 0;
         if let ReflectionMode::DynamicCubeMap { face_size } = settings.reflection {
