@@ -244,7 +244,7 @@ impl Renderer {
         opaque.water = scene
             .water
             .as_ref()
-            .map(|w| water_pass.shading(w, scene, settings));
+            .map(|w| water_pass.shading(w, scene, settings, &ambient));
         let (w, h) = (settings.width, settings.height);
         // The fused pass's clock starts here: the water's cube map above is cube-map time
         // (it was counted twice, in the cube maps and apportioned to these phases).

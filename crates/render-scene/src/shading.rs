@@ -157,7 +157,22 @@ pub fn lit(
 ) -> [f32; 3] {
     // Two-sided: light the side facing the viewer.
     let n = if n.dot(v) > 0.0 { -n } else { n };
-    let ambient = ambient.diffuse(n);
+    lit_facing(material, albedo, ambient.diffuse(n), p, n, v, lights)
+}
+
+/// [`lit`] for a unit normal `n` already facing the viewer, with the ambient light's
+/// diffuse radiance on it, `ambient` (`Irradiance::diffuse(n)`), given: a plane's is one
+/// value for all its points.
+#[inline]
+pub fn lit_facing(
+    material: &Material,
+    albedo: [f32; 3],
+    ambient: [f32; 3],
+    p: Vec3,
+    n: Vec3,
+    v: Vec3,
+    lights: &[Light],
+) -> [f32; 3] {
     let mut out = [
         albedo[0] * ambient[0],
         albedo[1] * ambient[1],

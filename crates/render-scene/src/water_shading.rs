@@ -4,9 +4,9 @@
 
 use glam::{Mat3, Vec3};
 
-use crate::shading::{ground_albedo, lit};
+use crate::shading::{ground_albedo, lit_facing};
 use crate::water::{FresnelTable, refract, sphere_map_direction, sphere_map_uv};
-use crate::{CubeMap, Environment, Irradiance, Light, SphereMap, WaterSurface};
+use crate::{CubeMap, Environment, Light, SphereMap, WaterSurface};
 
 /// Where the water's reflections come from.
 #[derive(Debug, Clone, Copy)]
@@ -46,22 +46,17 @@ pub struct WaterShading<'a> {
     pub from_water: &'a FresnelTable,
     /// Where reflections come from.
     pub reflection: WaterReflection<'a>,
+    /// The ambient light's diffuse radiance on the floor, `Irradiance::diffuse(Vec3::Y)`
+    /// (one value for the whole floor, so it is not evaluated per pixel).
+    pub floor_ambient: [f32; 3],
 }
 
 impl WaterShading<'_> {
     /// Radiance towards the eye from surface point `p` with unit normal `n` (up), seen
     /// along unit `v`; `footprint_m` is a pixel's width there (for floor filtering).
-    pub fn radiance(
-        &self,
-        p: Vec3,
-        v: Vec3,
-        n: Vec3,
-        footprint_m: f32,
-        ambient: &Irradiance,
-        lights: &[Light],
-    ) -> [f32; 3] {
+    pub fn radiance(&self, p: Vec3, v: Vec3, n: Vec3, footprint_m: f32, lights: &[Light]) -> [f32; 3] {
         let ior = self.surface.ior;
-        let floor = |dir: Vec3| self.floor_radiance(p, dir, footprint_m, ambient, lights);
+        let floor = |dir: Vec3| self.floor_radiance(p, dir, footprint_m, lights);
         let c = v.dot(n);
         let (r, reflected, transmitted) = if c <= 0.0 {
             // From the air: reflect the scene, refract onto the floor.
@@ -86,20 +81,14 @@ impl WaterShading<'_> {
 
     /// Lit floor seen from `p` along `dir` through the water, dimmed by Beer–Lambert
     /// absorption over the path; black when the ray never reaches the floor.
-    fn floor_radiance(
-        &self,
-        p: Vec3,
-        dir: Vec3,
-        footprint_m: f32,
-        ambient: &Irradiance,
-        lights: &[Light],
-    ) -> [f32; 3] {
+    fn floor_radiance(&self, p: Vec3, dir: Vec3, footprint_m: f32, lights: &[Light]) -> [f32; 3] {
         let Some((q, path_m)) = floor_hit(p, dir, self.surface.floor_height_m()) else {
             return [0.0; 3];
         };
         let floor = &self.surface.floor;
         let albedo = ground_albedo(floor, q.x, q.z, [footprint_m; 2]);
-        let lit = lit(floor, albedo, q, Vec3::Y, dir, ambient, lights);
+        // The ray goes down (`floor_hit`), so the floor's upper side faces it.
+        let lit = lit_facing(floor, albedo, self.floor_ambient, q, Vec3::Y, dir, lights);
         std::array::from_fn(|k| lit[k] * (-self.surface.absorption_per_m[k] * path_m).exp())
     }
 }
@@ -118,7 +107,7 @@ pub fn floor_hit(p: Vec3, dir: Vec3, floor_y: f32) -> Option<(Vec3, f32)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Material;
+    use crate::{Irradiance, Material};
     use num_complex::Complex64;
     use thinfilm::fresnel::Interface;
 
@@ -156,15 +145,9 @@ mod tests {
                 from_air: &from_air,
                 from_water: &from_water,
                 reflection: WaterReflection::Env(&env),
+                floor_ambient: white_ambient(),
             };
-            shading.radiance(
-                Vec3::ZERO,
-                -Vec3::Y,
-                Vec3::Y,
-                0.0,
-                &Irradiance::uniform([1.0; 3]),
-                &[],
-            )
+            shading.radiance(Vec3::ZERO, -Vec3::Y, Vec3::Y, 0.0, &[])
         };
         let clear = radiance([0.0; 3]);
         let murky = radiance([0.0, 1.0, 2.0]);
@@ -193,6 +176,7 @@ mod tests {
             from_air: &from_air,
             from_water: &from_water,
             reflection: WaterReflection::Env(&env),
+            floor_ambient: white_ambient(),
         };
         let p = Vec3::new(0.0, 0.0, 0.0);
         let critical = (1.0f32 / 1.333).asin();
@@ -200,7 +184,7 @@ mod tests {
             let a = deg.to_radians();
             // Looking up from under the water at `deg` from the vertical.
             let v = Vec3::new(a.sin(), a.cos(), 0.0);
-            let c = shading.radiance(p, v, Vec3::Y, 0.0, &Irradiance::uniform([1.0; 3]), &[]);
+            let c = shading.radiance(p, v, Vec3::Y, 0.0, &[]);
             assert!(c.iter().all(|x| x.is_finite()), "{deg}°: {c:?}");
             if a > critical {
                 // Only the (dark, downward) floor is seen: no sky gets through.
@@ -228,8 +212,14 @@ mod tests {
             from_air: &from_air,
             from_water: &from_water,
             reflection,
+            floor_ambient: white_ambient(),
         };
-        shading.radiance(p, v, n, 0.0, &Irradiance::uniform([1.0; 3]), &[])
+        shading.radiance(p, v, n, 0.0, &[])
+    }
+
+    /// A uniform ambient 1's diffuse radiance on the floor.
+    fn white_ambient() -> [f32; 3] {
+        Irradiance::uniform([1.0; 3]).diffuse(Vec3::Y)
     }
 
     #[test]

@@ -319,7 +319,7 @@ impl OpaqueCtx<'_> {
         let v = d.normalize_or(self.view.forward);
         let n = Vec3::new(a[0], a[1], a[2]).normalize_or(Vec3::Y);
         let footprint_m = (p - self.view.eye).length() * self.view.x_per_px;
-        water.radiance(p, v, n, footprint_m, self.ambient, self.lights)
+        water.radiance(p, v, n, footprint_m, self.lights)
     }
 }
 

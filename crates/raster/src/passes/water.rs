@@ -18,7 +18,7 @@ use render_scene::cubemap::FACE_BASES;
 use render_scene::shader_constants::WATER;
 use render_scene::water::FresnelTable;
 use render_scene::water_shading::{WaterReflection, WaterShading};
-use render_scene::{CubeMap, ReflectionMode, RenderScene, RenderSettings, WaterSurface};
+use render_scene::{CubeMap, Irradiance, ReflectionMode, RenderScene, RenderSettings, WaterSurface};
 
 use super::bubble::{BubbleCtx, setup_bubble_tris};
 use super::opaque::OpaqueCtx;
@@ -113,6 +113,7 @@ impl WaterPass {
         surface: &'a WaterSurface,
         scene: &'a RenderScene,
         settings: &'a RenderSettings,
+        ambient: &Irradiance,
     ) -> WaterShading<'a> {
         let (_, from_air, from_water) = self.tables.as_ref().expect("tables prepared");
         let env = WaterReflection::Env(&scene.environment);
@@ -130,6 +131,7 @@ impl WaterPass {
             from_air,
             from_water,
             reflection,
+            floor_ambient: ambient.diffuse(Vec3::Y),
         }
     }
 
