@@ -54,7 +54,14 @@ pub struct WaterShading<'a> {
 impl WaterShading<'_> {
     /// Radiance towards the eye from surface point `p` with unit normal `n` (up), seen
     /// along unit `v`; `footprint_m` is a pixel's width there (for floor filtering).
-    pub fn radiance(&self, p: Vec3, v: Vec3, n: Vec3, footprint_m: f32, lights: &[Light]) -> [f32; 3] {
+    pub fn radiance(
+        &self,
+        p: Vec3,
+        v: Vec3,
+        n: Vec3,
+        footprint_m: f32,
+        lights: &[Light],
+    ) -> [f32; 3] {
         let ior = self.surface.ior;
         let floor = |dir: Vec3| self.floor_radiance(p, dir, footprint_m, lights);
         let c = v.dot(n);

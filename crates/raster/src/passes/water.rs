@@ -18,7 +18,9 @@ use render_scene::cubemap::FACE_BASES;
 use render_scene::shader_constants::WATER;
 use render_scene::water::FresnelTable;
 use render_scene::water_shading::{WaterReflection, WaterShading};
-use render_scene::{CubeMap, Irradiance, ReflectionMode, RenderScene, RenderSettings, WaterSurface};
+use render_scene::{
+    CubeMap, Irradiance, ReflectionMode, RenderScene, RenderSettings, WaterSurface,
+};
 
 use super::bubble::{BubbleCtx, setup_bubble_tris};
 use super::opaque::OpaqueCtx;
