@@ -174,7 +174,7 @@ impl FilmField {
     /// The thickness is the coverage-weighted mean of the four taps,
     /// `Σ (w c / Σ w c) h` (0 when `Σ w c = 0`), the coverage their plain bilinear mean.
     /// At a texel's centre both are that texel's values exactly.
-    #[inline]
+    #[inline(always)]
     pub fn sample(&self, material_dir: Vec3) -> FilmSample {
         let (face, s, t) = face_coordinates(material_dir);
         let n = index_f32(self.face_size);
