@@ -338,20 +338,21 @@ impl Level {
     /// Border texels take the nearest interior texel along their own direction.
     fn fill_borders_from_neighbours(&mut self) {
         let m = self.face_size + 2;
+        // The ring of border texels only (each reads interior texels, so the order does not
+        // matter): the top and bottom rows whole, then the two columns between them.
         for f in 0..6 {
-            for y in 0..m {
-                for x in 0..m {
-                    if x != 0 && y != 0 && x != m - 1 && y != m - 1 {
-                        continue;
-                    }
-                    let (g, s, t) = face_coordinates(self.texel_direction(f, x, y));
-                    let to_index = |c: f32| {
-                        (((c + 1.0) * 0.5 * self.face_size as f32) as usize).min(self.face_size - 1)
-                    };
-                    let value = self.texel(g, to_index(s), to_index(t));
-                    let off = self.face_offset(f) + y * m + x;
-                    self.texels[off] = value;
-                }
+            let rows = [0, m - 1]
+                .into_iter()
+                .flat_map(|y| (0..m).map(move |x| (x, y)));
+            let columns = (1..m - 1).flat_map(|y| [(0, y), (m - 1, y)]);
+            for (x, y) in rows.chain(columns) {
+                let (g, s, t) = face_coordinates(self.texel_direction(f, x, y));
+                let to_index = |c: f32| {
+                    (((c + 1.0) * 0.5 * self.face_size as f32) as usize).min(self.face_size - 1)
+                };
+                let value = self.texel(g, to_index(s), to_index(t));
+                let off = self.face_offset(f) + y * m + x;
+                self.texels[off] = value;
             }
         }
     }
@@ -362,15 +363,25 @@ impl Level {
         let (m_src, m) = (above.face_size + 2, self.face_size + 2);
         if above.face_size == 2 * self.face_size {
             // Exact 2 × 2 boxes: the common case, without the general weights.
+            let n = self.face_size;
             for f in 0..6 {
                 let (src, dst) = (above.face_offset(f), self.face_offset(f));
-                for y in 0..self.face_size {
+                for y in 0..n {
                     let row = src + (2 * y + 1) * m_src + 1;
-                    for x in 0..self.face_size {
-                        let i = row + 2 * x;
-                        let q = [i, i + 1, i + m_src, i + m_src + 1].map(|j| above.texels[j]);
-                        self.texels[dst + (y + 1) * m + x + 1] =
-                            std::array::from_fn(|k| (q[0][k] + q[1][k] + q[2][k] + q[3][k]) * 0.25);
+                    let (upper, lower) = (
+                        &above.texels[row..row + 2 * n],
+                        &above.texels[row + m_src..row + m_src + 2 * n],
+                    );
+                    let out = &mut self.texels[dst + (y + 1) * m + 1..][..n];
+                    // Whole rows as slices of equal length: the loop runs without bounds
+                    // checks and vectorises; each texel is the same sum as before.
+                    for ((o, a), b) in out
+                        .iter_mut()
+                        .zip(upper.chunks_exact(2))
+                        .zip(lower.chunks_exact(2))
+                    {
+                        *o =
+                            std::array::from_fn(|k| (a[0][k] + a[1][k] + b[0][k] + b[1][k]) * 0.25);
                     }
                 }
             }

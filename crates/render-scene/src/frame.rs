@@ -179,7 +179,9 @@ pub fn tone_map(rgb: [f32; 3], tonemap: ToneMap) -> [f32; 3] {
 /// lanes side by side in SIMD registers.
 #[inline]
 pub fn tone_map_lanes<const N: usize>(mut rgb: [[f32; N]; 3], tonemap: ToneMap) -> [[f32; N]; 3] {
-    for_lanes(&mut rgb, |c| if c.is_nan() { 0.0 } else { c.max(0.0) });
+    // By comparison, not `f32::max`: the sign of max(−0, 0) is unspecified, and release
+    // builds gave −0.0 one pixel at a time and +0.0 in SIMD lanes. NaN and −0.0 give +0.0.
+    for_lanes(&mut rgb, |c| if c > 0.0 { c } else { 0.0 });
     match tonemap {
         ToneMap::Clamp => for_lanes(&mut rgb, |c| c.min(1.0)),
         ToneMap::Reinhard => for_lanes(
@@ -553,7 +555,8 @@ mod tests {
 
     /// `tone_map` as it was written before [`tone_map_lanes`], one pixel at a time.
     fn tone_map_one_pixel(rgb: [f32; 3], tonemap: ToneMap) -> [f32; 3] {
-        let rgb = rgb.map(|c| if c.is_nan() { 0.0 } else { c.max(0.0) });
+        // NaN and everything up to zero, −0.0 included, to +0.0 (see `tone_map_lanes`).
+        let rgb = rgb.map(|c| if c > 0.0 { c } else { 0.0 });
         let mat3_mul = |m: &[[f32; 3]; 3], v: [f32; 3]| {
             m.map(|row| row[0] * v[0] + row[1] * v[1] + row[2] * v[2])
         };
@@ -567,6 +570,25 @@ mod tests {
                 let v = v.map(|x| (x * (x + a0) - a1) / (x * (b0 * x + b1) + b2));
                 mat3_mul(&SRGB_FROM_ACES, v).map(|c| c.clamp(0.0, 1.0))
             }
+        }
+    }
+
+    #[test]
+    fn negative_zero_tone_maps_to_positive_zero_alone_and_in_lanes() {
+        // Release builds once gave −0.0 one pixel at a time and +0.0 in lanes (`f32::max`
+        // leaves the sign of a zero unspecified).
+        for tonemap in [ToneMap::Clamp, ToneMap::Reinhard, ToneMap::AcesFitted] {
+            let alone = tone_map([-0.0, f32::NAN, -3.0], tonemap);
+            assert_eq!(
+                alone.map(f32::to_bits),
+                [0; 3],
+                "{tonemap:?} alone: {alone:?}"
+            );
+            let lanes = tone_map_lanes([[-0.0f32; TONE_MAP_LANES]; 3], tonemap);
+            assert!(
+                lanes.iter().flatten().all(|c| c.to_bits() == 0),
+                "{tonemap:?} lanes: {lanes:?}"
+            );
         }
     }
 
