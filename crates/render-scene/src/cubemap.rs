@@ -148,6 +148,31 @@ impl CubeMap {
         mip_sizes(face_size).map(|n| 6 * (n + 2) * (n + 2)).sum()
     }
 
+    /// Per texel of a chain of `face_size`, laid out as [`CubeMap::level_texels`] of every
+    /// level one after another: the texel [`CubeMap::build_mips`] copies into it, a border
+    /// texel's source on the neighbouring face, an interior texel's own index.
+    ///
+    /// Why a table: at a face's corners the border texel's direction lies as far into
+    /// two neighbouring faces, and which one it reads turns on the last bit of its face
+    /// coordinates. A GPU's division is not correctly rounded, so the wgpu backend
+    /// computing them itself read the other face at some corners (an NVIDIA H200 did,
+    /// lavapipe did not); with this table it copies exactly what the CPU copies.
+    pub fn border_source_table(face_size: usize) -> Vec<u32> {
+        let mut table = Vec::with_capacity(Self::stored_texels(face_size));
+        for n in mip_sizes(face_size) {
+            let level = Level::black(n);
+            let start = table.len();
+            table.extend((0..6 * (n + 2) * (n + 2)).map(|i| (start + i) as u32));
+            for f in 0..6 {
+                for (x, y) in border_ring(n + 2) {
+                    let source = level.border_source(f, x, y);
+                    table[start + level.bordered_index(f, x, y)] = (start + source) as u32;
+                }
+            }
+        }
+        table
+    }
+
     /// Level `level`'s six bordered `(n + 2)²` faces row-major, `n` its face size (the
     /// layout the wgpu backend's mip buffer mirrors).
     ///
@@ -269,6 +294,15 @@ fn mip_sizes(face_size: usize) -> impl Iterator<Item = usize> {
     std::iter::successors(Some(face_size), |&n| (n > 1).then_some(n / 2))
 }
 
+/// The border ring of an `m × m` bordered face: the top and bottom rows whole, then the two
+/// columns between them.
+fn border_ring(m: usize) -> impl Iterator<Item = (usize, usize)> {
+    let rows = [0, m - 1]
+        .into_iter()
+        .flat_map(move |y| (0..m).map(move |x| (x, y)));
+    rows.chain((1..m - 1).flat_map(move |y| [(0, y), (m - 1, y)]))
+}
+
 impl Level {
     fn black(face_size: usize) -> Self {
         let m = face_size + 2;
@@ -337,24 +371,27 @@ impl Level {
 
     /// Border texels take the nearest interior texel along their own direction.
     fn fill_borders_from_neighbours(&mut self) {
-        let m = self.face_size + 2;
-        // The ring of border texels only (each reads interior texels, so the order does not
-        // matter): the top and bottom rows whole, then the two columns between them.
+        // Each border texel reads an interior texel, so the order does not matter.
         for f in 0..6 {
-            let rows = [0, m - 1]
-                .into_iter()
-                .flat_map(|y| (0..m).map(move |x| (x, y)));
-            let columns = (1..m - 1).flat_map(|y| [(0, y), (m - 1, y)]);
-            for (x, y) in rows.chain(columns) {
-                let (g, s, t) = face_coordinates(self.texel_direction(f, x, y));
-                let to_index = |c: f32| {
-                    (((c + 1.0) * 0.5 * self.face_size as f32) as usize).min(self.face_size - 1)
-                };
-                let value = self.texel(g, to_index(s), to_index(t));
-                let off = self.face_offset(f) + y * m + x;
-                self.texels[off] = value;
+            for (x, y) in border_ring(self.face_size + 2) {
+                let dst = self.bordered_index(f, x, y);
+                self.texels[dst] = self.texels[self.border_source(f, x, y)];
             }
         }
+    }
+
+    /// Index in this level of bordered texel `(x, y)` of face `face`.
+    fn bordered_index(&self, face: usize, x: usize, y: usize) -> usize {
+        self.face_offset(face) + y * (self.face_size + 2) + x
+    }
+
+    /// Index in this level of the interior texel that border texel `(x, y)` of face `face`
+    /// copies: the one its own direction falls in on the neighbouring face.
+    fn border_source(&self, face: usize, x: usize, y: usize) -> usize {
+        let (g, s, t) = face_coordinates(self.texel_direction(face, x, y));
+        let to_index =
+            |c: f32| (((c + 1.0) * 0.5 * self.face_size as f32) as usize).min(self.face_size - 1);
+        self.bordered_index(g, to_index(s) + 1, to_index(t) + 1)
     }
 
     /// Interior texels as area averages of `above`'s interior (exact 2 × 2 boxes when its
@@ -609,6 +646,58 @@ mod tests {
             .sum();
         assert!((l1.texel(3, 1, 2)[1] - want).abs() < 1e-6);
         assert_eq!(CubeMap::stored_texels(8), 6 * (100 + 36 + 16 + 9));
+    }
+
+    #[test]
+    fn border_source_table_indexes_the_chain_as_build_mips_fills_it() {
+        for n in [5, 8, 24] {
+            let cube = CubeMap::try_from_faces(n, linear_faces(n)).unwrap();
+            let table = CubeMap::border_source_table(n);
+            assert_eq!(table.len(), CubeMap::stored_texels(n));
+            let chain: Vec<[f32; 3]> = (0..cube.levels())
+                .flat_map(|l| cube.level_texels(l).iter().copied())
+                .collect();
+            for (k, &src) in table.iter().enumerate() {
+                assert_eq!(chain[k], chain[src as usize], "n {n}: texel {k} from {src}");
+            }
+        }
+    }
+
+    #[test]
+    fn every_border_texel_copies_an_interior_texel_of_a_neighbouring_face_next_to_it() {
+        let n = 16;
+        let table = CubeMap::border_source_table(n);
+        let (m, level) = (n + 2, Level::black(n));
+        let interior = |k: usize| {
+            let (f, r) = (k / (m * m), k % (m * m));
+            let (x, y) = (r % m, r / m);
+            (f, x, y, (1..=n).contains(&x) && (1..=n).contains(&y))
+        };
+        let mut corners = 0;
+        for (k, &src) in table[..6 * m * m].iter().enumerate() {
+            let (f, x, y, inside) = interior(k);
+            if inside {
+                assert_eq!(src as usize, k, "interior texel {k} is its own");
+                continue;
+            }
+            let (g, sx, sy, source_inside) = interior(src as usize);
+            assert!(
+                source_inside && g != f,
+                "border {f} ({x}, {y}) reads {g} ({sx}, {sy})"
+            );
+            let (a, b) = (
+                level.texel_direction(f, x, y).normalize(),
+                level.texel_direction(g, sx, sy).normalize(),
+            );
+            // A texel spans about 2/n rad at a face's centre; a corner's source is a
+            // texel diagonal away.
+            assert!(
+                a.angle_between(b) < 2.0 / n as f32,
+                "border {f} ({x}, {y}) from {g}"
+            );
+            corners += usize::from((x == 0 || x == m - 1) && (y == 0 || y == m - 1));
+        }
+        assert_eq!(corners, 24);
     }
 
     #[test]

@@ -125,6 +125,8 @@ impl Layouts {
                     },
                 ),
                 compute(2, uniform),
+                // `CubeMap::border_source_table`: which texel each border texel copies.
+                compute(6, storage()),
             ],
         );
         let water = layout(

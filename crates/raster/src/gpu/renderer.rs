@@ -46,6 +46,8 @@ pub struct GpuRenderer {
     reads: CubeReads,
     /// The last frame's cube mip chains, for [`GpuRenderer::read_cube_mips`].
     last_mips: Option<wgpu::Buffer>,
+    /// `CubeMap::border_source_table` of the last face size the mip passes built.
+    border_sources: Option<(usize, wgpu::Buffer)>,
 }
 
 /// The water's draw: its vertices and bind group (group 3), and with dynamic cube maps
@@ -85,6 +87,7 @@ impl GpuRenderer {
             textures: Vec::new(),
             reads: CubeReads::default(),
             last_mips: None,
+            border_sources: None,
         }
     }
 
@@ -417,13 +420,28 @@ impl GpuRenderer {
     /// copy; the passes are O(level-0 texels) on the device, and a buffer laid out like
     /// `CubeMap`'s levels is read with the same index arithmetic as the CPU's.
     fn encode_mips(
-        &self,
+        &mut self,
         encoder: &mut wgpu::CommandEncoder,
         (faces, mips): (&wgpu::Texture, &wgpu::Buffer),
         scene_group: &wgpu::BindGroup,
         face_size: usize,
         layers: u32,
     ) {
+        if self
+            .border_sources
+            .as_ref()
+            .is_none_or(|(n, _)| *n != face_size)
+        {
+            let table = CubeMap::border_source_table(face_size);
+            let bytes: Vec<u8> = table.iter().flat_map(|x| x.to_le_bytes()).collect();
+            let buffer = self
+                .gpu
+                .buffer("border sources", &bytes, wgpu::BufferUsages::STORAGE);
+            self.border_sources = Some((face_size, buffer));
+        }
+        let Some((_, border_sources)) = &self.border_sources else {
+            unreachable!("the table was just made")
+        };
         let device = &self.gpu.device;
         let faces = faces.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
@@ -450,6 +468,7 @@ impl GpuRenderer {
                         bind(0, wgpu::BindingResource::TextureView(&faces)),
                         bind(1, mips.as_entire_binding()),
                         bind(2, uniform.as_entire_binding()),
+                        bind(6, border_sources.as_entire_binding()),
                     ],
                 })
             })

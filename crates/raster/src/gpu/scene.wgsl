@@ -1258,6 +1258,12 @@ fn cs_mip_downsample(@builtin(global_invocation_id) id: vec3<u32>) {
     store_mip(mip_out_index(id.z, level, id.x + 1u, id.y + 1u), sum);
 }
 
+// render-scene `CubeMap::border_source_table`, one chain's worth: per texel of the chain
+// the texel it copies (a border texel's source on the neighbouring face). Taken from the
+// CPU rather than computed here: at a face's corners the choice of face turns on the
+// last bit of the coordinates, and a GPU's division is not correctly rounded.
+@group(3) @binding(6) var<storage, read> mip_border_source: array<u32>;
+
 @compute @workgroup_size(8, 8, 1)
 fn cs_mip_borders(@builtin(global_invocation_id) id: vec3<u32>) {
     let level = mip_step.level_sizes.x;
@@ -1269,15 +1275,8 @@ fn cs_mip_borders(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x != 0u && id.y != 0u && id.x != m - 1u && id.y != m - 1u) {
         return;
     }
-    let face = id.z % 6u;
-    let nf = f32(n);
-    let s = (2.0 * f32(id.x) - 1.0) / nf - 1.0;
-    let t = (2.0 * f32(id.y) - 1.0) / nf - 1.0;
-    let dir = FACE_MAJOR[face] + FACE_S[face] * s + FACE_T[face] * t;
-    let g = face_coordinates(dir);
-    let x = min(u32(max((g.y + 1.0) * 0.5 * nf, 0.0)), n - 1u);
-    let y = min(u32(max((g.z + 1.0) * 0.5 * nf, 0.0)), n - 1u);
-    let layer = id.z - face + u32(g.x);
-    let c = load_mip(mip_out_index(layer, level, x + 1u, y + 1u));
-    store_mip(mip_out_index(id.z, level, id.x, id.y), c);
+    let i = mip_out_index(id.z, level, id.x, id.y);
+    let chain = (id.z / 6u) * mip_offset(mip_levels());
+    let source = mip_border_source[(i - chain) / 3u];
+    store_mip(i, load_mip(chain + 3u * source));
 }
