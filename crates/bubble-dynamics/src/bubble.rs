@@ -88,6 +88,9 @@ pub struct Bubble {
     pub(crate) episodes: Vec<crate::collide::Episode>,
     /// The film flow on its cube-sphere, when `film_grid > 0`.
     pub(crate) grid_film: Option<Box<GridFilm>>,
+    /// Where the wet surface a bubble with a meniscus stands on holds its mesh's
+    /// centre, m.
+    pub(crate) anchor_m: Option<DVec3>,
 }
 
 /// A bubble's film thickness over its material sphere, as the cube map renderers read.
@@ -168,8 +171,12 @@ impl Bubble {
             episodes: Vec::new(),
             grid_film: (params.film_grid > 0)
                 .then(|| Box::new(grid_film(params, world, unit_positions, &rest, triangles))),
+            anchor_m: None,
         };
         bubble.refresh_inertial_mass();
+        if params.meniscus.is_some() {
+            bubble.anchor_m = Some(bubble.mean_position_m());
+        }
         bubble.volume_m3 = enclosed_volume_m3(&bubble.positions_m, bubble.topology.triangles());
         bubble.update_thickness();
         bubble
@@ -328,6 +335,30 @@ impl Bubble {
         self.inertial_mass_kg.iter().sum()
     }
 
+    /// Holds a bubble standing on a wet surface where it stands: the particles' common
+    /// motion removed (the meniscus pins the foot to the surface, which bears whatever
+    /// force that takes), their motion relative to the centre of mass kept.
+    pub(crate) fn hold_at_anchor(&mut self) {
+        let Some(anchor) = self.anchor_m else {
+            return;
+        };
+        let (shift, drift) = (anchor - self.mean_position_m(), self.velocity_m_per_s());
+        for (x, v) in self
+            .positions_m
+            .iter_mut()
+            .zip(&mut self.velocities_m_per_s)
+        {
+            *x += shift;
+            *v -= drift;
+        }
+    }
+
+    /// The particles' mean position, m: the mesh's centre, which the film's liquid moving
+    /// from vertex to vertex does not shift as it shifts the centre of mass.
+    fn mean_position_m(&self) -> DVec3 {
+        self.positions_m.iter().sum::<DVec3>() / self.positions_m.len() as f64
+    }
+
     /// Centre of mass of the particles, m.
     pub fn center_m(&self) -> DVec3 {
         let m = self.inertial_mass_kg();
@@ -476,6 +507,10 @@ fn grid_film(
             params.film_density_kg_per_m3 * h0 * params.radius_m / params.gibbs_elasticity_n_per_m;
         let g = world.gravity_m_per_s2;
         film.flow.set_surfactant(|d| (k * g.dot(d)).exp());
+    }
+    if let Some(m) = params.meniscus {
+        // The material frame is the world's at rest: up is against gravity.
+        film.flow.stand_on_wet_surface(m, -world.gravity_m_per_s2);
     }
     film
 }

@@ -4,7 +4,7 @@ use glam::DVec3;
 
 use crate::collider::Collider;
 use crate::error::ParamError;
-use crate::film_flow::FilmGradient;
+use crate::film_flow::{FilmGradient, Meniscus};
 use crate::icosphere::MAX_SUBDIVISIONS;
 use crate::validate::{finite_vec, non_negative, nonzero_vec, positive, unit_interval};
 use crate::wind::Wind;
@@ -206,6 +206,9 @@ pub struct BubbleParams {
     /// The discrete gradient that drives the film flow (film flow only; default the
     /// two-point one, [`FilmGradient`]).
     pub film_gradient: FilmGradient,
+    /// Stands the film on a wet surface, with a meniscus below its contact line that
+    /// regenerates it (film flow only; `None`: a free bubble).
+    pub meniscus: Option<Meniscus>,
 }
 
 impl Default for BubbleParams {
@@ -239,6 +242,7 @@ impl Default for BubbleParams {
             nucleation_per_m2_s: 0.0,
             bottom_warming_k: 0.0,
             film_gradient: FilmGradient::TwoPoint,
+            meniscus: None,
         }
     }
 }
@@ -316,6 +320,23 @@ impl BubbleParams {
                 self.bottom_warming_k,
                 format!("must lie in [-{MAX_WARMING_K}, {MAX_WARMING_K}] K"),
             ));
+        }
+        if let Some(m) = self.meniscus {
+            if let Some((name, value)) = m.invalid() {
+                return Err(ParamError::new(
+                    format!("meniscus.{name}"),
+                    value,
+                    "is out of range (contact_height in (-1, 1), regeneration_per_m_s >= 0, \
+                     regenerated_fraction in (0, 1], patch_radius_m > 0)",
+                ));
+            }
+            if self.film_grid == 0 {
+                return Err(ParamError::new(
+                    "meniscus",
+                    self.film_grid,
+                    "needs the film flow (film_grid > 0)",
+                ));
+            }
         }
         if self.initial_scale.min_element() <= 0.0 {
             return Err(ParamError::new(

@@ -290,6 +290,7 @@ impl World {
             );
             for b in &mut self.bubbles {
                 collide::resolve_static(b, &self.params.colliders, h);
+                b.hold_at_anchor();
             }
             self.check_divergence(step, k, t_s)?;
         }

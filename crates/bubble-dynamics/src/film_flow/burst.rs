@@ -79,6 +79,8 @@ pub struct BurstState {
     rng: SplitMix64,
     /// Per cell: 1 where film is, 0 where a hole is, between on the rim.
     coverage: Vec<f64>,
+    /// Per cell: never film (below a meniscus's contact line); empty when none is.
+    closed: Vec<bool>,
     burst_volume_m3: f64,
     /// Thickness of the film where the first hole opened on its own, m.
     first_hole_thickness_m: Option<f64>,
@@ -209,10 +211,19 @@ impl BurstState {
             holes: Vec::new(),
             rng: SplitMix64::new(seed ^ 0xB1AC_F11E),
             coverage: vec![1.0; cells],
+            closed: Vec::new(),
             burst_volume_m3: 0.0,
             first_hole_thickness_m: None,
             rims_driven_outside: false,
             black: BlackScratch::default(),
+        }
+    }
+
+    /// Closes the cells marked in `cells` for good: their coverage is zero from now on.
+    pub(crate) fn close(&mut self, cells: &[bool]) {
+        self.closed = cells.to_vec();
+        for (c, _) in self.coverage.iter_mut().zip(cells).filter(|x| *x.1) {
+            *c = 0.0;
         }
     }
 
@@ -435,11 +446,16 @@ impl BurstState {
         let grid = std::sync::Arc::clone(&flow.grid);
         for (i, (c, &a)) in grid.centres().iter().zip(grid.areas_sr()).enumerate() {
             let width = a.sqrt() * r;
+            let film = if self.closed.get(i) == Some(&true) {
+                0.0
+            } else {
+                1.0
+            };
             let open = self
                 .holes
                 .iter()
                 .map(|h| ((arc(h.site, *c) * r - h.radius_m) / width + 0.5).clamp(0.0, 1.0))
-                .fold(1.0, f64::min);
+                .fold(film, f64::min);
             self.coverage[i] = open;
             if open == 0.0 && flow.h_m[i] != 0.0 {
                 self.burst_volume_m3 += flow.h_m[i] * a * r2;

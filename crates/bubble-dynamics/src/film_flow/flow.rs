@@ -19,6 +19,7 @@ use super::advect::{AdvectionGeometry, AdvectionScratch, advect_momentum};
 use super::burst::{BurstParams, BurstState, Hole};
 use super::capillary::{Capillary, CapillaryScratch, smooth_thickness};
 use super::grid::CubeSphere;
+use super::meniscus::MeniscusState;
 use super::solve::{Hierarchy, SolveReport, Work};
 use super::thermal::{ThermalParams, up_from};
 use super::viscosity::viscous_bound;
@@ -133,6 +134,8 @@ pub struct FilmFlow {
     advection: std::sync::Arc<AdvectionGeometry>,
     pub(crate) params: FlowParams,
     pub(super) burst: Option<Box<BurstState>>,
+    /// The meniscus of a film standing on a wet surface.
+    pub(super) meniscus: Option<Box<MeniscusState>>,
     /// The viscous operator's Gershgorin bound per unit ν/R², fixed by the grid.
     pub(super) viscous_bound: f64,
     pub(crate) h_m: Vec<f64>,
@@ -197,6 +200,7 @@ impl FilmFlow {
         let edges = grid.edges().len();
         Self {
             burst: Some(Box::new(BurstState::new(params.burst, cells, params.seed))),
+            meniscus: None,
             viscous_bound: viscous_bound(&grid),
             advection: std::sync::Arc::new(AdvectionGeometry::new(&grid)),
             params,
@@ -338,10 +342,14 @@ impl FilmFlow {
         self.exchange_heat(&s.u_start, &mut s.cell, dt_s, up);
         self.momentum_explicit(&mut s, dt_s, forcing);
         self.air_shear(&mut s, dt_s, forcing.air_m_per_s);
+        if let Some(m) = &self.meniscus {
+            m.hold(&mut self.u_m_per_s, &mut s.drag);
+        }
         let report = self.marangoni_implicit(&mut s, dt_s);
         self.transport_thickness(&mut s, dt_s, forcing.g_eff_m_per_s2);
         self.capillary_smoothing(&mut s, dt_s);
         self.evaporate(dt_s);
+        self.feed_meniscus(dt_s);
         if let Some(mut burst) = self.burst.take() {
             burst.step(self, dt_s);
             self.burst = Some(burst);

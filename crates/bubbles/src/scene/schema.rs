@@ -4,14 +4,15 @@
 //! line and column rather than a silently ignored setting.
 
 use super::values::{
-    Absorption, Acceleration, AngularSpeed, Bounds, BubbleRadius, Coordinate, Count, CubeMapSize,
-    Damping, DecayPerMetre, DecayPerSecond, Direction, Direction2, Elasticity, Evaporation,
-    Exposure, FieldOfView, FilmGrid, FilmIndex, FilmThickness, FilmViscosity, GustSpeed,
-    InitialScale, Intensity, LightRadius, Luminance, LutAngleSamples, LutThicknessSamples,
-    MeshScale, MolarMass, NucleationRate, Num, Num3, ObjectRadius, PatternScale, Radiance,
-    Reflectance, RuptureThickness, Samples, Seconds, Shininess, SloshSpeed, Speed, Subdivisions,
-    SurfaceTension, TimeStep, Variation, Viscosity, Warming, WaterDepth, WaterIndex, WaterSlices,
-    WaveAmplitude, Wavelength, exact,
+    Absorption, Acceleration, AngularSpeed, Bounds, BubbleRadius, ContactHeight, Coordinate, Count,
+    CubeMapSize, Damping, DecayPerMetre, DecayPerSecond, Direction, Direction2, Elasticity,
+    Evaporation, Exposure, FieldOfView, FilmGrid, FilmIndex, FilmThickness, FilmViscosity,
+    GustSpeed, InitialScale, Intensity, LightRadius, Luminance, LutAngleSamples,
+    LutThicknessSamples, MeshScale, MolarMass, NucleationRate, Num, Num3, ObjectRadius,
+    PatchRadius, PatternScale, Radiance, Reflectance, RegeneratedFraction, RegenerationRate,
+    RuptureThickness, Samples, Seconds, Shininess, SloshSpeed, Speed, Subdivisions, SurfaceTension,
+    TimeStep, Variation, Viscosity, Warming, WaterDepth, WaterIndex, WaterSlices, WaveAmplitude,
+    Wavelength, exact,
 };
 use serde::Deserialize;
 
@@ -463,6 +464,30 @@ pub struct BubbleSpec {
     /// The film flow's discrete gradient (default `"two-point"`).
     #[serde(default)]
     pub film_gradient: Option<FilmGradientSpec>,
+    /// Stands the bubble on a wet surface: no film below the contact line, a meniscus
+    /// there that regenerates the film (film flow only).
+    #[serde(default)]
+    pub meniscus: Option<MeniscusSpec>,
+}
+
+/// A bubble's `[bubbles.meniscus]`: the wet surface it stands on (each field defaults
+/// to `bubble_dynamics::Meniscus::hemisphere`'s).
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeniscusSpec {
+    /// Height of the contact line above the bubble's centre over its radius (0: a
+    /// hemisphere).
+    #[serde(default)]
+    pub contact_height: Option<Num<ContactHeight>>,
+    /// Thin-film patches the meniscus pulls out per metre of contact line per second.
+    #[serde(default)]
+    pub regeneration_per_m_s: Option<Num<RegenerationRate>>,
+    /// A patch's thickness over the thickness of the film it replaces.
+    #[serde(default)]
+    pub regenerated_fraction: Option<Num<RegeneratedFraction>>,
+    /// Radius of a patch, m.
+    #[serde(default)]
+    pub patch_radius_m: Option<Num<PatchRadius>>,
 }
 
 /// A bubble's `film_gradient`: the discrete gradient that drives its film flow.

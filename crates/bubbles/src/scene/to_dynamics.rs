@@ -1,11 +1,11 @@
 //! Scene → `bubble_dynamics::World`.
 
 use super::Scene;
-use super::schema::{BubbleSpec, FilmGradientSpec, ObjectSpec};
+use super::schema::{BubbleSpec, FilmGradientSpec, MeniscusSpec, ObjectSpec};
 use super::values::{numbers, plain};
 use crate::error::CliError;
 use crate::limits;
-use bubble_dynamics::film_flow::FilmGradient;
+use bubble_dynamics::film_flow::{FilmGradient, Meniscus};
 use bubble_dynamics::{
     BubbleParams, Collider, DVec3, Gusts, Integrator, SimError, Wind, World, WorldParams,
 };
@@ -240,7 +240,25 @@ pub(crate) fn bubble_params(spec: &BubbleSpec, default_grid: u32) -> BubbleParam
                 FilmGradientSpec::TwoPoint => FilmGradient::TwoPoint,
                 FilmGradientSpec::Normal => FilmGradient::Normal,
             }),
+        meniscus: spec.meniscus.as_ref().map(meniscus),
         ..defaults
+    }
+}
+
+/// A `[bubbles.meniscus]`, each field omitted taken from [`Meniscus::hemisphere`].
+fn meniscus(spec: &MeniscusSpec) -> Meniscus {
+    let d = Meniscus::hemisphere();
+    Meniscus {
+        contact_height: or(spec.contact_height.map(|v| v.get()), d.contact_height),
+        regeneration_per_m_s: or(
+            spec.regeneration_per_m_s.map(|v| v.get()),
+            d.regeneration_per_m_s,
+        ),
+        regenerated_fraction: or(
+            spec.regenerated_fraction.map(|v| v.get()),
+            d.regenerated_fraction,
+        ),
+        patch_radius_m: or(spec.patch_radius_m.map(|v| v.get()), d.patch_radius_m),
     }
 }
 

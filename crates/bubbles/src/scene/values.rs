@@ -331,6 +331,14 @@ bounds! {
     Evaporation: 0.0, 1e4, "nm/s";
     /// How much warmer the air at a bubble's bottom is than at its top.
     Warming: -bubble_dynamics::MAX_WARMING_K, bubble_dynamics::MAX_WARMING_K, "K";
+    /// Height of a meniscus's contact line over the bubble's radius.
+    ContactHeight: -0.95, 0.95, "";
+    /// Thin-film patches a meniscus regenerates per metre of contact line.
+    RegenerationRate: 0.0, 1e4, "1/(m·s)";
+    /// A regenerated patch's thickness over the film's.
+    RegeneratedFraction: 0.01, 1.0, "";
+    /// Radius of a regenerated patch.
+    PatchRadius: 1e-4, 0.1, "m";
     /// Molar mass of the gas inside.
     MolarMass: 1e-3, 1.0, "kg/mol";
     /// Film refractive index.
