@@ -20,7 +20,7 @@ pub(crate) use to_dynamics::{bubble_params, default_film_grid};
 pub use to_raster::bubble_meshes;
 
 /// Built-in scenes, by name, with their TOML source.
-pub const BUILTINS: [(&str, &str); 11] = [
+pub const BUILTINS: [(&str, &str); 12] = [
     ("paper", include_str!("../../scenes/paper.toml")),
     ("crowd", include_str!("../../scenes/crowd.toml")),
     ("crowd-100", include_str!("../../scenes/crowd-100.toml")),
@@ -41,6 +41,7 @@ pub const BUILTINS: [(&str, &str); 11] = [
     ("demo-white", include_str!("../../scenes/demo-white.toml")),
     ("pond", include_str!("../../scenes/pond.toml")),
     ("swirl", include_str!("../../scenes/swirl.toml")),
+    ("dome", include_str!("../../scenes/dome.toml")),
 ];
 
 /// Name of the scene used when none is given.
