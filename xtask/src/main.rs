@@ -271,7 +271,7 @@ fn swirl_burst(dir: &str, bubbles: &dyn Fn(&[&str]) -> bool) -> bool {
 /// of the wind scene, the swirl at four ages, and the pond at two times for
 /// docs/water.md.
 fn gallery() -> bool {
-    const GALLERY: [(&str, &str, &str, &str); 6] = [
+    const GALLERY: [(&str, &str, &str, &str); 7] = [
         // scene, still time (s), animation length (s), fps
         ("wind", "0.2", "1.2", "15"),
         ("plane-collision", "0.15", "1.2", "15"),
@@ -279,6 +279,7 @@ fn gallery() -> bool {
         ("demo", "0.5", "2", "10"),
         ("pond", "1", "2", "10"),
         ("swirl", "5", "11.5", "8"),
+        ("dome", "8", "12", "8"),
     ];
     let dir = "docs/figures/gallery";
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
@@ -317,6 +318,11 @@ fn gallery() -> bool {
     for time_s in ["0.5", "5", "8", "10.5"] {
         let still = format!("{dir}/swirl_t{time_s}.png");
         ok &= bubbles(&["render", "swirl", "--out", &still, "--time-s", time_s]);
+    }
+    // The dome's film at four ages, full size (docs/gallery.md).
+    for time_s in ["1", "4", "8", "11"] {
+        let still = format!("{dir}/dome_t{time_s}.png");
+        ok &= bubbles(&["render", "dome", "--out", &still, "--time-s", time_s]);
     }
     for time_s in ["0.5", "2"] {
         let still = format!("{dir}/pond_t{time_s}s.png");
