@@ -134,11 +134,24 @@ impl FilmFlow {
     fn limit_gradients(&self, s: &mut Scratch) {
         let ea = self.grid.edge_arrays();
         let (gradient, range) = (&s.gradient, &s.neighbour_range);
+        // The limit is 1 wherever the range holds the whole rise: that test skips the
+        // division in most edges of a smooth film (x ≥ y > 0 gives x/y ≥ 1 exactly, so
+        // the factor is the same).
         let allowed = |h: f64, [lo, hi]: [f64; 2], rise: f64| {
             if rise > 0.0 {
-                ((hi - h) / rise).min(1.0)
+                let room = hi - h;
+                if room >= rise {
+                    1.0
+                } else {
+                    (room / rise).min(1.0)
+                }
             } else if rise < 0.0 {
-                ((lo - h) / rise).min(1.0)
+                let room = lo - h;
+                if room <= rise {
+                    1.0
+                } else {
+                    (room / rise).min(1.0)
+                }
             } else {
                 1.0
             }
