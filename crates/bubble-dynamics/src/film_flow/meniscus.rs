@@ -160,7 +160,7 @@ impl MeniscusState {
     }
 
     /// Opens this step's patches along the contact line (a Poisson number of them, at
-    /// uniformly random places).
+    /// most [`MAX_PATCHES_PER_STEP`], at uniformly random places).
     pub(super) fn regenerate(&mut self, grid: &CubeSphere, h_m: &mut [f64], dt_s: f64, r: f64) {
         let expected = self.params.regeneration_per_m_s * self.contact_length_m * dt_s;
         let count = poisson(&mut self.rng, expected);
@@ -204,15 +204,19 @@ impl MeniscusState {
     }
 }
 
-/// A Poisson-distributed count of mean `mean` (Knuth's product of uniforms; the means
-/// here are a few at most).
+/// Most patches one step opens: each walks every cell, and at rates that reach this the
+/// patches cover the whole foot every step anyway.
+const MAX_PATCHES_PER_STEP: u32 = 64;
+
+/// A Poisson-distributed count of mean `mean` (Knuth's product of uniforms), at most
+/// [`MAX_PATCHES_PER_STEP`].
 fn poisson(rng: &mut SplitMix64, mean: f64) -> u32 {
     if mean <= 0.0 {
         return 0;
     }
     let limit = (-mean).exp();
     let (mut count, mut product) = (0, rng.next_f64());
-    while product > limit && count < 1000 {
+    while product > limit && count < MAX_PATCHES_PER_STEP {
         count += 1;
         product *= rng.next_f64();
     }
@@ -256,5 +260,27 @@ impl FilmFlow {
         m.absorb(&mut self.h_m, self.grid.areas_sr(), r);
         m.regenerate(&self.grid, &mut self.h_m, dt_s, r);
         self.meniscus = Some(m);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn poisson_counts_have_the_mean_they_are_drawn_with_and_stop_at_the_cap() {
+        let mut rng = SplitMix64::new(7);
+        for mean in [0.05, 0.7, 3.0] {
+            let draws = 200_000;
+            let sum: u32 = (0..draws).map(|_| poisson(&mut rng, mean)).sum();
+            let measured = f64::from(sum) / f64::from(draws);
+            // The standard error of the mean is sqrt(mean / draws): 0.004 at 3.
+            assert!(
+                (measured - mean).abs() < 5.0 * (mean / 200_000.0_f64).sqrt(),
+                "{mean}: {measured}"
+            );
+        }
+        assert_eq!(poisson(&mut rng, 1e6), MAX_PATCHES_PER_STEP);
+        assert_eq!(poisson(&mut rng, 0.0), 0);
     }
 }
