@@ -96,7 +96,7 @@ pub struct Work {
     inv_diag: Vec<Vec<f64>>,
     stencil: Vec<Stencil>,
     residual: Vec<Vec<f64>>,
-    /// A level's `M z` before its residual is restricted (the finest level's length).
+    /// A level's residual `r − M z` before it is restricted (the finest level's length).
     operator: Vec<f64>,
     correction: Vec<Vec<f64>>,
     r: Vec<f64>,
@@ -266,18 +266,12 @@ impl Hierarchy {
                 let mut z = std::mem::take(&mut work.z);
                 let mut p = std::mem::take(&mut work.p);
                 let mut q = std::mem::take(&mut work.q);
-                apply(fine, &work.alpha[0], &work.stencil[0], x, &mut q);
-                for i in 0..nc {
-                    r[i] = b[i] - q[i];
-                }
+                residual(fine, &work.alpha[0], &work.stencil[0], x, b, &mut r);
                 // Relative to the warm start's residual: the step's change, not the whole field.
                 let mut start_norm = dot(&r, &r).sqrt();
                 let b_norm = if start_norm > 0.0 { start_norm } else { 1.0 };
                 if let Some(guess) = guess.filter(|_| start_norm > 0.0) {
-                    apply(fine, &work.alpha[0], &work.stencil[0], guess, &mut q);
-                    for i in 0..nc {
-                        z[i] = b[i] - q[i];
-                    }
+                    residual(fine, &work.alpha[0], &work.stencil[0], guess, b, &mut z);
                     let guess_norm = dot(&z, &z).sqrt();
                     if guess_norm < start_norm {
                         x.copy_from_slice(guess);
@@ -390,8 +384,8 @@ impl Hierarchy {
                 rc.resize(coarse.cells, 0.0);
                 let mut mz = std::mem::take(&mut work.operator);
                 mz.resize(level.cells, 0.0);
-                apply(level, &work.alpha[k], &work.stencil[k], z, &mut mz);
-                restrict_residual(&coarse.children, r, &mz, &mut rc);
+                residual(level, &work.alpha[k], &work.stencil[k], z, r, &mut mz);
+                restrict_residual(&coarse.children, &mz, &mut rc);
                 work.operator = mz;
                 let mut zc = std::mem::take(&mut work.correction[k + 1]);
                 zc.resize(coarse.cells, 0.0);
@@ -515,6 +509,32 @@ fn coarsen(fine: &Level, parent: &[u32], coarse_cells: usize) -> (Level, Vec<u32
 /// surfactant), which `diag·xᵢ − Σ w xⱼ` would lose to cancellation.
 #[inline(always)]
 fn apply(level: &Level, alpha: &[f64], stencil: &Stencil, x: &[f64], out: &mut [f64]) {
+    operator::<false>(level, (alpha, stencil), x, x, out);
+}
+
+/// `out = r − (diag(alpha) + L_w) x`: [`apply`]'s sums, each taken from `r` in the same
+/// pass (apply and then a subtraction read `M x` back from memory).
+#[inline(always)]
+fn residual(
+    level: &Level,
+    alpha: &[f64],
+    stencil: &Stencil,
+    x: &[f64],
+    r: &[f64],
+    out: &mut [f64],
+) {
+    operator::<true>(level, (alpha, stencil), x, r, out);
+}
+
+/// [`apply`] (`RESIDUAL` false: `r` unread) or [`residual`] (true).
+#[inline(always)]
+fn operator<const RESIDUAL: bool>(
+    level: &Level,
+    (alpha, stencil): (&[f64], &Stencil),
+    x: &[f64],
+    r: &[f64],
+    out: &mut [f64],
+) {
     for segment in &level.segments {
         match *segment {
             Segment::Cells { start, end } => {
@@ -524,24 +544,24 @@ fn apply(level: &Level, alpha: &[f64], stencil: &Stencil, x: &[f64], out: &mut [
                     for k in 0..SIDES {
                         sum += stencil[k][i] * (xi - x[level.neighbours[i][k] as usize]);
                     }
-                    out[i] = sum;
+                    out[i] = if RESIDUAL { r[i] - sum } else { sum };
                 }
             }
             Segment::Run { start, end, from } => {
-                apply_run(start..end, from, alpha, stencil, x, out)
+                operator_run::<RESIDUAL>(start..end, from, (alpha, stencil), x, r, out)
             }
         }
     }
 }
 
-/// [`apply`] on a [`Segment::Run`]: the same sums, read as slices.
+/// [`operator`] on a [`Segment::Run`]: the same sums, read as slices.
 #[inline(always)]
-fn apply_run(
+fn operator_run<const RESIDUAL: bool>(
     run: std::ops::Range<usize>,
     from: [usize; SIDES],
-    alpha: &[f64],
-    stencil: &Stencil,
+    (alpha, stencil): (&[f64], &Stencil),
     x: &[f64],
+    r: &[f64],
     out: &mut [f64],
 ) {
     let len = run.len();
@@ -549,7 +569,8 @@ fn apply_run(
     let (x2, x3) = (&x[from[2]..][..len], &x[from[3]..][..len]);
     let (w0, w1) = (&stencil[0][run.clone()], &stencil[1][run.clone()]);
     let (w2, w3) = (&stencil[2][run.clone()], &stencil[3][run.clone()]);
-    let (a, xs, out) = (&alpha[run.clone()], &x[run.clone()], &mut out[run]);
+    let (a, xs, r) = (&alpha[run.clone()], &x[run.clone()], &r[run.clone()]);
+    let out = &mut out[run];
     for i in 0..len {
         let xi = xs[i];
         let mut sum = a[i] * xi;
@@ -557,7 +578,7 @@ fn apply_run(
         sum += w1[i] * (xi - x1[i]);
         sum += w2[i] * (xi - x2[i]);
         sum += w3[i] * (xi - x3[i]);
-        out[i] = sum;
+        out[i] = if RESIDUAL { r[i] - sum } else { sum };
     }
 }
 
@@ -841,26 +862,40 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
 }
 
-/// `x += step·p`, `r −= step·q`, and returns `r·r` (one pass, as [`dot`] sums).
+/// `x += step·p`, `r −= step·q`, and returns `r·r`, in one pass (each lane's `r` squared
+/// as it is made), summed as [`dot`] sums.
 #[inline(always)]
 fn update_and_norm2(step: f64, p: &[f64], q: &[f64], x: &mut [f64], r: &mut [f64]) -> f64 {
-    for (xi, pi) in x.iter_mut().zip(p) {
+    let mut lanes = [0.0; LANES];
+    let (mut xc, mut rc) = (x.chunks_exact_mut(LANES), r.chunks_exact_mut(LANES));
+    let (pc, qc) = (p.chunks_exact(LANES), q.chunks_exact(LANES));
+    let (p_tail, q_tail) = (pc.remainder(), qc.remainder());
+    for (((xs, rs), ps), qs) in xc.by_ref().zip(rc.by_ref()).zip(pc).zip(qc) {
+        for k in 0..LANES {
+            xs[k] += step * ps[k];
+            rs[k] -= step * qs[k];
+            lanes[k] += rs[k] * rs[k];
+        }
+    }
+    for (xi, pi) in xc.into_remainder().iter_mut().zip(p_tail) {
         *xi += step * pi;
     }
-    for (ri, qi) in r.iter_mut().zip(q) {
+    let r_tail = rc.into_remainder();
+    for (ri, qi) in r_tail.iter_mut().zip(q_tail) {
         *ri -= step * qi;
     }
-    dot(r, r)
+    let tail: f64 = r_tail.iter().zip(r_tail.iter()).map(|(x, y)| x * y).sum();
+    (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
 }
 
-/// `rc` = the residual `r − M z` of a level (`mz` = `M z`, from [`apply`], which takes
-/// the face interiors as vectorised runs), restricted by summing each coarse cell's
-/// children (the equations are area-integrated), from zero and in increasing order, as a
-/// scatter over the fine cells summed them.
+/// `rc` = a level's residual `d = r − M z` (from [`residual`], which takes the face
+/// interiors as vectorised runs) restricted by summing each coarse cell's children (the
+/// equations are area-integrated), from zero and in increasing order, as a scatter over
+/// the fine cells summed them.
 #[inline(always)]
-fn restrict_residual(children: &[[u32; 4]], r: &[f64], mz: &[f64], rc: &mut [f64]) {
+fn restrict_residual(children: &[[u32; 4]], d: &[f64], rc: &mut [f64]) {
     for (v, ch) in rc.iter_mut().zip(children) {
-        let d = ch.map(|c| r[c as usize] - mz[c as usize]);
+        let d = ch.map(|c| d[c as usize]);
         *v = 0.0 + d[0] + d[1] + d[2] + d[3];
     }
 }
