@@ -862,25 +862,26 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
 }
 
-/// `x += step·p`, `r −= step·q`, and returns `r·r`, in one pass (each lane's `r` squared
-/// as it is made), summed as [`dot`] sums.
+/// `x += step·p`, `r −= step·q`, and returns `r·r`, summed as [`dot`] sums: each lane's
+/// `r` squared as it is made (one pass over `r`, where the dot read it back), `x` in a
+/// pass of its own (with both updated in one loop the compiler could not tell them
+/// apart and kept it scalar).
 #[inline(always)]
 fn update_and_norm2(step: f64, p: &[f64], q: &[f64], x: &mut [f64], r: &mut [f64]) -> f64 {
-    let mut lanes = [0.0; LANES];
-    let (mut xc, mut rc) = (x.chunks_exact_mut(LANES), r.chunks_exact_mut(LANES));
-    let (pc, qc) = (p.chunks_exact(LANES), q.chunks_exact(LANES));
-    let (p_tail, q_tail) = (pc.remainder(), qc.remainder());
-    for (((xs, rs), ps), qs) in xc.by_ref().zip(rc.by_ref()).zip(pc).zip(qc) {
-        for k in 0..LANES {
-            xs[k] += step * ps[k];
-            rs[k] -= step * qs[k];
-            lanes[k] += rs[k] * rs[k];
-        }
-    }
-    for (xi, pi) in xc.into_remainder().iter_mut().zip(p_tail) {
+    for (xi, pi) in x.iter_mut().zip(p) {
         *xi += step * pi;
     }
-    let r_tail = rc.into_remainder();
+    let main = r.len() - r.len() % LANES;
+    let (r, r_tail) = r.split_at_mut(main);
+    let (q, q_tail) = q.split_at(main);
+    let mut lanes = [0.0; LANES];
+    for (rs, qs) in r.chunks_exact_mut(LANES).zip(q.chunks_exact(LANES)) {
+        let next: [f64; LANES] = std::array::from_fn(|k| rs[k] - step * qs[k]);
+        rs.copy_from_slice(&next);
+        for k in 0..LANES {
+            lanes[k] += next[k] * next[k];
+        }
+    }
     for (ri, qi) in r_tail.iter_mut().zip(q_tail) {
         *ri -= step * qi;
     }
