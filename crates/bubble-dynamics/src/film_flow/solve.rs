@@ -924,12 +924,19 @@ fn restrict_weights(fine_edges: &[[u32; 2]], fine: &[f64], coarse: &mut Vec<f64>
     );
 }
 
-/// The lower Cholesky factor of the coarsest level's matrix, row-major, into `m` (a
-/// buffer kept from step to step: a fresh 74 kB one each step was a malloc and free).
+/// The lower Cholesky factor of the coarsest level's matrix, column-major (`m[k·n + i]`
+/// = `L[i][k]`), into `m` (a buffer kept from step to step: a fresh 74 kB one each step
+/// was a malloc and free).
+///
+/// Column by column, each earlier column's part taken off all the rows at once: every
+/// entry is the same sum in the same order as row by row, but where row by row each
+/// entry was one chain of dependent subtractions (the core waiting on each), a column's
+/// rows are independent lanes the compiler vectorises.
 fn dense_cholesky(level: &Level, alpha: &[f64], weight: &[f64], m: &mut Vec<f64>) {
     let n = level.cells;
     m.clear();
     m.resize(n * n, 0.0);
+    // The matrix is symmetric: column-major is the same as row-major.
     for i in 0..n {
         m[i * n + i] = alpha[i];
     }
@@ -941,37 +948,47 @@ fn dense_cholesky(level: &Level, alpha: &[f64], weight: &[f64], m: &mut Vec<f64>
         m[b * n + a] -= w;
     }
     for j in 0..n {
-        let mut d = m[j * n + j];
+        let (done, rest) = m.split_at_mut(j * n);
+        let column = &mut rest[j..n];
         for k in 0..j {
-            d -= m[j * n + k] * m[j * n + k];
-        }
-        let d = d.max(f64::MIN_POSITIVE).sqrt();
-        m[j * n + j] = d;
-        for i in j + 1..n {
-            let mut s = m[i * n + j];
-            for k in 0..j {
-                s -= m[i * n + k] * m[j * n + k];
+            let earlier = &done[k * n + j..][..n - j];
+            let c = earlier[0];
+            for (s, l) in column.iter_mut().zip(earlier) {
+                *s -= l * c;
             }
-            m[i * n + j] = s / d;
+        }
+        let d = column[0].max(f64::MIN_POSITIVE).sqrt();
+        column[0] = d;
+        for s in &mut column[1..] {
+            *s /= d;
         }
     }
 }
 
+/// Solves `L Lᵀ x = b` with [`dense_cholesky`]'s column-major factor `l`: forwards a
+/// column at a time (each `x[i]` the same sum in the same order as row by row, the rows
+/// independent lanes), backwards a row of `Lᵀ` (a column of `L`, contiguous) at a time.
 #[inline(always)]
 fn dense_solve(l: &[f64], n: usize, b: &[f64], x: &mut [f64]) {
-    for i in 0..n {
-        let mut s = b[i];
-        for k in 0..i {
-            s -= l[i * n + k] * x[k];
+    let (l, x) = (&l[..n * n], &mut x[..n]);
+    x.copy_from_slice(&b[..n]);
+    for k in 0..n {
+        let column = &l[k * n + k..][..n - k];
+        let (solved, rest) = x.split_at_mut(k + 1);
+        let xk = solved[k] / column[0];
+        solved[k] = xk;
+        for (s, lik) in rest.iter_mut().zip(&column[1..]) {
+            *s -= lik * xk;
         }
-        x[i] = s / l[i * n + i];
     }
     for i in (0..n).rev() {
-        let mut s = x[i];
-        for k in i + 1..n {
-            s -= l[k * n + i] * x[k];
+        let column = &l[i * n + i..][..n - i];
+        let (head, solved) = x.split_at_mut(i + 1);
+        let mut s = head[i];
+        for (lki, xk) in column[1..].iter().zip(solved.iter()) {
+            s -= lki * xk;
         }
-        x[i] = s / l[i * n + i];
+        head[i] = s / column[0];
     }
 }
 
