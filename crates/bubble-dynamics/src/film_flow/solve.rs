@@ -390,8 +390,8 @@ impl Hierarchy {
                 let mut zc = std::mem::take(&mut work.correction[k + 1]);
                 zc.resize(coarse.cells, 0.0);
                 self.v_cycle(work, k + 1, &rc, &mut zc);
-                for c in 0..level.cells {
-                    z[c] += zc[coarse.parent_of_fine[c] as usize];
+                for (zi, &parent) in z.iter_mut().zip(&coarse.parent_of_fine) {
+                    *zi += zc[parent as usize];
                 }
                 work.residual[k + 1] = rc;
                 work.correction[k + 1] = zc;
