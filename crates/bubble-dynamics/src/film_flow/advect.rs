@@ -207,11 +207,14 @@ pub(crate) fn advect_momentum(
     s: &mut AdvectionScratch,
 ) {
     cell_velocities(grid, geo, u, &mut s.cell_velocity);
+    // The largest squared speed's root: the same number as the largest root (the
+    // rounded root is monotonic), for one root where there was one a cell.
     let speed = s
         .cell_velocity
         .iter()
-        .map(|v| v.length())
-        .fold(0.0, f64::max);
+        .map(|v| v.length_squared())
+        .fold(0.0, f64::max)
+        .sqrt();
     if speed == 0.0 || !speed.is_finite() {
         return;
     }
