@@ -49,9 +49,21 @@ struct Level {
     neighbour_edges: Vec<[u32; SIDES]>,
     /// The cells as runs and stretches of single cells, in order.
     segments: Vec<Segment>,
+    /// The cells a backward sweep reads before it updates them (those with a neighbour
+    /// after them), as ranges: the only ones whose coarse correction is ever read. The
+    /// rest (about half: a face interior's second colour) it overwrites unread, since a
+    /// cell's update does not read its own value, so the V-cycle does not correct them.
+    read_before_update: Vec<std::ops::Range<usize>>,
     /// Fine cell → this level's cell, for the level below (finer) this one.
     parent_of_fine: Vec<u32>,
-    /// Fine edge → coarse edge it lies along (`u32::MAX` inside a coarse cell).
+    /// This level's cell → its four fine cells, in increasing order: the restrictions
+    /// sum each cell's children in the order a scatter over the fine cells added them
+    /// (so the same bits), with no zeroed sums to start from.
+    children: Vec<[u32; 4]>,
+    /// This level's edge → the two fine edges along it, in increasing order.
+    fine_edges: Vec<[u32; 2]>,
+    /// Fine edge → coarse edge it lies along (`u32::MAX` inside a coarse cell), for the
+    /// level above (coarser) this one: what [`Level::fine_edges`] is built from.
     coarse_edge_of_fine: Vec<u32>,
 }
 
@@ -89,7 +101,7 @@ pub struct Work {
     inv_diag: Vec<Vec<f64>>,
     stencil: Vec<Stencil>,
     residual: Vec<Vec<f64>>,
-    /// A level's `M z` before its residual is restricted (the finest level's length).
+    /// A level's residual `r − M z` before it is restricted (the finest level's length).
     operator: Vec<f64>,
     correction: Vec<Vec<f64>>,
     r: Vec<f64>,
@@ -141,7 +153,11 @@ impl Hierarchy {
             orders.push(chequered_order(n / 2));
             n /= 2;
         }
-        let levels = renumber(&levels, &orders);
+        let mut levels = renumber(&levels, &orders);
+        for k in 1..levels.len() {
+            let (fine, coarse) = levels.split_at_mut(k);
+            coarse[0].link_to_fine(&fine[k - 1]);
+        }
         let fine_order = orders.swap_remove(0);
         Self { levels, fine_order }
     }
@@ -255,18 +271,12 @@ impl Hierarchy {
                 let mut z = std::mem::take(&mut work.z);
                 let mut p = std::mem::take(&mut work.p);
                 let mut q = std::mem::take(&mut work.q);
-                apply(fine, &work.alpha[0], &work.stencil[0], x, &mut q);
-                for i in 0..nc {
-                    r[i] = b[i] - q[i];
-                }
+                residual(fine, &work.alpha[0], &work.stencil[0], x, b, &mut r);
                 // Relative to the warm start's residual: the step's change, not the whole field.
                 let mut start_norm = dot(&r, &r).sqrt();
                 let b_norm = if start_norm > 0.0 { start_norm } else { 1.0 };
                 if let Some(guess) = guess.filter(|_| start_norm > 0.0) {
-                    apply(fine, &work.alpha[0], &work.stencil[0], guess, &mut q);
-                    for i in 0..nc {
-                        z[i] = b[i] - q[i];
-                    }
+                    residual(fine, &work.alpha[0], &work.stencil[0], guess, b, &mut z);
                     let guess_norm = dot(&z, &z).sqrt();
                     if guess_norm < start_norm {
                         x.copy_from_slice(guess);
@@ -315,36 +325,25 @@ impl Hierarchy {
     fn prepare(&self, work: &mut Work, alpha: &[f64], weight: &[f64]) {
         let count = self.levels.len();
         work.alpha.resize(count, Vec::new());
+        // `work.weight[0]` stays unused: the finest level's weights are `weight` itself
+        // (a copy of them was a 0.4 MB memcpy a step at n = 64).
         work.weight.resize(count, Vec::new());
         work.residual.resize(count, Vec::new());
         work.correction.resize(count, Vec::new());
         gather(&self.fine_order, alpha, &mut work.alpha[0]);
-        work.weight[0].clear();
-        work.weight[0].extend_from_slice(weight);
         for k in 1..count {
-            let (fine, coarse) = (&self.levels[k - 1], &self.levels[k]);
+            let coarse = &self.levels[k];
             let (done, rest) = work.alpha.split_at_mut(k);
-            let alpha_c = &mut rest[0];
-            alpha_c.clear();
-            alpha_c.resize(coarse.cells, 0.0);
-            for (c, a) in done[k - 1].iter().enumerate() {
-                alpha_c[coarse.parent_of_fine[c] as usize] += a;
-            }
+            restrict_mass(&coarse.children, &done[k - 1], &mut rest[0]);
             let (done, rest) = work.weight.split_at_mut(k);
-            let weight_c = &mut rest[0];
-            weight_c.clear();
-            weight_c.resize(coarse.edges.len(), 0.0);
-            for (e, w) in done[k - 1].iter().enumerate() {
-                let ce = fine.coarse_edge_of_fine[e];
-                if ce != u32::MAX {
-                    weight_c[ce as usize] += 0.5 * w;
-                }
-            }
+            let fine_weight = if k == 1 { weight } else { &done[k - 1] };
+            restrict_weights(&coarse.fine_edges, fine_weight, &mut rest[0]);
         }
         work.inv_diag.resize(count, Vec::new());
         work.stencil.resize(count, Stencil::default());
         for (k, level) in self.levels.iter().enumerate() {
-            let (weight, alpha) = (&work.weight[k], &work.alpha[k]);
+            let weight = if k == 0 { weight } else { &work.weight[k] };
+            let alpha = &work.alpha[k];
             let stencil = &mut work.stencil[k];
             for (side, w) in stencil.iter_mut().enumerate() {
                 w.clear();
@@ -362,7 +361,12 @@ impl Hierarchy {
             );
         }
         let last = self.levels.len() - 1;
-        let (level, alpha, weight) = (&self.levels[last], &work.alpha[last], &work.weight[last]);
+        let weight = if last == 0 {
+            weight
+        } else {
+            &work.weight[last]
+        };
+        let (level, alpha) = (&self.levels[last], &work.alpha[last]);
         dense_cholesky(level, alpha, weight, &mut work.coarse_factor);
     }
 
@@ -371,27 +375,36 @@ impl Hierarchy {
         with_avx2(
             #[inline(always)]
             || {
+                // `z` is not zeroed: the dense solve writes every cell before it reads it,
+                // and the first sweep reads only the cells it has updated (as from zero).
                 let level = &self.levels[k];
-                z.iter_mut().for_each(|v| *v = 0.0);
                 if k + 1 == self.levels.len() {
                     dense_solve(&work.coarse_factor, level.cells, r, z);
                     return;
                 }
-                gauss_seidel(level, &work.inv_diag[k], &work.stencil[k], r, z, false);
+                relax_from_zero(level, &work.inv_diag[k], &work.stencil[k], r, z);
                 gauss_seidel(level, &work.inv_diag[k], &work.stencil[k], r, z, false);
                 let coarse = &self.levels[k + 1];
                 let mut rc = std::mem::take(&mut work.residual[k + 1]);
                 rc.resize(coarse.cells, 0.0);
                 let mut mz = std::mem::take(&mut work.operator);
-                mz.resize(level.cells, 0.0);
-                apply(level, &work.alpha[k], &work.stencil[k], z, &mut mz);
-                restrict_residual(&coarse.parent_of_fine, r, &mz, &mut rc);
+                // Kept at the finest level's length and sliced: resized to each level's in
+                // turn, it was zeroed again (0.15 MB at n = 64) every V-cycle.
+                if mz.len() < level.cells {
+                    mz.resize(level.cells, 0.0);
+                }
+                let d = &mut mz[..level.cells];
+                residual(level, &work.alpha[k], &work.stencil[k], z, r, d);
+                restrict_residual(&coarse.children, &mz, &mut rc);
                 work.operator = mz;
                 let mut zc = std::mem::take(&mut work.correction[k + 1]);
                 zc.resize(coarse.cells, 0.0);
                 self.v_cycle(work, k + 1, &rc, &mut zc);
-                for c in 0..level.cells {
-                    z[c] += zc[coarse.parent_of_fine[c] as usize];
+                for cells in level.read_before_update.iter().cloned() {
+                    let parents = &coarse.parent_of_fine[cells.clone()];
+                    for (zi, &parent) in z[cells].iter_mut().zip(parents) {
+                        *zi += zc[parent as usize];
+                    }
                 }
                 work.residual[k + 1] = rc;
                 work.correction[k + 1] = zc;
@@ -435,11 +448,40 @@ impl Level {
             cells,
             edges,
             segments: segments(&neighbours),
+            read_before_update: read_before_update(&neighbours),
             neighbours,
             neighbour_edges,
             parent_of_fine: Vec::new(),
+            children: Vec::new(),
+            fine_edges: Vec::new(),
             coarse_edge_of_fine: Vec::new(),
         }
+    }
+
+    /// Fills [`Level::children`] and [`Level::fine_edges`] of this (coarse) level from its
+    /// `parent_of_fine` and the finer level's `coarse_edge_of_fine`.
+    ///
+    /// # Panics
+    /// If a cell does not have four children or an edge two fine edges (not a halving).
+    fn link_to_fine(&mut self, fine: &Level) {
+        let mut children = vec![Vec::with_capacity(4); self.cells];
+        for (c, &parent) in self.parent_of_fine.iter().enumerate() {
+            children[parent as usize].push(c as u32);
+        }
+        let mut fine_edges = vec![Vec::with_capacity(2); self.edges.len()];
+        for (e, &coarse) in fine.coarse_edge_of_fine.iter().enumerate() {
+            if coarse != u32::MAX {
+                fine_edges[coarse as usize].push(e as u32);
+            }
+        }
+        self.children = children
+            .into_iter()
+            .map(|c| c.try_into().expect("4 children"))
+            .collect();
+        self.fine_edges = fine_edges
+            .into_iter()
+            .map(|e| e.try_into().expect("2 fine edges"))
+            .collect();
     }
 }
 
@@ -481,6 +523,32 @@ fn coarsen(fine: &Level, parent: &[u32], coarse_cells: usize) -> (Level, Vec<u32
 /// surfactant), which `diag·xᵢ − Σ w xⱼ` would lose to cancellation.
 #[inline(always)]
 fn apply(level: &Level, alpha: &[f64], stencil: &Stencil, x: &[f64], out: &mut [f64]) {
+    operator::<false>(level, (alpha, stencil), x, x, out);
+}
+
+/// `out = r − (diag(alpha) + L_w) x`: [`apply`]'s sums, each taken from `r` in the same
+/// pass (apply and then a subtraction read `M x` back from memory).
+#[inline(always)]
+fn residual(
+    level: &Level,
+    alpha: &[f64],
+    stencil: &Stencil,
+    x: &[f64],
+    r: &[f64],
+    out: &mut [f64],
+) {
+    operator::<true>(level, (alpha, stencil), x, r, out);
+}
+
+/// [`apply`] (`RESIDUAL` false: `r` unread) or [`residual`] (true).
+#[inline(always)]
+fn operator<const RESIDUAL: bool>(
+    level: &Level,
+    (alpha, stencil): (&[f64], &Stencil),
+    x: &[f64],
+    r: &[f64],
+    out: &mut [f64],
+) {
     for segment in &level.segments {
         match *segment {
             Segment::Cells { start, end } => {
@@ -490,24 +558,24 @@ fn apply(level: &Level, alpha: &[f64], stencil: &Stencil, x: &[f64], out: &mut [
                     for k in 0..SIDES {
                         sum += stencil[k][i] * (xi - x[level.neighbours[i][k] as usize]);
                     }
-                    out[i] = sum;
+                    out[i] = if RESIDUAL { r[i] - sum } else { sum };
                 }
             }
             Segment::Run { start, end, from } => {
-                apply_run(start..end, from, alpha, stencil, x, out)
+                operator_run::<RESIDUAL>(start..end, from, (alpha, stencil), x, r, out)
             }
         }
     }
 }
 
-/// [`apply`] on a [`Segment::Run`]: the same sums, read as slices.
+/// [`operator`] on a [`Segment::Run`]: the same sums, read as slices.
 #[inline(always)]
-fn apply_run(
+fn operator_run<const RESIDUAL: bool>(
     run: std::ops::Range<usize>,
     from: [usize; SIDES],
-    alpha: &[f64],
-    stencil: &Stencil,
+    (alpha, stencil): (&[f64], &Stencil),
     x: &[f64],
+    r: &[f64],
     out: &mut [f64],
 ) {
     let len = run.len();
@@ -515,7 +583,8 @@ fn apply_run(
     let (x2, x3) = (&x[from[2]..][..len], &x[from[3]..][..len]);
     let (w0, w1) = (&stencil[0][run.clone()], &stencil[1][run.clone()]);
     let (w2, w3) = (&stencil[2][run.clone()], &stencil[3][run.clone()]);
-    let (a, xs, out) = (&alpha[run.clone()], &x[run.clone()], &mut out[run]);
+    let (a, xs, r) = (&alpha[run.clone()], &x[run.clone()], &r[run.clone()]);
+    let out = &mut out[run];
     for i in 0..len {
         let xi = xs[i];
         let mut sum = a[i] * xi;
@@ -523,7 +592,7 @@ fn apply_run(
         sum += w1[i] * (xi - x1[i]);
         sum += w2[i] * (xi - x2[i]);
         sum += w3[i] * (xi - x3[i]);
-        out[i] = sum;
+        out[i] = if RESIDUAL { r[i] - sum } else { sum };
     }
 }
 
@@ -549,6 +618,74 @@ fn gauss_seidel(
         for segment in &level.segments {
             relax_segment(level, system, segment, z, back);
         }
+    }
+}
+
+/// The first forward Gauss–Seidel sweep of a V-cycle, as [`gauss_seidel`] from `z = 0`
+/// but with whatever `z` holds left unread: each cell reads the neighbours the sweep has
+/// updated (those before it) and takes zero for the rest, so the V-cycle need not zero
+/// `z` first. A zero neighbour still multiplies its weight: the same operations, so the
+/// same bits, as the sweep over a zeroed `z`.
+#[inline(always)]
+fn relax_from_zero(level: &Level, inv_diag: &[f64], stencil: &Stencil, r: &[f64], z: &mut [f64]) {
+    let system = (inv_diag, stencil, r);
+    for segment in &level.segments {
+        match *segment {
+            Segment::Cells { start, end } => {
+                for i in start..end {
+                    relax_cell_from_zero(level, system, i, z);
+                }
+            }
+            Segment::Run { start, end, from } if from[0] > start => {
+                relax_run_from_zero(start..end, inv_diag, stencil, r, z);
+            }
+            Segment::Run { start, end, from } => {
+                relax_run(start..end, from, inv_diag, stencil, r, z);
+            }
+        }
+    }
+}
+
+/// [`relax_cell`] in [`relax_from_zero`]'s sweep: neighbours after `i` read as zero.
+#[inline(always)]
+fn relax_cell_from_zero(
+    level: &Level,
+    (inv_diag, w, r): (&[f64], &Stencil, &[f64]),
+    i: usize,
+    z: &mut [f64],
+) {
+    let nb = &level.neighbours[i];
+    let (z0, z1) = (swept(z, nb[0], i), swept(z, nb[1], i));
+    let (z2, z3) = (swept(z, nb[2], i), swept(z, nb[3], i));
+    let near = w[0][i] * z0 + w[1][i] * z1;
+    let far = w[2][i] * z2 + w[3][i] * z3;
+    z[i] = (r[i] + near + far) * inv_diag[i];
+}
+
+/// Cell `j`'s value in a sweep from zero that has reached cell `i`: updated if before it.
+#[inline(always)]
+fn swept(z: &[f64], j: u32, i: usize) -> f64 {
+    let j = j as usize;
+    if j < i { z[j] } else { 0.0 }
+}
+
+/// [`relax_run`] in [`relax_from_zero`]'s sweep for a run whose neighbours all come after
+/// it: all zero, so none is read.
+#[inline(always)]
+fn relax_run_from_zero(
+    run: std::ops::Range<usize>,
+    inv_diag: &[f64],
+    stencil: &Stencil,
+    r: &[f64],
+    z: &mut [f64],
+) {
+    let (w0, w1) = (&stencil[0][run.clone()], &stencil[1][run.clone()]);
+    let (w2, w3) = (&stencil[2][run.clone()], &stencil[3][run.clone()]);
+    let (inv_diag, r, cells) = (&inv_diag[run.clone()], &r[run.clone()], &mut z[run]);
+    for i in 0..cells.len() {
+        let near = w0[i] * 0.0 + w1[i] * 0.0;
+        let far = w2[i] * 0.0 + w3[i] * 0.0;
+        cells[i] = (r[i] + near + far) * inv_diag[i];
     }
 }
 
@@ -679,6 +816,21 @@ fn segments(neighbours: &[[u32; SIDES]]) -> Vec<Segment> {
     out
 }
 
+/// [`Level::read_before_update`]: maximal ranges of the cells with a neighbour after them.
+fn read_before_update(neighbours: &[[u32; SIDES]]) -> Vec<std::ops::Range<usize>> {
+    let mut out: Vec<std::ops::Range<usize>> = Vec::new();
+    for (i, nb) in neighbours.iter().enumerate() {
+        if !nb.iter().any(|&j| j as usize > i) {
+            continue;
+        }
+        match out.last_mut() {
+            Some(cells) if cells.end == i => cells.end = i + 1,
+            _ => out.push(i..i + 1),
+        }
+    }
+    out
+}
+
 /// `out[i] = values[order[i]]`.
 fn gather(order: &[u32], values: &[f64], out: &mut Vec<f64>) {
     out.clear();
@@ -739,35 +891,81 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
 }
 
-/// `x += step·p`, `r −= step·q`, and returns `r·r` (one pass, as [`dot`] sums).
+/// `x += step·p`, `r −= step·q`, and returns `r·r`, summed as [`dot`] sums: each lane's
+/// `r` squared as it is made (one pass over `r`, where the dot read it back), `x` in a
+/// pass of its own (with both updated in one loop the compiler could not tell them
+/// apart and kept it scalar).
 #[inline(always)]
 fn update_and_norm2(step: f64, p: &[f64], q: &[f64], x: &mut [f64], r: &mut [f64]) -> f64 {
     for (xi, pi) in x.iter_mut().zip(p) {
         *xi += step * pi;
     }
-    for (ri, qi) in r.iter_mut().zip(q) {
+    let main = r.len() - r.len() % LANES;
+    let (r, r_tail) = r.split_at_mut(main);
+    let (q, q_tail) = q.split_at(main);
+    let mut lanes = [0.0; LANES];
+    for (rs, qs) in r.chunks_exact_mut(LANES).zip(q.chunks_exact(LANES)) {
+        let next: [f64; LANES] = std::array::from_fn(|k| rs[k] - step * qs[k]);
+        rs.copy_from_slice(&next);
+        for k in 0..LANES {
+            lanes[k] += next[k] * next[k];
+        }
+    }
+    for (ri, qi) in r_tail.iter_mut().zip(q_tail) {
         *ri -= step * qi;
     }
-    dot(r, r)
+    let tail: f64 = r_tail.iter().zip(r_tail.iter()).map(|(x, y)| x * y).sum();
+    (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
 }
 
-/// `rc` = the residual `r − M z` of a level (`mz` = `M z`, from [`apply`], which takes
-/// the face interiors as vectorised runs), restricted by summing each coarse cell's
-/// children (the equations are area-integrated).
+/// `rc` = a level's residual `d = r − M z` (from [`residual`], which takes the face
+/// interiors as vectorised runs) restricted by summing each coarse cell's children (the
+/// equations are area-integrated), from zero and in increasing order, as a scatter over
+/// the fine cells summed them.
 #[inline(always)]
-fn restrict_residual(parent_of_fine: &[u32], r: &[f64], mz: &[f64], rc: &mut [f64]) {
-    rc.iter_mut().for_each(|v| *v = 0.0);
-    for ((&parent, r), mz) in parent_of_fine.iter().zip(r).zip(mz) {
-        rc[parent as usize] += r - mz;
+fn restrict_residual(children: &[[u32; 4]], d: &[f64], rc: &mut [f64]) {
+    for (v, ch) in rc.iter_mut().zip(children) {
+        let d = ch.map(|c| d[c as usize]);
+        *v = 0.0 + d[0] + d[1] + d[2] + d[3];
     }
 }
 
-/// The lower Cholesky factor of the coarsest level's matrix, row-major, into `m` (a
-/// buffer kept from step to step: a fresh 74 kB one each step was a malloc and free).
+/// The mass term of a coarse level: the sum of each cell's children's, as
+/// [`restrict_residual`] sums.
+fn restrict_mass(children: &[[u32; 4]], fine: &[f64], coarse: &mut Vec<f64>) {
+    coarse.clear();
+    let sum = |ch: &[u32; 4]| 0.0 + fine[ch[0] as usize] + fine[ch[1] as usize];
+    coarse.extend(
+        children
+            .iter()
+            .map(|ch| sum(ch) + fine[ch[2] as usize] + fine[ch[3] as usize]),
+    );
+}
+
+/// The edge weights of a coarse level: half the sum of the two fine edges' along each
+/// (see the module's documentation), summed from zero in increasing order.
+fn restrict_weights(fine_edges: &[[u32; 2]], fine: &[f64], coarse: &mut Vec<f64>) {
+    coarse.clear();
+    coarse.extend(
+        fine_edges
+            .iter()
+            .map(|&[e, f]| 0.0 + 0.5 * fine[e as usize] + 0.5 * fine[f as usize]),
+    );
+}
+
+/// The lower Cholesky factor of the coarsest level's matrix, column-major (`m[k·n + i]`
+/// = `L[i][k]`), into `m` (a buffer kept from step to step: a fresh 74 kB one each step
+/// was a malloc and free).
+///
+/// Column by column, each earlier column's part taken off all the rows at once: every
+/// entry is the same sum in the same order as row by row, but where row by row each
+/// entry was one chain of dependent subtractions (the core waiting on each), a column's
+/// rows are independent lanes the compiler vectorises.
 fn dense_cholesky(level: &Level, alpha: &[f64], weight: &[f64], m: &mut Vec<f64>) {
     let n = level.cells;
     m.clear();
     m.resize(n * n, 0.0);
+    // The matrix is symmetric: column-major is the same as row-major.
     for i in 0..n {
         m[i * n + i] = alpha[i];
     }
@@ -779,37 +977,47 @@ fn dense_cholesky(level: &Level, alpha: &[f64], weight: &[f64], m: &mut Vec<f64>
         m[b * n + a] -= w;
     }
     for j in 0..n {
-        let mut d = m[j * n + j];
+        let (done, rest) = m.split_at_mut(j * n);
+        let column = &mut rest[j..n];
         for k in 0..j {
-            d -= m[j * n + k] * m[j * n + k];
-        }
-        let d = d.max(f64::MIN_POSITIVE).sqrt();
-        m[j * n + j] = d;
-        for i in j + 1..n {
-            let mut s = m[i * n + j];
-            for k in 0..j {
-                s -= m[i * n + k] * m[j * n + k];
+            let earlier = &done[k * n + j..][..n - j];
+            let c = earlier[0];
+            for (s, l) in column.iter_mut().zip(earlier) {
+                *s -= l * c;
             }
-            m[i * n + j] = s / d;
+        }
+        let d = column[0].max(f64::MIN_POSITIVE).sqrt();
+        column[0] = d;
+        for s in &mut column[1..] {
+            *s /= d;
         }
     }
 }
 
+/// Solves `L Lᵀ x = b` with [`dense_cholesky`]'s column-major factor `l`: forwards a
+/// column at a time (each `x[i]` the same sum in the same order as row by row, the rows
+/// independent lanes), backwards a row of `Lᵀ` (a column of `L`, contiguous) at a time.
 #[inline(always)]
 fn dense_solve(l: &[f64], n: usize, b: &[f64], x: &mut [f64]) {
-    for i in 0..n {
-        let mut s = b[i];
-        for k in 0..i {
-            s -= l[i * n + k] * x[k];
+    let (l, x) = (&l[..n * n], &mut x[..n]);
+    x.copy_from_slice(&b[..n]);
+    for k in 0..n {
+        let column = &l[k * n + k..][..n - k];
+        let (solved, rest) = x.split_at_mut(k + 1);
+        let xk = solved[k] / column[0];
+        solved[k] = xk;
+        for (s, lik) in rest.iter_mut().zip(&column[1..]) {
+            *s -= lik * xk;
         }
-        x[i] = s / l[i * n + i];
     }
     for i in (0..n).rev() {
-        let mut s = x[i];
-        for k in i + 1..n {
-            s -= l[k * n + i] * x[k];
+        let column = &l[i * n + i..][..n - i];
+        let (head, solved) = x.split_at_mut(i + 1);
+        let mut s = head[i];
+        for (lki, xk) in column[1..].iter().zip(solved.iter()) {
+            s -= lki * xk;
         }
-        x[i] = s / l[i * n + i];
+        head[i] = s / column[0];
     }
 }
 
@@ -960,7 +1168,9 @@ mod tests {
     }
 
     /// Gauss–Seidel sweeps (both ways) and the operator give bit for bit the same numbers
-    /// through the runs as cell by cell, and the runs cover most of the fine level.
+    /// through the runs as cell by cell, the first sweep of a V-cycle the same as a sweep
+    /// from zero, a backward sweep the same whatever the cells it does not read first
+    /// hold, and the runs cover most of the fine level.
     #[test]
     fn runs_relax_and_apply_exactly_as_single_cells_do() {
         let h = Hierarchy::new(&CubeSphere::new(16));
@@ -978,6 +1188,22 @@ mod tests {
                 gauss_seidel(&single, &inv_diag, &stencil, &r, &mut z_cells, back);
                 assert_eq!(z_runs, z_cells);
             }
+            // The first sweep leaves what `z` held unread: from garbage as from zero.
+            let mut from_zero = vec![0.0; n];
+            gauss_seidel(level, &inv_diag, &stencil, &r, &mut from_zero, false);
+            let mut from_garbage = vec![f64::NAN; n];
+            relax_from_zero(level, &inv_diag, &stencil, &r, &mut from_garbage);
+            assert_eq!(from_garbage, from_zero);
+            // A backward sweep reads only `read_before_update`'s cells before it updates
+            // them: the others' values (the correction skips them) may be anything.
+            let mut full = z_runs.clone();
+            gauss_seidel(level, &inv_diag, &stencil, &r, &mut full, true);
+            let mut skipped = vec![f64::NAN; n];
+            for cells in level.read_before_update.iter().cloned() {
+                skipped[cells.clone()].copy_from_slice(&z_runs[cells]);
+            }
+            gauss_seidel(level, &inv_diag, &stencil, &r, &mut skipped, true);
+            assert_eq!(skipped, full);
             let (mut by_runs, mut by_cells) = (vec![0.0; n], vec![0.0; n]);
             apply(level, &inv_diag, &stencil, &z_runs, &mut by_runs);
             apply(&single, &inv_diag, &stencil, &z_runs, &mut by_cells);
