@@ -213,3 +213,58 @@ fn a_meniscus_without_the_film_flow_or_out_of_range_is_refused_by_name() {
     .to_string();
     assert!(err.contains("meniscus.contact_height"), "{err}");
 }
+
+/// Every bit of both standing bubbles' films and particles after `steps` world steps on
+/// `threads` threads.
+fn standing_state_on(threads: usize, steps: usize) -> Vec<u64> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool");
+    pool.install(|| {
+        let bubble = |x: f64, seed: u64| BubbleParams {
+            center_m: DVec3::new(x, 0.0, 0.0),
+            radius_m: 0.03,
+            film_grid: 16,
+            seed,
+            drainage_viscosity_pa_s: 1e-6,
+            meniscus: Some(Meniscus {
+                regeneration_per_m_s: 400.0,
+                ..Meniscus::hemisphere()
+            }),
+            ..BubbleParams::default()
+        };
+        let bubbles = vec![bubble(-0.04, 1), bubble(0.04, 2)];
+        let mut w = World::try_new(WorldParams::default(), bubbles).unwrap();
+        for _ in 0..steps {
+            w.step().unwrap();
+        }
+        let mut bits = Vec::new();
+        for b in w.bubbles() {
+            let flow = b.film_flow().expect("a film flow");
+            bits.extend(flow.thickness_m().iter().map(|h| h.to_bits()));
+            bits.push(flow.meniscus_volume_m3().to_bits());
+            bits.extend(
+                b.positions_m()
+                    .iter()
+                    .flat_map(|x| x.to_array().map(f64::to_bits)),
+            );
+        }
+        bits
+    })
+}
+
+#[test]
+fn standing_bubbles_regenerate_bit_identically_on_1_and_2_threads() {
+    let one = standing_state_on(1, 40);
+    assert_eq!(one, standing_state_on(2, 40));
+    // The patches did open: the meniscus took up liquid from both films.
+    let volumes: Vec<f64> = [16 * 16 * 6, 2 * 16 * 16 * 6 + 1 + 642 * 3]
+        .iter()
+        .map(|&k| f64::from_bits(one[k]))
+        .collect();
+    assert!(
+        volumes.iter().all(|&v| v > 0.0),
+        "meniscus volumes {volumes:?}"
+    );
+}
