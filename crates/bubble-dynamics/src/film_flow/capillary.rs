@@ -121,11 +121,14 @@ fn substep(
     let r2 = radius_m * radius_m;
     s.laplacian.clear();
     s.laplacian.resize(grid.cells(), 0.0);
+    // A slice, not the vector: a store through a `&mut Vec` made every edge load its
+    // pointer and length again.
+    let laplacian = &mut s.laplacian[..];
     for (([a, b], l), d) in ea.cells.iter().zip(&ea.length).zip(&ea.dual_length) {
         let (a, b) = (*a as usize, *b as usize);
         let f = (h_m[b] - h_m[a]) * l / d;
-        s.laplacian[a] += f;
-        s.laplacian[b] -= f;
+        laplacian[a] += f;
+        laplacian[b] -= f;
     }
     for (lap, area) in s.laplacian.iter_mut().zip(grid.areas_sr()) {
         *lap /= area * r2;
@@ -145,7 +148,10 @@ fn substep(
         let (a, b) = (*a as usize, *b as usize);
         let rise = s.laplacian[b] - s.laplacian[a];
         let donor = h_m[if rise >= 0.0 { a } else { b }];
-        let m = (mobility.per_cubed * donor * donor * donor).min(mobility.cap);
+        // `x < cap` picks as `x.min(cap)` does (NaN included: the cap), without its
+        // NaN test.
+        let m = mobility.per_cubed * donor * donor * donor;
+        let m = if m < mobility.cap { m } else { mobility.cap };
         m * rise / (d * radius_m) * l * dt_s / radius_m
     }));
     // Each donor gives at most half its content: h stays ≥ 0.
