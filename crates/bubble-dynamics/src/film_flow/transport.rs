@@ -54,10 +54,18 @@ impl FilmFlow {
         let fastest = edges
             .zip(&self.u_m_per_s)
             .map(|((([a, b], per_area), &c), &u)| {
-                let h = self.h_m[*a as usize].max(self.h_m[*b as usize]);
+                let (ha, hb) = (self.h_m[*a as usize], self.h_m[*b as usize]);
+                let h = if hb > ha { hb } else { ha };
                 (u.abs() + 3.0 * c.abs() * h * h) * per_area
             })
-            .fold(0.0, f64::max);
+            // Maxima by comparisons (`max` tests for NaN): the same for thicknesses that
+            // are numbers, and the fold skips a NaN speed as `max` does.
+            .fold(
+                0.0,
+                |fastest, speed| {
+                    if speed > fastest { speed } else { fastest }
+                },
+            );
         fastest * dt_s / self.params.radius_m
     }
 
