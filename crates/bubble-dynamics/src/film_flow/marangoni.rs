@@ -80,15 +80,17 @@ impl FilmFlow {
         }
         let substeps = (2.0 * fastest * dt_per_r).ceil().clamp(1.0, 64.0) as u32;
         let sub_dt_per_r = dt_per_r / f64::from(substeps);
+        // Written in place through the resized buffer, not pushed: a push may reallocate,
+        // so every edge loaded Γ's pointer and length again.
+        s.edge2.resize(ea.cells.len(), 0.0);
         for _ in 0..substeps {
-            let flux = &mut s.edge2;
-            flux.clear();
-            let edges = ea.cells.iter().zip(&ea.length);
-            flux.extend(edges.zip(&s.u_start).map(|(([a, b], l), &u0)| {
+            let gamma = &self.gamma[..];
+            let edges = ea.cells.iter().zip(&ea.length).zip(&s.u_start);
+            for (f, (([a, b], l), &u0)) in s.edge2.iter_mut().zip(edges) {
                 let up = if u0 >= 0.0 { *a } else { *b } as usize;
-                self.gamma[up] * u0 * l
-            }));
-            apply_limited_fluxes(&g, flux, sub_dt_per_r, &mut self.gamma, &mut s.cell);
+                *f = gamma[up] * u0 * l;
+            }
+            apply_limited_fluxes(&g, &s.edge2, sub_dt_per_r, &mut self.gamma, &mut s.cell);
         }
     }
 
