@@ -121,11 +121,14 @@ fn substep(
     let r2 = radius_m * radius_m;
     s.laplacian.clear();
     s.laplacian.resize(grid.cells(), 0.0);
+    // A slice, not the vector: a store through a `&mut Vec` made every edge load its
+    // pointer and length again.
+    let laplacian = &mut s.laplacian[..];
     for (([a, b], l), d) in ea.cells.iter().zip(&ea.length).zip(&ea.dual_length) {
         let (a, b) = (*a as usize, *b as usize);
         let f = (h_m[b] - h_m[a]) * l / d;
-        s.laplacian[a] += f;
-        s.laplacian[b] -= f;
+        laplacian[a] += f;
+        laplacian[b] -= f;
     }
     for (lap, area) in s.laplacian.iter_mut().zip(grid.areas_sr()) {
         *lap /= area * r2;
@@ -139,15 +142,22 @@ fn substep(
     // a mean-thickness mobility drew liquid out of the thin film one cell further at the
     // pool's rate, emptying it in a step (bubbles resting on the ground burst within a
     // second). At the donor's, a thin cell gives at its own slow rate.
-    s.flux.clear();
+    //
+    // Written in place through the resized buffer, not pushed: a push may reallocate, so
+    // every edge loaded the Laplacian's pointer and length and the mobility again.
+    s.flux.resize(ea.cells.len(), 0.0);
+    let (laplacian, Mobility { per_cubed, cap }) = (&s.laplacian[..], mobility);
     let edges = ea.cells.iter().zip(&ea.length).zip(&ea.dual_length);
-    s.flux.extend(edges.map(|(([a, b], l), d)| {
+    for (flux, (([a, b], l), d)) in s.flux.iter_mut().zip(edges) {
         let (a, b) = (*a as usize, *b as usize);
-        let rise = s.laplacian[b] - s.laplacian[a];
+        let rise = laplacian[b] - laplacian[a];
         let donor = h_m[if rise >= 0.0 { a } else { b }];
-        let m = (mobility.per_cubed * donor * donor * donor).min(mobility.cap);
-        m * rise / (d * radius_m) * l * dt_s / radius_m
-    }));
+        // `x < cap` picks as `x.min(cap)` does (NaN included: the cap), without its
+        // NaN test.
+        let m = per_cubed * donor * donor * donor;
+        let m = if m < cap { m } else { cap };
+        *flux = m * rise / (d * radius_m) * l * dt_s / radius_m;
+    }
     // Each donor gives at most half its content: h stays ≥ 0.
     apply_limited_fluxes(grid, &s.flux, 1.0, h_m, &mut s.outflow);
 }

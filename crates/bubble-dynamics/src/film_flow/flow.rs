@@ -433,17 +433,24 @@ impl FilmFlow {
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn air_shear(&mut self, s: &mut Scratch, dt_s: f64, air_m_per_s: DVec3) {
         let p = &self.params;
-        s.drag.clear();
-        s.drag.resize(self.u_m_per_s.len(), 1.0);
         if p.air_viscosity_pa_s <= 0.0 {
+            s.drag.clear();
+            s.drag.resize(self.u_m_per_s.len(), 1.0);
             return;
         }
+        // Every factor is written below: the buffer needs its length, not a fill.
+        s.drag.resize(self.u_m_per_s.len(), 1.0);
         let nu_air = p.air_viscosity_pa_s / p.air_density_kg_per_m3.max(f64::MIN_POSITIVE);
         let (r, eddy) = (p.radius_m, 0.25 * p.radius_m);
-        // 1/δ = max(√(|Δu|/(ν_air ℓ)), 1/R): a multiply where 1/δ was a division.
+        // 1/δ = max(√(|Δu|/(ν_air ℓ)), 1/R): a multiply where 1/δ was a division. The
+        // maximum by a comparison, which picks as `max` does (NaN included: 1/R) without
+        // its NaN test.
         let per_layer_depth = {
-            let per_slip = 1.0 / (nu_air * eddy);
-            move |slip: f64| (slip * per_slip).sqrt().max(1.0 / r)
+            let (per_slip, floor) = (1.0 / (nu_air * eddy), 1.0 / r);
+            move |slip: f64| {
+                let depth = (slip * per_slip).sqrt();
+                if depth > floor { depth } else { floor }
+            }
         };
         let ea = self.grid.edge_arrays();
         let slopes = match p.gradient {

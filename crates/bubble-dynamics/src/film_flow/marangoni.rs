@@ -80,15 +80,17 @@ impl FilmFlow {
         }
         let substeps = (2.0 * fastest * dt_per_r).ceil().clamp(1.0, 64.0) as u32;
         let sub_dt_per_r = dt_per_r / f64::from(substeps);
+        // Written in place through the resized buffer, not pushed: a push may reallocate,
+        // so every edge loaded Γ's pointer and length again.
+        s.edge2.resize(ea.cells.len(), 0.0);
         for _ in 0..substeps {
-            let flux = &mut s.edge2;
-            flux.clear();
-            let edges = ea.cells.iter().zip(&ea.length);
-            flux.extend(edges.zip(&s.u_start).map(|(([a, b], l), &u0)| {
+            let gamma = &self.gamma[..];
+            let edges = ea.cells.iter().zip(&ea.length).zip(&s.u_start);
+            for (f, (([a, b], l), &u0)) in s.edge2.iter_mut().zip(edges) {
                 let up = if u0 >= 0.0 { *a } else { *b } as usize;
-                self.gamma[up] * u0 * l
-            }));
-            apply_limited_fluxes(&g, flux, sub_dt_per_r, &mut self.gamma, &mut s.cell);
+                *f = gamma[up] * u0 * l;
+            }
+            apply_limited_fluxes(&g, &s.edge2, sub_dt_per_r, &mut self.gamma, &mut s.cell);
         }
     }
 
@@ -134,6 +136,9 @@ impl FilmFlow {
         let rhs = &mut s.rhs;
         rhs.clear();
         rhs.extend(g.areas_sr().iter().zip(gamma).map(|(a, gm)| a * gm));
+        // A slice, not the vector: a store through a `&mut Vec` made every edge load its
+        // pointer and length again.
+        let rhs = &mut rhs[..];
         let velocities = self.u_m_per_s.iter().zip(&s.u_start).zip(&s.drag);
         let inverse_dual = if NORMAL {
             &ea.inverse_normal_dual_length
@@ -277,10 +282,12 @@ impl FilmFlow {
         let r = self.params.radius_m;
         let g = std::sync::Arc::clone(&self.grid);
         let (ea, per_area) = (g.edge_arrays(), g.inverse_areas_per_sr());
-        let (solution, gamma) = (&s.cell2, &self.gamma);
-        let next = &mut s.rhs;
-        next.clear();
-        next.extend_from_slice(gamma);
+        let (solution, gamma) = (&s.cell2[..], &self.gamma[..]);
+        s.rhs.clear();
+        s.rhs.extend_from_slice(gamma);
+        // Slices, not the vectors: a store through a `&mut Vec` made every edge load the
+        // vectors' pointers and lengths again.
+        let next = &mut s.rhs[..];
         let scale = dt_s / r;
         let per_edge = self.u_m_per_s.iter_mut().zip(&s.edge).zip(&s.stiffness);
         let inverse_dual = if NORMAL {
@@ -304,7 +311,7 @@ impl FilmFlow {
             next[b] += moved * per_area[b];
         }
         if !next.iter().any(|&x| x < 0.0) {
-            std::mem::swap(&mut self.gamma, next);
+            std::mem::swap(&mut self.gamma, &mut s.rhs);
             return;
         }
         // A violent step (a film torn near zero thickness, where the waves run at

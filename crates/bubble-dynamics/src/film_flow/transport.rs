@@ -54,10 +54,18 @@ impl FilmFlow {
         let fastest = edges
             .zip(&self.u_m_per_s)
             .map(|((([a, b], per_area), &c), &u)| {
-                let h = self.h_m[*a as usize].max(self.h_m[*b as usize]);
+                let (ha, hb) = (self.h_m[*a as usize], self.h_m[*b as usize]);
+                let h = if hb > ha { hb } else { ha };
                 (u.abs() + 3.0 * c.abs() * h * h) * per_area
             })
-            .fold(0.0, f64::max);
+            // Maxima by comparisons (`max` tests for NaN): the same for thicknesses that
+            // are numbers, and the fold skips a NaN speed as `max` does.
+            .fold(
+                0.0,
+                |fastest, speed| {
+                    if speed > fastest { speed } else { fastest }
+                },
+            );
         fastest * dt_s / self.params.radius_m
     }
 
@@ -82,12 +90,13 @@ impl FilmFlow {
         }
         let cells = &self.grid.edge_arrays().cells;
         let per_area = self.grid.inverse_areas_per_sr();
+        let (h, ratio) = (&mut self.h_m[..], &s.cell[..]);
         for ([a, b], f) in cells.iter().zip(&s.edge2) {
             let (a, b) = (*a as usize, *b as usize);
             let donor = if *f >= 0.0 { a } else { b };
-            let moved = f * s.cell[donor];
-            self.h_m[a] -= moved * per_area[a];
-            self.h_m[b] += moved * per_area[b];
+            let moved = f * ratio[donor];
+            h[a] -= moved * per_area[a];
+            h[b] += moved * per_area[b];
         }
     }
 
@@ -101,14 +110,17 @@ impl FilmFlow {
         range.clear();
         range.extend(self.h_m.iter().map(|h| [*h, *h]));
         let ea = g.edge_arrays();
+        // Slices, not the vectors: a store through a `&mut Vec` made every edge load the
+        // vectors' pointers and lengths again.
+        let (gradient, range) = (&mut gradient[..], &mut range[..]);
         for (([a, b], normal), l) in ea.cells.iter().zip(&ea.normal).zip(&ea.length) {
             let (a, b) = (*a as usize, *b as usize);
             let (ha, hb) = (self.h_m[a], self.h_m[b]);
             let flux = *normal * (0.5 * (ha + hb) * l);
             gradient[a] += flux;
             gradient[b] -= flux;
-            range[a] = [range[a][0].min(hb), range[a][1].max(hb)];
-            range[b] = [range[b][0].min(ha), range[b][1].max(ha)];
+            range[a] = widened(range[a], hb);
+            range[b] = widened(range[b], ha);
         }
         let per_area = g.inverse_areas_per_sr();
         for ((grad, ia), c) in gradient.iter_mut().zip(per_area).zip(g.centres()) {
@@ -137,20 +149,21 @@ impl FilmFlow {
         // The limit is 1 wherever the range holds the whole rise: that test skips the
         // division in most edges of a smooth film (x ≥ y > 0 gives x/y ≥ 1 exactly, so
         // the factor is the same).
+        // (`q < 1` picks as `q.min(1)` does, NaN included, without its NaN test.)
         let allowed = |h: f64, [lo, hi]: [f64; 2], rise: f64| {
             if rise > 0.0 {
                 let room = hi - h;
                 if room >= rise {
                     1.0
                 } else {
-                    (room / rise).min(1.0)
+                    at_most_one(room / rise)
                 }
             } else if rise < 0.0 {
                 let room = lo - h;
                 if room <= rise {
                     1.0
                 } else {
-                    (room / rise).min(1.0)
+                    at_most_one(room / rise)
                 }
             } else {
                 1.0
@@ -160,13 +173,15 @@ impl FilmFlow {
         phi.clear();
         phi.resize(self.h_m.len(), 1.0);
         rises.resize(ea.cells.len(), [0.0; 2]);
+        let phi = &mut phi[..];
         for (([a, b], reach), kept) in ea.cells.iter().zip(&ea.reach).zip(rises.iter_mut()) {
             let (a, b) = (*a as usize, *b as usize);
             let rise = [gradient[a].dot(reach[0]), gradient[b].dot(reach[1])];
             let fa = allowed(self.h_m[a], range[a], rise[0]);
             let fb = allowed(self.h_m[b], range[b], rise[1]);
-            phi[a] = phi[a].min(fa);
-            phi[b] = phi[b].min(fb);
+            // Both at most 1 and neither NaN: the comparison is the minimum.
+            phi[a] = if fa < phi[a] { fa } else { phi[a] };
+            phi[b] = if fb < phi[b] { fb } else { phi[b] };
             *kept = rise;
         }
         for f in phi.iter_mut() {
@@ -183,6 +198,7 @@ impl FilmFlow {
         volume.resize(ea.cells.len(), 0.0);
         outflow.clear();
         outflow.resize(self.grid.cells(), 0.0);
+        let outflow = &mut outflow[..];
         let edges = ea.cells.iter().zip(&s.rise).zip(&ea.length);
         let speeds = self.u_m_per_s.iter().zip(&s.drain_rate);
         for (((&u, &c), (([a, b], rise), l)), v) in speeds.zip(edges).zip(volume.iter_mut()) {
@@ -223,5 +239,33 @@ fn face_thickness(
         (b, a, rise[1])
     };
     let (h_up, h_down) = (h[up], h[down]);
-    (h_up + rise * phi[up]).clamp(h_up.min(h_down), h_up.max(h_down))
+    // The clamp by comparisons: `clamp`, `min` and `max` each tested for NaN (and
+    // `clamp` its bounds' order), a dozen instructions an edge that pick the same value
+    // from any thickness that is a number.
+    let (lo, hi) = if h_down < h_up {
+        (h_down, h_up)
+    } else {
+        (h_up, h_down)
+    };
+    let face = h_up + rise * phi[up];
+    if face < lo {
+        lo
+    } else if face > hi {
+        hi
+    } else {
+        face
+    }
+}
+
+/// `range` widened to hold `h`: `[lo.min(h), hi.max(h)]` for a range and an `h` that are
+/// numbers, by comparisons (`min` and `max` each also test for NaN).
+#[inline(always)]
+fn widened([lo, hi]: [f64; 2], h: f64) -> [f64; 2] {
+    [if h < lo { h } else { lo }, if h > hi { h } else { hi }]
+}
+
+/// `q.min(1.0)`, NaN included (a NaN `q` gives 1), by one comparison.
+#[inline(always)]
+fn at_most_one(q: f64) -> f64 {
+    if q < 1.0 { q } else { 1.0 }
 }

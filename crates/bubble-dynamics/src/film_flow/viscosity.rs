@@ -23,9 +23,9 @@ impl FilmFlow {
         let rate = self.viscous_bound * nu_m2_per_s / (r * r);
         let stages = legendre_stages((dt_s * rate / EULER_RATE_LIMIT).ceil().max(1.0));
         let w1 = 2.0 / f64::from(stages * stages + stages);
-        // Y₀ = u kept as the stage before last; Y₁ = Y₀ + w₁ dt M(Y₀).
-        s.stage.clear();
-        s.stage.extend_from_slice(&self.u_m_per_s);
+        // Y₁ = Y₀ + w₁ dt M(Y₀), with Y₀ = u. The first stage reads no stage before last
+        // (it only writes Y₀ there), so `s.stage` needs its length, not a copy of u.
+        s.stage.resize(self.u_m_per_s.len(), 0.0);
         self.viscous_stage(s, nu_m2_per_s, w1 * dt_s, 1.0, 0.0);
         for j in 2..=stages {
             // Yⱼ = μⱼ Yⱼ₋₁ + νⱼ Yⱼ₋₂ + μⱼ w₁ dt M(Yⱼ₋₁), μⱼ = (2j − 1)/j, νⱼ = (1 − j)/j.
