@@ -332,6 +332,25 @@ fn gallery() -> bool {
         ]);
     }
     ok &= swirl_burst(dir, &bubbles);
+    // The dome's burst: its hole opens on the left at about 11.987 s, the rim crosses in 5 ms.
+    ok &= bubbles(&[
+        "animate",
+        "dome",
+        "--start-s",
+        "11.986",
+        "--seconds",
+        "0.007",
+        "--fps",
+        "30",
+        "--slow-motion",
+        "200",
+        "--out",
+        &format!("{dir}/dome_burst.apng"),
+        "--width",
+        "320",
+        "--height",
+        "240",
+    ]);
     let gif = format!("{dir}/wind.gif");
     ok &= bubbles(&[
         "animate",
