@@ -265,6 +265,33 @@ impl FrameJob {
             .map_err(|e| CliError::input(format!("{}: {e}", self.scene.origin)))
     }
 
+    /// Renders the current state with the CPU backend while the solver takes `steps`
+    /// more steps on the other core: the frame shows the state before those steps, one
+    /// frame behind the solver (the live viewer's pipeline, where the solver and the
+    /// renderer otherwise wait on each other). Returns the frame, what the steps brought
+    /// (bursts) and the wall time they took, s.
+    ///
+    /// The reference and wgpu backends step first and then render the stepped state.
+    pub fn render_while_stepping(
+        &mut self,
+        steps: u32,
+    ) -> Result<(&Frame, Vec<Event>, f64), CliError> {
+        if self.film_spec.is_some() || self.gpu.is_some() {
+            let (events, sim_s) = step_world(&mut self.world, steps);
+            let events = events?;
+            return Ok((self.render()?, events, sim_s));
+        }
+        self.frame_inputs();
+        let (world, renderer) = (&mut self.world, &mut self.renderer);
+        let (scene, tables, settings) = (&self.render_scene, &self.tables, &self.settings);
+        let ((events, sim_s), frame) = rayon::join(
+            || step_world(world, steps),
+            || renderer.render(scene, tables, settings).map(drop),
+        );
+        frame.map_err(|e| CliError::input(format!("{}: {e}", self.scene.origin)))?;
+        Ok((self.renderer.frame(), events?, sim_s))
+    }
+
     /// One solver step, returning what happened (bursts).
     pub fn step_events(&mut self) -> Result<Vec<Event>, CliError> {
         self.world
@@ -339,4 +366,21 @@ fn film_tables(luts: LutSet) -> FilmTables {
         transmittance: None,
         lights: luts.lights.into_iter().map(|(_, lut)| lut).collect(),
     }
+}
+
+/// Takes `steps` solver steps; returns their events (or the first failure) and their wall
+/// time, s.
+fn step_world(world: &mut World, steps: u32) -> (Result<Vec<Event>, CliError>, f64) {
+    let start = std::time::Instant::now();
+    let mut events = Vec::new();
+    for _ in 0..steps {
+        match world.step() {
+            Ok(more) => events.extend(more),
+            Err(e) => {
+                let failed = CliError::runtime(format!("simulation failed: {e}"));
+                return (Err(failed), start.elapsed().as_secs_f64());
+            }
+        }
+    }
+    (Ok(events), start.elapsed().as_secs_f64())
 }

@@ -8,6 +8,7 @@ use super::font;
 use super::pixels::WindowPixels;
 use crate::error::CliError;
 use crate::frame::FrameJob;
+use bubble_dynamics::Event;
 use raster::FrameTimings;
 use std::num::NonZeroU32;
 use std::path::Path;
@@ -72,18 +73,30 @@ impl Presenter {
         }
     }
 
-    /// Renders the job's current state at its size, upscales it to the window's `size`,
-    /// draws `overlay` over it and presents; returns the render's timings.
-    pub(super) fn draw(
+    /// Renders the job's state at its size, upscales it to the window's `size`, draws
+    /// `overlay` over it and presents, with `steps` solver steps: the CPU presenter
+    /// renders the state before them while they run on the other core; the GPU presenter
+    /// takes them first. Returns the render's timings, the steps' events and their wall
+    /// time, s.
+    pub(super) fn draw_while_stepping(
         &mut self,
         job: &mut FrameJob,
         size: (u32, u32),
         overlay: Option<&str>,
-    ) -> Result<FrameTimings, CliError> {
+        steps: u32,
+    ) -> Result<(FrameTimings, Vec<Event>, f64), CliError> {
         match self {
-            Presenter::Cpu(cpu) => cpu.draw(job, size, overlay),
+            Presenter::Cpu(cpu) => cpu.draw_while_stepping(job, size, overlay, steps),
             #[cfg(feature = "wgpu")]
-            Presenter::Gpu(gpu) => gpu.draw(job, overlay),
+            Presenter::Gpu(gpu) => {
+                let start = std::time::Instant::now();
+                let mut events = Vec::new();
+                for _ in 0..steps {
+                    events.extend(job.step_events()?);
+                }
+                let sim_s = start.elapsed().as_secs_f64();
+                Ok((gpu.draw(job, overlay)?, events, sim_s))
+            }
         }
     }
 
@@ -108,18 +121,21 @@ impl Presenter {
 }
 
 impl CpuPresenter {
-    /// Renders, fills the window's buffer (tone-mapped, upscaled if smaller), draws the
-    /// overlay and presents. Allocates nothing once the buffers have grown.
-    fn draw(
+    /// Renders while the solver takes `steps` steps on the other core
+    /// ([`FrameJob::render_while_stepping`]), fills the window's buffer (tone-mapped,
+    /// upscaled if smaller), draws the overlay and presents. Allocates nothing once the
+    /// buffers have grown.
+    fn draw_while_stepping(
         &mut self,
         job: &mut FrameJob,
         (w, h): (u32, u32),
         overlay: Option<&str>,
-    ) -> Result<FrameTimings, CliError> {
+        steps: u32,
+    ) -> Result<(FrameTimings, Vec<Event>, f64), CliError> {
         let tone = (job.settings().exposure_ev, job.settings().tonemap);
         let internal_size = (job.settings().width, job.settings().height);
         let window_size = (w as usize, h as usize);
-        let frame = job.render()?;
+        let (frame, events, sim_s) = job.render_while_stepping(steps)?;
         // Waits for the X server to finish reading the last frame from the shared buffer.
         let mut buffer = self
             .surface
@@ -133,6 +149,6 @@ impl CpuPresenter {
         buffer
             .present()
             .map_err(|e| CliError::runtime(format!("window present: {e}")))?;
-        Ok(frame.timings)
+        Ok((frame.timings, events, sim_s))
     }
 }

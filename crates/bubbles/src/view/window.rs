@@ -108,6 +108,8 @@ struct FrameTotals {
     frame_s: f64,
     steps: u64,
     slow_motion_frames: u64,
+    /// Whether the solver ran alongside the render (the CPU presenter), not before it.
+    sim_alongside: bool,
 }
 
 impl Stats {
@@ -138,8 +140,7 @@ impl FrameTotals {
         [sim_s, bake_s]: [f64; 2],
         t: &FrameTimings,
         frame_s: f64,
-        steps: u32,
-        slow: bool,
+        (steps, slow): (u32, bool),
     ) {
         self.sim_s += sim_s;
         self.bake_s += bake_s;
@@ -151,20 +152,26 @@ impl FrameTotals {
 
     /// The mean frame on one line: solver, the solver's state baked for the renderer, the
     /// render (its phases' sum) and the rest (tone mapping, upscaling, overlay, presenting).
+    /// A solver that ran alongside the render is not part of the frame's sum.
     fn summary(&self, frames: u64) -> String {
         let n = frames.max(1) as f64;
         let ms = |s: f64| s / n * 1e3;
+        let (when, in_sum) = if self.sim_alongside {
+            (" alongside the render", 0.0)
+        } else {
+            ("", self.sim_s)
+        };
         format!(
-            "view: mean frame {:.1} ms: sim {:.1} ms ({:.1} steps, slow motion in {} of {frames} \
-             frames), bake {:.1} ms, render {:.1} ms, the rest {:.1} ms (tone map, upscale, \
-             overlay, present)",
+            "view: mean frame {:.1} ms: sim {:.1} ms{when} ({:.1} steps, slow motion in {} of \
+             {frames} frames), bake {:.1} ms, render {:.1} ms, the rest {:.1} ms (tone map, \
+             upscale, overlay, present)",
             ms(self.frame_s),
             ms(self.sim_s),
             self.steps as f64 / n,
             self.slow_motion_frames,
             ms(self.bake_s),
             ms(self.render_s),
-            ms(self.frame_s - self.sim_s - self.bake_s - self.render_s)
+            ms(self.frame_s - in_sum - self.bake_s - self.render_s)
         )
     }
 }
@@ -376,23 +383,21 @@ impl App {
         Ok(())
     }
 
-    /// Steps the solver to catch up with the wall clock, at its fixed step; returns the
-    /// steps taken.
-    fn simulate(&mut self, now: Instant) -> Result<u32, CliError> {
+    /// The solver steps that catch up with the wall clock, at its fixed step (at most
+    /// [`MAX_STEPS_PER_FRAME`]; beyond that the view falls into slow motion).
+    fn steps_due(&mut self, now: Instant) -> u32 {
         let elapsed = self
             .last_frame
             .map_or(0.0, |t| (now - t).as_secs_f64().min(MAX_FRAME_S));
         self.last_frame = Some(now);
         if self.state.paused {
             self.behind_s = 0.0;
-            return Ok(0);
+            return 0;
         }
         self.behind_s += elapsed;
         let dt = self.job.dt_s();
         let mut steps = 0;
         while self.behind_s >= dt && steps < MAX_STEPS_PER_FRAME {
-            let events = self.job.step_events()?;
-            self.report(&events);
             self.behind_s -= dt;
             steps += 1;
         }
@@ -400,7 +405,7 @@ impl App {
         if self.stats.slow_motion {
             self.behind_s = 0.0;
         }
-        Ok(steps)
+        steps
     }
 
     fn report(&mut self, events: &[Event]) {
@@ -422,8 +427,7 @@ impl App {
             return Ok(());
         };
         let start = Instant::now();
-        let steps = self.simulate(start)?;
-        let sim_s = start.elapsed().as_secs_f64();
+        let steps = self.steps_due(start);
         if let Some(camera) = self.state.orbit.camera() {
             self.job.set_camera(camera);
         }
@@ -434,12 +438,20 @@ impl App {
             return Ok(());
         };
         let overlay = has_overlay.then_some(self.overlay.as_str());
-        let t = gfx.presenter.draw(&mut self.job, (win_w, win_h), overlay)?;
+        // The CPU presenter renders while the solver steps on the other core; the GPU
+        // presenter steps first.
+        let (t, events, sim_s) =
+            gfx.presenter
+                .draw_while_stepping(&mut self.job, (win_w, win_h), overlay, steps)?;
+        let alongside = !gfx.presenter.is_gpu();
+        self.report(&events);
         self.scale.update(t.total_s() as f32);
         let frame_s = start.elapsed().as_secs_f64();
         if let Some(q) = &mut self.quit_after {
             let bake_s = self.job.last_bake_s();
-            (q.totals).add([sim_s, bake_s], &t, frame_s, steps, self.stats.slow_motion);
+            q.totals.sim_alongside = alongside;
+            let motion = (steps, self.stats.slow_motion);
+            (q.totals).add([sim_s, bake_s], &t, frame_s, motion);
         }
         self.stats.mix(sim_s, &t, frame_s);
         Ok(())
