@@ -212,16 +212,15 @@ fn figures() -> bool {
     fig2 && chart && paper && furnace && sodium && gallery
 }
 
-/// The swirl scene's burst in slow motion (docs/gallery.md): an animated PNG 200× slower
-/// than real time from just before the hole opens (t = 11.4667 s) until the bubble is
-/// gone, and two larger stills 1 ms apart taken as the frames of a second animation.
-fn swirl_burst(dir: &str, bubbles: &dyn Fn(&[&str]) -> bool) -> bool {
-    let movie = format!("{dir}/swirl_burst.apng");
-    let mut ok = bubbles(&[
+/// `scene`'s burst as `dir/<scene>_burst.apng`: 7 ms from `start_s`, 200× slower than
+/// real time, 30 fps at 320 × 240.
+fn burst_movie(dir: &str, scene: &str, start_s: &str, bubbles: &dyn Fn(&[&str]) -> bool) -> bool {
+    let movie = format!("{dir}/{scene}_burst.apng");
+    bubbles(&[
         "animate",
-        "swirl",
+        scene,
         "--start-s",
-        "11.466",
+        start_s,
         "--seconds",
         "0.007",
         "--fps",
@@ -234,7 +233,14 @@ fn swirl_burst(dir: &str, bubbles: &dyn Fn(&[&str]) -> bool) -> bool {
         "320",
         "--height",
         "240",
-    ]);
+    ])
+}
+
+/// The swirl scene's burst in slow motion (docs/gallery.md): an animated PNG 200× slower
+/// than real time from just before the hole opens (t = 11.4667 s) until the bubble is
+/// gone, and two larger stills 1 ms apart taken as the frames of a second animation.
+fn swirl_burst(dir: &str, bubbles: &dyn Fn(&[&str]) -> bool) -> bool {
+    let mut ok = burst_movie(dir, "swirl", "11.466", bubbles);
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let frames = std::env::temp_dir().join("bubbles-swirl-burst-stills");
     let _ = std::fs::remove_dir_all(&frames);
@@ -333,24 +339,7 @@ fn gallery() -> bool {
     }
     ok &= swirl_burst(dir, &bubbles);
     // The dome's burst: its hole opens on the left at about 11.987 s, the rim crosses in 5 ms.
-    ok &= bubbles(&[
-        "animate",
-        "dome",
-        "--start-s",
-        "11.986",
-        "--seconds",
-        "0.007",
-        "--fps",
-        "30",
-        "--slow-motion",
-        "200",
-        "--out",
-        &format!("{dir}/dome_burst.apng"),
-        "--width",
-        "320",
-        "--height",
-        "240",
-    ]);
+    ok &= burst_movie(dir, "dome", "11.986", &bubbles);
     let gif = format!("{dir}/wind.gif");
     ok &= bubbles(&[
         "animate",
