@@ -13,6 +13,7 @@
 //! keep the exact law. Fluxes that sum to zero keep liquid conserved to rounding, each
 //! donor limited to half its content keeps h ≥ 0.
 
+use super::compare::smaller;
 use super::flow::apply_limited_fluxes;
 use super::grid::CubeSphere;
 
@@ -152,10 +153,7 @@ fn substep(
         let (a, b) = (*a as usize, *b as usize);
         let rise = laplacian[b] - laplacian[a];
         let donor = h_m[if rise >= 0.0 { a } else { b }];
-        // `x < cap` picks as `x.min(cap)` does (NaN included: the cap), without its
-        // NaN test.
-        let m = per_cubed * donor * donor * donor;
-        let m = if m < cap { m } else { cap };
+        let m = smaller(per_cubed * donor * donor * donor, cap);
         *flux = m * rise / (d * radius_m) * l * dt_s / radius_m;
     }
     // Each donor gives at most half its content: h stays ≥ 0.

@@ -18,6 +18,7 @@ use glam::DVec3;
 use super::advect::{AdvectionGeometry, AdvectionScratch, advect_momentum};
 use super::burst::{BurstParams, BurstState, Hole};
 use super::capillary::{Capillary, CapillaryScratch, smooth_thickness};
+use super::compare::larger;
 use super::grid::CubeSphere;
 use super::meniscus::MeniscusState;
 use super::solve::{Hierarchy, SolveReport, Work};
@@ -442,15 +443,10 @@ impl FilmFlow {
         s.drag.resize(self.u_m_per_s.len(), 1.0);
         let nu_air = p.air_viscosity_pa_s / p.air_density_kg_per_m3.max(f64::MIN_POSITIVE);
         let (r, eddy) = (p.radius_m, 0.25 * p.radius_m);
-        // 1/δ = max(√(|Δu|/(ν_air ℓ)), 1/R): a multiply where 1/δ was a division. The
-        // maximum by a comparison, which picks as `max` does (NaN included: 1/R) without
-        // its NaN test.
+        // 1/δ = max(√(|Δu|/(ν_air ℓ)), 1/R): a multiply where 1/δ was a division.
         let per_layer_depth = {
             let (per_slip, floor) = (1.0 / (nu_air * eddy), 1.0 / r);
-            move |slip: f64| {
-                let depth = (slip * per_slip).sqrt();
-                if depth > floor { depth } else { floor }
-            }
+            move |slip: f64| larger((slip * per_slip).sqrt(), floor)
         };
         let ea = self.grid.edge_arrays();
         let slopes = match p.gradient {

@@ -139,9 +139,16 @@ impl MeniscusState {
     /// Pins the surfaces at the walls: their velocity zero, and the Marangoni step's
     /// implicit factor zero there, so that the step does not change it.
     pub(super) fn hold(&self, u_m_per_s: &mut [f64], implicit_factor: &mut [f64]) {
+        self.pin(u_m_per_s);
+        for &e in &self.walls {
+            implicit_factor[e as usize] = 0.0;
+        }
+    }
+
+    /// The surfaces' velocity at the walls set to zero.
+    fn pin(&self, u_m_per_s: &mut [f64]) {
         for &e in &self.walls {
             u_m_per_s[e as usize] = 0.0;
-            implicit_factor[e as usize] = 0.0;
         }
     }
 
@@ -238,8 +245,7 @@ impl FilmFlow {
         let r = self.params.radius_m;
         let mut state = MeniscusState::new(&self.grid, meniscus, up, r, self.params.seed);
         state.absorb(&mut self.h_m, self.grid.areas_sr(), r);
-        let mut unused_factor = vec![0.0; self.u_m_per_s.len()];
-        state.hold(&mut self.u_m_per_s, &mut unused_factor);
+        state.pin(&mut self.u_m_per_s);
         self.with_burst(|burst, _| burst.close(state.bath()));
         self.meniscus = Some(Box::new(state));
     }

@@ -6,6 +6,7 @@ mod advect;
 mod burst;
 mod capillary;
 mod cell_map;
+mod compare;
 mod flow;
 pub mod grid;
 mod marangoni;

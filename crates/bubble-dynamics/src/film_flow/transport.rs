@@ -10,6 +10,7 @@
 
 use glam::DVec3;
 
+use super::compare::{larger, smaller};
 use super::flow::{FilmFlow, MAX_OUTFLOW_FRACTION, Scratch};
 
 /// Most sub-steps one thickness transport takes.
@@ -55,17 +56,11 @@ impl FilmFlow {
             .zip(&self.u_m_per_s)
             .map(|((([a, b], per_area), &c), &u)| {
                 let (ha, hb) = (self.h_m[*a as usize], self.h_m[*b as usize]);
-                let h = if hb > ha { hb } else { ha };
+                let h = larger(hb, ha);
                 (u.abs() + 3.0 * c.abs() * h * h) * per_area
             })
-            // Maxima by comparisons (`max` tests for NaN): the same for thicknesses that
-            // are numbers, and the fold skips a NaN speed as `max` does.
-            .fold(
-                0.0,
-                |fastest, speed| {
-                    if speed > fastest { speed } else { fastest }
-                },
-            );
+            // The fold skips a NaN speed as `max` does.
+            .fold(0.0, |fastest, speed| larger(speed, fastest));
         fastest * dt_s / self.params.radius_m
     }
 
@@ -149,21 +144,20 @@ impl FilmFlow {
         // The limit is 1 wherever the range holds the whole rise: that test skips the
         // division in most edges of a smooth film (x ≥ y > 0 gives x/y ≥ 1 exactly, so
         // the factor is the same).
-        // (`q < 1` picks as `q.min(1)` does, NaN included, without its NaN test.)
         let allowed = |h: f64, [lo, hi]: [f64; 2], rise: f64| {
             if rise > 0.0 {
                 let room = hi - h;
                 if room >= rise {
                     1.0
                 } else {
-                    at_most_one(room / rise)
+                    smaller(room / rise, 1.0)
                 }
             } else if rise < 0.0 {
                 let room = lo - h;
                 if room <= rise {
                     1.0
                 } else {
-                    at_most_one(room / rise)
+                    smaller(room / rise, 1.0)
                 }
             } else {
                 1.0
@@ -179,9 +173,8 @@ impl FilmFlow {
             let rise = [gradient[a].dot(reach[0]), gradient[b].dot(reach[1])];
             let fa = allowed(self.h_m[a], range[a], rise[0]);
             let fb = allowed(self.h_m[b], range[b], rise[1]);
-            // Both at most 1 and neither NaN: the comparison is the minimum.
-            phi[a] = if fa < phi[a] { fa } else { phi[a] };
-            phi[b] = if fb < phi[b] { fb } else { phi[b] };
+            phi[a] = smaller(fa, phi[a]);
+            phi[b] = smaller(fb, phi[b]);
             *kept = rise;
         }
         for f in phi.iter_mut() {
@@ -257,15 +250,8 @@ fn face_thickness(
     }
 }
 
-/// `range` widened to hold `h`: `[lo.min(h), hi.max(h)]` for a range and an `h` that are
-/// numbers, by comparisons (`min` and `max` each also test for NaN).
+/// `range` widened to hold `h`: `[lo.min(h), hi.max(h)]` for a range that is numbers.
 #[inline(always)]
 fn widened([lo, hi]: [f64; 2], h: f64) -> [f64; 2] {
-    [if h < lo { h } else { lo }, if h > hi { h } else { hi }]
-}
-
-/// `q.min(1.0)`, NaN included (a NaN `q` gives 1), by one comparison.
-#[inline(always)]
-fn at_most_one(q: f64) -> f64 {
-    if q < 1.0 { q } else { 1.0 }
+    [smaller(h, lo), larger(h, hi)]
 }

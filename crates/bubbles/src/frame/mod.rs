@@ -277,8 +277,7 @@ impl FrameJob {
         steps: u32,
     ) -> Result<(&Frame, Vec<Event>, f64), CliError> {
         if self.film_spec.is_some() || self.gpu.is_some() {
-            let (events, sim_s) = step_world(&mut self.world, steps);
-            let events = events?;
+            let (events, sim_s) = self.step_timed(steps)?;
             return Ok((self.render()?, events, sim_s));
         }
         self.frame_inputs();
@@ -290,6 +289,13 @@ impl FrameJob {
         );
         frame.map_err(|e| CliError::input(format!("{}: {e}", self.scene.origin)))?;
         Ok((self.renderer.frame(), events?, sim_s))
+    }
+
+    /// Takes `steps` solver steps; returns what they brought (bursts) and their wall
+    /// time, s.
+    pub fn step_timed(&mut self, steps: u32) -> Result<(Vec<Event>, f64), CliError> {
+        let (events, sim_s) = step_world(&mut self.world, steps);
+        Ok((events?, sim_s))
     }
 
     /// One solver step, returning what happened (bursts).

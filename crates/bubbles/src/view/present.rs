@@ -89,12 +89,7 @@ impl Presenter {
             Presenter::Cpu(cpu) => cpu.draw_while_stepping(job, size, overlay, steps),
             #[cfg(feature = "wgpu")]
             Presenter::Gpu(gpu) => {
-                let start = std::time::Instant::now();
-                let mut events = Vec::new();
-                for _ in 0..steps {
-                    events.extend(job.step_events()?);
-                }
-                let sim_s = start.elapsed().as_secs_f64();
+                let (events, sim_s) = job.step_timed(steps)?;
                 Ok((gpu.draw(job, overlay)?, events, sim_s))
             }
         }

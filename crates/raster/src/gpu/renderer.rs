@@ -427,21 +427,7 @@ impl GpuRenderer {
         face_size: usize,
         layers: u32,
     ) {
-        if self
-            .border_sources
-            .as_ref()
-            .is_none_or(|(n, _)| *n != face_size)
-        {
-            let table = CubeMap::border_source_table(face_size);
-            let bytes: Vec<u8> = table.iter().flat_map(|x| x.to_le_bytes()).collect();
-            let buffer = self
-                .gpu
-                .buffer("border sources", &bytes, wgpu::BufferUsages::STORAGE);
-            self.border_sources = Some((face_size, buffer));
-        }
-        let Some((_, border_sources)) = &self.border_sources else {
-            unreachable!("the table was just made")
-        };
+        let border_sources = self.border_sources(face_size);
         let device = &self.gpu.device;
         let faces = faces.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
@@ -487,6 +473,23 @@ impl GpuRenderer {
             pass.set_pipeline(&self.layouts.mip_borders);
             pass.dispatch_workgroups(groups_of(n + 2), groups_of(n + 2), layers);
         }
+    }
+
+    /// `CubeMap::border_source_table(face_size)` on the device, uploaded once per face
+    /// size.
+    fn border_sources(&mut self, face_size: usize) -> wgpu::Buffer {
+        if let Some((n, buffer)) = &self.border_sources
+            && *n == face_size
+        {
+            return buffer.clone();
+        }
+        let table = CubeMap::border_source_table(face_size);
+        let bytes: Vec<u8> = table.iter().flat_map(|x| x.to_le_bytes()).collect();
+        let buffer = self
+            .gpu
+            .buffer("border sources", &bytes, wgpu::BufferUsages::STORAGE);
+        self.border_sources = Some((face_size, buffer.clone()));
+        buffer
     }
 
     /// The water's vertices, bind group and cube texture (`m`² texels a face, six faces,
