@@ -23,6 +23,7 @@ use super::grid::CubeSphere;
 use super::meniscus::MeniscusState;
 use super::solve::{Hierarchy, SolveReport, Work};
 use super::thermal::{ThermalParams, up_from};
+use super::upwind::UpwindGeometry;
 use super::viscosity::viscous_bound;
 
 /// Thickness floor of the Marangoni coefficient `E_f/(ρh)`, m: a hole or a Newton black
@@ -133,6 +134,8 @@ pub struct FilmFlow {
     pub(super) hierarchy: std::sync::Arc<Hierarchy>,
     /// The momentum advection's weights, fixed by the grid.
     advection: std::sync::Arc<AdvectionGeometry>,
+    /// The thickness transport's weights, fixed by the grid.
+    pub(super) transport: std::sync::Arc<UpwindGeometry>,
     pub(crate) params: FlowParams,
     pub(super) burst: Option<Box<BurstState>>,
     /// The meniscus of a film standing on a wet surface.
@@ -163,14 +166,9 @@ pub(super) struct Scratch {
     pub(super) u_start: Vec<f64>,
     pub(super) stiffness: Vec<f64>,
     pub(super) guess: Vec<f64>,
-    pub(super) gradient: Vec<DVec3>,
-    /// Per cell: the least and greatest thickness of the cell and its edge neighbours.
-    pub(super) neighbour_range: Vec<[f64; 2]>,
-    /// Per cell: the factor its thickness gradient is limited by.
-    pub(super) limiter: Vec<f64>,
-    /// Per edge: how far cell `a`'s and cell `b`'s unlimited gradients carry their
-    /// thickness to the edge midpoint, m.
-    pub(super) rise: Vec<[f64; 2]>,
+    /// Per side `k` and cell: how far the cell's limited gradient carries its thickness
+    /// to that side's midpoint, m.
+    pub(super) limited_rise: [Vec<f64>; 4],
     pub(super) drag: Vec<f64>,
     /// Per edge: the drainage speed's coefficient over `h²`, s⁻¹·m⁻¹.
     pub(super) drain_rate: Vec<f64>,
@@ -204,6 +202,7 @@ impl FilmFlow {
             meniscus: None,
             viscous_bound: viscous_bound(&grid),
             advection: std::sync::Arc::new(AdvectionGeometry::new(&grid)),
+            transport: std::sync::Arc::new(UpwindGeometry::new(&grid)),
             params,
             h_m: h,
             gamma: vec![1.0; cells],

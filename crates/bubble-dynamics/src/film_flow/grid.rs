@@ -308,6 +308,11 @@ impl CubeSphere {
         across * ea.inverse_normal_dual_length[e] - along * ea.cross_per_length[e]
     }
 
+    /// Where the face-structured passes find each face's interior edges.
+    pub fn layout(&self) -> FaceLayout {
+        FaceLayout { n: self.n }
+    }
+
     /// Cells along a face edge.
     pub fn face_size(&self) -> usize {
         self.n
@@ -416,7 +421,65 @@ fn build_edges(corners: &[[u32; 4]], centres: &[DVec3], vertices: &[DVec3]) -> V
         }
     }
     assert!(first_cell.is_empty(), "cube-sphere edges left unpaired");
+    let n = (((corners.len() / 6) as f64).sqrt().round()) as usize;
+    edges.sort_by_key(|e| structured_key(n, e.a as usize, e.b as usize));
     edges
+}
+
+/// Where edge `a → b` goes in the face-structured edge order ([`FaceLayout`]): a face's
+/// interior x-edges row by row, then its interior y-edges row by row, then the seams
+/// between faces in the order they were found.
+fn structured_key(n: usize, a: usize, b: usize) -> (u8, usize) {
+    if a / (n * n) != b / (n * n) {
+        (2, 0)
+    } else if b == a + 1 {
+        (0, FaceLayout { n }.x_edge_of_cell(b))
+    } else {
+        (1, FaceLayout { n }.y_edge_of_cell(b))
+    }
+}
+
+/// The face-structured numbering of a cube-sphere's edges: within a face, the interior
+/// edges lie in rows in the order of the cells they join, so a pass over a face's
+/// interior reads each neighbour and each edge as a contiguous slice (and vectorises)
+/// where the edge-by-edge passes gather and scatter through index arrays.
+///
+/// # Guarantees
+/// - The x-edge of cell `(face, y, x)`, `x ≥ 1`, joins `(face, y, x − 1)` (`a`) to it
+///   (`b`), at [`FaceLayout::x_edge_of_cell`]; the x-edges of one row are consecutive.
+/// - Its y-edge, `y ≥ 1`, joins `(face, y − 1, x)` (`a`) to it (`b`), at
+///   [`FaceLayout::y_edge_of_cell`]; the y-edges of one row are consecutive.
+/// - The `12·n` seam edges come last, from [`FaceLayout::first_seam_edge`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FaceLayout {
+    /// Cells along a face edge.
+    pub n: usize,
+}
+
+impl FaceLayout {
+    /// The x-edge whose `b` cell is `cell` (`x ≥ 1`).
+    pub fn x_edge_of_cell(self, cell: usize) -> usize {
+        let n = self.n;
+        let (face, y, x) = (cell / (n * n), (cell / n) % n, cell % n);
+        debug_assert!(x >= 1, "cell {cell} has no x-edge inside its face");
+        face * n * (n - 1) + y * (n - 1) + x - 1
+    }
+
+    /// The y-edge whose `b` cell is `cell` (`y ≥ 1`).
+    pub fn y_edge_of_cell(self, cell: usize) -> usize {
+        let n = self.n;
+        let face = cell / (n * n);
+        debug_assert!(
+            (cell / n) % n >= 1,
+            "cell {cell} has no y-edge inside its face"
+        );
+        6 * n * (n - 1) + face * n * (n - 1) + cell % (n * n) - n
+    }
+
+    /// The first seam edge (between two faces).
+    pub fn first_seam_edge(self) -> usize {
+        12 * self.n * (self.n - 1)
+    }
 }
 
 fn edge(a: u32, b: u32, (p, q): (u32, u32), centres: &[DVec3], vertices: &[DVec3]) -> GridEdge {
@@ -447,6 +510,40 @@ fn edge(a: u32, b: u32, (p, q): (u32, u32), centres: &[DVec3], vertices: &[DVec3
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn interior_edges_lie_in_rows_at_their_structured_index() {
+        for n in [1, 2, 5, 16] {
+            let g = CubeSphere::new(n);
+            let (layout, edges) = (g.layout(), g.edges());
+            for cell in 0..g.cells() {
+                let (x, y) = (cell % n, (cell / n) % n);
+                if x >= 1 {
+                    let e = &edges[layout.x_edge_of_cell(cell)];
+                    assert_eq!(
+                        (e.a as usize, e.b as usize),
+                        (cell - 1, cell),
+                        "n {n} x-edge"
+                    );
+                }
+                if y >= 1 {
+                    let e = &edges[layout.y_edge_of_cell(cell)];
+                    assert_eq!(
+                        (e.a as usize, e.b as usize),
+                        (cell - n, cell),
+                        "n {n} y-edge"
+                    );
+                }
+            }
+            let seams = &edges[layout.first_seam_edge()..];
+            assert_eq!(seams.len(), 12 * n, "n {n}");
+            assert!(
+                seams
+                    .iter()
+                    .all(|e| e.a as usize / (n * n) != e.b as usize / (n * n))
+            );
+        }
+    }
 
     #[test]
     fn areas_sum_to_the_sphere_and_edges_pair_every_cell_side() {

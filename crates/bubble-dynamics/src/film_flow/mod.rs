@@ -12,9 +12,11 @@ pub mod grid;
 mod marangoni;
 mod meniscus;
 pub(crate) mod on_bubble;
+mod sides;
 pub mod solve;
 mod thermal;
 mod transport;
+mod upwind;
 mod viscosity;
 
 pub use burst::{BLACK_RELAX_S, BurstParams, Hole, RIM_CELLS_PER_SUBSTEP};
