@@ -10,11 +10,15 @@
 //! velocity correction with the surfactant's move (into a copy, so the correction still
 //! reads the surfactant the solve started from and the rare redo needs no restore).
 
+use super::compare::larger;
 use super::flow::{
     FilmFlow, FilmGradient, H_FLOOR_M, SOLVE_MAX_ITERATIONS, SOLVE_TOLERANCE, Scratch,
-    apply_limited_fluxes,
 };
+use super::fluxes::{apply_limited, net_inflow};
+use super::grid::EdgeArrays;
+use super::sides::{CellSides, EdgeRun};
 use super::solve::{SolveLimits, SolveReport};
+use crate::avx2::with_avx2;
 
 /// Most solves a step's defect correction of the cross term takes (it takes about 11 on
 /// the swirl film at n = 64: each cuts the error by about 0.35, the cross operator's
@@ -80,17 +84,21 @@ impl FilmFlow {
         }
         let substeps = (2.0 * fastest * dt_per_r).ceil().clamp(1.0, 64.0) as u32;
         let sub_dt_per_r = dt_per_r / f64::from(substeps);
-        // Written in place through the resized buffer, not pushed: a push may reallocate,
-        // so every edge loaded Γ's pointer and length again.
         s.edge2.resize(ea.cells.len(), 0.0);
+        let sides = &self.transport.sides;
+        let (areas, per_area) = (g.areas_sr(), g.inverse_areas_per_sr());
         for _ in 0..substeps {
-            let gamma = &self.gamma[..];
-            let edges = ea.cells.iter().zip(&ea.length).zip(&s.u_start);
-            for (f, (([a, b], l), &u0)) in s.edge2.iter_mut().zip(edges) {
-                let up = if u0 >= 0.0 { *a } else { *b } as usize;
-                *f = gamma[up] * u0 * l;
-            }
-            apply_limited_fluxes(&g, &s.edge2, sub_dt_per_r, &mut self.gamma, &mut s.cell);
+            upwind_fluxes(sides, ea, &self.gamma, &s.u_start, &mut s.edge2);
+            let (flux, gamma) = (&s.edge2, &mut self.gamma);
+            apply_limited(
+                sides,
+                areas,
+                per_area,
+                flux,
+                sub_dt_per_r,
+                gamma,
+                &mut s.cell,
+            );
         }
     }
 
@@ -115,60 +123,82 @@ impl FilmFlow {
     /// forever and most film tests blew up.
     fn fluxes_weights_and_right_hand_side<const NORMAL: bool>(&self, s: &mut Scratch, dt_s: f64) {
         let p = &self.params;
-        let per_r2 = 1.0 / (p.radius_m * p.radius_m);
-        let per_r = 1.0 / p.radius_m;
-        let dt_per_r = dt_s / p.radius_m;
         let g = &self.grid;
         let ea = g.edge_arrays();
-        let (gamma, h) = (&self.gamma, &self.h_m);
         let n = ea.cells.len();
         if NORMAL {
             g.cells_to_vertices(&s.cell2, &mut s.vertex);
             s.cross.resize(n, 0.0);
         }
-        let (at_vertex, cross_term) = (&s.vertex, &mut s.cross);
-        // Written in place through resized buffers: three pushes an edge each checked
-        // the capacity.
         s.edge.resize(n, 0.0);
         s.stiffness.resize(n, 0.0);
         s.weight.resize(n, 0.0);
-        let outputs = s.edge.iter_mut().zip(&mut s.stiffness).zip(&mut s.weight);
-        let rhs = &mut s.rhs;
-        rhs.clear();
-        rhs.extend(g.areas_sr().iter().zip(gamma).map(|(a, gm)| a * gm));
-        // A slice, not the vector: a store through a `&mut Vec` made every edge load its
-        // pointer and length again.
-        let rhs = &mut rhs[..];
-        let velocities = self.u_m_per_s.iter().zip(&s.u_start).zip(&s.drag);
+        let edge = EdgeConstants {
+            // `dt E/ρ`: over the edge's thickness, the stiffness `k`.
+            dt_e_per_rho: dt_s * p.elasticity_n_per_m / p.density_kg_per_m3,
+            dt_per_r2: dt_s / (p.radius_m * p.radius_m),
+            per_r: 1.0 / p.radius_m,
+        };
+        let sides = &self.transport.sides;
+        with_avx2(
+            #[inline(always)]
+            || {
+                for run in sides.every_edge_run(&ea.cells) {
+                    self.central_fluxes_run::<NORMAL>(s, run, edge);
+                }
+            },
+        );
+        // `A Γ − dt Σ F/R`: each cell's net inflow of the fluxes, gathered.
+        net_inflow(sides, &s.edge, &mut s.rhs);
+        let dt_per_r = dt_s / p.radius_m;
+        let cells = s.rhs.iter_mut().zip(g.areas_sr()).zip(&self.gamma);
+        for ((rhs, area), gamma) in cells {
+            *rhs = area * gamma + dt_per_r * *rhs;
+        }
+    }
+
+    /// [`Self::fluxes_weights_and_right_hand_side`]'s edge pass over one run of edges.
+    #[inline(always)]
+    fn central_fluxes_run<const NORMAL: bool>(
+        &self,
+        s: &mut Scratch,
+        run: EdgeRun,
+        c: EdgeConstants,
+    ) {
+        let ea = self.grid.edge_arrays();
+        let (len, edges) = (run.len, run.edges());
+        let (ga, gb) = (&self.gamma[run.a_cells()], &self.gamma[run.b_cells()]);
+        let (ha, hb) = (&self.h_m[run.a_cells()], &self.h_m[run.b_cells()]);
+        let (ga, gb, ha, hb) = (&ga[..len], &gb[..len], &ha[..len], &hb[..len]);
+        let (u, u0) = (&self.u_m_per_s[edges.clone()], &s.u_start[edges.clone()]);
+        let (drag, l) = (&s.drag[edges.clone()], &ea.length[edges.clone()]);
         let inverse_dual = if NORMAL {
             &ea.inverse_normal_dual_length
         } else {
             &ea.inverse_dual_length
         };
-        let lengths = ea.length.iter().zip(inverse_dual);
-        let edges = velocities.zip(ea.cells.iter().zip(lengths));
-        for (e, ((((&u, &u0), drag), ([a, b], (l, id))), ((flux, stiffness), weight))) in
-            edges.zip(outputs).enumerate()
-        {
-            let (a, b) = (*a as usize, *b as usize);
-            let gamma_c = 0.5 * (gamma[a] + gamma[b]);
-            let h_edge = (0.5 * (h[a] + h[b])).max(H_FLOOR_M);
-            let k = dt_s * p.elasticity_n_per_m / (p.density_kg_per_m3 * h_edge) * drag;
+        let id = &inverse_dual[edges.clone()];
+        let (u, u0, drag, l, id) = (&u[..len], &u0[..len], &drag[..len], &l[..len], &id[..len]);
+        let flux = &mut s.edge[edges.clone()];
+        let stiffness = &mut s.stiffness[edges.clone()];
+        let weight = &mut s.weight[edges.clone()];
+        for i in 0..len {
+            let gamma_c = 0.5 * (ga[i] + gb[i]);
+            let h_edge = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
+            let k = c.dt_e_per_rho / h_edge * drag[i];
             let u = if NORMAL {
+                let e = run.start + i;
                 let [v0, v1] = ea.vertices[e];
-                let along = at_vertex[v1 as usize] - at_vertex[v0 as usize];
-                let du = k * ea.cross_per_length[e] * along * per_r;
-                cross_term[e] = du / gamma_c.max(f64::MIN_POSITIVE);
-                u + cross_term[e]
+                let along = s.vertex[v1 as usize] - s.vertex[v0 as usize];
+                let du = k * ea.cross_per_length[e] * along * c.per_r;
+                s.cross[e] = du / gamma_c.max(f64::MIN_POSITIVE);
+                u[i] + s.cross[e]
             } else {
-                u
+                u[i]
             };
-            let f = gamma_c * (u - u0) * l;
-            *flux = f;
-            rhs[a] -= dt_per_r * f;
-            rhs[b] += dt_per_r * f;
-            *stiffness = k;
-            *weight = dt_s * k * l * id * per_r2;
+            flux[i] = gamma_c * (u - u0[i]) * l[i];
+            stiffness[i] = k;
+            weight[i] = c.dt_per_r2 * k * l[i] * id[i];
         }
     }
 
@@ -281,36 +311,28 @@ impl FilmFlow {
     ) {
         let r = self.params.radius_m;
         let g = std::sync::Arc::clone(&self.grid);
-        let (ea, per_area) = (g.edge_arrays(), g.inverse_areas_per_sr());
-        let (solution, gamma) = (&s.cell2[..], &self.gamma[..]);
-        s.rhs.clear();
-        s.rhs.extend_from_slice(gamma);
-        // Slices, not the vectors: a store through a `&mut Vec` made every edge load the
-        // vectors' pointers and lengths again.
-        let next = &mut s.rhs[..];
+        let transport = std::sync::Arc::clone(&self.transport);
+        let (ea, sides) = (g.edge_arrays(), &transport.sides);
         let scale = dt_s / r;
-        let per_edge = self.u_m_per_s.iter_mut().zip(&s.edge).zip(&s.stiffness);
-        let inverse_dual = if NORMAL {
-            &ea.inverse_normal_dual_length
-        } else {
-            &ea.inverse_dual_length
-        };
-        let edges = ea.cells.iter().zip(ea.length.iter().zip(inverse_dual));
-        for (e, (((u, f_adv), k), ([a, b], (l, id)))) in per_edge.zip(edges).enumerate() {
-            let (a, b) = (*a as usize, *b as usize);
-            let gamma_c = 0.5 * (gamma[a] + gamma[b]);
-            let slope = (solution[b] - solution[a]) * id / r;
-            let du = -k * slope / gamma_c.max(f64::MIN_POSITIVE);
-            if NORMAL {
-                *u += du + s.cross[e];
-            } else {
-                *u += du;
-            }
-            let moved = scale * (f_adv + gamma_c * du * l);
-            next[a] -= moved * per_area[a];
-            next[b] += moved * per_area[b];
+        s.edge2.resize(ea.cells.len(), 0.0);
+        with_avx2(
+            #[inline(always)]
+            || {
+                for run in sides.every_edge_run(&ea.cells) {
+                    self.correct_velocity_run::<NORMAL>(s, run, scale);
+                }
+            },
+        );
+        net_inflow(sides, &s.edge2, &mut s.rhs);
+        let cells = s
+            .rhs
+            .iter_mut()
+            .zip(&self.gamma)
+            .zip(g.inverse_areas_per_sr());
+        for ((next, gamma), per_area) in cells {
+            *next = gamma + *next * per_area;
         }
-        if !next.iter().any(|&x| x < 0.0) {
+        if !s.rhs.iter().any(|&x| x < 0.0) {
             std::mem::swap(&mut self.gamma, &mut s.rhs);
             return;
         }
@@ -318,15 +340,88 @@ impl FilmFlow {
         // hundreds of m/s) overshot: redo it with every flux upwind and each donor
         // limited, which keeps Γ positive and still conserves it. (The starting
         // velocity's transport is done: this moves Γ with the step's change only.)
-        let flux = &mut s.edge2;
-        flux.clear();
-        let edges = ea.cells.iter().zip(&ea.length);
-        let changes = self.u_m_per_s.iter().zip(&s.u_start);
-        flux.extend(changes.zip(edges).map(|((&u, &u0), ([a, b], l))| {
-            let du = u - u0;
-            let up = if du >= 0.0 { *a } else { *b } as usize;
-            self.gamma[up] * du * l
-        }));
-        apply_limited_fluxes(&g, flux, scale, &mut self.gamma, &mut s.cell);
+        let change = &mut s.edge;
+        change.clear();
+        change.extend(self.u_m_per_s.iter().zip(&s.u_start).map(|(u, u0)| u - u0));
+        upwind_fluxes(sides, ea, &self.gamma, change, &mut s.edge2);
+        let (areas, per_area) = (g.areas_sr(), g.inverse_areas_per_sr());
+        let (flux, gamma) = (&s.edge2, &mut self.gamma);
+        apply_limited(sides, areas, per_area, flux, scale, gamma, &mut s.cell);
     }
+
+    /// [`Self::correct_velocity_and_move_surfactant`]'s edge pass over one run: the
+    /// velocity corrected, and the volume of surfactant it and the transport flux move
+    /// into `s.edge2`.
+    #[inline(always)]
+    fn correct_velocity_run<const NORMAL: bool>(
+        &mut self,
+        s: &mut Scratch,
+        run: EdgeRun,
+        scale: f64,
+    ) {
+        let ea = self.grid.edge_arrays();
+        let per_r = 1.0 / self.params.radius_m;
+        let (len, edges) = (run.len, run.edges());
+        let (ga, gb) = (&self.gamma[run.a_cells()], &self.gamma[run.b_cells()]);
+        let (xa, xb) = (&s.cell2[run.a_cells()], &s.cell2[run.b_cells()]);
+        let (ga, gb, xa, xb) = (&ga[..len], &gb[..len], &xa[..len], &xb[..len]);
+        let inverse_dual = if NORMAL {
+            &ea.inverse_normal_dual_length
+        } else {
+            &ea.inverse_dual_length
+        };
+        let (id, l) = (&inverse_dual[edges.clone()], &ea.length[edges.clone()]);
+        let (f_adv, k) = (&s.edge[edges.clone()], &s.stiffness[edges.clone()]);
+        let (id, l, f_adv, k) = (&id[..len], &l[..len], &f_adv[..len], &k[..len]);
+        let (u, moved) = (
+            &mut self.u_m_per_s[edges.clone()],
+            &mut s.edge2[edges.clone()],
+        );
+        let (u, moved) = (&mut u[..len], &mut moved[..len]);
+        for i in 0..len {
+            let gamma_c = 0.5 * (ga[i] + gb[i]);
+            let slope = (xb[i] - xa[i]) * id[i] * per_r;
+            let du = -k[i] * slope / larger(gamma_c, f64::MIN_POSITIVE);
+            u[i] += if NORMAL {
+                du + s.cross[run.start + i]
+            } else {
+                du
+            };
+            moved[i] = scale * (f_adv[i] + gamma_c * du * l[i]);
+        }
+    }
+}
+
+/// The constants of the Marangoni step's edge pass.
+#[derive(Clone, Copy)]
+struct EdgeConstants {
+    /// `dt·E_f/ρ`, m³/s·… : over an edge's thickness, its stiffness `k`.
+    dt_e_per_rho: f64,
+    /// The step over R², s/m².
+    dt_per_r2: f64,
+    /// 1/R, per m.
+    per_r: f64,
+}
+
+/// The upwind volume `Γ_up·u·l` (per R and time) across every edge at speeds `u`, into
+/// `out`.
+fn upwind_fluxes(sides: &CellSides, ea: &EdgeArrays, gamma: &[f64], u: &[f64], out: &mut [f64]) {
+    with_avx2(
+        #[inline(always)]
+        || {
+            for run in sides.every_edge_run(&ea.cells) {
+                let (len, edges) = (run.len, run.edges());
+                let (ga, gb) = (&gamma[run.a_cells()], &gamma[run.b_cells()]);
+                let (u, l, f) = (
+                    &u[edges.clone()],
+                    &ea.length[edges.clone()],
+                    &mut out[edges],
+                );
+                let (ga, gb, u, l) = (&ga[..len], &gb[..len], &u[..len], &l[..len]);
+                for i in 0..len {
+                    f[i] = if u[i] >= 0.0 { ga[i] } else { gb[i] } * u[i] * l[i];
+                }
+            }
+        },
+    )
 }

@@ -8,6 +8,7 @@ mod capillary;
 mod cell_map;
 mod compare;
 mod flow;
+mod fluxes;
 pub mod grid;
 mod marangoni;
 mod meniscus;

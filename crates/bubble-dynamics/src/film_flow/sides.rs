@@ -16,9 +16,10 @@ pub(crate) const RIGHT: usize = 1;
 pub(crate) const BOTTOM: usize = 2;
 /// The side towards +y (the y-edge of the cell above).
 pub(crate) const TOP: usize = 3;
-/// Whether the cell is the `a` cell (the normal points away from it) of the edge on each
-/// side, inside a face.
-pub(crate) const IS_A: [bool; 4] = [false, true, false, true];
+/// Inside a face, the sign of each side's volume in the cell's inflow (a volume is
+/// positive from an edge's `a` cell to its `b` cell; the cell is the `a` cell of its right
+/// and top edges): a sign multiplies exactly, so the gathers need no branch.
+pub(crate) const INFLOW: [f64; 4] = [1.0, -1.0, 1.0, -1.0];
 
 /// Every cell's neighbour and edge on each side, and the sides each seam edge joins.
 ///
@@ -26,7 +27,7 @@ pub(crate) const IS_A: [bool; 4] = [false, true, false, true];
 /// - `neighbour[c][k]` and `edge[c][k]` are the cell across side `k` of cell `c` and the
 ///   edge between them; `is_a[c][k]` says whether `c` is that edge's `a` cell.
 /// - Inside a face these follow [`FaceLayout`]: `c ∓ 1` and `c ∓ n` across the x and y
-///   sides, with [`IS_A`].
+///   sides, with the signs [`INFLOW`].
 /// - `seam_sides[e − first_seam_edge]` is `[side of a, side of b]` of seam edge `e`.
 #[derive(Clone, Debug)]
 pub(crate) struct CellSides {
@@ -40,6 +41,78 @@ pub(crate) struct CellSides {
     pub(crate) is_a: Vec<[bool; 4]>,
     /// Per seam edge: the side it is of its `a` cell and of its `b` cell.
     pub(crate) seam_sides: Vec<[u8; 2]>,
+    /// The cells inside the faces as runs, one a face row ([`CellRun`]).
+    pub(crate) cell_runs: Vec<CellRun>,
+    /// The cells on the faces' rims (a side on a seam), in increasing order: the runs
+    /// leave them out, and passes take them one by one through the tables (as runs of
+    /// one they cost as much as the whole inside, each run's slices set up for a cell).
+    pub(crate) rim_cells: Vec<u32>,
+    /// The edges inside the faces as runs: each face row's x-edges, each face's y-edges
+    /// ([`EdgeRun`]); the seam edges follow from [`FaceLayout::first_seam_edge`].
+    pub(crate) edge_runs: Vec<EdgeRun>,
+}
+
+/// Consecutive cells inside a face: their neighbours and edges on each side are
+/// consecutive too, and their sides' volumes flow in with the signs [`INFLOW`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct CellRun {
+    /// The first cell.
+    pub(crate) start: usize,
+    /// How many cells.
+    pub(crate) len: usize,
+    /// On each side, the first cell's neighbour.
+    pub(crate) neighbour: [usize; 4],
+    /// On each side, the first cell's edge.
+    pub(crate) edge: [usize; 4],
+}
+
+impl CellRun {
+    /// The run's cells.
+    pub(crate) fn cells(&self) -> std::ops::Range<usize> {
+        self.start..self.start + self.len
+    }
+
+    /// The run's neighbours on side `k`.
+    pub(crate) fn neighbours(&self, k: usize) -> std::ops::Range<usize> {
+        self.neighbour[k]..self.neighbour[k] + self.len
+    }
+
+    /// The run's edges on side `k`.
+    pub(crate) fn edges(&self, k: usize) -> std::ops::Range<usize> {
+        self.edge[k]..self.edge[k] + self.len
+    }
+}
+
+/// Consecutive edges whose `a` cells and `b` cells are consecutive too.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct EdgeRun {
+    /// The first edge.
+    pub(crate) start: usize,
+    /// How many edges.
+    pub(crate) len: usize,
+    /// The first edge's `a` cell.
+    pub(crate) a: usize,
+    /// The first edge's `b` cell.
+    pub(crate) b: usize,
+    /// The side the edges are of their `a` cells and of their `b` cells.
+    pub(crate) sides: [usize; 2],
+}
+
+impl EdgeRun {
+    /// The run's edges.
+    pub(crate) fn edges(&self) -> std::ops::Range<usize> {
+        self.start..self.start + self.len
+    }
+
+    /// The run's `a` cells.
+    pub(crate) fn a_cells(&self) -> std::ops::Range<usize> {
+        self.a..self.a + self.len
+    }
+
+    /// The run's `b` cells.
+    pub(crate) fn b_cells(&self) -> std::ops::Range<usize> {
+        self.b..self.b + self.len
+    }
 }
 
 impl CellSides {
@@ -67,19 +140,110 @@ impl CellSides {
                 seam_sides.push(sides);
             }
         }
-        Self {
+        let mut sides = Self {
             layout,
             neighbour,
             edge,
             is_a,
             seam_sides,
+            cell_runs: Vec::new(),
+            rim_cells: Vec::new(),
+            edge_runs: Vec::new(),
+        };
+        (sides.cell_runs, sides.rim_cells) = sides.find_cell_runs();
+        sides.edge_runs = edge_runs(grid);
+        sides
+    }
+
+    /// The cells inside the faces as [`CellRun`]s, one a face row, and the rim's cells.
+    fn find_cell_runs(&self) -> (Vec<CellRun>, Vec<u32>) {
+        let n = self.n();
+        let (mut runs, mut rim) = (Vec::new(), Vec::new());
+        for face in 0..6 {
+            for y in 0..n {
+                let row = face * n * n + y * n;
+                if y == 0 || y + 1 >= n || n < 3 {
+                    rim.extend((row..row + n).map(|c| c as u32));
+                    continue;
+                }
+                rim.push(row as u32);
+                let c = row + 1;
+                runs.push(CellRun {
+                    start: c,
+                    len: n - 2,
+                    neighbour: self.neighbour[c].map(|j| j as usize),
+                    edge: self.edge[c].map(|e| e as usize),
+                });
+                rim.push((row + n - 1) as u32);
+            }
         }
+        (runs, rim)
+    }
+
+    /// The sign of each side's volume in cell `c`'s inflow (as [`INFLOW`] inside a face).
+    pub(crate) fn inflow(&self, c: usize) -> [f64; 4] {
+        self.is_a[c].map(|a| if a { -1.0 } else { 1.0 })
     }
 
     /// Cells along a face edge.
     pub(crate) fn n(&self) -> usize {
         self.layout.n
     }
+
+    /// Every edge as a run, in increasing order: the runs inside the faces, then each
+    /// seam edge alone (`cells` the edges' `[a, b]`). For edge passes, whose seams are
+    /// few beside the faces' edges.
+    pub(crate) fn every_edge_run<'a>(
+        &'a self,
+        cells: &'a [[u32; 2]],
+    ) -> impl Iterator<Item = EdgeRun> + 'a {
+        let first = self.layout.first_seam_edge();
+        let seams = cells[first..].iter().zip(&self.seam_sides).enumerate();
+        let seams = seams.map(move |(i, ([a, b], [ka, kb]))| EdgeRun {
+            start: first + i,
+            len: 1,
+            a: *a as usize,
+            b: *b as usize,
+            sides: [*ka as usize, *kb as usize],
+        });
+        self.edge_runs.iter().copied().chain(seams)
+    }
+}
+
+/// The edges inside the faces as [`EdgeRun`]s: each face row's x-edges, each face's
+/// y-edges.
+fn edge_runs(grid: &CubeSphere) -> Vec<EdgeRun> {
+    let layout = grid.layout();
+    let n = layout.n;
+    let mut runs = Vec::new();
+    for face in 0..6 {
+        for y in 0..n {
+            let a = face * n * n + y * n;
+            let start = face * n * (n - 1) + y * (n - 1);
+            let sides = [RIGHT, LEFT];
+            runs.push(EdgeRun {
+                start,
+                len: n - 1,
+                a,
+                b: a + 1,
+                sides,
+            });
+        }
+    }
+    for face in 0..6 {
+        let a = face * n * n;
+        let start = 6 * n * (n - 1) + face * n * (n - 1);
+        let sides = [TOP, BOTTOM];
+        runs.push(EdgeRun {
+            start,
+            len: n * (n - 1),
+            a,
+            b: a + n,
+            sides,
+        });
+    }
+    runs.retain(|r| r.len > 0);
+    runs
 }
 
 /// The side of cell `c` that the direction `towards` (an edge midpoint) lies beyond, in
@@ -127,10 +291,46 @@ mod tests {
                     assert_eq!(sides.edge[c][TOP] as usize, layout.y_edge_of_cell(c + n));
                 }
                 if x >= 1 && y >= 1 && x + 1 < n && y + 1 < n {
-                    assert_eq!(sides.is_a[c], IS_A, "cell {c}");
+                    assert_eq!(sides.inflow(c), INFLOW, "cell {c}");
                 }
             }
             assert_eq!(sides.seam_sides.len(), 12 * n);
+            runs_cover_everything_once(&grid, &sides);
+        }
+    }
+
+    /// Every cell lies in exactly one run or on the rim, every edge inside a face in
+    /// exactly one run, and what a run says of its members' sides and ends is what the
+    /// tables say.
+    fn runs_cover_everything_once(grid: &CubeSphere, sides: &CellSides) {
+        let mut cells: Vec<usize> = sides.cell_runs.iter().flat_map(|r| r.cells()).collect();
+        cells.extend(sides.rim_cells.iter().map(|&c| c as usize));
+        cells.sort_unstable();
+        assert_eq!(cells, (0..grid.cells()).collect::<Vec<_>>());
+        for run in &sides.cell_runs {
+            for (i, c) in run.cells().enumerate() {
+                for k in 0..4 {
+                    assert_eq!(run.neighbour[k] + i, sides.neighbour[c][k] as usize);
+                    assert_eq!(run.edge[k] + i, sides.edge[c][k] as usize);
+                }
+                assert_eq!(sides.inflow(c), INFLOW, "cell {c}");
+            }
+        }
+        let edges: Vec<usize> = sides.edge_runs.iter().flat_map(|r| r.edges()).collect();
+        let inside = grid.layout().first_seam_edge();
+        assert_eq!(edges, (0..inside).collect::<Vec<_>>());
+        let ea = grid.edge_arrays();
+        for run in &sides.edge_runs {
+            for (i, e) in run.edges().enumerate() {
+                assert_eq!(
+                    ea.cells[e],
+                    [(run.a + i) as u32, (run.b + i) as u32],
+                    "edge {e}"
+                );
+                let [ka, kb] = run.sides;
+                assert_eq!(sides.edge[run.a + i][ka] as usize, e, "edge {e}: side of a");
+                assert_eq!(sides.edge[run.b + i][kb] as usize, e, "edge {e}: side of b");
+            }
         }
     }
 }

@@ -11,6 +11,7 @@ use glam::DVec3;
 
 use super::compare::larger;
 use super::flow::{FilmFlow, Scratch};
+use super::fluxes::apply_limited;
 use super::upwind;
 use crate::avx2::with_avx2;
 
@@ -84,9 +85,9 @@ impl FilmFlow {
                 };
                 let ea = self.grid.edge_arrays();
                 upwind::volumes(geo, ea, &self.h_m, &s.limited_rise, speeds, &mut s.edge2);
-                upwind::outflow_ratios(geo, self.grid.areas_sr(), &self.h_m, &s.edge2, &mut s.cell);
-                let per_area = self.grid.inverse_areas_per_sr();
-                upwind::apply(geo, per_area, &s.edge2, &s.cell, &mut self.h_m);
+                let (areas, per_area) = (self.grid.areas_sr(), self.grid.inverse_areas_per_sr());
+                let (volume, h) = (&s.edge2, &mut self.h_m);
+                apply_limited(&geo.sides, areas, per_area, volume, 1.0, h, &mut s.cell);
             },
         )
     }
