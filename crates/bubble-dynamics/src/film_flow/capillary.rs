@@ -14,8 +14,10 @@
 //! donor limited to half its content keeps h ≥ 0.
 
 use super::compare::smaller;
-use super::flow::apply_limited_fluxes;
+use super::fluxes::{apply_limited, net_inflow};
 use super::grid::CubeSphere;
+use super::sides::CellSides;
+use crate::avx2::with_avx2;
 
 /// Most explicit sub-steps a film step spends on capillary smoothing.
 pub(crate) const MAX_SUBSTEPS: u32 = 64;
@@ -52,6 +54,7 @@ pub(crate) struct CapillaryScratch {
 /// Moves liquid by the capillary pressure over `dt_s`; `h_m` per cell.
 pub(crate) fn smooth_thickness(
     grid: &CubeSphere,
+    sides: &CellSides,
     c: Capillary,
     dt_s: f64,
     h_m: &mut [f64],
@@ -82,7 +85,7 @@ pub(crate) fn smooth_thickness(
     let cap = max_mobility * (STABLE_RATE_DT / (rate * sub_dt)).min(1.0);
     let mobility = Mobility { per_cubed, cap };
     for _ in 0..substeps as u32 {
-        substep(grid, c.radius_m, mobility, sub_dt, h_m, s);
+        substep((grid, sides), c.radius_m, mobility, sub_dt, h_m, s);
     }
 }
 
@@ -109,9 +112,10 @@ struct Mobility {
     cap: f64,
 }
 
-/// One forward-Euler sub-step of `∂h/∂t = −∇·(M ∇(−∇²h))`.
+/// One forward-Euler sub-step of `∂h/∂t = −∇·(M ∇(−∇²h))`: two passes over the edges
+/// (the thickness's differences, then the volumes), each followed by the cells' gathers.
 fn substep(
-    grid: &CubeSphere,
+    (grid, sides): (&CubeSphere, &CellSides),
     radius_m: f64,
     mobility: Mobility,
     dt_s: f64,
@@ -119,20 +123,31 @@ fn substep(
     s: &mut CapillaryScratch,
 ) {
     let ea = grid.edge_arrays();
-    let r2 = radius_m * radius_m;
-    s.laplacian.clear();
-    s.laplacian.resize(grid.cells(), 0.0);
-    // A slice, not the vector: a store through a `&mut Vec` made every edge load its
-    // pointer and length again.
-    let laplacian = &mut s.laplacian[..];
-    for (([a, b], l), d) in ea.cells.iter().zip(&ea.length).zip(&ea.dual_length) {
-        let (a, b) = (*a as usize, *b as usize);
-        let f = (h_m[b] - h_m[a]) * l / d;
-        laplacian[a] += f;
-        laplacian[b] -= f;
-    }
-    for (lap, area) in s.laplacian.iter_mut().zip(grid.areas_sr()) {
-        *lap /= area * r2;
+    s.flux.resize(ea.cells.len(), 0.0);
+    // ∇²h as the net inflow of the differences `(h_b − h_a) l/d` (their sum out of a
+    // cell, with the sign of an inflow: a cell below its neighbours gains).
+    with_avx2(
+        #[inline(always)]
+        || {
+            for run in sides.every_edge_run(&ea.cells) {
+                let (len, edges) = (run.len, run.edges());
+                let (ha, hb) = (&h_m[run.a_cells()], &h_m[run.b_cells()]);
+                let (l, per_d) = (
+                    &ea.length[edges.clone()],
+                    &ea.inverse_dual_length[edges.clone()],
+                );
+                let (ha, hb, l, per_d) = (&ha[..len], &hb[..len], &l[..len], &per_d[..len]);
+                let out = &mut s.flux[edges];
+                for i in 0..len {
+                    out[i] = (ha[i] - hb[i]) * l[i] * per_d[i];
+                }
+            }
+        },
+    );
+    net_inflow(sides, &s.flux, &mut s.laplacian);
+    let per_r2 = 1.0 / (radius_m * radius_m);
+    for (lap, per_area) in s.laplacian.iter_mut().zip(grid.inverse_areas_per_sr()) {
+        *lap *= per_area * per_r2;
     }
     // Volume from a to b over the sub-step, per R² (m·sr): the flux runs down the
     // pressure −(σ/2)∇²h, i.e. up the gradient of ∇²h (the ½σ is in the mobility), so
@@ -143,19 +158,31 @@ fn substep(
     // a mean-thickness mobility drew liquid out of the thin film one cell further at the
     // pool's rate, emptying it in a step (bubbles resting on the ground burst within a
     // second). At the donor's, a thin cell gives at its own slow rate.
-    //
-    // Written in place through the resized buffer, not pushed: a push may reallocate, so
-    // every edge loaded the Laplacian's pointer and length and the mobility again.
-    s.flux.resize(ea.cells.len(), 0.0);
     let (laplacian, Mobility { per_cubed, cap }) = (&s.laplacian[..], mobility);
-    let edges = ea.cells.iter().zip(&ea.length).zip(&ea.dual_length);
-    for (flux, (([a, b], l), d)) in s.flux.iter_mut().zip(edges) {
-        let (a, b) = (*a as usize, *b as usize);
-        let rise = laplacian[b] - laplacian[a];
-        let donor = h_m[if rise >= 0.0 { a } else { b }];
-        let m = smaller(per_cubed * donor * donor * donor, cap);
-        *flux = m * rise / (d * radius_m) * l * dt_s / radius_m;
-    }
+    let per_length = dt_s / (radius_m * radius_m);
+    with_avx2(
+        #[inline(always)]
+        || {
+            for run in sides.every_edge_run(&ea.cells) {
+                let (len, edges) = (run.len, run.edges());
+                let (ha, hb) = (&h_m[run.a_cells()], &h_m[run.b_cells()]);
+                let (la, lb) = (&laplacian[run.a_cells()], &laplacian[run.b_cells()]);
+                let (l, per_d) = (
+                    &ea.length[edges.clone()],
+                    &ea.inverse_dual_length[edges.clone()],
+                );
+                let (ha, hb, la, lb) = (&ha[..len], &hb[..len], &la[..len], &lb[..len]);
+                let (l, per_d, out) = (&l[..len], &per_d[..len], &mut s.flux[edges]);
+                for i in 0..len {
+                    let rise = lb[i] - la[i];
+                    let donor = if rise >= 0.0 { ha[i] } else { hb[i] };
+                    let m = smaller(per_cubed * donor * donor * donor, cap);
+                    out[i] = m * rise * per_d[i] * l[i] * per_length;
+                }
+            }
+        },
+    );
     // Each donor gives at most half its content: h stays ≥ 0.
-    apply_limited_fluxes(grid, &s.flux, 1.0, h_m, &mut s.outflow);
+    let (areas, per_area) = (grid.areas_sr(), grid.inverse_areas_per_sr());
+    apply_limited(sides, areas, per_area, &s.flux, 1.0, h_m, &mut s.outflow);
 }

@@ -481,42 +481,7 @@ impl FilmFlow {
             drainage_viscosity_pa_s: mu,
             radius_m: p.radius_m,
         };
-        smooth_thickness(&self.grid, c, dt_s, &mut self.h_m, &mut s.capillary);
-    }
-}
-
-/// Moves `scale·flux_e` (per unit sphere area) from cell `a` to `b` of every edge, each
-/// donor's outgoing fluxes scaled so that no cell gives more than
-/// [`MAX_OUTFLOW_FRACTION`] of its content in one step (`ratio` is scratch).
-///
-/// Two passes over the edges: each donor's outflow, then the limited fluxes moved. The
-/// limit is each donor's `budget/outflow`, taken once a cell from the values the step
-/// starts with (limiting the fluxes in a pass of their own, before moving them, took it
-/// once an edge and walked the edges three times).
-pub(super) fn apply_limited_fluxes(
-    g: &CubeSphere,
-    flux: &[f64],
-    scale: f64,
-    values: &mut [f64],
-    ratio: &mut Vec<f64>,
-) {
-    ratio.clear();
-    ratio.resize(g.cells(), 0.0);
-    let cells = &g.edge_arrays().cells;
-    for ([a, b], f) in cells.iter().zip(flux) {
-        let donor = if *f >= 0.0 { *a } else { *b } as usize;
-        ratio[donor] += (scale * f).abs();
-    }
-    for ((r, area), v) in ratio.iter_mut().zip(g.areas_sr()).zip(values.iter()) {
-        let budget = MAX_OUTFLOW_FRACTION * area * v;
-        *r = if *r > budget { budget / *r } else { 1.0 };
-    }
-    let areas = g.areas_sr();
-    for ([a, b], f) in cells.iter().zip(flux) {
-        let (a, b) = (*a as usize, *b as usize);
-        let donor = if *f >= 0.0 { a } else { b };
-        let moved = scale * (f * ratio[donor]);
-        values[a] -= moved / areas[a];
-        values[b] += moved / areas[b];
+        let sides = &self.transport.sides;
+        smooth_thickness(&self.grid, sides, c, dt_s, &mut self.h_m, &mut s.capillary);
     }
 }
