@@ -15,6 +15,8 @@
 
 use glam::DVec3;
 
+use crate::avx2::with_avx2;
+
 use super::advect::{AdvectionGeometry, AdvectionScratch, advect_momentum};
 use super::burst::{BurstParams, BurstState, Hole};
 use super::capillary::{Capillary, CapillaryScratch, smooth_thickness};
@@ -452,19 +454,34 @@ impl FilmFlow {
             FilmGradient::TwoPoint => &ea.centre_gradient,
             FilmGradient::Normal => &ea.centre_normal_gradient,
         };
-        let edges = ea.cells.iter().zip(slopes);
-        for ((u, ([a, b], slope)), factor) in self.u_m_per_s.iter_mut().zip(edges).zip(&mut s.drag)
-        {
-            let h = (0.5 * (self.h_m[*a as usize] + self.h_m[*b as usize])).max(H_FLOOR_M);
-            let per_layer = p.air_viscosity_pa_s / (p.density_kg_per_m3 * h);
-            // The potential flow's surface velocity is the gradient of 1.5 U·x: taken as
-            // the discrete gradient between cell centres, curl-free like the real one.
-            let outside = 1.5 * air_m_per_s.dot(*slope);
-            let k_out = per_layer * per_layer_depth((*u - outside).abs());
-            let k_in = per_layer * per_layer_depth(u.abs());
-            *factor = 1.0 / (1.0 + dt_s * (k_out + k_in));
-            *u = (*u + dt_s * k_out * outside) * *factor;
-        }
+        // The potential flow's surface velocity is the gradient of 1.5 U·x: taken as the
+        // discrete gradient between cell centres, curl-free like the real one. (Its own
+        // pass: the slopes are vectors, which the edge runs below would read strided.)
+        let outside = &mut s.edge;
+        outside.clear();
+        outside.extend(slopes.iter().map(|slope| 1.5 * air_m_per_s.dot(*slope)));
+        let per_layer = p.air_viscosity_pa_s / p.density_kg_per_m3;
+        let sides = &self.transport.sides;
+        with_avx2(
+            #[inline(always)]
+            || {
+                for run in sides.every_edge_run(&ea.cells) {
+                    let (len, edges) = (run.len, run.edges());
+                    let (ha, hb) = (&self.h_m[run.a_cells()], &self.h_m[run.b_cells()]);
+                    let (ha, hb, outside) = (&ha[..len], &hb[..len], &s.edge[edges.clone()]);
+                    let u = &mut self.u_m_per_s[edges.clone()];
+                    let factor = &mut s.drag[edges];
+                    for i in 0..len {
+                        let h = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
+                        let k = per_layer / h;
+                        let k_out = k * per_layer_depth((u[i] - outside[i]).abs());
+                        let k_in = k * per_layer_depth(u[i].abs());
+                        factor[i] = 1.0 / (1.0 + dt_s * (k_out + k_in));
+                        u[i] = (u[i] + dt_s * k_out * outside[i]) * factor[i];
+                    }
+                }
+            },
+        );
     }
 
     /// The capillary pressure's flow relative to the surfaces (module `capillary`); none
