@@ -19,11 +19,12 @@ use super::advect::{AdvectionGeometry, AdvectionScratch, advect_momentum};
 use super::burst::{BurstParams, BurstState, Hole};
 use super::capillary::{Capillary, CapillaryScratch, smooth_thickness};
 use super::compare::larger;
+use super::face_rows::FaceRows;
 use super::grid::CubeSphere;
 use super::meniscus::MeniscusState;
 use super::solve::{Hierarchy, SolveReport, Work};
 use super::thermal::{ThermalParams, up_from};
-use super::viscosity::viscous_bound;
+use super::viscosity::{ViscousScratch, viscous_bound};
 
 /// Thickness floor of the Marangoni coefficient `E_f/(ρh)`, m: a hole or a Newton black
 /// film keeps a finite (if huge) stiffness.
@@ -131,6 +132,8 @@ pub struct Forcing {
 pub struct FilmFlow {
     pub(crate) grid: std::sync::Arc<CubeSphere>,
     pub(super) hierarchy: std::sync::Arc<Hierarchy>,
+    /// The grid's edges and vertices face by face in rows, for the momentum passes.
+    pub(super) rows: std::sync::Arc<FaceRows>,
     /// The momentum advection's weights, fixed by the grid.
     advection: std::sync::Arc<AdvectionGeometry>,
     pub(crate) params: FlowParams,
@@ -174,8 +177,8 @@ pub(super) struct Scratch {
     pub(super) drag: Vec<f64>,
     /// Per edge: the drainage speed's coefficient over `h²`, s⁻¹·m⁻¹.
     pub(super) drain_rate: Vec<f64>,
-    /// The viscous step's stage before the one under way, m/s per edge.
-    pub(super) stage: Vec<f64>,
+    /// The viscous step's buffers.
+    pub(super) viscous: ViscousScratch,
     /// Per edge: the Marangoni gradient's cross term (along the edge) as a velocity
     /// change, m/s, from the surfactant of the last sweep.
     pub(super) cross: Vec<f64>,
@@ -199,11 +202,13 @@ impl FilmFlow {
         let h: Vec<f64> = grid.centres().iter().map(|&c| h_m(c)).collect();
         let cells = grid.cells();
         let edges = grid.edges().len();
+        let rows = FaceRows::new(&grid);
         Self {
             burst: Some(Box::new(BurstState::new(params.burst, cells, params.seed))),
             meniscus: None,
             viscous_bound: viscous_bound(&grid),
-            advection: std::sync::Arc::new(AdvectionGeometry::new(&grid)),
+            advection: std::sync::Arc::new(AdvectionGeometry::new(&grid, &rows)),
+            rows: std::sync::Arc::new(rows),
             params,
             h_m: h,
             gamma: vec![1.0; cells],
@@ -384,6 +389,7 @@ impl FilmFlow {
         let r = self.params.radius_m;
         advect_momentum(
             &self.grid,
+            &self.rows,
             &self.advection,
             r,
             dt_s,

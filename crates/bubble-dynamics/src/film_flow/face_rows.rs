@@ -1,0 +1,513 @@
+//! The grid's edges and vertices face by face in rows, so that the momentum passes
+//! (`advect`, `viscosity`) take each face's interior as contiguous slices, where the
+//! grid's own numbering reaches a cell's edges and an edge's vertices through index
+//! arrays.
+//!
+//! The edge velocities are copied into the rows at the start of a pass and back at its
+//! end ([`FaceRows::to_rows`], [`FaceRows::to_grid`]). An edge on a face's border is in
+//! both its faces' rows, a copy each with its own orientation; every quantity of an edge
+//! is kept in that copy's orientation, so a copy is the grid's value or its negation,
+//! exactly (IEEE negation commutes with every rounding the passes do), and the two copies
+//! stay negations or equals of each other.
+//!
+//! Each value the passes compute is the same sum in the same order as the grid-numbered
+//! passes took it: a vertex's circulation over its edges, and a cell's terms over its
+//! edges, in the grid's increasing edge order. Inside a face that order is one fixed
+//! order of the local sides, which the row loops take; the vertices on the faces' borders
+//! and the cells where the order differs are taken one by one from lists
+//! ([`FaceRows::seam_vertices`], [`FaceRows::irregular_cells`]), so the rows give the
+//! grid-numbered passes' bits.
+
+use glam::DVec3;
+
+use super::grid::{CubeSphere, FACE_BASES};
+
+/// Which side of a cell an edge is: bottom (`t` low), left (`s` low), right, top.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Side {
+    Bottom = 0,
+    Left = 1,
+    Right = 2,
+    Top = 3,
+}
+
+/// The four sides in the local order: a cell's edges in the grid's order, inside a face.
+pub(crate) const SIDES: [Side; 4] = [Side::Bottom, Side::Left, Side::Right, Side::Top];
+
+/// A grid vertex on a face's border, its circulation taken edge by edge.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SeamVertex {
+    /// Its edges in the grid's order: a local copy of each and the weight `±d` of that
+    /// copy's velocity in the circulation (the sign its orientation's).
+    pub(crate) edges: [(u32, f64); 4],
+    /// How many of `edges` there are (3 at a cube corner).
+    pub(crate) edge_count: u8,
+    /// Its local copies (two on a border, three at a corner).
+    pub(crate) copies: [u32; 3],
+    /// How many of `copies` there are.
+    pub(crate) copy_count: u8,
+}
+
+/// An edge between two faces: its two local copies.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SeamEdge {
+    /// Its cells, the lower-numbered first, each with the side of it the edge is on and
+    /// that cell's face's copy of the edge.
+    pub(crate) cells: [(u32, Side, u32); 2],
+}
+
+/// A local copy of an edge on a face's border, with its ends and cells in its own
+/// orientation.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BorderEdge {
+    /// The local edge.
+    pub(crate) edge: u32,
+    /// Its tail and head vertices (local, in its face).
+    pub(crate) ends: [u32; 2],
+    /// The cells its normal points from and into.
+    pub(crate) cells: [u32; 2],
+}
+
+/// A cell whose edges, in the grid's order, are not in the local order [`SIDES`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct IrregularCell {
+    pub(crate) cell: u32,
+    /// The side of each of its edges, in the grid's order.
+    pub(crate) order: [Side; 4],
+    /// The local edge on each of those sides.
+    pub(crate) edges: [u32; 4],
+    /// The local vertices at the ends of each.
+    pub(crate) ends: [[u32; 2]; 4],
+}
+
+/// The face-row numbering of a grid of `n` cells a face.
+///
+/// Per face `f` (cells `f·n² + y·n + x` as the grid numbers them):
+/// - the X-edges (along grid lines of constant `s`), `n + 1` a row, `n` rows: X-edge
+///   `(i, y)` between cells `(i − 1, y)` and `(i, y)`, its local normal towards `+s`;
+/// - the Y-edges (constant `t`), `n` a row, `n + 1` rows: Y-edge `(x, j)` between cells
+///   `(x, j − 1)` and `(x, j)`, its local normal towards `+t`;
+/// - the vertices, `n + 1` a row: vertex `(i, j)` at the corner `(s_i, t_j)`.
+///
+/// A local X-edge's tangent (`midpoint × normal`) points towards `−t` (its tail `v0` the
+/// upper vertex), a Y-edge's towards `+s` (its tail the left vertex): the faces' `(s, t)`
+/// are left-handed seen from outside.
+#[derive(Clone, Debug)]
+pub(crate) struct FaceRows {
+    pub(crate) n: usize,
+    /// Per local edge: the grid's edge.
+    pub(crate) edge: Vec<u32>,
+    /// Per local edge: `true` where the grid's normal is against the local one.
+    pub(crate) flipped: Vec<bool>,
+    /// Per local edge: the arc between its cells' centres, rad.
+    pub(crate) dual_length: Vec<f64>,
+    /// Per local edge: its arc length, rad.
+    pub(crate) length: Vec<f64>,
+    /// Per local edge: `1/length`, per rad.
+    pub(crate) inverse_length: Vec<f64>,
+    /// Per local edge: `1/dual_length`, per rad.
+    pub(crate) inverse_dual_length: Vec<f64>,
+    /// Per local vertex: the grid's vertex.
+    pub(crate) vertex: Vec<u32>,
+    /// Per local vertex: its dual area, sr.
+    pub(crate) vertex_area: Vec<f64>,
+    /// Per local vertex: `1/area`, per sr.
+    pub(crate) vertex_inverse_area: Vec<f64>,
+    /// The vertices on the faces' borders.
+    pub(crate) seam_vertices: Vec<SeamVertex>,
+    /// The edges on the faces' borders.
+    pub(crate) seam_edges: Vec<SeamEdge>,
+    /// The local copies of the edges on the faces' borders, each with its ends and cells.
+    pub(crate) border_edges: Vec<BorderEdge>,
+    /// The cells whose edges the grid numbers out of the local order.
+    pub(crate) irregular_cells: Vec<IrregularCell>,
+}
+
+impl FaceRows {
+    /// Local edges a face: `2n(n + 1)`, the X-edges' rows then the Y-edges'.
+    pub(crate) fn edges_per_face(&self) -> usize {
+        2 * self.n * (self.n + 1)
+    }
+
+    /// Local vertices a face.
+    pub(crate) fn vertices_per_face(&self) -> usize {
+        (self.n + 1) * (self.n + 1)
+    }
+
+    /// Local vertices in all.
+    pub(crate) fn vertices(&self) -> usize {
+        self.vertex.len()
+    }
+
+    /// Local X-edge `(i, y)` of face `f`.
+    pub(crate) fn x_edge(&self, f: usize, i: usize, y: usize) -> usize {
+        f * self.edges_per_face() + y * (self.n + 1) + i
+    }
+
+    /// Local Y-edge `(x, j)` of face `f`.
+    pub(crate) fn y_edge(&self, f: usize, x: usize, j: usize) -> usize {
+        f * self.edges_per_face() + self.n * (self.n + 1) + j * self.n + x
+    }
+
+    /// Local vertex `(i, j)` of face `f`.
+    pub(crate) fn vertex_at(&self, f: usize, i: usize, j: usize) -> usize {
+        f * self.vertices_per_face() + j * (self.n + 1) + i
+    }
+
+    /// The local edge on side `side` of cell `c`.
+    #[inline]
+    pub(crate) fn cell_edge(&self, c: usize, side: Side) -> usize {
+        let n = self.n;
+        let (f, x, y) = (c / (n * n), c % n, (c / n) % n);
+        match side {
+            Side::Bottom => self.y_edge(f, x, y),
+            Side::Left => self.x_edge(f, x, y),
+            Side::Right => self.x_edge(f, x + 1, y),
+            Side::Top => self.y_edge(f, x, y + 1),
+        }
+    }
+
+    /// The local vertices at the ends of side `side` of cell `c`: its tail `v0` and head
+    /// `v1` in the local orientation.
+    #[inline]
+    pub(crate) fn side_vertices(&self, c: usize, side: Side) -> [usize; 2] {
+        let n = self.n;
+        let (f, x, y) = (c / (n * n), c % n, (c / n) % n);
+        let at = |i, j| self.vertex_at(f, i, j);
+        match side {
+            Side::Bottom => [at(x, y), at(x + 1, y)],
+            Side::Left => [at(x, y + 1), at(x, y)],
+            Side::Right => [at(x + 1, y + 1), at(x + 1, y)],
+            Side::Top => [at(x, y + 1), at(x + 1, y + 1)],
+        }
+    }
+
+    /// `±1`: local edge `k`'s orientation against the grid's.
+    pub(crate) fn sign(&self, k: usize) -> f64 {
+        if self.flipped[k] { -1.0 } else { 1.0 }
+    }
+
+    /// The grid's edge values `grid` (in the grid's orientation) into `rows` (each copy
+    /// in its own).
+    pub(crate) fn to_rows(&self, grid: &[f64], rows: &mut Vec<f64>) {
+        rows.clear();
+        let copy = |(&e, &flipped): (&u32, &bool)| {
+            let u = grid[e as usize];
+            if flipped { -u } else { u }
+        };
+        rows.extend(self.edge.iter().zip(&self.flipped).map(copy));
+    }
+
+    /// The rows' edge values back into the grid's numbering and orientation (a border
+    /// edge's two copies agree).
+    pub(crate) fn to_grid(&self, rows: &[f64], grid: &mut [f64]) {
+        for ((&e, &flipped), &u) in self.edge.iter().zip(&self.flipped).zip(rows) {
+            grid[e as usize] = if flipped { -u } else { u };
+        }
+    }
+
+    /// Derives the numbering from `grid`'s geometry.
+    ///
+    /// # Panics
+    /// If an edge is not on a side of its cells, or the orientations disagree.
+    pub(crate) fn new(grid: &CubeSphere) -> Self {
+        let n = grid.face_size();
+        let mut rows = Self {
+            n,
+            edge: Vec::new(),
+            flipped: Vec::new(),
+            dual_length: Vec::new(),
+            length: Vec::new(),
+            inverse_length: Vec::new(),
+            inverse_dual_length: Vec::new(),
+            vertex: Vec::new(),
+            vertex_area: Vec::new(),
+            vertex_inverse_area: Vec::new(),
+            seam_vertices: Vec::new(),
+            seam_edges: Vec::new(),
+            border_edges: Vec::new(),
+            irregular_cells: Vec::new(),
+        };
+        let local_edges = 6 * rows.edges_per_face();
+        rows.edge = vec![u32::MAX; local_edges];
+        rows.flipped = vec![false; local_edges];
+        let edges = grid.edges();
+        for (e, ge) in edges.iter().enumerate() {
+            let mut copies = [(0, Side::Bottom, 0); 2];
+            for (copy, c) in copies.iter_mut().zip([ge.a, ge.b]) {
+                let side = side_of(n, c as usize, ge.midpoint);
+                let k = rows.cell_edge(c as usize, side);
+                // The local normal points away from the cell on its right and top sides.
+                let away = matches!(side, Side::Right | Side::Top);
+                let flipped = away != (c == ge.a);
+                if rows.edge[k] != u32::MAX {
+                    assert_eq!(rows.edge[k], e as u32, "local edge {k} twice");
+                    assert_eq!(rows.flipped[k], flipped, "local edge {k}: orientation");
+                }
+                rows.edge[k] = e as u32;
+                rows.flipped[k] = flipped;
+                *copy = (c, side, k as u32);
+            }
+            if copies[0].2 != copies[1].2 {
+                copies.sort_by_key(|c| c.0);
+                rows.seam_edges.push(SeamEdge { cells: copies });
+            }
+        }
+        assert!(
+            rows.edge.iter().all(|&e| e != u32::MAX),
+            "a local edge unset"
+        );
+        let ea = grid.edge_arrays();
+        let local = |a: &[f64]| rows.edge.iter().map(|&e| a[e as usize]).collect();
+        rows.dual_length = local(&ea.dual_length);
+        rows.length = local(&ea.length);
+        rows.inverse_length = local(&ea.inverse_length);
+        rows.inverse_dual_length = local(&ea.inverse_dual_length);
+        rows.vertex = vec![u32::MAX; 6 * rows.vertices_per_face()];
+        for c in 0..grid.cells() {
+            for side in SIDES {
+                let k = rows.cell_edge(c, side);
+                let ge = &edges[rows.edge[k] as usize];
+                let ends = if rows.flipped[k] {
+                    [ge.v1, ge.v0]
+                } else {
+                    [ge.v0, ge.v1]
+                };
+                for (v, id) in rows.side_vertices(c, side).into_iter().zip(ends) {
+                    let old = std::mem::replace(&mut rows.vertex[v], id);
+                    assert!(old == u32::MAX || old == id, "local vertex {v}: two ids");
+                }
+            }
+        }
+        let areas = grid.vertex_areas_sr();
+        rows.vertex_area = rows.vertex.iter().map(|&v| areas[v as usize]).collect();
+        let inverse = grid.inverse_vertex_areas_per_sr();
+        rows.vertex_inverse_area = rows.vertex.iter().map(|&v| inverse[v as usize]).collect();
+        rows.border_edges = border_edges(&rows);
+        rows.seam_vertices = seam_vertices(&rows, grid);
+        rows.irregular_cells = (0..grid.cells())
+            .filter_map(|c| irregular(&rows, c))
+            .collect();
+        rows
+    }
+
+    /// Whether local vertex `(i, j)` is on its face's border.
+    fn on_border(&self, i: usize, j: usize) -> bool {
+        i == 0 || j == 0 || i == self.n || j == self.n
+    }
+
+    /// The circulation `Σ ±u d` about every local vertex of the local edge velocities
+    /// `u`, each then finished by `finish(circulation, scale)` with the vertex's entry of
+    /// `scale` (a per-local-vertex array), into `out`.
+    ///
+    /// About an inner vertex `(i, j)` the grid's edge order is X-edge `(i, j − 1)`,
+    /// Y-edges `(i − 1, j)` and `(i, j)`, X-edge `(i, j)`: the first and third run into
+    /// the vertex's tail end (`−u d`), the others into its head (`+u d`).
+    #[inline(always)]
+    pub(crate) fn circulation(
+        &self,
+        u: &[f64],
+        out: &mut Vec<f64>,
+        scale: &[f64],
+        finish: impl Fn(f64, f64) -> f64,
+    ) {
+        let n = self.n;
+        out.resize(self.vertices(), 0.0);
+        let d = &self.dual_length;
+        for f in 0..6 {
+            for j in 1..n {
+                let inner = n - 1;
+                let below = self.x_edge(f, 1, j - 1)..self.x_edge(f, n, j - 1);
+                let left = self.y_edge(f, 0, j)..self.y_edge(f, n - 1, j);
+                let right = self.y_edge(f, 1, j)..self.y_edge(f, n, j);
+                let above = self.x_edge(f, 1, j)..self.x_edge(f, n, j);
+                let (ub, db) = (&u[below.clone()], &d[below]);
+                let (ul, dl) = (&u[left.clone()], &d[left]);
+                let (ur, dr) = (&u[right.clone()], &d[right]);
+                let (ua, da) = (&u[above.clone()], &d[above]);
+                let start = self.vertex_at(f, 1, j);
+                let row = &mut out[start..start + inner];
+                let scale = &scale[start..start + inner];
+                for i in 0..inner {
+                    let z = 0.0 - ub[i] * db[i] + ul[i] * dl[i] - ur[i] * dr[i] + ua[i] * da[i];
+                    row[i] = finish(z, scale[i]);
+                }
+            }
+        }
+        for v in &self.seam_vertices {
+            let mut z = 0.0;
+            for &(k, w) in &v.edges[..usize::from(v.edge_count)] {
+                z += u[k as usize] * w;
+            }
+            let z = finish(z, scale[v.copies[0] as usize]);
+            for &k in &v.copies[..usize::from(v.copy_count)] {
+                out[k as usize] = z;
+            }
+        }
+    }
+}
+
+/// Each seam edge's two copies, each with its ends and cells in its own orientation: the
+/// local normal points away from a cell on its right or top side.
+fn border_edges(rows: &FaceRows) -> Vec<BorderEdge> {
+    let mut out = Vec::with_capacity(2 * rows.seam_edges.len());
+    for e in &rows.seam_edges {
+        for (mine, other) in [(0, 1), (1, 0)] {
+            let (c, side, k) = e.cells[mine];
+            let across = e.cells[other].0;
+            let away = matches!(side, Side::Right | Side::Top);
+            out.push(BorderEdge {
+                edge: k,
+                ends: rows.side_vertices(c as usize, side).map(|v| v as u32),
+                cells: if away { [c, across] } else { [across, c] },
+            });
+        }
+    }
+    out
+}
+
+/// The vertices on the faces' borders, each with its edges in the grid's order.
+fn seam_vertices(rows: &FaceRows, grid: &CubeSphere) -> Vec<SeamVertex> {
+    let n = rows.n;
+    let vertices = grid.vertex_areas_sr().len();
+    // Each grid edge's first local copy.
+    let mut copy_of = vec![u32::MAX; grid.edges().len()];
+    for (k, &e) in rows.edge.iter().enumerate().rev() {
+        copy_of[e as usize] = k as u32;
+    }
+    let mut around: Vec<Vec<(u32, f64)>> = vec![Vec::new(); vertices];
+    for (e, ge) in grid.edges().iter().enumerate() {
+        let k = copy_of[e];
+        let d = ge.dual_length * rows.sign(k as usize);
+        // Counter-clockwise about v1 seen from outside.
+        around[ge.v1 as usize].push((k, d));
+        around[ge.v0 as usize].push((k, -d));
+    }
+    let mut index = vec![usize::MAX; vertices];
+    let mut seams: Vec<SeamVertex> = Vec::new();
+    for f in 0..6 {
+        for j in 0..=n {
+            for i in (0..=n).filter(|&i| rows.on_border(i, j)) {
+                let local = rows.vertex_at(f, i, j);
+                let v = rows.vertex[local] as usize;
+                if index[v] == usize::MAX {
+                    index[v] = seams.len();
+                    let ring = &around[v];
+                    assert!(
+                        (3..=4).contains(&ring.len()),
+                        "vertex {v}: {} edges",
+                        ring.len()
+                    );
+                    let mut edges = [(0, 0.0); 4];
+                    edges[..ring.len()].copy_from_slice(ring);
+                    seams.push(SeamVertex {
+                        edges,
+                        edge_count: ring.len() as u8,
+                        copies: [0; 3],
+                        copy_count: 0,
+                    });
+                }
+                let s = &mut seams[index[v]];
+                s.copies[usize::from(s.copy_count)] = local as u32;
+                s.copy_count += 1;
+            }
+        }
+    }
+    seams
+}
+
+/// Cell `c`'s edge order, where the grid's differs from the local one.
+fn irregular(rows: &FaceRows, c: usize) -> Option<IrregularCell> {
+    let mut order = SIDES;
+    order.sort_by_key(|&side| rows.edge[rows.cell_edge(c, side)]);
+    (order != SIDES).then(|| IrregularCell {
+        cell: c as u32,
+        order,
+        edges: order.map(|side| rows.cell_edge(c, side) as u32),
+        ends: order.map(|side| rows.side_vertices(c, side).map(|v| v as u32)),
+    })
+}
+
+/// Which side of cell `c` (of a grid of `n` a face) the edge with midpoint `m` is.
+fn side_of(n: usize, c: usize, m: DVec3) -> Side {
+    let (f, x, y) = (c / (n * n), c % n, (c / n) % n);
+    let (major, su, tv) = FACE_BASES[f];
+    let p = m / m.dot(major.as_dvec3());
+    let cells = |v: f64| (v + 1.0) * n as f64 / 2.0;
+    let (s, t) = (cells(p.dot(su.as_dvec3())), cells(p.dot(tv.as_dvec3())));
+    let near = |a: f64, b: usize| (a - b as f64).abs() < 0.25;
+    match () {
+        () if near(s, x) => Side::Left,
+        () if near(s, x + 1) => Side::Right,
+        () if near(t, y) => Side::Bottom,
+        () if near(t, y + 1) => Side::Top,
+        () => panic!("edge at ({s}, {t}) not on a side of cell {c}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_rows_hold_every_edge_and_vertex_of_the_grid() {
+        for n in [1, 2, 3, 8] {
+            let g = CubeSphere::new(n);
+            let rows = FaceRows::new(&g);
+            // Edges inside a face keep the grid's normal.
+            for f in 0..6 {
+                for k in 1..n {
+                    for m in 0..n {
+                        assert!(!rows.flipped[rows.x_edge(f, k, m)], "n {n}");
+                        assert!(!rows.flipped[rows.y_edge(f, m, k)], "n {n}");
+                    }
+                }
+            }
+            let mut seen = vec![0; g.edges().len()];
+            rows.edge.iter().for_each(|&e| seen[e as usize] += 1);
+            let seams = seen.iter().filter(|&&s| s == 2).count();
+            assert!(seen.iter().all(|&s| s == 1 || s == 2), "n {n}");
+            assert_eq!(seams, 12 * n, "n {n}");
+            assert_eq!(rows.seam_edges.len(), 12 * n, "n {n}");
+            assert_eq!(rows.seam_vertices.len(), 12 * (n - 1) + 8, "n {n}");
+            // Round trip.
+            let u: Vec<f64> = (0..g.edges().len()).map(|e| e as f64 - 7.5).collect();
+            let (mut local, mut back) = (Vec::new(), vec![0.0; u.len()]);
+            rows.to_rows(&u, &mut local);
+            rows.to_grid(&local, &mut back);
+            assert_eq!(u, back, "n {n}");
+        }
+    }
+
+    /// The rows' circulation is the grid-numbered scatter's, bit for bit.
+    #[test]
+    fn the_rows_circulation_is_the_scattered_one() {
+        for n in [1, 2, 5, 16] {
+            let g = CubeSphere::new(n);
+            let rows = FaceRows::new(&g);
+            let u: Vec<f64> = (0..g.edges().len())
+                .map(|e| ((e * 7919) % 1000) as f64 * 1e-3 - 0.4)
+                .collect();
+            let ea = g.edge_arrays();
+            let mut want = vec![0.0; g.vertex_areas_sr().len()];
+            for ((&u, d), [v0, v1]) in u.iter().zip(&ea.dual_length).zip(&ea.vertices) {
+                want[*v1 as usize] += u * d;
+                want[*v0 as usize] -= u * d;
+            }
+            for (z, a) in want.iter_mut().zip(g.vertex_areas_sr()) {
+                *z /= a * 0.3;
+            }
+            let (mut local, mut got) = (Vec::new(), Vec::new());
+            rows.to_rows(&u, &mut local);
+            rows.circulation(&local, &mut got, &rows.vertex_area, |z, a| z / (a * 0.3));
+            for (k, (z, v)) in got.iter().zip(&rows.vertex).enumerate() {
+                let w = want[*v as usize];
+                assert_eq!(
+                    z.to_bits(),
+                    w.to_bits(),
+                    "n {n}: local vertex {k}: {z} vs {w}"
+                );
+            }
+        }
+    }
+}
