@@ -206,6 +206,16 @@ impl FaceRows {
         }
     }
 
+    /// `rows[k] += value(e)` for each local edge `k` of grid edge `e`, `value` in the
+    /// grid's orientation (negated for a flipped copy: the grid's sum, negated, exactly).
+    #[inline(always)]
+    pub(crate) fn add_from_grid(&self, rows: &mut [f64], value: impl Fn(usize) -> f64) {
+        for ((u, &e), &flipped) in rows.iter_mut().zip(&self.edge).zip(&self.flipped) {
+            let v = value(e as usize);
+            *u += if flipped { -v } else { v };
+        }
+    }
+
     /// Derives the numbering from `grid`'s geometry.
     ///
     /// # Panics

@@ -177,8 +177,10 @@ pub(super) struct Scratch {
     pub(super) drag: Vec<f64>,
     /// Per edge: the drainage speed's coefficient over `h²`, s⁻¹·m⁻¹.
     pub(super) drain_rate: Vec<f64>,
+    /// The edge velocities in the face rows during the explicit momentum step, m/s.
+    rows_u: Vec<f64>,
     /// The viscous step's buffers.
-    pub(super) viscous: ViscousScratch,
+    viscous: ViscousScratch,
     /// Per edge: the Marangoni gradient's cross term (along the edge) as a velocity
     /// change, m/s, from the surfactant of the last sweep.
     pub(super) cross: Vec<f64>,
@@ -387,43 +389,41 @@ impl FilmFlow {
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn momentum_explicit(&mut self, s: &mut Scratch, dt_s: f64, forcing: &Forcing) {
         let r = self.params.radius_m;
-        advect_momentum(
-            &self.grid,
-            &self.rows,
-            &self.advection,
-            r,
-            dt_s,
-            &mut self.u_m_per_s,
-            &mut s.advect,
-        );
+        // On the face rows from here to the end (module `face_rows`).
+        let u = &mut s.rows_u;
+        self.rows.to_rows(&self.u_m_per_s, u);
+        advect_momentum(&self.rows, &self.advection, r, dt_s, u, &mut s.advect);
         let nu = self.params.viscosity_pa_s / self.params.density_kg_per_m3;
         let g = forcing.g_eff_m_per_s2;
+        let ea = self.grid.edge_arrays();
         match self.params.gradient {
             FilmGradient::TwoPoint => {
-                let ea = self.grid.edge_arrays();
                 // Gravity as the discrete gradient of the potential g·x between cell
                 // centres, so a discrete Marangoni gradient can balance it exactly (the
                 // edge projection g·n carries an O(Δx) curl that no tension gradient can
                 // hold).
-                for (u, c) in self.u_m_per_s.iter_mut().zip(&ea.centre_gradient) {
-                    *u += dt_s * g.dot(*c);
+                let gradient = &ea.centre_gradient;
+                self.rows.add_from_grid(u, |e| dt_s * g.dot(gradient[e]));
+                if !self.temperature_k.is_empty() {
+                    self.rows.to_grid(u, &mut self.u_m_per_s);
+                    self.thermal_stress(dt_s, &mut s.vertex);
+                    self.rows.to_rows(&self.u_m_per_s, u);
                 }
-                self.thermal_stress(dt_s, &mut s.vertex);
                 if nu > 0.0 {
-                    self.viscous_step(s, nu, dt_s);
+                    self.viscous_step(u, &mut s.viscous, nu, dt_s);
                 }
+                self.rows.to_grid(u, &mut self.u_m_per_s);
             }
             FilmGradient::Normal => {
                 if nu > 0.0 {
-                    self.viscous_step(s, nu, dt_s);
+                    self.viscous_step(u, &mut s.viscous, nu, dt_s);
                 }
                 // Gravity as the normal gradient of the cells' g·x, after the viscous
                 // stress: that gradient has a grid-scale circulation where grid lines are askew,
                 // which the viscous operator would turn into a flow no tension can hold.
-                let ea = self.grid.edge_arrays();
-                for (u, c) in self.u_m_per_s.iter_mut().zip(&ea.centre_normal_gradient) {
-                    *u += dt_s * g.dot(*c);
-                }
+                let gradient = &ea.centre_normal_gradient;
+                self.rows.add_from_grid(u, |e| dt_s * g.dot(gradient[e]));
+                self.rows.to_grid(u, &mut self.u_m_per_s);
                 self.thermal_stress(dt_s, &mut s.vertex);
             }
         }

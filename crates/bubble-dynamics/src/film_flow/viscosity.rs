@@ -8,8 +8,10 @@
 //! the cost of `s` of them: the stage count grows as n, not n². Each stage is a
 //! forward-Euler sub-step of its own length plus a blend with the two stages before it.
 
+use crate::avx2::with_avx2;
+
 use super::face_rows::{FaceRows, SIDES, Side};
-use super::flow::{FilmFlow, Scratch};
+use super::flow::FilmFlow;
 use super::grid::CubeSphere;
 
 /// Largest `dt·λ` a forward-Euler sub-step is given (of the 2 it can take): the margin
@@ -19,9 +21,7 @@ const EULER_RATE_LIMIT: f64 = 1.5;
 /// Buffers of the viscous step, reused across steps.
 #[derive(Clone, Debug, Default)]
 pub(super) struct ViscousScratch {
-    /// The edge velocities in the face rows ([`FaceRows`]), m/s.
-    pub(super) u: Vec<f64>,
-    /// The stage before the one under way, in the rows, m/s.
+    /// The stage before the one under way, in the face rows ([`FaceRows`]), m/s.
     pub(super) stage: Vec<f64>,
     /// Per local vertex: the vorticity on the unit sphere (m/s per rad).
     vorticity: Vec<f64>,
@@ -30,26 +30,32 @@ pub(super) struct ViscousScratch {
 }
 
 impl FilmFlow {
-    /// `u ← u + ∫ viscous dt` over `dt_s` for kinematic viscosity `nu_m2_per_s`.
+    /// `u ← u + ∫ viscous dt` over `dt_s` for kinematic viscosity `nu_m2_per_s`, on the
+    /// edge velocities `u` in the face rows ([`FaceRows`]).
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
-    pub(super) fn viscous_step(&mut self, s: &mut Scratch, nu_m2_per_s: f64, dt_s: f64) {
+    pub(super) fn viscous_step(
+        &self,
+        u: &mut [f64],
+        v: &mut ViscousScratch,
+        nu_m2_per_s: f64,
+        dt_s: f64,
+    ) {
         let r = self.params.radius_m;
         let rate = self.viscous_bound * nu_m2_per_s / (r * r);
         let stages = legendre_stages((dt_s * rate / EULER_RATE_LIMIT).ceil().max(1.0));
         let w1 = 2.0 / f64::from(stages * stages + stages);
-        let v = &mut s.viscous;
-        self.rows.to_rows(&self.u_m_per_s, &mut v.u);
         // Y₁ = Y₀ + w₁ dt M(Y₀), with Y₀ = u. The first stage reads no stage before last
         // (it only writes Y₀ there), so `v.stage` needs its length, not a copy of u.
-        v.stage.resize(v.u.len(), 0.0);
-        self.viscous_stage(v, nu_m2_per_s, w1 * dt_s, 1.0, 0.0);
-        for j in 2..=stages {
-            // Yⱼ = μⱼ Yⱼ₋₁ + νⱼ Yⱼ₋₂ + μⱼ w₁ dt M(Yⱼ₋₁), μⱼ = (2j − 1)/j, νⱼ = (1 − j)/j.
-            let j = f64::from(j);
-            let mu = (2.0 * j - 1.0) / j;
-            self.viscous_stage(v, nu_m2_per_s, mu * w1 * dt_s, mu, (1.0 - j) / j);
-        }
-        self.rows.to_grid(&v.u, &mut self.u_m_per_s);
+        v.stage.resize(u.len(), 0.0);
+        with_avx2(|| {
+            self.viscous_stage(u, v, nu_m2_per_s, w1 * dt_s, 1.0, 0.0);
+            for j in 2..=stages {
+                // Yⱼ = μⱼ Yⱼ₋₁ + νⱼ Yⱼ₋₂ + μⱼ w₁ dt M(Yⱼ₋₁), μⱼ = (2j − 1)/j, νⱼ = (1 − j)/j.
+                let j = f64::from(j);
+                let mu = (2.0 * j - 1.0) / j;
+                self.viscous_stage(u, v, nu_m2_per_s, mu * w1 * dt_s, mu, (1.0 - j) / j);
+            }
+        });
     }
 
     /// One stage on the rows: `u ← mu·u + nu_prev·stage + dt_s·M(u)` with the stage
@@ -59,8 +65,10 @@ impl FilmFlow {
     /// `face_rows`): each edge's change is odd in the edge's orientation (a difference
     /// across it, one along it and its own velocity), so a flipped copy's is the grid's
     /// negated, exactly.
+    #[inline(always)]
     pub(super) fn viscous_stage(
         &self,
+        u: &mut [f64],
         v: &mut ViscousScratch,
         nu: f64,
         dt_s: f64,
@@ -68,7 +76,7 @@ impl FilmFlow {
         nu_prev: f64,
     ) {
         let rows = &self.rows;
-        vorticity_and_divergence(&self.grid, rows, v);
+        vorticity_and_divergence(&self.grid, rows, u, v);
         let (vorticity, divergence) = (&v.vorticity, &v.divergence);
         // Vorticity and divergence per R (of the unit sphere's), and each difference of
         // them per R again: every term of the stress carries 1/R², taken once here.
@@ -93,7 +101,7 @@ impl FilmFlow {
             // into (i, y).
             for y in 0..n {
                 let k = rows.x_edge(f, 1, y)..rows.x_edge(f, n, y);
-                let (u, y_prev) = (&mut v.u[k.clone()], &mut v.stage[k.clone()]);
+                let (u, y_prev) = (&mut u[k.clone()], &mut v.stage[k.clone()]);
                 let (il, id) = (&il[k.clone()], &id[k]);
                 let (head, tail) = (rows.vertex_at(f, 1, y), rows.vertex_at(f, 1, y + 1));
                 let (head, tail) = (
@@ -112,7 +120,7 @@ impl FilmFlow {
             // into (x, j).
             for j in 1..n {
                 let k = rows.y_edge(f, 0, j)..rows.y_edge(f, n, j);
-                let (u, y_prev) = (&mut v.u[k.clone()], &mut v.stage[k.clone()]);
+                let (u, y_prev) = (&mut u[k.clone()], &mut v.stage[k.clone()]);
                 let (il, id) = (&il[k.clone()], &id[k]);
                 let tail = rows.vertex_at(f, 0, j);
                 let (tail, head) = (
@@ -134,17 +142,17 @@ impl FilmFlow {
             let [from, into] = b.cells.map(|c| divergence[c as usize]);
             let curl_curl = (head - tail) * il[k];
             let grad_div = (into - from) * id[k];
-            step(&mut v.u[k], &mut v.stage[k], curl_curl, grad_div);
+            step(&mut u[k], &mut v.stage[k], curl_curl, grad_div);
         }
     }
 }
 
 /// The vorticity at each local vertex into `v.vorticity` and the divergence of each cell
-/// into `v.divergence`, of the edge velocities `v.u` (in the rows), on the unit sphere
+/// into `v.divergence`, of the edge velocities `u` (in the rows), on the unit sphere
 /// (m/s per rad). A cell's divergence sums its edges' `±u l` in the grid's edge order,
 /// `+` where the local normal points out of it (its right and top sides).
-fn vorticity_and_divergence(grid: &CubeSphere, rows: &FaceRows, v: &mut ViscousScratch) {
-    let u = &v.u;
+#[inline(always)]
+fn vorticity_and_divergence(grid: &CubeSphere, rows: &FaceRows, u: &[f64], v: &mut ViscousScratch) {
     rows.circulation(u, &mut v.vorticity, &rows.vertex_inverse_area, |z, ia| {
         z * ia
     });
@@ -215,9 +223,9 @@ mod tests {
 
     use glam::DVec3;
 
-    use super::super::flow::{FilmFlow, FlowParams, Scratch};
+    use super::super::flow::{FilmFlow, FlowParams};
     use super::super::{CubeSphere, Hierarchy};
-    use super::legendre_stages;
+    use super::{ViscousScratch, legendre_stages};
 
     /// Each stage count is the fewest whose span covers the sub-steps: 1 → 1, 2..3 → 2,
     /// 4..6 → 3, 22 → 7.
@@ -265,24 +273,29 @@ mod tests {
     #[test]
     fn legendre_stages_match_small_euler_steps_and_damp_the_roughest_field() {
         let (mut f, nu) = viscous_film();
-        let mut s = Scratch::default();
+        let mut s = ViscousScratch::default();
         let dt = step_of(&f, nu, 54.5);
         f.set_velocity(|d: DVec3| d.cross(DVec3::Z) * (3.0 * d.z) * 1e-3);
-        let euler_steps = |f: &mut FilmFlow, s: &mut Scratch| {
-            // Plain forward-Euler sub-steps, not through the stage weights under test.
-            let v = &mut s.viscous;
-            f.rows.to_rows(&f.u_m_per_s, &mut v.u);
-            v.stage.resize(v.u.len(), 0.0);
-            for _ in 0..100 {
-                f.viscous_stage(v, nu, dt / 100.0, 1.0, 0.0);
-            }
-            f.rows.to_grid(&v.u, &mut f.u_m_per_s);
+        // Steps of the grid's edge velocities, through the face rows.
+        let mut u = Vec::new();
+        let mut on_rows = |f: &mut FilmFlow, step: &mut dyn FnMut(&FilmFlow, &mut [f64])| {
+            f.rows.to_rows(&f.u_m_per_s, &mut u);
+            step(f, &mut u);
+            f.rows.to_grid(&u, &mut f.u_m_per_s);
         };
-        euler_steps(&mut f, &mut s);
+        let mut euler_steps = |f: &FilmFlow, u: &mut [f64]| {
+            // Plain forward-Euler sub-steps, not through the stage weights under test.
+            s.stage.resize(u.len(), 0.0);
+            for _ in 0..100 {
+                f.viscous_stage(u, &mut s, nu, dt / 100.0, 1.0, 0.0);
+            }
+        };
+        on_rows(&mut f, &mut euler_steps);
         let smooth = f.u_m_per_s.clone();
-        euler_steps(&mut f, &mut s);
+        on_rows(&mut f, &mut euler_steps);
         let euler = std::mem::replace(&mut f.u_m_per_s, smooth.clone());
-        f.viscous_step(&mut s, nu, dt);
+        let mut s = ViscousScratch::default();
+        on_rows(&mut f, &mut |f, u| f.viscous_step(u, &mut s, nu, dt));
         // The vortex's decay over the step, by each: first order in time alike, they
         // differ by about dt·λ/4 of it (λ the vortex's rate, dt·λ 0.05 here).
         let decay = |u: &[f64]| {
@@ -303,7 +316,8 @@ mod tests {
             *u = if k % 2 == 0 { 1e-3 } else { -1e-3 };
         }
         let before = energy(&f);
-        f.viscous_step(&mut s, nu, step_of(&f, nu, 149.5));
+        let long = step_of(&f, nu, 149.5);
+        on_rows(&mut f, &mut |f, u| f.viscous_step(u, &mut s, nu, long));
         let after = energy(&f);
         assert!(after < before, "energy {before:e} → {after:e}");
     }
