@@ -73,6 +73,10 @@ pub(crate) struct AdvectionGeometry {
     irregular: Vec<IrregularWeights>,
     /// The narrowest dual edge, rad.
     min_dual_length: f64,
+    /// A bound on any cell's speed per unit speed of its fastest edge: the largest sum of
+    /// a cell's four reconstruction weights' lengths, with a margin of 1e-9 for the
+    /// rounding of the velocities' sums.
+    speed_bound: f64,
 }
 
 /// An irregular cell's weights, its sides in the grid's order.
@@ -145,7 +149,12 @@ impl AdvectionGeometry {
                 }
             })
             .collect();
+        let speed_bound = (0..cells)
+            .map(|c| (0..4).map(|i| side(c, i).2.length()).sum::<f64>())
+            .fold(0.0, f64::max)
+            * (1.0 + 1e-9);
         Self {
+            speed_bound,
             to_cell,
             centre: std::array::from_fn(|a| centres.iter().map(|c| c[a]).collect()),
             coriolis: weights,
@@ -226,11 +235,17 @@ pub(crate) struct AdvectionScratch {
     u0: Vec<f64>,
     /// Per cell: its squared speed, m²/s².
     speed_squared: Vec<f64>,
-    /// Per local vertex: the vorticity, 1/s.
+    /// Per local vertex: the vorticity of the velocities the stage under way starts
+    /// from, 1/s.
     vorticity: Vec<f64>,
+    /// Per local vertex: the vorticity of those it ends with.
+    next_vorticity: Vec<f64>,
     /// Per side of a cell (in [`SIDES`] order), per cell: the cell's term of that side's
-    /// rate, m/s², in the rows' orientation.
-    rate: [Vec<f64>; 4],
+    /// rate, m/s², in the rows' orientation, kept for the cells' sides on the faces'
+    /// borders.
+    border_rate: [Vec<f64>; 4],
+    /// The same for the row of cells under way and the one before (even and odd rows).
+    row_rate: [[Vec<f64>; 4]; 2],
 }
 
 /// Advances the edge velocities `u` (m/s, in the face rows) by `u·∇u` over `dt_s` on a
@@ -243,6 +258,49 @@ pub(crate) fn advect_momentum(
     u: &mut [f64],
     s: &mut AdvectionScratch,
 ) {
+    let Some(substeps) = substeps(rows, geo, radius_m, dt_s, u, s) else {
+        return;
+    };
+    let h = dt_s / f64::from(substeps);
+    with_avx2(
+        #[inline(always)]
+        || {
+            rows.circulation(u, &mut s.vorticity, &rows.vertex_area, |z, a| {
+                z / (a * radius_m)
+            });
+            for k in 1..=substeps {
+                ssp_rk3(rows, geo, radius_m, h, u, s, k < substeps);
+            }
+        },
+    );
+}
+
+/// The sub-steps that keep the fastest cell within [`MAX_COURANT`] of the narrowest dual
+/// edge (none for a film at rest, or whose speed is not finite).
+///
+/// Where the fastest edge's speed bounds the fastest cell's within that (a cell's
+/// velocity is at most [`AdvectionGeometry::speed_bound`] times its fastest edge's), that
+/// is one sub-step, without the cells' velocities: the count is what they give, since the
+/// exact Courant number is at most the bound's. The one difference: a field whose every
+/// cell velocity cancels to zero, which the speeds alone would leave as it is, is
+/// advected.
+fn substeps(
+    rows: &FaceRows,
+    geo: &AdvectionGeometry,
+    radius_m: f64,
+    dt_s: f64,
+    u: &[f64],
+    s: &mut AdvectionScratch,
+) -> Option<u32> {
+    let courant = |speed: f64| speed * dt_s / (geo.min_dual_length * radius_m);
+    // `f64::max`'s largest: a speed that is not a number is passed over.
+    let fastest_edge = u.iter().fold(0.0, |m, v| larger(v.abs(), m));
+    if fastest_edge == 0.0 {
+        return None;
+    }
+    if courant(geo.speed_bound * fastest_edge) <= MAX_COURANT {
+        return Some(1);
+    }
     // The largest squared speed's root: the same number as the largest root (the
     // rounded root is monotonic), for one root where there was one a cell.
     let fastest = with_avx2(
@@ -251,23 +309,14 @@ pub(crate) fn advect_momentum(
     );
     let speed = fastest.sqrt();
     if speed == 0.0 || !speed.is_finite() {
-        return;
+        return None;
     }
-    let courant = speed * dt_s / (geo.min_dual_length * radius_m);
-    let substeps = (courant / MAX_COURANT).ceil().clamp(1.0, 64.0) as u32;
-    let h = dt_s / f64::from(substeps);
-    with_avx2(
-        #[inline(always)]
-        || {
-            for _ in 0..substeps {
-                ssp_rk3(rows, geo, radius_m, h, u, s);
-            }
-        },
-    );
+    Some((courant(speed) / MAX_COURANT).ceil().clamp(1.0, 64.0) as u32)
 }
 
 /// One Shu–Osher third-order step of `u`: `u₁ = u + hL(u)`, `u₂ = ¾u + ¼(u₁ + hL(u₁))`,
-/// `u ← ⅓u + ⅔(u₂ + hL(u₂))`.
+/// `u ← ⅓u + ⅔(u₂ + hL(u₂))`, from `u`'s vorticity in `s.vorticity`; it leaves the new
+/// `u`'s there where `next` (for the next sub-step).
 #[inline(always)]
 fn ssp_rk3(
     rows: &FaceRows,
@@ -276,67 +325,165 @@ fn ssp_rk3(
     h: f64,
     u: &mut [f64],
     s: &mut AdvectionScratch,
+    next: bool,
 ) {
     s.u0.clear();
     s.u0.extend_from_slice(u);
     // Stage 1: u holds u₁.
-    acceleration(rows, geo, radius_m, u, s);
-    update(rows, &s.rate, u, &s.u0, |u, _, r| u + h * r);
+    stage(rows, geo, radius_m, u, s, true, |u, _, r| u + h * r);
     // Stage 2: u holds u₂.
-    acceleration(rows, geo, radius_m, u, s);
-    update(rows, &s.rate, u, &s.u0, |u, u0, r| {
+    stage(rows, geo, radius_m, u, s, true, |u, u0, r| {
         0.75 * u0 + 0.25 * (u + h * r)
     });
     // Stage 3.
-    acceleration(rows, geo, radius_m, u, s);
-    update(rows, &s.rate, u, &s.u0, |u, u0, r| {
+    stage(rows, geo, radius_m, u, s, next, |u, u0, r| {
         u0 / 3.0 + (2.0 / 3.0) * (u + h * r)
     });
 }
 
-/// `u ← step(u, u0, rate)` on every local edge, the rate the sum of its two cells' terms
-/// (the lower-numbered cell's first).
+/// One stage, in one pass over each face's rows: `u ← step(u, s.u0, rate)` on every
+/// local edge, the rate the rotation term `−ζ (k×u)·n` of `u` (with its vorticity in
+/// `s.vorticity`) summed over the edge's two cells (the lower-numbered cell's term
+/// first); where `next`, the new `u`'s vorticity then replaces it.
+///
+/// Row `y` of a face takes its cells' terms (its irregular cells' in the grid's order),
+/// then moves its X-edges (both their cells are in the row) and its Y-edges below it (the
+/// row before holds their other cells), then takes the vorticity of its vertex row `y`,
+/// whose edges have all moved by then. No row reads an edge a row before it has moved.
+/// The edges on the faces' borders move last, from their two faces' cells' terms, kept
+/// for that in `s.border_rate`.
 #[inline(always)]
-fn update(
+fn stage(
     rows: &FaceRows,
-    rate: &[Vec<f64>; 4],
+    geo: &AdvectionGeometry,
+    radius_m: f64,
     u: &mut [f64],
-    u0: &[f64],
+    s: &mut AdvectionScratch,
+    next: bool,
     step: impl Fn(f64, f64, f64) -> f64,
 ) {
     let n = rows.n;
-    let [bottom, left, right, top] = rate;
+    let cells = 6 * n * n;
+    s.next_vorticity.resize(rows.vertices(), 0.0);
+    for r in &mut s.border_rate {
+        r.resize(cells, 0.0);
+    }
+    for r in s.row_rate.iter_mut().flatten() {
+        r.resize(n, 0.0);
+    }
+    let (vorticity, u0) = (&s.vorticity, &s.u0);
+    let mut irregular = rows.irregular_cells.iter().zip(&geo.irregular).peekable();
+    let [even, odd] = &mut s.row_rate;
     for f in 0..6 {
-        let cells = f * n * n;
-        // The X-edges inside the face: cell (i − 1, y)'s right side and (i, y)'s left.
         for y in 0..n {
-            let k = rows.x_edge(f, 1, y);
-            let c = cells + y * n;
-            let (u, u0) = (&mut u[k..k + n - 1], &u0[k..k + n - 1]);
-            let (ra, rb) = (&right[c..c + n - 1], &left[c + 1..c + n]);
-            for i in 0..n - 1 {
-                u[i] = step(u[i], u0[i], (0.0 + ra[i]) + rb[i]);
+            let c = f * n * n + y * n;
+            let (rate, before) = if y % 2 == 0 {
+                (&mut *even, &*odd)
+            } else {
+                (&mut *odd, &*even)
+            };
+            cell_row(rows, geo, u, vorticity, f, y, rate);
+            while let Some((ic, w)) = irregular.next_if(|(ic, _)| (ic.cell as usize) < c + n) {
+                let x = ic.cell as usize - c;
+                let z = ic
+                    .ends
+                    .map(|[v0, v1]| 0.5 * (vorticity[v0 as usize] + vorticity[v1 as usize]));
+                let terms = cell_rates(z, ic.edges.map(|k| u[k as usize]), &w.coriolis);
+                for (side, r) in ic.order.into_iter().zip(terms) {
+                    rate[side as usize][x] = r;
+                }
             }
-        }
-        // The Y-edges inside: cell (x, j − 1)'s top and (x, j)'s bottom.
-        for j in 1..n {
-            let k = rows.y_edge(f, 0, j);
-            let c = cells + j * n;
-            let (u, u0) = (&mut u[k..k + n], &u0[k..k + n]);
-            let (ra, rb) = (&top[c - n..c], &bottom[c..c + n]);
+            let [bottom, left, right, top] = &*rate;
+            let border = &mut s.border_rate;
+            border[Side::Left as usize][c] = left[0];
+            border[Side::Right as usize][c + n - 1] = right[n - 1];
+            if y == 0 {
+                border[Side::Bottom as usize][c..c + n].copy_from_slice(bottom);
+            }
+            if y == n - 1 {
+                border[Side::Top as usize][c..c + n].copy_from_slice(top);
+            }
+            // The X-edges inside the face: cell (i − 1, y)'s right side and (i, y)'s left.
+            let k = rows.x_edge(f, 1, y);
+            let (ux, u0x) = (&mut u[k..k + n - 1], &u0[k..k + n - 1]);
+            let (ra, rb) = (&right[..n - 1], &left[1..]);
+            for i in 0..n - 1 {
+                ux[i] = step(ux[i], u0x[i], (0.0 + ra[i]) + rb[i]);
+            }
+            if y == 0 {
+                continue;
+            }
+            // The Y-edges below: cell (x, y − 1)'s top and (x, y)'s bottom.
+            let k = rows.y_edge(f, 0, y);
+            let (uy, u0y) = (&mut u[k..k + n], &u0[k..k + n]);
+            let (ra, rb) = (&before[Side::Top as usize][..n], &bottom[..n]);
             for x in 0..n {
-                u[x] = step(u[x], u0[x], (0.0 + ra[x]) + rb[x]);
+                uy[x] = step(uy[x], u0y[x], (0.0 + ra[x]) + rb[x]);
+            }
+            if next {
+                rows.circulation_row(u, f, y, &mut s.next_vorticity, &rows.vertex_area, |z, a| {
+                    z / (a * radius_m)
+                });
             }
         }
     }
+    let border = &s.border_rate;
     for e in &rows.seam_edges {
         let [(ca, sa, ka), (cb, sb, kb)] = e.cells;
         let term =
-            |c: u32, side: Side, k: u32| rows.sign(k as usize) * rate[side as usize][c as usize];
+            |c: u32, side: Side, k: u32| rows.sign(k as usize) * border[side as usize][c as usize];
         let r = (0.0 + term(ca, sa, ka)) + term(cb, sb, kb);
         for k in [ka as usize, kb as usize] {
             u[k] = step(u[k], u0[k], rows.sign(k) * r);
         }
+    }
+    if next {
+        rows.seam_circulation(u, &mut s.next_vorticity, &rows.vertex_area, |z, a| {
+            z / (a * radius_m)
+        });
+        std::mem::swap(&mut s.vorticity, &mut s.next_vorticity);
+    }
+}
+
+/// Row `y` of face `f`'s cells' terms of their sides' rates into `rate` (per side, per
+/// cell of the row), from the edge velocities `u` and the vertices' `vorticity`.
+#[inline(always)]
+fn cell_row(
+    rows: &FaceRows,
+    geo: &AdvectionGeometry,
+    u: &[f64],
+    vorticity: &[f64],
+    f: usize,
+    y: usize,
+    rate: &mut [Vec<f64>; 4],
+) {
+    let n = rows.n;
+    let c = f * n * n + y * n;
+    let (uy, ux) = (rows.y_edge(f, 0, y), rows.x_edge(f, 0, y));
+    let (bottom, top) = (&u[uy..uy + n], &u[uy + n..uy + 2 * n]);
+    let (left, right) = (&u[ux..ux + n], &u[ux + 1..ux + n + 1]);
+    let (vb, vt) = (rows.vertex_at(f, 0, y), rows.vertex_at(f, 0, y + 1));
+    let (zb0, zb1) = (&vorticity[vb..vb + n], &vorticity[vb + 1..vb + n + 1]);
+    let (zt0, zt1) = (&vorticity[vt..vt + n], &vorticity[vt + 1..vt + n + 1]);
+    let [w0, w1, w2] = &geo.coriolis;
+    let [w0, w1, w2] = [w0, w1, w2].map(|w| slices(w, c..c + n));
+    let [ob, ol, or, ot] = rate;
+    let (ob, ol, or, ot) = (&mut ob[..n], &mut ol[..n], &mut or[..n], &mut ot[..n]);
+    for x in 0..n {
+        let z = [
+            0.5 * (zb0[x] + zb1[x]),
+            0.5 * (zb0[x] + zt0[x]),
+            0.5 * (zb1[x] + zt1[x]),
+            0.5 * (zt0[x] + zt1[x]),
+        ];
+        let u = [bottom[x], left[x], right[x], top[x]];
+        let w = [
+            [w0[0][x], w0[1][x], w0[2][x], w0[3][x]],
+            [w1[0][x], w1[1][x], w1[2][x], w1[3][x]],
+            [w2[0][x], w2[1][x], w2[2][x], w2[3][x]],
+        ];
+        let [b, l, r, t] = cell_rates(z, u, &w);
+        (ob[x], ol[x], or[x], ot[x]) = (b, l, r, t);
     }
 }
 
@@ -405,68 +552,6 @@ fn velocity(w: &[[f64; 3]; 4], u: [f64; 4], c: [f64; 3]) -> [f64; 3] {
     ]
 }
 
-/// The rotation term `−ζ (k×u)·n` of each cell on each of its sides into `s.rate`, m/s².
-#[inline(always)]
-fn acceleration(
-    rows: &FaceRows,
-    geo: &AdvectionGeometry,
-    radius_m: f64,
-    u: &[f64],
-    s: &mut AdvectionScratch,
-) {
-    rows.circulation(u, &mut s.vorticity, &rows.vertex_area, |z, a| {
-        z / (a * radius_m)
-    });
-    let vorticity = &s.vorticity;
-    let n = rows.n;
-    for r in &mut s.rate {
-        r.resize(6 * n * n, 0.0);
-    }
-    let [out_b, out_l, out_r, out_t] = &mut s.rate;
-    let [w0, w1, w2] = &geo.coriolis;
-    for f in 0..6 {
-        for y in 0..n {
-            let c = f * n * n + y * n;
-            let (uy, ux) = (rows.y_edge(f, 0, y), rows.x_edge(f, 0, y));
-            let (bottom, top) = (&u[uy..uy + n], &u[uy + n..uy + 2 * n]);
-            let (left, right) = (&u[ux..ux + n], &u[ux + 1..ux + n + 1]);
-            let (vb, vt) = (rows.vertex_at(f, 0, y), rows.vertex_at(f, 0, y + 1));
-            let (zb0, zb1) = (&vorticity[vb..vb + n], &vorticity[vb + 1..vb + n + 1]);
-            let (zt0, zt1) = (&vorticity[vt..vt + n], &vorticity[vt + 1..vt + n + 1]);
-            let [w0, w1, w2] = [w0, w1, w2].map(|w| slices(w, c..c + n));
-            let (ob, ol) = (&mut out_b[c..c + n], &mut out_l[c..c + n]);
-            let (or, ot) = (&mut out_r[c..c + n], &mut out_t[c..c + n]);
-            for x in 0..n {
-                let z = [
-                    0.5 * (zb0[x] + zb1[x]),
-                    0.5 * (zb0[x] + zt0[x]),
-                    0.5 * (zb1[x] + zt1[x]),
-                    0.5 * (zt0[x] + zt1[x]),
-                ];
-                let u = [bottom[x], left[x], right[x], top[x]];
-                let w = [
-                    [w0[0][x], w0[1][x], w0[2][x], w0[3][x]],
-                    [w1[0][x], w1[1][x], w1[2][x], w1[3][x]],
-                    [w2[0][x], w2[1][x], w2[2][x], w2[3][x]],
-                ];
-                let [b, l, r, t] = cell_rates(z, u, &w);
-                (ob[x], ol[x], or[x], ot[x]) = (b, l, r, t);
-            }
-        }
-    }
-    for (ic, w) in rows.irregular_cells.iter().zip(&geo.irregular) {
-        let c = ic.cell as usize;
-        let z = ic
-            .ends
-            .map(|[v0, v1]| 0.5 * (vorticity[v0 as usize] + vorticity[v1 as usize]));
-        let v = ic.edges.map(|k| u[k as usize]);
-        let rates = cell_rates(z, v, &w.coriolis);
-        for (side, r) in ic.order.into_iter().zip(rates) {
-            s.rate[side as usize][c] = r;
-        }
-    }
-}
-
 /// The same range of each of `arrays`.
 #[inline(always)]
 fn slices<const N: usize>(arrays: &[Vec<f64>; N], r: std::ops::Range<usize>) -> [&[f64]; N] {
@@ -532,6 +617,38 @@ mod tests {
         let squared = v.iter().map(|v| DVec3::from_array(*v).length_squared());
         assert!(squared.eq(speeds), "the squared speeds are the velocities'");
         assert!(worst < 0.02, "worst reconstruction error {worst:.3e}");
+    }
+
+    /// The fastest cell is never faster than the bound the sub-steps take from the fastest
+    /// edge: a rotation, a rough field and one edge alone.
+    #[test]
+    fn the_fastest_edge_bounds_the_fastest_cell() {
+        for n in [3, 16] {
+            let grid = CubeSphere::new(n);
+            let rows = FaceRows::new(&grid);
+            let geo = AdvectionGeometry::new(&grid, &rows);
+            let edges = grid.edges().len();
+            let rough = (0..edges).map(|e| ((e * 7919) % 1000) as f64 * 1e-3 - 0.5);
+            let single = (0..edges).map(|e| if e == edges / 2 { 1.0 } else { 0.0 });
+            for field in [
+                rotation_about_z(&grid, 1.0),
+                rough.collect(),
+                single.collect(),
+            ] {
+                let mut u = Vec::new();
+                rows.to_rows(&field, &mut u);
+                let fastest = fastest_speed_squared(&rows, &geo, &u, &mut Vec::new()).sqrt();
+                let edge = u.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
+                eprintln!(
+                    "n {n}: fastest cell {fastest:.4}, bound {:.4}",
+                    geo.speed_bound * edge
+                );
+                assert!(
+                    fastest <= geo.speed_bound * edge,
+                    "n {n}: {fastest} > bound"
+                );
+            }
+        }
     }
 
     #[test]

@@ -20,6 +20,7 @@
 
 use glam::DVec3;
 
+use super::flow::FilmGradient;
 use super::grid::{CubeSphere, FACE_BASES};
 
 /// Which side of a cell an edge is: bottom (`t` low), left (`s` low), right, top.
@@ -99,6 +100,9 @@ pub(crate) struct FaceRows {
     pub(crate) edge: Vec<u32>,
     /// Per local edge: `true` where the grid's normal is against the local one.
     pub(crate) flipped: Vec<bool>,
+    /// Per local edge: `−1` where flipped, else `1` (a value times it is the value or its
+    /// negation, exactly).
+    pub(crate) signs: Vec<f64>,
     /// Per local edge: the arc between its cells' centres, rad.
     pub(crate) dual_length: Vec<f64>,
     /// Per local edge: its arc length, rad.
@@ -121,6 +125,9 @@ pub(crate) struct FaceRows {
     pub(crate) border_edges: Vec<BorderEdge>,
     /// The cells whose edges the grid numbers out of the local order.
     pub(crate) irregular_cells: Vec<IrregularCell>,
+    /// The grid's centre gradients (two-point, normal) in the rows by component, once
+    /// [`Self::add_gradient`] has asked for them.
+    gradients: [std::sync::OnceLock<[Vec<f64>; 3]>; 2],
 }
 
 impl FaceRows {
@@ -184,35 +191,53 @@ impl FaceRows {
 
     /// `±1`: local edge `k`'s orientation against the grid's.
     pub(crate) fn sign(&self, k: usize) -> f64 {
-        if self.flipped[k] { -1.0 } else { 1.0 }
+        self.signs[k]
     }
 
     /// The grid's edge values `grid` (in the grid's orientation) into `rows` (each copy
     /// in its own).
     pub(crate) fn to_rows(&self, grid: &[f64], rows: &mut Vec<f64>) {
-        rows.clear();
-        let copy = |(&e, &flipped): (&u32, &bool)| {
-            let u = grid[e as usize];
-            if flipped { -u } else { u }
-        };
-        rows.extend(self.edge.iter().zip(&self.flipped).map(copy));
+        // Every entry is written: the buffer needs its length, not a fill.
+        rows.resize(self.edge.len(), 0.0);
+        for ((u, &e), &sign) in rows.iter_mut().zip(&self.edge).zip(&self.signs) {
+            *u = grid[e as usize] * sign;
+        }
     }
 
     /// The rows' edge values back into the grid's numbering and orientation (a border
     /// edge's two copies agree).
     pub(crate) fn to_grid(&self, rows: &[f64], grid: &mut [f64]) {
-        for ((&e, &flipped), &u) in self.edge.iter().zip(&self.flipped).zip(rows) {
-            grid[e as usize] = if flipped { -u } else { u };
+        for ((&e, &sign), &u) in self.edge.iter().zip(&self.signs).zip(rows) {
+            grid[e as usize] = u * sign;
         }
     }
 
-    /// `rows[k] += value(e)` for each local edge `k` of grid edge `e`, `value` in the
-    /// grid's orientation (negated for a flipped copy: the grid's sum, negated, exactly).
-    #[inline(always)]
-    pub(crate) fn add_from_grid(&self, rows: &mut [f64], value: impl Fn(usize) -> f64) {
-        for ((u, &e), &flipped) in rows.iter_mut().zip(&self.edge).zip(&self.flipped) {
-            let v = value(e as usize);
-            *u += if flipped { -v } else { v };
+    /// `u += dt_s·(g·c)` on every local edge, `c` its grid edge's centre gradient for
+    /// `kind` (`grid`'s, from which the rows were derived) in its own orientation: the
+    /// grid's sum, negated for a flipped copy, exactly. The gradients are taken into the
+    /// rows, by component, the first time `kind` is asked for.
+    pub(crate) fn add_gradient(
+        &self,
+        u: &mut [f64],
+        grid: &CubeSphere,
+        kind: FilmGradient,
+        g: DVec3,
+        dt_s: f64,
+    ) {
+        let ea = grid.edge_arrays();
+        let (per_edge, rows) = match kind {
+            FilmGradient::TwoPoint => (&ea.centre_gradient, &self.gradients[0]),
+            FilmGradient::Normal => (&ea.centre_normal_gradient, &self.gradients[1]),
+        };
+        let [x, y, z] = rows.get_or_init(|| {
+            std::array::from_fn(|a| {
+                let along = self.edge.iter().zip(&self.signs);
+                along.map(|(&e, &s)| per_edge[e as usize][a] * s).collect()
+            })
+        });
+        for (((u, x), y), z) in u.iter_mut().zip(x).zip(y).zip(z) {
+            // `g.dot(c)` as glam sums it.
+            *u += dt_s * (g.x * x + g.y * y + g.z * z);
         }
     }
 
@@ -226,6 +251,7 @@ impl FaceRows {
             n,
             edge: Vec::new(),
             flipped: Vec::new(),
+            signs: Vec::new(),
             dual_length: Vec::new(),
             length: Vec::new(),
             inverse_length: Vec::new(),
@@ -237,6 +263,7 @@ impl FaceRows {
             seam_edges: Vec::new(),
             border_edges: Vec::new(),
             irregular_cells: Vec::new(),
+            gradients: Default::default(),
         };
         let local_edges = 6 * rows.edges_per_face();
         rows.edge = vec![u32::MAX; local_edges];
@@ -267,6 +294,11 @@ impl FaceRows {
             rows.edge.iter().all(|&e| e != u32::MAX),
             "a local edge unset"
         );
+        rows.signs = rows
+            .flipped
+            .iter()
+            .map(|&f| if f { -1.0 } else { 1.0 })
+            .collect();
         let ea = grid.edge_arrays();
         let local = |a: &[f64]| rows.edge.iter().map(|&e| a[e as usize]).collect();
         rows.dual_length = local(&ea.dual_length);
@@ -321,29 +353,55 @@ impl FaceRows {
         scale: &[f64],
         finish: impl Fn(f64, f64) -> f64,
     ) {
-        let n = self.n;
         out.resize(self.vertices(), 0.0);
-        let d = &self.dual_length;
         for f in 0..6 {
-            for j in 1..n {
-                let inner = n - 1;
-                let below = self.x_edge(f, 1, j - 1)..self.x_edge(f, n, j - 1);
-                let left = self.y_edge(f, 0, j)..self.y_edge(f, n - 1, j);
-                let right = self.y_edge(f, 1, j)..self.y_edge(f, n, j);
-                let above = self.x_edge(f, 1, j)..self.x_edge(f, n, j);
-                let (ub, db) = (&u[below.clone()], &d[below]);
-                let (ul, dl) = (&u[left.clone()], &d[left]);
-                let (ur, dr) = (&u[right.clone()], &d[right]);
-                let (ua, da) = (&u[above.clone()], &d[above]);
-                let start = self.vertex_at(f, 1, j);
-                let row = &mut out[start..start + inner];
-                let scale = &scale[start..start + inner];
-                for i in 0..inner {
-                    let z = 0.0 - ub[i] * db[i] + ul[i] * dl[i] - ur[i] * dr[i] + ua[i] * da[i];
-                    row[i] = finish(z, scale[i]);
-                }
+            for j in 1..self.n {
+                self.circulation_row(u, f, j, out, scale, &finish);
             }
         }
+        self.seam_circulation(u, out, scale, finish);
+    }
+
+    /// [`Self::circulation`] of row `j` (`1 ≤ j < n`) of face `f`'s inner vertices: it
+    /// reads X-edges `(1..n, j − 1)` and `(1..n, j)` and Y-edges `(0..n, j)`.
+    #[inline(always)]
+    pub(crate) fn circulation_row(
+        &self,
+        u: &[f64],
+        f: usize,
+        j: usize,
+        out: &mut [f64],
+        scale: &[f64],
+        finish: impl Fn(f64, f64) -> f64,
+    ) {
+        let (n, d) = (self.n, &self.dual_length);
+        let inner = n - 1;
+        let below = self.x_edge(f, 1, j - 1)..self.x_edge(f, n, j - 1);
+        let left = self.y_edge(f, 0, j)..self.y_edge(f, n - 1, j);
+        let right = self.y_edge(f, 1, j)..self.y_edge(f, n, j);
+        let above = self.x_edge(f, 1, j)..self.x_edge(f, n, j);
+        let (ub, db) = (&u[below.clone()], &d[below]);
+        let (ul, dl) = (&u[left.clone()], &d[left]);
+        let (ur, dr) = (&u[right.clone()], &d[right]);
+        let (ua, da) = (&u[above.clone()], &d[above]);
+        let start = self.vertex_at(f, 1, j);
+        let row = &mut out[start..start + inner];
+        let scale = &scale[start..start + inner];
+        for i in 0..inner {
+            let z = 0.0 - ub[i] * db[i] + ul[i] * dl[i] - ur[i] * dr[i] + ua[i] * da[i];
+            row[i] = finish(z, scale[i]);
+        }
+    }
+
+    /// [`Self::circulation`] of the vertices on the faces' borders, into each copy.
+    #[inline(always)]
+    pub(crate) fn seam_circulation(
+        &self,
+        u: &[f64],
+        out: &mut [f64],
+        scale: &[f64],
+        finish: impl Fn(f64, f64) -> f64,
+    ) {
         for v in &self.seam_vertices {
             let mut z = 0.0;
             for &(k, w) in &v.edges[..usize::from(v.edge_count)] {

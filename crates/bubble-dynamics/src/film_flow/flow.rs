@@ -395,15 +395,14 @@ impl FilmFlow {
         advect_momentum(&self.rows, &self.advection, r, dt_s, u, &mut s.advect);
         let nu = self.params.viscosity_pa_s / self.params.density_kg_per_m3;
         let g = forcing.g_eff_m_per_s2;
-        let ea = self.grid.edge_arrays();
         match self.params.gradient {
             FilmGradient::TwoPoint => {
                 // Gravity as the discrete gradient of the potential g·x between cell
                 // centres, so a discrete Marangoni gradient can balance it exactly (the
                 // edge projection g·n carries an O(Δx) curl that no tension gradient can
                 // hold).
-                let gradient = &ea.centre_gradient;
-                self.rows.add_from_grid(u, |e| dt_s * g.dot(gradient[e]));
+                let kind = FilmGradient::TwoPoint;
+                self.rows.add_gradient(u, &self.grid, kind, g, dt_s);
                 if !self.temperature_k.is_empty() {
                     self.rows.to_grid(u, &mut self.u_m_per_s);
                     self.thermal_stress(dt_s, &mut s.vertex);
@@ -421,8 +420,8 @@ impl FilmFlow {
                 // Gravity as the normal gradient of the cells' g·x, after the viscous
                 // stress: that gradient has a grid-scale circulation where grid lines are askew,
                 // which the viscous operator would turn into a flow no tension can hold.
-                let gradient = &ea.centre_normal_gradient;
-                self.rows.add_from_grid(u, |e| dt_s * g.dot(gradient[e]));
+                let kind = FilmGradient::Normal;
+                self.rows.add_gradient(u, &self.grid, kind, g, dt_s);
                 self.rows.to_grid(u, &mut self.u_m_per_s);
                 self.thermal_stress(dt_s, &mut s.vertex);
             }
