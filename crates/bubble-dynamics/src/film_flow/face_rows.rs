@@ -3,8 +3,8 @@
 //! grid's own numbering reaches a cell's edges and an edge's vertices through index
 //! arrays.
 //!
-//! The edge velocities are copied into the rows at the start of a pass and back at its
-//! end ([`FaceRows::to_rows`], [`FaceRows::to_grid`]). An edge on a face's border is in
+//! The edge velocities are copied into the rows at the start of the explicit momentum
+//! step and back at its end ([`FaceRows::to_rows`], [`FaceRows::to_grid`]). An edge on a face's border is in
 //! both its faces' rows, a copy each with its own orientation; every quantity of an edge
 //! is kept in that copy's orientation, so a copy is the grid's value or its negation,
 //! exactly (IEEE negation commutes with every rounding the passes do), and the two copies

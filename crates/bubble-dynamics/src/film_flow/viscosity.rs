@@ -10,7 +10,7 @@
 
 use crate::avx2::with_avx2;
 
-use super::face_rows::{FaceRows, SIDES, Side};
+use super::face_rows::{FaceRows, Side};
 use super::flow::FilmFlow;
 use super::grid::CubeSphere;
 
@@ -47,15 +47,19 @@ impl FilmFlow {
         // Y₁ = Y₀ + w₁ dt M(Y₀), with Y₀ = u. The first stage reads no stage before last
         // (it only writes Y₀ there), so `v.stage` needs its length, not a copy of u.
         v.stage.resize(u.len(), 0.0);
-        with_avx2(|| {
-            self.viscous_stage(u, v, nu_m2_per_s, w1 * dt_s, 1.0, 0.0);
-            for j in 2..=stages {
-                // Yⱼ = μⱼ Yⱼ₋₁ + νⱼ Yⱼ₋₂ + μⱼ w₁ dt M(Yⱼ₋₁), μⱼ = (2j − 1)/j, νⱼ = (1 − j)/j.
-                let j = f64::from(j);
-                let mu = (2.0 * j - 1.0) / j;
-                self.viscous_stage(u, v, nu_m2_per_s, mu * w1 * dt_s, mu, (1.0 - j) / j);
-            }
-        });
+        with_avx2(
+            #[inline(always)]
+            || {
+                self.viscous_stage(u, v, nu_m2_per_s, w1 * dt_s, 1.0, 0.0);
+                for j in 2..=stages {
+                    // Yⱼ = μⱼ Yⱼ₋₁ + νⱼ Yⱼ₋₂ + μⱼ w₁ dt M(Yⱼ₋₁), μⱼ = (2j − 1)/j,
+                    // νⱼ = (1 − j)/j.
+                    let j = f64::from(j);
+                    let mu = (2.0 * j - 1.0) / j;
+                    self.viscous_stage(u, v, nu_m2_per_s, mu * w1 * dt_s, mu, (1.0 - j) / j);
+                }
+            },
+        );
     }
 
     /// One stage on the rows: `u ← mu·u + nu_prev·stage + dt_s·M(u)` with the stage
@@ -189,7 +193,6 @@ fn vorticity_and_divergence(grid: &CubeSphere, rows: &FaceRows, u: &[f64], v: &m
         let c = cell.cell as usize;
         divergence[c] = d * ia[c];
     }
-    debug_assert_eq!(SIDES[0], Side::Bottom);
 }
 
 /// The fewest RKL1 stages `s` whose span `s(s + 1)/2` covers `euler_substeps`.
