@@ -21,12 +21,13 @@ use super::advect::{AdvectionGeometry, AdvectionScratch, advect_momentum};
 use super::burst::{BurstParams, BurstState, Hole};
 use super::capillary::{Capillary, CapillaryScratch, smooth_thickness};
 use super::compare::larger;
+use super::face_rows::FaceRows;
 use super::grid::CubeSphere;
 use super::meniscus::MeniscusState;
 use super::solve::{Hierarchy, SolveReport, Work};
 use super::thermal::{ThermalParams, up_from};
 use super::upwind::UpwindGeometry;
-use super::viscosity::viscous_bound;
+use super::viscosity::{ViscousScratch, viscous_bound};
 
 /// Thickness floor of the Marangoni coefficient `E_f/(ρh)`, m: a hole or a Newton black
 /// film keeps a finite (if huge) stiffness.
@@ -134,6 +135,8 @@ pub struct Forcing {
 pub struct FilmFlow {
     pub(crate) grid: std::sync::Arc<CubeSphere>,
     pub(super) hierarchy: std::sync::Arc<Hierarchy>,
+    /// The grid's edges and vertices face by face in rows, for the momentum passes.
+    pub(super) rows: std::sync::Arc<FaceRows>,
     /// The momentum advection's weights, fixed by the grid.
     advection: std::sync::Arc<AdvectionGeometry>,
     /// The thickness transport's weights, fixed by the grid.
@@ -174,8 +177,10 @@ pub(super) struct Scratch {
     pub(super) drag: Vec<f64>,
     /// Per edge: the drainage speed's coefficient over `h²`, s⁻¹·m⁻¹.
     pub(super) drain_rate: Vec<f64>,
-    /// The viscous step's stage before the one under way, m/s per edge.
-    pub(super) stage: Vec<f64>,
+    /// The edge velocities in the face rows during the explicit momentum step, m/s.
+    rows_u: Vec<f64>,
+    /// The viscous step's buffers.
+    viscous: ViscousScratch,
     /// Per edge: the Marangoni gradient's cross term (along the edge) as a velocity
     /// change, m/s, from the surfactant of the last sweep.
     pub(super) cross: Vec<f64>,
@@ -199,11 +204,13 @@ impl FilmFlow {
         let h: Vec<f64> = grid.centres().iter().map(|&c| h_m(c)).collect();
         let cells = grid.cells();
         let edges = grid.edges().len();
+        let rows = FaceRows::new(&grid);
         Self {
             burst: Some(Box::new(BurstState::new(params.burst, cells, params.seed))),
             meniscus: None,
             viscous_bound: viscous_bound(&grid),
-            advection: std::sync::Arc::new(AdvectionGeometry::new(&grid)),
+            advection: std::sync::Arc::new(AdvectionGeometry::new(&grid, &rows)),
+            rows: std::sync::Arc::new(rows),
             transport: std::sync::Arc::new(UpwindGeometry::new(&grid)),
             params,
             h_m: h,
@@ -383,42 +390,40 @@ impl FilmFlow {
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn momentum_explicit(&mut self, s: &mut Scratch, dt_s: f64, forcing: &Forcing) {
         let r = self.params.radius_m;
-        advect_momentum(
-            &self.grid,
-            &self.advection,
-            r,
-            dt_s,
-            &mut self.u_m_per_s,
-            &mut s.advect,
-        );
+        // On the face rows from here to the end (module `face_rows`).
+        let u = &mut s.rows_u;
+        self.rows.to_rows(&self.u_m_per_s, u);
+        advect_momentum(&self.rows, &self.advection, r, dt_s, u, &mut s.advect);
         let nu = self.params.viscosity_pa_s / self.params.density_kg_per_m3;
         let g = forcing.g_eff_m_per_s2;
         match self.params.gradient {
             FilmGradient::TwoPoint => {
-                let ea = self.grid.edge_arrays();
                 // Gravity as the discrete gradient of the potential g·x between cell
                 // centres, so a discrete Marangoni gradient can balance it exactly (the
                 // edge projection g·n carries an O(Δx) curl that no tension gradient can
                 // hold).
-                for (u, c) in self.u_m_per_s.iter_mut().zip(&ea.centre_gradient) {
-                    *u += dt_s * g.dot(*c);
+                let kind = FilmGradient::TwoPoint;
+                self.rows.add_gradient(u, &self.grid, kind, g, dt_s);
+                if !self.temperature_k.is_empty() {
+                    self.rows.to_grid(u, &mut self.u_m_per_s);
+                    self.thermal_stress(dt_s, &mut s.vertex);
+                    self.rows.to_rows(&self.u_m_per_s, u);
                 }
-                self.thermal_stress(dt_s, &mut s.vertex);
                 if nu > 0.0 {
-                    self.viscous_step(s, nu, dt_s);
+                    self.viscous_step(u, &mut s.viscous, nu, dt_s);
                 }
+                self.rows.to_grid(u, &mut self.u_m_per_s);
             }
             FilmGradient::Normal => {
                 if nu > 0.0 {
-                    self.viscous_step(s, nu, dt_s);
+                    self.viscous_step(u, &mut s.viscous, nu, dt_s);
                 }
                 // Gravity as the normal gradient of the cells' g·x, after the viscous
                 // stress: that gradient has a grid-scale circulation where grid lines are askew,
                 // which the viscous operator would turn into a flow no tension can hold.
-                let ea = self.grid.edge_arrays();
-                for (u, c) in self.u_m_per_s.iter_mut().zip(&ea.centre_normal_gradient) {
-                    *u += dt_s * g.dot(*c);
-                }
+                let kind = FilmGradient::Normal;
+                self.rows.add_gradient(u, &self.grid, kind, g, dt_s);
+                self.rows.to_grid(u, &mut self.u_m_per_s);
                 self.thermal_stress(dt_s, &mut s.vertex);
             }
         }

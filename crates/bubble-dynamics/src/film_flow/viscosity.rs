@@ -8,86 +8,190 @@
 //! the cost of `s` of them: the stage count grows as n, not n². Each stage is a
 //! forward-Euler sub-step of its own length plus a blend with the two stages before it.
 
-use super::flow::{FilmFlow, Scratch};
+use crate::avx2::with_avx2;
+
+use super::face_rows::{FaceRows, Side};
+use super::flow::FilmFlow;
 use super::grid::CubeSphere;
 
 /// Largest `dt·λ` a forward-Euler sub-step is given (of the 2 it can take): the margin
 /// the sub-stepped scheme kept, kept for the stages' span.
 const EULER_RATE_LIMIT: f64 = 1.5;
 
+/// Buffers of the viscous step, reused across steps.
+#[derive(Clone, Debug, Default)]
+pub(super) struct ViscousScratch {
+    /// The stage before the one under way, in the face rows ([`FaceRows`]), m/s.
+    pub(super) stage: Vec<f64>,
+    /// Per local vertex: the vorticity on the unit sphere (m/s per rad).
+    vorticity: Vec<f64>,
+    /// Per cell: the divergence on the unit sphere (m/s per rad).
+    divergence: Vec<f64>,
+}
+
 impl FilmFlow {
-    /// `u ← u + ∫ viscous dt` over `dt_s` for kinematic viscosity `nu_m2_per_s`.
+    /// `u ← u + ∫ viscous dt` over `dt_s` for kinematic viscosity `nu_m2_per_s`, on the
+    /// edge velocities `u` in the face rows ([`FaceRows`]).
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
-    pub(super) fn viscous_step(&mut self, s: &mut Scratch, nu_m2_per_s: f64, dt_s: f64) {
+    pub(super) fn viscous_step(
+        &self,
+        u: &mut [f64],
+        v: &mut ViscousScratch,
+        nu_m2_per_s: f64,
+        dt_s: f64,
+    ) {
         let r = self.params.radius_m;
         let rate = self.viscous_bound * nu_m2_per_s / (r * r);
         let stages = legendre_stages((dt_s * rate / EULER_RATE_LIMIT).ceil().max(1.0));
         let w1 = 2.0 / f64::from(stages * stages + stages);
         // Y₁ = Y₀ + w₁ dt M(Y₀), with Y₀ = u. The first stage reads no stage before last
-        // (it only writes Y₀ there), so `s.stage` needs its length, not a copy of u.
-        s.stage.resize(self.u_m_per_s.len(), 0.0);
-        self.viscous_stage(s, nu_m2_per_s, w1 * dt_s, 1.0, 0.0);
-        for j in 2..=stages {
-            // Yⱼ = μⱼ Yⱼ₋₁ + νⱼ Yⱼ₋₂ + μⱼ w₁ dt M(Yⱼ₋₁), μⱼ = (2j − 1)/j, νⱼ = (1 − j)/j.
-            let j = f64::from(j);
-            let mu = (2.0 * j - 1.0) / j;
-            self.viscous_stage(s, nu_m2_per_s, mu * w1 * dt_s, mu, (1.0 - j) / j);
-        }
+        // (it only writes Y₀ there), so `v.stage` needs its length, not a copy of u.
+        v.stage.resize(u.len(), 0.0);
+        with_avx2(
+            #[inline(always)]
+            || {
+                self.viscous_stage(u, v, nu_m2_per_s, w1 * dt_s, 1.0, 0.0);
+                for j in 2..=stages {
+                    // Yⱼ = μⱼ Yⱼ₋₁ + νⱼ Yⱼ₋₂ + μⱼ w₁ dt M(Yⱼ₋₁), μⱼ = (2j − 1)/j,
+                    // νⱼ = (1 − j)/j.
+                    let j = f64::from(j);
+                    let mu = (2.0 * j - 1.0) / j;
+                    self.viscous_stage(u, v, nu_m2_per_s, mu * w1 * dt_s, mu, (1.0 - j) / j);
+                }
+            },
+        );
     }
 
-    /// One stage: `u ← mu·u + nu_prev·s.stage + dt_s·M(u)` with the stage before last in
-    /// `s.stage`, which then holds the `u` this stage started from.
-    fn viscous_stage(&mut self, s: &mut Scratch, nu: f64, dt_s: f64, mu: f64, nu_prev: f64) {
-        self.vorticity_and_divergence(s);
-        let ea = self.grid.edge_arrays();
-        let (vorticity, divergence) = (&s.vertex, &s.cell);
+    /// One stage on the rows: `u ← mu·u + nu_prev·stage + dt_s·M(u)` with the stage
+    /// before last in `v.stage`, which then holds the `u` this stage started from.
+    ///
+    /// Every value is the grid-numbered pass's, in the rows' orientation (module
+    /// `face_rows`): each edge's change is odd in the edge's orientation (a difference
+    /// across it, one along it and its own velocity), so a flipped copy's is the grid's
+    /// negated, exactly.
+    #[inline(always)]
+    pub(super) fn viscous_stage(
+        &self,
+        u: &mut [f64],
+        v: &mut ViscousScratch,
+        nu: f64,
+        dt_s: f64,
+        mu: f64,
+        nu_prev: f64,
+    ) {
+        let rows = &self.rows;
+        vorticity_and_divergence(&self.grid, rows, u, v);
+        let (vorticity, divergence) = (&v.vorticity, &v.divergence);
         // Vorticity and divergence per R (of the unit sphere's), and each difference of
         // them per R again: every term of the stress carries 1/R², taken once here.
         let r = self.params.radius_m;
         let rate = dt_s * nu / (r * r);
-        let per_length = ea.inverse_length.iter().zip(&ea.inverse_dual_length);
-        let ends = ea.cells.iter().zip(&ea.vertices);
-        let velocities = self.u_m_per_s.iter_mut().zip(s.stage.iter_mut());
-        for ((u, y_prev), ((il, id), ([a, b], [v0, v1]))) in velocities.zip(per_length.zip(ends)) {
-            let curl_curl = (vorticity[*v1 as usize] - vorticity[*v0 as usize]) * il;
-            let grad_div = (divergence[*b as usize] - divergence[*a as usize]) * id;
+        // The first stage (mu 1, nu_prev 0) is a plain forward-Euler step: no blend.
+        let step = |u: &mut f64, y_prev: &mut f64, curl_curl: f64, grad_div: f64| {
             let y = *u;
             let change = rate * (4.0 * grad_div - curl_curl + 2.0 * y);
-            // The first stage (mu 1, nu_prev 0) is a plain forward-Euler step: no blend.
             *u = if nu_prev == 0.0 {
                 y + change
             } else {
                 mu * y + nu_prev * *y_prev + change
             };
             *y_prev = y;
+        };
+        let n = rows.n;
+        let (il, id) = (&rows.inverse_length, &rows.inverse_dual_length);
+        for f in 0..6 {
+            let cells = f * n * n;
+            // X-edge (i, y): tail the vertex (i, y + 1), head (i, y); from cell (i − 1, y)
+            // into (i, y).
+            for y in 0..n {
+                let k = rows.x_edge(f, 1, y)..rows.x_edge(f, n, y);
+                let (u, y_prev) = (&mut u[k.clone()], &mut v.stage[k.clone()]);
+                let (il, id) = (&il[k.clone()], &id[k]);
+                let (head, tail) = (rows.vertex_at(f, 1, y), rows.vertex_at(f, 1, y + 1));
+                let (head, tail) = (
+                    &vorticity[head..head + n - 1],
+                    &vorticity[tail..tail + n - 1],
+                );
+                let c = cells + y * n;
+                let (from, into) = (&divergence[c..c + n - 1], &divergence[c + 1..c + n]);
+                for i in 0..n - 1 {
+                    let curl_curl = (head[i] - tail[i]) * il[i];
+                    let grad_div = (into[i] - from[i]) * id[i];
+                    step(&mut u[i], &mut y_prev[i], curl_curl, grad_div);
+                }
+            }
+            // Y-edge (x, j): tail the vertex (x, j), head (x + 1, j); from cell (x, j − 1)
+            // into (x, j).
+            for j in 1..n {
+                let k = rows.y_edge(f, 0, j)..rows.y_edge(f, n, j);
+                let (u, y_prev) = (&mut u[k.clone()], &mut v.stage[k.clone()]);
+                let (il, id) = (&il[k.clone()], &id[k]);
+                let tail = rows.vertex_at(f, 0, j);
+                let (tail, head) = (
+                    &vorticity[tail..tail + n],
+                    &vorticity[tail + 1..tail + n + 1],
+                );
+                let c = cells + j * n;
+                let (from, into) = (&divergence[c - n..c], &divergence[c..c + n]);
+                for x in 0..n {
+                    let curl_curl = (head[x] - tail[x]) * il[x];
+                    let grad_div = (into[x] - from[x]) * id[x];
+                    step(&mut u[x], &mut y_prev[x], curl_curl, grad_div);
+                }
+            }
+        }
+        for b in &rows.border_edges {
+            let k = b.edge as usize;
+            let [tail, head] = b.ends.map(|e| vorticity[e as usize]);
+            let [from, into] = b.cells.map(|c| divergence[c as usize]);
+            let curl_curl = (head - tail) * il[k];
+            let grad_div = (into - from) * id[k];
+            step(&mut u[k], &mut v.stage[k], curl_curl, grad_div);
         }
     }
+}
 
-    /// The vorticity at each grid vertex into `s.vertex` and the divergence of each cell
-    /// into `s.cell`, of the edge velocities, on the unit sphere (m/s per rad).
-    fn vorticity_and_divergence(&self, s: &mut Scratch) {
-        let g = &self.grid;
-        let vorticity = &mut s.vertex;
-        vorticity.clear();
-        vorticity.resize(g.vertex_areas_sr().len(), 0.0);
-        let divergence = &mut s.cell;
-        divergence.clear();
-        divergence.resize(g.cells(), 0.0);
-        let ea = g.edge_arrays();
-        let lengths = ea.length.iter().zip(&ea.dual_length);
-        let ends = ea.cells.iter().zip(&ea.vertices);
-        for ((&u, (l, d)), ([a, b], [v0, v1])) in self.u_m_per_s.iter().zip(lengths).zip(ends) {
-            vorticity[*v1 as usize] += u * d;
-            vorticity[*v0 as usize] -= u * d;
-            divergence[*a as usize] += u * l;
-            divergence[*b as usize] -= u * l;
+/// The vorticity at each local vertex into `v.vorticity` and the divergence of each cell
+/// into `v.divergence`, of the edge velocities `u` (in the rows), on the unit sphere
+/// (m/s per rad). A cell's divergence sums its edges' `±u l` in the grid's edge order,
+/// `+` where the local normal points out of it (its right and top sides).
+#[inline(always)]
+fn vorticity_and_divergence(grid: &CubeSphere, rows: &FaceRows, u: &[f64], v: &mut ViscousScratch) {
+    rows.circulation(u, &mut v.vorticity, &rows.vertex_inverse_area, |z, ia| {
+        z * ia
+    });
+    let n = rows.n;
+    let divergence = &mut v.divergence;
+    divergence.resize(6 * n * n, 0.0);
+    let (l, ia) = (&rows.length, grid.inverse_areas_per_sr());
+    for f in 0..6 {
+        for y in 0..n {
+            let c = f * n * n + y * n;
+            let (ky, kx) = (rows.y_edge(f, 0, y), rows.x_edge(f, 0, y));
+            let (bottom, top) = (&u[ky..ky + n], &u[ky + n..ky + 2 * n]);
+            let (lb, lt) = (&l[ky..ky + n], &l[ky + n..ky + 2 * n]);
+            let (left, right) = (&u[kx..kx + n], &u[kx + 1..kx + n + 1]);
+            let (ll, lr) = (&l[kx..kx + n], &l[kx + 1..kx + n + 1]);
+            let (out, ia) = (&mut divergence[c..c + n], &ia[c..c + n]);
+            for x in 0..n {
+                let d =
+                    0.0 - bottom[x] * lb[x] - left[x] * ll[x] + right[x] * lr[x] + top[x] * lt[x];
+                out[x] = d * ia[x];
+            }
         }
-        for (z, ia) in vorticity.iter_mut().zip(g.inverse_vertex_areas_per_sr()) {
-            *z *= ia;
+    }
+    for cell in &rows.irregular_cells {
+        let mut d = 0.0;
+        for (side, k) in cell.order.into_iter().zip(cell.edges) {
+            let flux = u[k as usize] * l[k as usize];
+            if matches!(side, Side::Right | Side::Top) {
+                d += flux;
+            } else {
+                d -= flux;
+            }
         }
-        for (d, ia) in divergence.iter_mut().zip(g.inverse_areas_per_sr()) {
-            *d *= ia;
-        }
+        let c = cell.cell as usize;
+        divergence[c] = d * ia[c];
     }
 }
 
@@ -122,9 +226,9 @@ mod tests {
 
     use glam::DVec3;
 
-    use super::super::flow::{FilmFlow, FlowParams, Scratch};
+    use super::super::flow::{FilmFlow, FlowParams};
     use super::super::{CubeSphere, Hierarchy};
-    use super::legendre_stages;
+    use super::{ViscousScratch, legendre_stages};
 
     /// Each stage count is the fewest whose span covers the sub-steps: 1 → 1, 2..3 → 2,
     /// 4..6 → 3, 22 → 7.
@@ -172,21 +276,29 @@ mod tests {
     #[test]
     fn legendre_stages_match_small_euler_steps_and_damp_the_roughest_field() {
         let (mut f, nu) = viscous_film();
-        let mut s = Scratch::default();
+        let mut s = ViscousScratch::default();
         let dt = step_of(&f, nu, 54.5);
         f.set_velocity(|d: DVec3| d.cross(DVec3::Z) * (3.0 * d.z) * 1e-3);
-        let euler_steps = |f: &mut FilmFlow, s: &mut Scratch| {
+        // Steps of the grid's edge velocities, through the face rows.
+        let mut u = Vec::new();
+        let mut on_rows = |f: &mut FilmFlow, step: &mut dyn FnMut(&FilmFlow, &mut [f64])| {
+            f.rows.to_rows(&f.u_m_per_s, &mut u);
+            step(f, &mut u);
+            f.rows.to_grid(&u, &mut f.u_m_per_s);
+        };
+        let mut euler_steps = |f: &FilmFlow, u: &mut [f64]| {
             // Plain forward-Euler sub-steps, not through the stage weights under test.
-            s.stage.resize(f.u_m_per_s.len(), 0.0);
+            s.stage.resize(u.len(), 0.0);
             for _ in 0..100 {
-                f.viscous_stage(s, nu, dt / 100.0, 1.0, 0.0);
+                f.viscous_stage(u, &mut s, nu, dt / 100.0, 1.0, 0.0);
             }
         };
-        euler_steps(&mut f, &mut s);
+        on_rows(&mut f, &mut euler_steps);
         let smooth = f.u_m_per_s.clone();
-        euler_steps(&mut f, &mut s);
+        on_rows(&mut f, &mut euler_steps);
         let euler = std::mem::replace(&mut f.u_m_per_s, smooth.clone());
-        f.viscous_step(&mut s, nu, dt);
+        let mut s = ViscousScratch::default();
+        on_rows(&mut f, &mut |f, u| f.viscous_step(u, &mut s, nu, dt));
         // The vortex's decay over the step, by each: first order in time alike, they
         // differ by about dt·λ/4 of it (λ the vortex's rate, dt·λ 0.05 here).
         let decay = |u: &[f64]| {
@@ -207,7 +319,8 @@ mod tests {
             *u = if k % 2 == 0 { 1e-3 } else { -1e-3 };
         }
         let before = energy(&f);
-        f.viscous_step(&mut s, nu, step_of(&f, nu, 149.5));
+        let long = step_of(&f, nu, 149.5);
+        on_rows(&mut f, &mut |f, u| f.viscous_step(u, &mut s, nu, long));
         let after = energy(&f);
         assert!(after < before, "energy {before:e} → {after:e}");
     }

@@ -1,0 +1,614 @@
+//! The grid's edges and vertices face by face in rows, so that the momentum passes
+//! (`advect`, `viscosity`) take each face's interior as contiguous slices, where the
+//! grid's own numbering reaches a cell's edges and an edge's vertices through index
+//! arrays.
+//!
+//! The edge velocities are copied into the rows at the start of the explicit momentum
+//! step and back at its end ([`FaceRows::to_rows`], [`FaceRows::to_grid`]). An edge on a face's border is in
+//! both its faces' rows, a copy each with its own orientation; every quantity of an edge
+//! is kept in that copy's orientation, so a copy is the grid's value or its negation,
+//! exactly (IEEE negation commutes with every rounding the passes do), and the two copies
+//! stay negations or equals of each other.
+//!
+//! The row loops sum a vertex's circulation over its edges, and a cell's terms over its
+//! sides, in one fixed order of the local sides ([`SIDES`]): the grid's own edge order
+//! inside a face, as `CubeSphere::new` numbers the edges. The vertices on the faces'
+//! borders, and the cells there whose edges the grid numbers in another order, are taken
+//! one by one from lists in the grid's order ([`FaceRows::seam_vertices`],
+//! [`FaceRows::irregular_cells`]). So each value is the same sum in the same order as a
+//! pass over the grid's numbering takes it, and the rows give its bits. (A renumbering of
+//! the grid's edges would leave the rows' sums as they are, mathematically the same.)
+
+use glam::DVec3;
+
+use super::flow::FilmGradient;
+use super::grid::{CubeSphere, FACE_BASES};
+
+/// Which side of a cell an edge is: bottom (`t` low), left (`s` low), right, top.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Side {
+    Bottom = 0,
+    Left = 1,
+    Right = 2,
+    Top = 3,
+}
+
+/// The four sides in the local order: a cell's edges in the grid's order, inside a face.
+pub(crate) const SIDES: [Side; 4] = [Side::Bottom, Side::Left, Side::Right, Side::Top];
+
+/// A grid vertex on a face's border, its circulation taken edge by edge.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SeamVertex {
+    /// Its edges in the grid's order: a local copy of each and the weight `±d` of that
+    /// copy's velocity in the circulation (the sign its orientation's).
+    pub(crate) edges: [(u32, f64); 4],
+    /// How many of `edges` there are (3 at a cube corner).
+    pub(crate) edge_count: u8,
+    /// Its local copies (two on a border, three at a corner).
+    pub(crate) copies: [u32; 3],
+    /// How many of `copies` there are.
+    pub(crate) copy_count: u8,
+}
+
+/// An edge between two faces: its two local copies.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SeamEdge {
+    /// Its cells, the lower-numbered first, each with the side of it the edge is on and
+    /// that cell's face's copy of the edge.
+    pub(crate) cells: [(u32, Side, u32); 2],
+}
+
+/// A local copy of an edge on a face's border, with its ends and cells in its own
+/// orientation.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BorderEdge {
+    /// The local edge.
+    pub(crate) edge: u32,
+    /// Its tail and head vertices (local, in its face).
+    pub(crate) ends: [u32; 2],
+    /// The cells its normal points from and into.
+    pub(crate) cells: [u32; 2],
+}
+
+/// A cell whose edges, in the grid's order, are not in the local order [`SIDES`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct IrregularCell {
+    pub(crate) cell: u32,
+    /// The side of each of its edges, in the grid's order.
+    pub(crate) order: [Side; 4],
+    /// The local edge on each of those sides.
+    pub(crate) edges: [u32; 4],
+    /// The local vertices at the ends of each.
+    pub(crate) ends: [[u32; 2]; 4],
+}
+
+/// The face-row numbering of a grid of `n` cells a face.
+///
+/// Per face `f` (cells `f·n² + y·n + x` as the grid numbers them):
+/// - the X-edges (along grid lines of constant `s`), `n + 1` a row, `n` rows: X-edge
+///   `(i, y)` between cells `(i − 1, y)` and `(i, y)`, its local normal towards `+s`;
+/// - the Y-edges (constant `t`), `n` a row, `n + 1` rows: Y-edge `(x, j)` between cells
+///   `(x, j − 1)` and `(x, j)`, its local normal towards `+t`;
+/// - the vertices, `n + 1` a row: vertex `(i, j)` at the corner `(s_i, t_j)`.
+///
+/// A local X-edge's tangent (`midpoint × normal`) points towards `−t` (its tail `v0` the
+/// upper vertex), a Y-edge's towards `+s` (its tail the left vertex): the faces' `(s, t)`
+/// are left-handed seen from outside.
+#[derive(Clone, Debug)]
+pub(crate) struct FaceRows {
+    pub(crate) n: usize,
+    /// Per local edge: the grid's edge.
+    pub(crate) edge: Vec<u32>,
+    /// Per local edge: `true` where the grid's normal is against the local one.
+    pub(crate) flipped: Vec<bool>,
+    /// Per local edge: `−1` where flipped, else `1` (a value times it is the value or its
+    /// negation, exactly).
+    pub(crate) signs: Vec<f64>,
+    /// Per local edge: the arc between its cells' centres, rad.
+    pub(crate) dual_length: Vec<f64>,
+    /// Per local edge: its arc length, rad.
+    pub(crate) length: Vec<f64>,
+    /// Per local edge: `1/length`, per rad.
+    pub(crate) inverse_length: Vec<f64>,
+    /// Per local edge: `1/dual_length`, per rad.
+    pub(crate) inverse_dual_length: Vec<f64>,
+    /// Per local vertex: the grid's vertex.
+    pub(crate) vertex: Vec<u32>,
+    /// Per local vertex: its dual area, sr.
+    pub(crate) vertex_area: Vec<f64>,
+    /// Per local vertex: `1/area`, per sr.
+    pub(crate) vertex_inverse_area: Vec<f64>,
+    /// The vertices on the faces' borders.
+    pub(crate) seam_vertices: Vec<SeamVertex>,
+    /// The edges on the faces' borders.
+    pub(crate) seam_edges: Vec<SeamEdge>,
+    /// The local copies of the edges on the faces' borders, each with its ends and cells.
+    pub(crate) border_edges: Vec<BorderEdge>,
+    /// The cells on the faces' borders whose edges the grid numbers out of the local
+    /// order.
+    pub(crate) irregular_cells: Vec<IrregularCell>,
+    /// The grid's centre gradients (two-point, normal) in the rows by component, once
+    /// [`Self::add_gradient`] has asked for them.
+    gradients: [std::sync::OnceLock<[Vec<f64>; 3]>; 2],
+}
+
+impl FaceRows {
+    /// Local edges a face: `2n(n + 1)`, the X-edges' rows then the Y-edges'.
+    pub(crate) fn edges_per_face(&self) -> usize {
+        2 * self.n * (self.n + 1)
+    }
+
+    /// Local vertices a face.
+    pub(crate) fn vertices_per_face(&self) -> usize {
+        (self.n + 1) * (self.n + 1)
+    }
+
+    /// Local vertices in all.
+    pub(crate) fn vertices(&self) -> usize {
+        self.vertex.len()
+    }
+
+    /// Local X-edge `(i, y)` of face `f`.
+    pub(crate) fn x_edge(&self, f: usize, i: usize, y: usize) -> usize {
+        f * self.edges_per_face() + y * (self.n + 1) + i
+    }
+
+    /// Local Y-edge `(x, j)` of face `f`.
+    pub(crate) fn y_edge(&self, f: usize, x: usize, j: usize) -> usize {
+        f * self.edges_per_face() + self.n * (self.n + 1) + j * self.n + x
+    }
+
+    /// Local vertex `(i, j)` of face `f`.
+    pub(crate) fn vertex_at(&self, f: usize, i: usize, j: usize) -> usize {
+        f * self.vertices_per_face() + j * (self.n + 1) + i
+    }
+
+    /// The local edge on side `side` of cell `c`.
+    #[inline]
+    pub(crate) fn cell_edge(&self, c: usize, side: Side) -> usize {
+        let n = self.n;
+        let (f, x, y) = (c / (n * n), c % n, (c / n) % n);
+        match side {
+            Side::Bottom => self.y_edge(f, x, y),
+            Side::Left => self.x_edge(f, x, y),
+            Side::Right => self.x_edge(f, x + 1, y),
+            Side::Top => self.y_edge(f, x, y + 1),
+        }
+    }
+
+    /// The local vertices at the ends of side `side` of cell `c`: its tail `v0` and head
+    /// `v1` in the local orientation.
+    #[inline]
+    pub(crate) fn side_vertices(&self, c: usize, side: Side) -> [usize; 2] {
+        let n = self.n;
+        let (f, x, y) = (c / (n * n), c % n, (c / n) % n);
+        let at = |i, j| self.vertex_at(f, i, j);
+        match side {
+            Side::Bottom => [at(x, y), at(x + 1, y)],
+            Side::Left => [at(x, y + 1), at(x, y)],
+            Side::Right => [at(x + 1, y + 1), at(x + 1, y)],
+            Side::Top => [at(x, y + 1), at(x + 1, y + 1)],
+        }
+    }
+
+    /// `±1`: local edge `k`'s orientation against the grid's.
+    pub(crate) fn sign(&self, k: usize) -> f64 {
+        self.signs[k]
+    }
+
+    /// The grid's edge values `grid` (in the grid's orientation) into `rows` (each copy
+    /// in its own).
+    pub(crate) fn to_rows(&self, grid: &[f64], rows: &mut Vec<f64>) {
+        // Every entry is written: the buffer needs its length, not a fill.
+        rows.resize(self.edge.len(), 0.0);
+        for ((u, &e), &sign) in rows.iter_mut().zip(&self.edge).zip(&self.signs) {
+            *u = grid[e as usize] * sign;
+        }
+    }
+
+    /// The rows' edge values back into the grid's numbering and orientation (a border
+    /// edge's two copies agree).
+    pub(crate) fn to_grid(&self, rows: &[f64], grid: &mut [f64]) {
+        for ((&e, &sign), &u) in self.edge.iter().zip(&self.signs).zip(rows) {
+            grid[e as usize] = u * sign;
+        }
+    }
+
+    /// `u += dt_s·(g·c)` on every local edge, `c` its grid edge's centre gradient for
+    /// `kind` (`grid`'s, from which the rows were derived) in its own orientation: the
+    /// grid's sum, negated for a flipped copy, exactly. The gradients are taken into the
+    /// rows, by component, the first time `kind` is asked for.
+    pub(crate) fn add_gradient(
+        &self,
+        u: &mut [f64],
+        grid: &CubeSphere,
+        kind: FilmGradient,
+        g: DVec3,
+        dt_s: f64,
+    ) {
+        let ea = grid.edge_arrays();
+        let (per_edge, rows) = match kind {
+            FilmGradient::TwoPoint => (&ea.centre_gradient, &self.gradients[0]),
+            FilmGradient::Normal => (&ea.centre_normal_gradient, &self.gradients[1]),
+        };
+        let [x, y, z] = rows.get_or_init(|| {
+            std::array::from_fn(|a| {
+                let along = self.edge.iter().zip(&self.signs);
+                along.map(|(&e, &s)| per_edge[e as usize][a] * s).collect()
+            })
+        });
+        for (((u, x), y), z) in u.iter_mut().zip(x).zip(y).zip(z) {
+            // `g.dot(c)` as glam sums it.
+            *u += dt_s * (g.x * x + g.y * y + g.z * z);
+        }
+    }
+
+    /// Derives the numbering from `grid`'s geometry.
+    ///
+    /// # Panics
+    /// If an edge is not on a side of its cells, or the orientations disagree.
+    pub(crate) fn new(grid: &CubeSphere) -> Self {
+        let n = grid.face_size();
+        let mut rows = Self {
+            n,
+            edge: Vec::new(),
+            flipped: Vec::new(),
+            signs: Vec::new(),
+            dual_length: Vec::new(),
+            length: Vec::new(),
+            inverse_length: Vec::new(),
+            inverse_dual_length: Vec::new(),
+            vertex: Vec::new(),
+            vertex_area: Vec::new(),
+            vertex_inverse_area: Vec::new(),
+            seam_vertices: Vec::new(),
+            seam_edges: Vec::new(),
+            border_edges: Vec::new(),
+            irregular_cells: Vec::new(),
+            gradients: Default::default(),
+        };
+        let local_edges = 6 * rows.edges_per_face();
+        rows.edge = vec![u32::MAX; local_edges];
+        rows.flipped = vec![false; local_edges];
+        let edges = grid.edges();
+        for (e, ge) in edges.iter().enumerate() {
+            let mut copies = [(0, Side::Bottom, 0); 2];
+            for (copy, c) in copies.iter_mut().zip([ge.a, ge.b]) {
+                let side = side_of(n, c as usize, ge.midpoint);
+                let k = rows.cell_edge(c as usize, side);
+                // The local normal points away from the cell on its right and top sides.
+                let away = matches!(side, Side::Right | Side::Top);
+                let flipped = away != (c == ge.a);
+                if rows.edge[k] != u32::MAX {
+                    assert_eq!(rows.edge[k], e as u32, "local edge {k} twice");
+                    assert_eq!(rows.flipped[k], flipped, "local edge {k}: orientation");
+                }
+                rows.edge[k] = e as u32;
+                rows.flipped[k] = flipped;
+                *copy = (c, side, k as u32);
+            }
+            if copies[0].2 != copies[1].2 {
+                copies.sort_by_key(|c| c.0);
+                rows.seam_edges.push(SeamEdge { cells: copies });
+            }
+        }
+        assert!(
+            rows.edge.iter().all(|&e| e != u32::MAX),
+            "a local edge unset"
+        );
+        rows.signs = rows
+            .flipped
+            .iter()
+            .map(|&f| if f { -1.0 } else { 1.0 })
+            .collect();
+        let ea = grid.edge_arrays();
+        let local = |a: &[f64]| rows.edge.iter().map(|&e| a[e as usize]).collect();
+        rows.dual_length = local(&ea.dual_length);
+        rows.length = local(&ea.length);
+        rows.inverse_length = local(&ea.inverse_length);
+        rows.inverse_dual_length = local(&ea.inverse_dual_length);
+        rows.vertex = vec![u32::MAX; 6 * rows.vertices_per_face()];
+        for c in 0..grid.cells() {
+            for side in SIDES {
+                let k = rows.cell_edge(c, side);
+                let ge = &edges[rows.edge[k] as usize];
+                let ends = if rows.flipped[k] {
+                    [ge.v1, ge.v0]
+                } else {
+                    [ge.v0, ge.v1]
+                };
+                for (v, id) in rows.side_vertices(c, side).into_iter().zip(ends) {
+                    let old = std::mem::replace(&mut rows.vertex[v], id);
+                    assert!(old == u32::MAX || old == id, "local vertex {v}: two ids");
+                }
+            }
+        }
+        let areas = grid.vertex_areas_sr();
+        rows.vertex_area = rows.vertex.iter().map(|&v| areas[v as usize]).collect();
+        let inverse = grid.inverse_vertex_areas_per_sr();
+        rows.vertex_inverse_area = rows.vertex.iter().map(|&v| inverse[v as usize]).collect();
+        rows.border_edges = border_edges(&rows);
+        rows.seam_vertices = seam_vertices(&rows, grid);
+        rows.irregular_cells = (0..grid.cells())
+            .filter_map(|c| irregular(&rows, c))
+            .collect();
+        rows
+    }
+
+    /// Whether local vertex `(i, j)` is on its face's border.
+    fn on_border(&self, i: usize, j: usize) -> bool {
+        i == 0 || j == 0 || i == self.n || j == self.n
+    }
+
+    /// The circulation `Σ ±u d` about every local vertex of the local edge velocities
+    /// `u`, each then finished by `finish(circulation, scale)` with the vertex's entry of
+    /// `scale` (a per-local-vertex array), into `out`.
+    ///
+    /// About an inner vertex `(i, j)` the grid's edge order is X-edge `(i, j − 1)`,
+    /// Y-edges `(i − 1, j)` and `(i, j)`, X-edge `(i, j)`: the first and third run into
+    /// the vertex's tail end (`−u d`), the others into its head (`+u d`).
+    #[inline(always)]
+    pub(crate) fn circulation(
+        &self,
+        u: &[f64],
+        out: &mut Vec<f64>,
+        scale: &[f64],
+        finish: impl Fn(f64, f64) -> f64,
+    ) {
+        out.resize(self.vertices(), 0.0);
+        for f in 0..6 {
+            for j in 1..self.n {
+                self.circulation_row(u, f, j, out, scale, &finish);
+            }
+        }
+        self.seam_circulation(u, out, scale, finish);
+    }
+
+    /// [`Self::circulation`] of row `j` (`1 ≤ j < n`) of face `f`'s inner vertices: it
+    /// reads X-edges `(1..n, j − 1)` and `(1..n, j)` and Y-edges `(0..n, j)`.
+    #[inline(always)]
+    pub(crate) fn circulation_row(
+        &self,
+        u: &[f64],
+        f: usize,
+        j: usize,
+        out: &mut [f64],
+        scale: &[f64],
+        finish: impl Fn(f64, f64) -> f64,
+    ) {
+        let (n, d) = (self.n, &self.dual_length);
+        let inner = n - 1;
+        let below = self.x_edge(f, 1, j - 1)..self.x_edge(f, n, j - 1);
+        let left = self.y_edge(f, 0, j)..self.y_edge(f, n - 1, j);
+        let right = self.y_edge(f, 1, j)..self.y_edge(f, n, j);
+        let above = self.x_edge(f, 1, j)..self.x_edge(f, n, j);
+        let (ub, db) = (&u[below.clone()], &d[below]);
+        let (ul, dl) = (&u[left.clone()], &d[left]);
+        let (ur, dr) = (&u[right.clone()], &d[right]);
+        let (ua, da) = (&u[above.clone()], &d[above]);
+        let start = self.vertex_at(f, 1, j);
+        let row = &mut out[start..start + inner];
+        let scale = &scale[start..start + inner];
+        for i in 0..inner {
+            let z = 0.0 - ub[i] * db[i] + ul[i] * dl[i] - ur[i] * dr[i] + ua[i] * da[i];
+            row[i] = finish(z, scale[i]);
+        }
+    }
+
+    /// [`Self::circulation`] of the vertices on the faces' borders, into each copy.
+    #[inline(always)]
+    pub(crate) fn seam_circulation(
+        &self,
+        u: &[f64],
+        out: &mut [f64],
+        scale: &[f64],
+        finish: impl Fn(f64, f64) -> f64,
+    ) {
+        for v in &self.seam_vertices {
+            let mut z = 0.0;
+            for &(k, w) in &v.edges[..usize::from(v.edge_count)] {
+                z += u[k as usize] * w;
+            }
+            let z = finish(z, scale[v.copies[0] as usize]);
+            for &k in &v.copies[..usize::from(v.copy_count)] {
+                out[k as usize] = z;
+            }
+        }
+    }
+}
+
+/// Each seam edge's two copies, each with its ends and cells in its own orientation: the
+/// local normal points away from a cell on its right or top side.
+fn border_edges(rows: &FaceRows) -> Vec<BorderEdge> {
+    let mut out = Vec::with_capacity(2 * rows.seam_edges.len());
+    for e in &rows.seam_edges {
+        for (mine, other) in [(0, 1), (1, 0)] {
+            let (c, side, k) = e.cells[mine];
+            let across = e.cells[other].0;
+            let away = matches!(side, Side::Right | Side::Top);
+            out.push(BorderEdge {
+                edge: k,
+                ends: rows.side_vertices(c as usize, side).map(|v| v as u32),
+                cells: if away { [c, across] } else { [across, c] },
+            });
+        }
+    }
+    out
+}
+
+/// The vertices on the faces' borders, each with its edges in the grid's order.
+fn seam_vertices(rows: &FaceRows, grid: &CubeSphere) -> Vec<SeamVertex> {
+    let n = rows.n;
+    let vertices = grid.vertex_areas_sr().len();
+    // Each grid edge's first local copy.
+    let mut copy_of = vec![u32::MAX; grid.edges().len()];
+    for (k, &e) in rows.edge.iter().enumerate().rev() {
+        copy_of[e as usize] = k as u32;
+    }
+    let mut around: Vec<Vec<(u32, f64)>> = vec![Vec::new(); vertices];
+    for (e, ge) in grid.edges().iter().enumerate() {
+        let k = copy_of[e];
+        let d = ge.dual_length * rows.sign(k as usize);
+        // Counter-clockwise about v1 seen from outside.
+        around[ge.v1 as usize].push((k, d));
+        around[ge.v0 as usize].push((k, -d));
+    }
+    let mut index = vec![usize::MAX; vertices];
+    let mut seams: Vec<SeamVertex> = Vec::new();
+    for f in 0..6 {
+        for j in 0..=n {
+            for i in (0..=n).filter(|&i| rows.on_border(i, j)) {
+                let local = rows.vertex_at(f, i, j);
+                let v = rows.vertex[local] as usize;
+                if index[v] == usize::MAX {
+                    index[v] = seams.len();
+                    let ring = &around[v];
+                    assert!(
+                        (3..=4).contains(&ring.len()),
+                        "vertex {v}: {} edges",
+                        ring.len()
+                    );
+                    let mut edges = [(0, 0.0); 4];
+                    edges[..ring.len()].copy_from_slice(ring);
+                    seams.push(SeamVertex {
+                        edges,
+                        edge_count: ring.len() as u8,
+                        copies: [0; 3],
+                        copy_count: 0,
+                    });
+                }
+                let s = &mut seams[index[v]];
+                s.copies[usize::from(s.copy_count)] = local as u32;
+                s.copy_count += 1;
+            }
+        }
+    }
+    seams
+}
+
+/// Cell `c`'s edge order, where it is on its face's border and the grid's order differs
+/// from the local one.
+fn irregular(rows: &FaceRows, c: usize) -> Option<IrregularCell> {
+    let n = rows.n;
+    let (x, y) = (c % n, (c / n) % n);
+    if !(x == 0 || y == 0 || x == n - 1 || y == n - 1) {
+        return None;
+    }
+    let mut order = SIDES;
+    order.sort_by_key(|&side| rows.edge[rows.cell_edge(c, side)]);
+    (order != SIDES).then(|| IrregularCell {
+        cell: c as u32,
+        order,
+        edges: order.map(|side| rows.cell_edge(c, side) as u32),
+        ends: order.map(|side| rows.side_vertices(c, side).map(|v| v as u32)),
+    })
+}
+
+/// Which side of cell `c` (of a grid of `n` a face) the edge with midpoint `m` is.
+fn side_of(n: usize, c: usize, m: DVec3) -> Side {
+    let (f, x, y) = (c / (n * n), c % n, (c / n) % n);
+    let (major, su, tv) = FACE_BASES[f];
+    let p = m / m.dot(major.as_dvec3());
+    let cells = |v: f64| (v + 1.0) * n as f64 / 2.0;
+    let (s, t) = (cells(p.dot(su.as_dvec3())), cells(p.dot(tv.as_dvec3())));
+    let near = |a: f64, b: usize| (a - b as f64).abs() < 0.25;
+    match () {
+        () if near(s, x) => Side::Left,
+        () if near(s, x + 1) => Side::Right,
+        () if near(t, y) => Side::Bottom,
+        () if near(t, y + 1) => Side::Top,
+        () => panic!("edge at ({s}, {t}) not on a side of cell {c}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Whether the grid numbers inner vertex `(i, j)`'s edges in the order the rows sum
+    /// them.
+    fn in_grid_order(rows: &FaceRows, f: usize, i: usize, j: usize) -> bool {
+        let ids = [
+            rows.x_edge(f, i, j - 1),
+            rows.y_edge(f, i - 1, j),
+            rows.y_edge(f, i, j),
+            rows.x_edge(f, i, j),
+        ]
+        .map(|k| rows.edge[k]);
+        ids.is_sorted()
+    }
+
+    #[test]
+    fn the_rows_hold_every_edge_and_vertex_of_the_grid() {
+        for n in [1, 2, 3, 8] {
+            let g = CubeSphere::new(n);
+            let rows = FaceRows::new(&g);
+            // Edges inside a face keep the grid's normal.
+            for f in 0..6 {
+                for k in 1..n {
+                    for m in 0..n {
+                        assert!(!rows.flipped[rows.x_edge(f, k, m)], "n {n}");
+                        assert!(!rows.flipped[rows.y_edge(f, m, k)], "n {n}");
+                    }
+                }
+            }
+            let mut seen = vec![0; g.edges().len()];
+            rows.edge.iter().for_each(|&e| seen[e as usize] += 1);
+            let seams = seen.iter().filter(|&&s| s == 2).count();
+            assert!(seen.iter().all(|&s| s == 1 || s == 2), "n {n}");
+            assert_eq!(seams, 12 * n, "n {n}");
+            assert_eq!(rows.seam_edges.len(), 12 * n, "n {n}");
+            assert_eq!(rows.seam_vertices.len(), 12 * (n - 1) + 8, "n {n}");
+            // Round trip.
+            let u: Vec<f64> = (0..g.edges().len()).map(|e| e as f64 - 7.5).collect();
+            let (mut local, mut back) = (Vec::new(), vec![0.0; u.len()]);
+            rows.to_rows(&u, &mut local);
+            rows.to_grid(&local, &mut back);
+            assert_eq!(u, back, "n {n}");
+        }
+    }
+
+    /// The rows' circulation is the grid-numbered scatter's: bit for bit about every
+    /// vertex whose edges the grid numbers in the order the rows sum them (all, as the
+    /// grid numbers them now), to rounding about any other.
+    #[test]
+    fn the_rows_circulation_is_the_scattered_one() {
+        for n in [1, 2, 5, 16] {
+            let g = CubeSphere::new(n);
+            let rows = FaceRows::new(&g);
+            let u: Vec<f64> = (0..g.edges().len())
+                .map(|e| ((e * 7919) % 1000) as f64 * 1e-3 - 0.4)
+                .collect();
+            let ea = g.edge_arrays();
+            let mut scale = vec![0.0; g.vertex_areas_sr().len()];
+            let mut want = vec![0.0; g.vertex_areas_sr().len()];
+            for ((&u, d), [v0, v1]) in u.iter().zip(&ea.dual_length).zip(&ea.vertices) {
+                want[*v1 as usize] += u * d;
+                want[*v0 as usize] -= u * d;
+                scale[*v1 as usize] += (u * d).abs();
+                scale[*v0 as usize] += (u * d).abs();
+            }
+            for (z, a) in want.iter_mut().zip(g.vertex_areas_sr()) {
+                *z /= a * 0.3;
+            }
+            let (mut local, mut got) = (Vec::new(), Vec::new());
+            rows.to_rows(&u, &mut local);
+            rows.circulation(&local, &mut got, &rows.vertex_area, |z, a| z / (a * 0.3));
+            for f in 0..6 {
+                for j in 0..=n {
+                    for i in 0..=n {
+                        let k = rows.vertex_at(f, i, j);
+                        let v = rows.vertex[k] as usize;
+                        let (z, w) = (got[k], want[v]);
+                        if rows.on_border(i, j) || in_grid_order(&rows, f, i, j) {
+                            assert_eq!(z.to_bits(), w.to_bits(), "n {n}: vertex {k}: {z} vs {w}");
+                        } else {
+                            let tolerance = 1e-14 * scale[v] / (g.vertex_areas_sr()[v] * 0.3);
+                            assert!((z - w).abs() <= tolerance, "n {n}: vertex {k}: {z} vs {w}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
