@@ -82,10 +82,14 @@ struct Level {
     read_before_update: Vec<std::ops::Range<usize>>,
     /// Fine cell → this level's cell, for the level below (finer) this one.
     parent_of_fine: Vec<u32>,
-    /// This level's cell → its four fine cells, in increasing order: the restrictions
-    /// sum each cell's children in the order a scatter over the fine cells added them
-    /// (so the same bits), with no zeroed sums to start from.
-    children: Vec<[u32; 4]>,
+    /// This level's cells as stretches whose children lie every other fine cell: the
+    /// restrictions sum each cell's four children in increasing order, the order a
+    /// scatter over the fine cells added them (so the same bits), with no zeroed sums
+    /// to start from and no child indices to load.
+    child_runs: Vec<ChildRun>,
+    /// The finer level's [`Level::read_before_update`] cells as stretches whose parents
+    /// (on this level) step by one every other cell: the coarse correction's reads.
+    parent_runs: Vec<ParentRun>,
     /// This level's edge → the two fine edges along it, in increasing order.
     fine_edges: Vec<[u32; 2]>,
     /// Fine edge → coarse edge it lies along (`u32::MAX` inside a coarse cell), for the
@@ -405,7 +409,7 @@ impl Hierarchy {
         for k in 1..count {
             let coarse = &self.levels[k];
             let (done, rest) = work.alpha.split_at_mut(k);
-            restrict_mass(&coarse.children, &done[k - 1], &mut rest[0]);
+            restrict(&coarse.child_runs, &done[k - 1], &mut rest[0]);
             let (done, rest) = work.weight.split_at_mut(k);
             let fine_weight = if k == 1 { weight } else { &done[k - 1] };
             restrict_weights(&coarse.fine_edges, fine_weight, &mut rest[0]);
@@ -526,17 +530,12 @@ impl Hierarchy {
                 }
                 let d = &mut mz[..level.cells];
                 residual(level, &work.mass[k], stencil, z, r, d);
-                restrict_residual(&coarse.children, &mz, &mut rc);
+                restrict(&coarse.child_runs, &mz, &mut rc);
                 work.operator = mz;
                 let mut zc = std::mem::take(&mut work.correction[k + 1]);
                 zc.resize(coarse.cells, 0.0);
                 self.v_cycle(work, k + 1, &rc, &mut zc);
-                for cells in level.read_before_update.iter().cloned() {
-                    let parents = &coarse.parent_of_fine[cells.clone()];
-                    for (zi, &parent) in z[cells].iter_mut().zip(parents) {
-                        *zi += zc[parent as usize];
-                    }
-                }
+                correct(&coarse.parent_runs, &zc, z);
                 work.residual[k + 1] = rc;
                 work.correction[k + 1] = zc;
                 let (inv_diag, stencil) = (&work.inv_diag[k], &work.stencil32[k]);
@@ -622,14 +621,16 @@ impl Level {
             neighbours,
             neighbour_edges,
             parent_of_fine: Vec::new(),
-            children: Vec::new(),
+            child_runs: Vec::new(),
+            parent_runs: Vec::new(),
             fine_edges: Vec::new(),
             coarse_edge_of_fine: Vec::new(),
         }
     }
 
-    /// Fills [`Level::children`] and [`Level::fine_edges`] of this (coarse) level from its
-    /// `parent_of_fine` and the finer level's `coarse_edge_of_fine`.
+    /// Fills [`Level::child_runs`], [`Level::parent_runs`] and [`Level::fine_edges`] of
+    /// this (coarse) level from its `parent_of_fine` and the finer level's
+    /// `read_before_update` and `coarse_edge_of_fine`.
     ///
     /// # Panics
     /// If a cell does not have four children or an edge two fine edges (not a halving).
@@ -644,10 +645,12 @@ impl Level {
                 fine_edges[coarse as usize].push(e as u32);
             }
         }
-        self.children = children
+        let children: Vec<[u32; 4]> = children
             .into_iter()
             .map(|c| c.try_into().expect("4 children"))
             .collect();
+        self.child_runs = child_runs(&children);
+        self.parent_runs = parent_runs(&self.parent_of_fine, &fine.read_before_update);
         self.fine_edges = fine_edges
             .into_iter()
             .map(|e| e.try_into().expect("2 fine edges"))
@@ -1223,26 +1226,121 @@ fn update_and_norm2(step: f64, p: &[f64], q: &[f64], x: &mut [f64], r: &mut [f64
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
 }
 
-/// `rc` = a level's residual `d = r − M z` (from [`residual`], which takes the face
-/// interiors as vectorised runs) restricted by summing each coarse cell's children (the
-/// equations are area-integrated), from zero and in increasing order, as a scatter over
-/// the fine cells summed them.
+/// A stretch of coarse cells `start..end` whose `q`-th children are the fine cells
+/// `from[q]`, `from[q] + 2`, … (a coarse row's cells, one colour, have every other fine
+/// cell of a row of each colour as children).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ChildRun {
+    start: usize,
+    end: usize,
+    from: [usize; 4],
+}
+
+/// [`Level::child_runs`] from each coarse cell's children: maximal stretches of stride 2.
+fn child_runs(children: &[[u32; 4]]) -> Vec<ChildRun> {
+    let mut out = Vec::new();
+    let mut c = 0;
+    while c < children.len() {
+        let from = children[c].map(|f| f as usize);
+        let at = |end: usize| from.map(|f| (f + 2 * (end - c)) as u32);
+        let mut end = c + 1;
+        while end < children.len() && children[end] == at(end) {
+            end += 1;
+        }
+        out.push(ChildRun {
+            start: c,
+            end,
+            from,
+        });
+        c = end;
+    }
+    out
+}
+
+/// `coarse` = the fine values summed over each coarse cell's children, from zero and in
+/// increasing order, as a scatter over the fine cells summed them: the restriction of
+/// a level's residual `r − M z` (the equations are area-integrated) and of its mass term.
 #[inline(always)]
-fn restrict_residual(children: &[[u32; 4]], d: &[f32], rc: &mut [f32]) {
-    for (v, ch) in rc.iter_mut().zip(children) {
-        let d = ch.map(|c| d[c as usize]);
-        *v = 0.0 + d[0] + d[1] + d[2] + d[3];
+fn restrict<T: Real>(runs: &[ChildRun], fine: &[T], coarse: &mut Vec<T>) {
+    coarse.resize(runs.last().map_or(0, |r| r.end), T::ZERO);
+    for run in runs {
+        let len = run.end - run.start;
+        let (a, b) = (
+            every_other(fine, run.from[0], len),
+            every_other(fine, run.from[1], len),
+        );
+        let (c, d) = (
+            every_other(fine, run.from[2], len),
+            every_other(fine, run.from[3], len),
+        );
+        let children = a.zip(b).zip(c.zip(d));
+        for (v, ((a, b), (c, d))) in coarse[run.start..run.end].iter_mut().zip(children) {
+            *v = T::ZERO + *a + *b + *c + *d;
+        }
     }
 }
 
-/// The mass term of a coarse level: the sum of each cell's children's, as
-/// [`restrict_residual`] sums.
+/// `values[from]`, `values[from + 2]`, … , `len` of them.
 #[inline(always)]
-fn restrict_mass(children: &[[u32; 4]], fine: &[f64], coarse: &mut Vec<f64>) {
-    coarse.resize(children.len(), 0.0);
-    for (v, ch) in coarse.iter_mut().zip(children) {
-        let (f0, f1) = (fine[ch[0] as usize], fine[ch[1] as usize]);
-        *v = 0.0 + f0 + f1 + fine[ch[2] as usize] + fine[ch[3] as usize];
+fn every_other<T>(
+    values: &[T],
+    from: usize,
+    len: usize,
+) -> std::iter::StepBy<std::slice::Iter<'_, T>> {
+    values[from..][..2 * len - 1].iter().step_by(2)
+}
+
+/// A stretch of fine cells `start..end` whose parents are the coarse cells `from[0]`,
+/// `from[1]`, `from[0] + 1`, `from[1] + 1`, … in turn (a fine row's cells of one colour
+/// alternate between the coarse colours, each in order).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ParentRun {
+    start: usize,
+    end: usize,
+    from: [usize; 2],
+}
+
+/// [`Level::parent_runs`]: the fine cells `cells` cut into maximal [`ParentRun`]s.
+fn parent_runs(parent: &[u32], cells: &[std::ops::Range<usize>]) -> Vec<ParentRun> {
+    let mut out = Vec::new();
+    for range in cells.iter().cloned() {
+        let mut i = range.start;
+        while i < range.end {
+            let from = [
+                parent[i] as usize,
+                parent[(i + 1).min(range.end - 1)] as usize,
+            ];
+            let mut end = i + 1;
+            while end < range.end && parent[end] as usize == from[(end - i) % 2] + (end - i) / 2 {
+                end += 1;
+            }
+            out.push(ParentRun {
+                start: i,
+                end,
+                from,
+            });
+            i = end;
+        }
+    }
+    out
+}
+
+/// `z += zc` at each [`ParentRun`]'s cells from their parents: the V-cycle's coarse
+/// correction, where a backward sweep reads it.
+#[inline(always)]
+fn correct(runs: &[ParentRun], zc: &[f32], z: &mut [f32]) {
+    for run in runs {
+        let len = run.end - run.start;
+        let n = len / 2;
+        let (even, odd) = (&zc[run.from[0]..][..n], &zc[run.from[1]..][..n]);
+        let mut pairs = z[run.start..run.end].chunks_exact_mut(2);
+        for (pair, (a, b)) in (&mut pairs).zip(even.iter().zip(odd)) {
+            pair[0] += *a;
+            pair[1] += *b;
+        }
+        if let Some(zi) = pairs.into_remainder().first_mut() {
+            *zi += zc[run.from[0] + n];
+        }
     }
 }
 
@@ -1578,6 +1676,41 @@ mod tests {
             in_runs * 4 > h.levels[0].cells * 3,
             "{in_runs} cells in runs"
         );
+    }
+
+    /// The restriction's and the correction's stretches name every coarse cell's four
+    /// children in increasing order, and each read-before-update fine cell's parent.
+    #[test]
+    fn child_and_parent_runs_match_the_parents() {
+        for n in [6, 16, 64] {
+            let h = Hierarchy::new(&CubeSphere::new(n));
+            for k in 1..h.levels.len() {
+                let (fine, coarse) = (&h.levels[k - 1], &h.levels[k]);
+                let mut children = vec![Vec::new(); coarse.cells];
+                for (c, &p) in coarse.parent_of_fine.iter().enumerate() {
+                    children[p as usize].push(c);
+                }
+                for run in &coarse.child_runs {
+                    for c in run.start..run.end {
+                        let at = run.from.map(|f| f + 2 * (c - run.start));
+                        assert_eq!(children[c], at, "n = {n}, level {k}, cell {c}");
+                    }
+                }
+                assert_eq!(coarse.child_runs.last().map(|r| r.end), Some(coarse.cells));
+                let mut read = Vec::new();
+                for run in &coarse.parent_runs {
+                    for i in run.start..run.end {
+                        let j = i - run.start;
+                        let parent = run.from[j % 2] + j / 2;
+                        assert_eq!(coarse.parent_of_fine[i] as usize, parent, "cell {i}");
+                        read.push(i);
+                    }
+                }
+                let expected: Vec<usize> =
+                    fine.read_before_update.iter().cloned().flatten().collect();
+                assert_eq!(read, expected);
+            }
+        }
     }
 
     #[test]
