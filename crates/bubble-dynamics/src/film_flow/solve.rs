@@ -1330,13 +1330,12 @@ fn parent_runs(parent: &[u32], cells: &[std::ops::Range<usize>]) -> Vec<ParentRu
 #[inline(always)]
 fn correct(runs: &[ParentRun], zc: &[f32], z: &mut [f32]) {
     for run in runs {
-        let len = run.end - run.start;
-        let n = len / 2;
+        let n = (run.end - run.start) / 2;
         let (even, odd) = (&zc[run.from[0]..][..n], &zc[run.from[1]..][..n]);
         let mut pairs = z[run.start..run.end].chunks_exact_mut(2);
         for (pair, (a, b)) in (&mut pairs).zip(even.iter().zip(odd)) {
-            pair[0] += *a;
-            pair[1] += *b;
+            let pair: &mut [f32; 2] = pair.try_into().expect("a pair");
+            *pair = [pair[0] + *a, pair[1] + *b];
         }
         if let Some(zi) = pairs.into_remainder().first_mut() {
             *zi += zc[run.from[0] + n];
@@ -1691,9 +1690,10 @@ mod tests {
                     children[p as usize].push(c);
                 }
                 for run in &coarse.child_runs {
-                    for c in run.start..run.end {
-                        let at = run.from.map(|f| f + 2 * (c - run.start));
-                        assert_eq!(children[c], at, "n = {n}, level {k}, cell {c}");
+                    let cells = children[run.start..run.end].iter().enumerate();
+                    for (j, children) in cells {
+                        let at = run.from.map(|f| f + 2 * j);
+                        assert_eq!(*children, at, "n = {n}, level {k}, cell {}", run.start + j);
                     }
                 }
                 assert_eq!(coarse.child_runs.last().map(|r| r.end), Some(coarse.cells));
