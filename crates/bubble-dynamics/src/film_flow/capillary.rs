@@ -130,14 +130,11 @@ fn substep(
         #[inline(always)]
         || {
             for run in sides.every_edge_run(&ea.cells) {
-                let (len, edges) = (run.len, run.edges());
-                let (ha, hb) = (&h_m[run.a_cells()], &h_m[run.b_cells()]);
-                let (l, per_d) = (
-                    &ea.length[edges.clone()],
-                    &ea.inverse_dual_length[edges.clone()],
-                );
+                let len = run.len;
+                let (ha, hb) = run.ends(&h_m);
+                let (l, per_d) = (run.along(&ea.length), run.along(&ea.inverse_dual_length));
                 let (ha, hb, l, per_d) = (&ha[..len], &hb[..len], &l[..len], &per_d[..len]);
-                let out = &mut s.flux[edges];
+                let out = run.along_mut(&mut s.flux);
                 for i in 0..len {
                     out[i] = (ha[i] - hb[i]) * l[i] * per_d[i];
                 }
@@ -164,15 +161,12 @@ fn substep(
         #[inline(always)]
         || {
             for run in sides.every_edge_run(&ea.cells) {
-                let (len, edges) = (run.len, run.edges());
-                let (ha, hb) = (&h_m[run.a_cells()], &h_m[run.b_cells()]);
-                let (la, lb) = (&laplacian[run.a_cells()], &laplacian[run.b_cells()]);
-                let (l, per_d) = (
-                    &ea.length[edges.clone()],
-                    &ea.inverse_dual_length[edges.clone()],
-                );
+                let len = run.len;
+                let (ha, hb) = run.ends(&h_m);
+                let (la, lb) = run.ends(&laplacian);
+                let (l, per_d) = (run.along(&ea.length), run.along(&ea.inverse_dual_length));
                 let (ha, hb, la, lb) = (&ha[..len], &hb[..len], &la[..len], &lb[..len]);
-                let (l, per_d, out) = (&l[..len], &per_d[..len], &mut s.flux[edges]);
+                let (l, per_d, out) = (&l[..len], &per_d[..len], run.along_mut(&mut s.flux));
                 for i in 0..len {
                     let rise = lb[i] - la[i];
                     let donor = if rise >= 0.0 { ha[i] } else { hb[i] };

@@ -471,11 +471,11 @@ impl FilmFlow {
             #[inline(always)]
             || {
                 for run in sides.every_edge_run(&ea.cells) {
-                    let (len, edges) = (run.len, run.edges());
-                    let (ha, hb) = (&self.h_m[run.a_cells()], &self.h_m[run.b_cells()]);
-                    let (ha, hb, outside) = (&ha[..len], &hb[..len], &s.edge[edges.clone()]);
-                    let u = &mut self.u_m_per_s[edges.clone()];
-                    let factor = &mut s.drag[edges];
+                    let len = run.len;
+                    let (ha, hb) = run.ends(&self.h_m);
+                    let (ha, hb, outside) = (&ha[..len], &hb[..len], run.along(&s.edge));
+                    let u = run.along_mut(&mut self.u_m_per_s);
+                    let factor = run.along_mut(&mut s.drag);
                     for i in 0..len {
                         let h = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
                         let k = per_layer / h;

@@ -166,22 +166,22 @@ impl FilmFlow {
         c: EdgeConstants,
     ) {
         let ea = self.grid.edge_arrays();
-        let (len, edges) = (run.len, run.edges());
-        let (ga, gb) = (&self.gamma[run.a_cells()], &self.gamma[run.b_cells()]);
-        let (ha, hb) = (&self.h_m[run.a_cells()], &self.h_m[run.b_cells()]);
+        let len = run.len;
+        let (ga, gb) = run.ends(&self.gamma);
+        let (ha, hb) = run.ends(&self.h_m);
         let (ga, gb, ha, hb) = (&ga[..len], &gb[..len], &ha[..len], &hb[..len]);
-        let (u, u0) = (&self.u_m_per_s[edges.clone()], &s.u_start[edges.clone()]);
-        let (drag, l) = (&s.drag[edges.clone()], &ea.length[edges.clone()]);
+        let (u, u0) = (run.along(&self.u_m_per_s), run.along(&s.u_start));
+        let (drag, l) = (run.along(&s.drag), run.along(&ea.length));
         let inverse_dual = if NORMAL {
             &ea.inverse_normal_dual_length
         } else {
             &ea.inverse_dual_length
         };
-        let id = &inverse_dual[edges.clone()];
+        let id = run.along(&inverse_dual);
         let (u, u0, drag, l, id) = (&u[..len], &u0[..len], &drag[..len], &l[..len], &id[..len]);
-        let flux = &mut s.edge[edges.clone()];
-        let stiffness = &mut s.stiffness[edges.clone()];
-        let weight = &mut s.weight[edges.clone()];
+        let flux = run.along_mut(&mut s.edge);
+        let stiffness = run.along_mut(&mut s.stiffness);
+        let weight = run.along_mut(&mut s.weight);
         for i in 0..len {
             let gamma_c = 0.5 * (ga[i] + gb[i]);
             let h_edge = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
@@ -361,21 +361,21 @@ impl FilmFlow {
     ) {
         let ea = self.grid.edge_arrays();
         let per_r = 1.0 / self.params.radius_m;
-        let (len, edges) = (run.len, run.edges());
-        let (ga, gb) = (&self.gamma[run.a_cells()], &self.gamma[run.b_cells()]);
-        let (xa, xb) = (&s.cell2[run.a_cells()], &s.cell2[run.b_cells()]);
+        let len = run.len;
+        let (ga, gb) = run.ends(&self.gamma);
+        let (xa, xb) = run.ends(&s.cell2);
         let (ga, gb, xa, xb) = (&ga[..len], &gb[..len], &xa[..len], &xb[..len]);
         let inverse_dual = if NORMAL {
             &ea.inverse_normal_dual_length
         } else {
             &ea.inverse_dual_length
         };
-        let (id, l) = (&inverse_dual[edges.clone()], &ea.length[edges.clone()]);
-        let (f_adv, k) = (&s.edge[edges.clone()], &s.stiffness[edges.clone()]);
+        let (id, l) = (run.along(&inverse_dual), run.along(&ea.length));
+        let (f_adv, k) = (run.along(&s.edge), run.along(&s.stiffness));
         let (id, l, f_adv, k) = (&id[..len], &l[..len], &f_adv[..len], &k[..len]);
         let (u, moved) = (
-            &mut self.u_m_per_s[edges.clone()],
-            &mut s.edge2[edges.clone()],
+            run.along_mut(&mut self.u_m_per_s),
+            run.along_mut(&mut s.edge2),
         );
         let (u, moved) = (&mut u[..len], &mut moved[..len]);
         for i in 0..len {
@@ -410,13 +410,9 @@ fn upwind_fluxes(sides: &CellSides, ea: &EdgeArrays, gamma: &[f64], u: &[f64], o
         #[inline(always)]
         || {
             for run in sides.every_edge_run(&ea.cells) {
-                let (len, edges) = (run.len, run.edges());
-                let (ga, gb) = (&gamma[run.a_cells()], &gamma[run.b_cells()]);
-                let (u, l, f) = (
-                    &u[edges.clone()],
-                    &ea.length[edges.clone()],
-                    &mut out[edges],
-                );
+                let len = run.len;
+                let (ga, gb) = run.ends(&gamma);
+                let (u, l, f) = (run.along(&u), run.along(&ea.length), run.along_mut(out));
                 let (ga, gb, u, l) = (&ga[..len], &gb[..len], &u[..len], &l[..len]);
                 for i in 0..len {
                     f[i] = if u[i] >= 0.0 { ga[i] } else { gb[i] } * u[i] * l[i];

@@ -113,6 +113,24 @@ impl EdgeRun {
     pub(crate) fn b_cells(&self) -> std::ops::Range<usize> {
         self.b..self.b + self.len
     }
+
+    /// A cell field's values at the run's `a` cells and at its `b` cells.
+    #[inline(always)]
+    pub(crate) fn ends<'a>(&self, cells: &'a [f64]) -> (&'a [f64], &'a [f64]) {
+        (&cells[self.a_cells()], &cells[self.b_cells()])
+    }
+
+    /// A per-edge array's values along the run.
+    #[inline(always)]
+    pub(crate) fn along<'a>(&self, per_edge: &'a [f64]) -> &'a [f64] {
+        &per_edge[self.edges()]
+    }
+
+    /// A per-edge array's values along the run, to write.
+    #[inline(always)]
+    pub(crate) fn along_mut<'a>(&self, per_edge: &'a mut [f64]) -> &'a mut [f64] {
+        &mut per_edge[self.edges()]
+    }
 }
 
 impl CellSides {

@@ -57,10 +57,10 @@ impl FilmFlow {
                 // is exact in any order: the same number as one running maximum).
                 let mut lanes = [0.0; 4];
                 for run in self.transport.sides.every_edge_run(&ea.cells) {
-                    let (len, edges) = (run.len, run.edges());
+                    let len = run.len;
                     let (ha, hb) = (&h[run.a_cells()][..len], &h[run.b_cells()][..len]);
-                    let (u, c) = (&u[edges.clone()], &drain_rate[edges.clone()]);
-                    let per_area = &ea.length_per_smaller_area[edges];
+                    let (u, c) = (run.along(&u), run.along(&drain_rate));
+                    let per_area = run.along(&ea.length_per_smaller_area);
                     for i in 0..len {
                         let h = larger(hb[i], ha[i]);
                         let speed = (u[i].abs() + 3.0 * c[i].abs() * h * h) * per_area[i];
