@@ -131,7 +131,7 @@ fn substep(
         || {
             for run in sides.every_edge_run(&ea.cells) {
                 let len = run.len;
-                let (ha, hb) = run.ends(&h_m);
+                let (ha, hb) = run.ends(h_m);
                 let (l, per_d) = (run.along(&ea.length), run.along(&ea.inverse_dual_length));
                 let (ha, hb, l, per_d) = (&ha[..len], &hb[..len], &l[..len], &per_d[..len]);
                 let out = run.along_mut(&mut s.flux);
@@ -162,8 +162,8 @@ fn substep(
         || {
             for run in sides.every_edge_run(&ea.cells) {
                 let len = run.len;
-                let (ha, hb) = run.ends(&h_m);
-                let (la, lb) = run.ends(&laplacian);
+                let (ha, hb) = run.ends(h_m);
+                let (la, lb) = run.ends(laplacian);
                 let (l, per_d) = (run.along(&ea.length), run.along(&ea.inverse_dual_length));
                 let (ha, hb, la, lb) = (&ha[..len], &hb[..len], &la[..len], &lb[..len]);
                 let (l, per_d, out) = (&l[..len], &per_d[..len], run.along_mut(&mut s.flux));

@@ -177,7 +177,7 @@ impl FilmFlow {
         } else {
             &ea.inverse_dual_length
         };
-        let id = run.along(&inverse_dual);
+        let id = run.along(inverse_dual);
         let (u, u0, drag, l, id) = (&u[..len], &u0[..len], &drag[..len], &l[..len], &id[..len]);
         let flux = run.along_mut(&mut s.edge);
         let stiffness = run.along_mut(&mut s.stiffness);
@@ -370,7 +370,7 @@ impl FilmFlow {
         } else {
             &ea.inverse_dual_length
         };
-        let (id, l) = (run.along(&inverse_dual), run.along(&ea.length));
+        let (id, l) = (run.along(inverse_dual), run.along(&ea.length));
         let (f_adv, k) = (run.along(&s.edge), run.along(&s.stiffness));
         let (id, l, f_adv, k) = (&id[..len], &l[..len], &f_adv[..len], &k[..len]);
         let (u, moved) = (
@@ -411,8 +411,8 @@ fn upwind_fluxes(sides: &CellSides, ea: &EdgeArrays, gamma: &[f64], u: &[f64], o
         || {
             for run in sides.every_edge_run(&ea.cells) {
                 let len = run.len;
-                let (ga, gb) = run.ends(&gamma);
-                let (u, l, f) = (run.along(&u), run.along(&ea.length), run.along_mut(out));
+                let (ga, gb) = run.ends(gamma);
+                let (u, l, f) = (run.along(u), run.along(&ea.length), run.along_mut(out));
                 let (ga, gb, u, l) = (&ga[..len], &gb[..len], &u[..len], &l[..len]);
                 for i in 0..len {
                     f[i] = if u[i] >= 0.0 { ga[i] } else { gb[i] } * u[i] * l[i];

@@ -59,7 +59,7 @@ impl FilmFlow {
                 for run in self.transport.sides.every_edge_run(&ea.cells) {
                     let len = run.len;
                     let (ha, hb) = (&h[run.a_cells()][..len], &h[run.b_cells()][..len]);
-                    let (u, c) = (run.along(&u), run.along(&drain_rate));
+                    let (u, c) = (run.along(u), run.along(drain_rate));
                     let per_area = run.along(&ea.length_per_smaller_area);
                     for i in 0..len {
                         let h = larger(hb[i], ha[i]);

@@ -224,10 +224,10 @@ pub(crate) fn volumes(
     volume.resize(ea.cells.len(), 0.0);
     for run in &geo.sides.edge_runs {
         let len = run.len;
-        let (u, c) = (run.along(&speeds.u), run.along(&speeds.drain_rate));
+        let (u, c) = (run.along(speeds.u), run.along(speeds.drain_rate));
         let (l, out) = (run.along(&ea.length), run.along_mut(volume));
         let (u, c, l) = (&u[..len], &c[..len], &l[..len]);
-        let (ha, hb) = run.ends(&h);
+        let (ha, hb) = run.ends(h);
         let [ka, kb] = run.sides;
         let (ra, rb) = (&rise[ka][run.a_cells()], &rise[kb][run.b_cells()]);
         let (ha, hb, ra, rb) = (&ha[..len], &hb[..len], &ra[..len], &rb[..len]);
