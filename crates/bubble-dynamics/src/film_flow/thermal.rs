@@ -25,7 +25,11 @@
 
 use glam::DVec3;
 
+use super::compare::{larger, smaller};
 use super::flow::{FilmFlow, FilmGradient, H_FLOOR_M};
+use super::fluxes::side_slices;
+use super::sides::INFLOW;
+use crate::avx2::with_avx2;
 use crate::params::GAS_CONSTANT_J_PER_MOL_K;
 
 /// Specific heat of the film liquid (water), J/(kg·K).
@@ -95,6 +99,38 @@ impl ThermalParams {
 }
 
 /// The unit direction against `g` (+Y where there is no gravity).
+/// A cell's four sides as the temperature's upwind transport sees them.
+struct Inflow {
+    /// Each side's surface speed, m/s (positive from the edge's `a` cell to its `b`).
+    u: [f64; 4],
+    /// Each side's length, rad.
+    length: [f64; 4],
+    /// Each side's sign of a speed into the cell ([`INFLOW`] inside a face).
+    inflow: [f64; 4],
+}
+
+impl Inflow {
+    /// The cell's change of temperature over a sub-step: `(θ_up − θ)` times the fraction
+    /// of the cell that flows in over each side (`scale_per_area` the sub-step over the
+    /// radius and the cell's area), at most [`MAX_INFLOW_FRACTION`] a side.
+    #[inline(always)]
+    fn warming(&self, scale_per_area: f64, across: [f64; 4], own: f64) -> f64 {
+        let side = |k: usize| {
+            let inward = self.inflow[k] * self.u[k];
+            let fraction = smaller(
+                scale_per_area * inward * self.length[k],
+                MAX_INFLOW_FRACTION,
+            );
+            if inward > 0.0 {
+                fraction * (across[k] - own)
+            } else {
+                0.0
+            }
+        };
+        (side(0) + side(1)) + (side(2) + side(3))
+    }
+}
+
 pub(super) fn up_from(g_eff_m_per_s2: DVec3) -> DVec3 {
     (-g_eff_m_per_s2).try_normalize().unwrap_or(DVec3::Y)
 }
@@ -126,8 +162,6 @@ impl FilmFlow {
 
     /// `∂θ/∂t + u·∇θ = 0`, upwind: each cell takes `(θ_up − θ)` times what flows in.
     fn advect_temperature(&mut self, u: &[f64], before: &mut Vec<f64>, dt_s: f64) {
-        let ea = self.grid.edge_arrays();
-        let per_area = self.grid.inverse_areas_per_sr();
         let courant = self.grid.fastest_crossing(u) * dt_s / self.params.radius_m;
         if courant == 0.0 {
             return;
@@ -136,15 +170,48 @@ impl FilmFlow {
             .ceil()
             .clamp(1.0, f64::from(MAX_SUBSTEPS)) as u32;
         let scale = dt_s / (self.params.radius_m * f64::from(substeps));
+        let (sides, ea) = (&self.transport.sides, self.grid.edge_arrays());
+        let per_area = self.grid.inverse_areas_per_sr();
         for _ in 0..substeps {
             before.clear();
             before.extend_from_slice(&self.temperature_k);
-            for (([a, b], l), &u) in ea.cells.iter().zip(&ea.length).zip(u) {
-                let (a, b) = (*a as usize, *b as usize);
-                let (from, to) = if u >= 0.0 { (a, b) } else { (b, a) };
-                let inflow = (scale * u.abs() * l * per_area[to]).min(MAX_INFLOW_FRACTION);
-                self.temperature_k[to] += inflow * (before[from] - before[to]);
-            }
+            let theta = &mut self.temperature_k;
+            // Each cell gathers what flows in over its four sides (the edges scattered
+            // into their downwind cells before: the same terms, summed cell by cell).
+            with_avx2(
+                #[inline(always)]
+                || {
+                    for run in &sides.cell_runs {
+                        let len = run.len;
+                        let u = side_slices(run, u);
+                        let l = side_slices(run, &ea.length);
+                        let across: [&[f64]; 4] =
+                            std::array::from_fn(|k| &before[run.neighbours(k)]);
+                        let (own, pa) = (&before[run.cells()], &per_area[run.cells()]);
+                        let out = &mut theta[run.cells()];
+                        for i in 0..len {
+                            let sides = Inflow {
+                                u: u.map(|u| u[i]),
+                                length: l.map(|l| l[i]),
+                                inflow: INFLOW,
+                            };
+                            let across = across.map(|a| a[i]);
+                            out[i] = own[i] + sides.warming(scale * pa[i], across, own[i]);
+                        }
+                    }
+                    for &c in &sides.rim_cells {
+                        let c = c as usize;
+                        let inflow = Inflow {
+                            u: sides.edge[c].map(|e| u[e as usize]),
+                            length: sides.edge[c].map(|e| ea.length[e as usize]),
+                            inflow: sides.inflow(c),
+                        };
+                        let across = sides.neighbour[c].map(|j| before[j as usize]);
+                        theta[c] =
+                            before[c] + inflow.warming(scale * per_area[c], across, before[c]);
+                    }
+                },
+            );
         }
     }
 
@@ -163,12 +230,23 @@ impl FilmFlow {
         let (theta, h) = (&self.temperature_k, &self.h_m);
         match p.gradient {
             FilmGradient::TwoPoint => {
-                let edges = ea.cells.iter().zip(&ea.inverse_dual_length);
-                for (u, ([a, b], id)) in self.u_m_per_s.iter_mut().zip(edges) {
-                    let (a, b) = (*a as usize, *b as usize);
-                    let h_edge = (0.5 * (h[a] + h[b])).max(H_FLOOR_M);
-                    *u += per * (theta[b] - theta[a]) * id / h_edge;
-                }
+                let (sides, u) = (&self.transport.sides, &mut self.u_m_per_s);
+                with_avx2(
+                    #[inline(always)]
+                    || {
+                        for run in sides.every_edge_run(&ea.cells) {
+                            let len = run.len;
+                            let ((ta, tb), (ha, hb)) = (run.ends(theta), run.ends(h));
+                            let (ta, tb, ha, hb) = (&ta[..len], &tb[..len], &ha[..len], &hb[..len]);
+                            let id = &run.along(&ea.inverse_dual_length)[..len];
+                            let u = run.along_mut(u);
+                            for i in 0..len {
+                                let h_edge = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
+                                u[i] += per * (tb[i] - ta[i]) * id[i] / h_edge;
+                            }
+                        }
+                    },
+                );
             }
             FilmGradient::Normal => {
                 g.cells_to_vertices(theta, at_vertex);
