@@ -17,7 +17,6 @@ use super::compare::smaller;
 use super::fluxes::{apply_limited, net_inflow};
 use super::grid::CubeSphere;
 use super::sides::CellSides;
-use crate::avx2::with_avx2;
 
 /// Most explicit sub-steps a film step spends on capillary smoothing.
 pub(crate) const MAX_SUBSTEPS: u32 = 64;
@@ -126,18 +125,17 @@ fn substep(
     s.flux.resize(ea.cells.len(), 0.0);
     // ∇²h as the net inflow of the differences `(h_b − h_a) l/d` (their sum out of a
     // cell, with the sign of an inflow: a cell below its neighbours gains).
-    with_avx2(
+    sides.for_each_edge_run(
+        &ea.cells,
         #[inline(always)]
-        || {
-            for run in sides.every_edge_run(&ea.cells) {
-                let len = run.len;
-                let (ha, hb) = run.ends(h_m);
-                let (l, per_d) = (run.along(&ea.length), run.along(&ea.inverse_dual_length));
-                let (ha, hb, l, per_d) = (&ha[..len], &hb[..len], &l[..len], &per_d[..len]);
-                let out = run.along_mut(&mut s.flux);
-                for i in 0..len {
-                    out[i] = (ha[i] - hb[i]) * l[i] * per_d[i];
-                }
+        |run| {
+            let len = run.len;
+            let (ha, hb) = run.ends(h_m);
+            let (l, per_d) = (run.along(&ea.length), run.along(&ea.inverse_dual_length));
+            let (ha, hb, l, per_d) = (&ha[..len], &hb[..len], &l[..len], &per_d[..len]);
+            let out = run.along_mut(&mut s.flux);
+            for i in 0..len {
+                out[i] = (ha[i] - hb[i]) * l[i] * per_d[i];
             }
         },
     );
@@ -157,22 +155,21 @@ fn substep(
     // second). At the donor's, a thin cell gives at its own slow rate.
     let (laplacian, Mobility { per_cubed, cap }) = (&s.laplacian[..], mobility);
     let per_length = dt_s / (radius_m * radius_m);
-    with_avx2(
+    sides.for_each_edge_run(
+        &ea.cells,
         #[inline(always)]
-        || {
-            for run in sides.every_edge_run(&ea.cells) {
-                let len = run.len;
-                let (ha, hb) = run.ends(h_m);
-                let (la, lb) = run.ends(laplacian);
-                let (l, per_d) = (run.along(&ea.length), run.along(&ea.inverse_dual_length));
-                let (ha, hb, la, lb) = (&ha[..len], &hb[..len], &la[..len], &lb[..len]);
-                let (l, per_d, out) = (&l[..len], &per_d[..len], run.along_mut(&mut s.flux));
-                for i in 0..len {
-                    let rise = lb[i] - la[i];
-                    let donor = if rise >= 0.0 { ha[i] } else { hb[i] };
-                    let m = smaller(per_cubed * donor * donor * donor, cap);
-                    out[i] = m * rise * per_d[i] * l[i] * per_length;
-                }
+        |run| {
+            let len = run.len;
+            let (ha, hb) = run.ends(h_m);
+            let (la, lb) = run.ends(laplacian);
+            let (l, per_d) = (run.along(&ea.length), run.along(&ea.inverse_dual_length));
+            let (ha, hb, la, lb) = (&ha[..len], &hb[..len], &la[..len], &lb[..len]);
+            let (l, per_d, out) = (&l[..len], &per_d[..len], run.along_mut(&mut s.flux));
+            for i in 0..len {
+                let rise = lb[i] - la[i];
+                let donor = if rise >= 0.0 { ha[i] } else { hb[i] };
+                let m = smaller(per_cubed * donor * donor * donor, cap);
+                out[i] = m * rise * per_d[i] * l[i] * per_length;
             }
         },
     );

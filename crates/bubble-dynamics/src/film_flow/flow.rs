@@ -15,8 +15,6 @@
 
 use glam::DVec3;
 
-use crate::avx2::with_avx2;
-
 use super::advect::{AdvectionGeometry, AdvectionScratch, advect_momentum};
 use super::burst::{BurstParams, BurstState, Hole};
 use super::capillary::{Capillary, CapillaryScratch, smooth_thickness};
@@ -467,23 +465,22 @@ impl FilmFlow {
         outside.extend(slopes.iter().map(|slope| 1.5 * air_m_per_s.dot(*slope)));
         let per_layer = p.air_viscosity_pa_s / p.density_kg_per_m3;
         let sides = &self.transport.sides;
-        with_avx2(
+        sides.for_each_edge_run(
+            &ea.cells,
             #[inline(always)]
-            || {
-                for run in sides.every_edge_run(&ea.cells) {
-                    let len = run.len;
-                    let (ha, hb) = run.ends(&self.h_m);
-                    let (ha, hb, outside) = (&ha[..len], &hb[..len], run.along(&s.edge));
-                    let u = run.along_mut(&mut self.u_m_per_s);
-                    let factor = run.along_mut(&mut s.drag);
-                    for i in 0..len {
-                        let h = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
-                        let k = per_layer / h;
-                        let k_out = k * per_layer_depth((u[i] - outside[i]).abs());
-                        let k_in = k * per_layer_depth(u[i].abs());
-                        factor[i] = 1.0 / (1.0 + dt_s * (k_out + k_in));
-                        u[i] = (u[i] + dt_s * k_out * outside[i]) * factor[i];
-                    }
+            |run| {
+                let len = run.len;
+                let (ha, hb) = run.ends(&self.h_m);
+                let (ha, hb, outside) = (&ha[..len], &hb[..len], run.along(&s.edge));
+                let u = run.along_mut(&mut self.u_m_per_s);
+                let factor = run.along_mut(&mut s.drag);
+                for i in 0..len {
+                    let h = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
+                    let k = per_layer / h;
+                    let k_out = k * per_layer_depth((u[i] - outside[i]).abs());
+                    let k_in = k * per_layer_depth(u[i].abs());
+                    factor[i] = 1.0 / (1.0 + dt_s * (k_out + k_in));
+                    u[i] = (u[i] + dt_s * k_out * outside[i]) * factor[i];
                 }
             },
         );

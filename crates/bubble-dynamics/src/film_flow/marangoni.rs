@@ -18,7 +18,6 @@ use super::fluxes::{apply_limited, net_inflow};
 use super::grid::EdgeArrays;
 use super::sides::{CellSides, EdgeRun};
 use super::solve::{SolveLimits, SolveReport};
-use crate::avx2::with_avx2;
 
 /// Most solves a step's defect correction of the cross term takes (it takes about 11 on
 /// the swirl film at n = 64: each cuts the error by about 0.35, the cross operator's
@@ -140,12 +139,11 @@ impl FilmFlow {
             per_r: 1.0 / p.radius_m,
         };
         let sides = &self.transport.sides;
-        with_avx2(
+        sides.for_each_edge_run(
+            &ea.cells,
             #[inline(always)]
-            || {
-                for run in sides.every_edge_run(&ea.cells) {
-                    self.central_fluxes_run::<NORMAL>(s, run, edge);
-                }
+            |run| {
+                self.central_fluxes_run::<NORMAL>(s, run, edge);
             },
         );
         // `A Γ − dt Σ F/R`: each cell's net inflow of the fluxes, gathered.
@@ -315,12 +313,11 @@ impl FilmFlow {
         let (ea, sides) = (g.edge_arrays(), &transport.sides);
         let scale = dt_s / r;
         s.edge2.resize(ea.cells.len(), 0.0);
-        with_avx2(
+        sides.for_each_edge_run(
+            &ea.cells,
             #[inline(always)]
-            || {
-                for run in sides.every_edge_run(&ea.cells) {
-                    self.correct_velocity_run::<NORMAL>(s, run, scale);
-                }
+            |run| {
+                self.correct_velocity_run::<NORMAL>(s, run, scale);
             },
         );
         net_inflow(sides, &s.edge2, &mut s.rhs);
@@ -406,17 +403,16 @@ struct EdgeConstants {
 /// The upwind volume `Γ_up·u·l` (per R and time) across every edge at speeds `u`, into
 /// `out`.
 fn upwind_fluxes(sides: &CellSides, ea: &EdgeArrays, gamma: &[f64], u: &[f64], out: &mut [f64]) {
-    with_avx2(
+    sides.for_each_edge_run(
+        &ea.cells,
         #[inline(always)]
-        || {
-            for run in sides.every_edge_run(&ea.cells) {
-                let len = run.len;
-                let (ga, gb) = run.ends(gamma);
-                let (u, l, f) = (run.along(u), run.along(&ea.length), run.along_mut(out));
-                let (ga, gb, u, l) = (&ga[..len], &gb[..len], &u[..len], &l[..len]);
-                for i in 0..len {
-                    f[i] = if u[i] >= 0.0 { ga[i] } else { gb[i] } * u[i] * l[i];
-                }
+        |run| {
+            let len = run.len;
+            let (ga, gb) = run.ends(gamma);
+            let (u, l, f) = (run.along(u), run.along(&ea.length), run.along_mut(out));
+            let (ga, gb, u, l) = (&ga[..len], &gb[..len], &u[..len], &l[..len]);
+            for i in 0..len {
+                f[i] = if u[i] >= 0.0 { ga[i] } else { gb[i] } * u[i] * l[i];
             }
         },
     )

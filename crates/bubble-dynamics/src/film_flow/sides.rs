@@ -7,6 +7,7 @@
 //! which no compiler vectorises; a cell that gathers its four sides from slices does.
 
 use super::grid::{CubeSphere, FACE_BASES, FaceLayout};
+use crate::avx2::with_avx2;
 
 /// The side towards −x in the face's own coordinates (the cell's x-edge).
 pub(crate) const LEFT: usize = 0;
@@ -206,6 +207,20 @@ impl CellSides {
     /// Cells along a face edge.
     pub(crate) fn n(&self) -> usize {
         self.layout.n
+    }
+
+    /// Runs `pass` on every edge run ([`Self::every_edge_run`]), compiled for AVX2 where
+    /// the processor has it (a `#[inline(always)]` closure is compiled so with it).
+    #[inline(always)]
+    pub(crate) fn for_each_edge_run(&self, cells: &[[u32; 2]], mut pass: impl FnMut(EdgeRun)) {
+        with_avx2(
+            #[inline(always)]
+            || {
+                for run in self.every_edge_run(cells) {
+                    pass(run);
+                }
+            },
+        )
     }
 
     /// Every edge as a run, in increasing order: the runs inside the faces, then each

@@ -231,19 +231,18 @@ impl FilmFlow {
         match p.gradient {
             FilmGradient::TwoPoint => {
                 let (sides, u) = (&self.transport.sides, &mut self.u_m_per_s);
-                with_avx2(
+                sides.for_each_edge_run(
+                    &ea.cells,
                     #[inline(always)]
-                    || {
-                        for run in sides.every_edge_run(&ea.cells) {
-                            let len = run.len;
-                            let ((ta, tb), (ha, hb)) = (run.ends(theta), run.ends(h));
-                            let (ta, tb, ha, hb) = (&ta[..len], &tb[..len], &ha[..len], &hb[..len]);
-                            let id = &run.along(&ea.inverse_dual_length)[..len];
-                            let u = run.along_mut(u);
-                            for i in 0..len {
-                                let h_edge = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
-                                u[i] += per * (tb[i] - ta[i]) * id[i] / h_edge;
-                            }
+                    |run| {
+                        let len = run.len;
+                        let ((ta, tb), (ha, hb)) = (run.ends(theta), run.ends(h));
+                        let (ta, tb, ha, hb) = (&ta[..len], &tb[..len], &ha[..len], &hb[..len]);
+                        let id = &run.along(&ea.inverse_dual_length)[..len];
+                        let u = run.along_mut(u);
+                        for i in 0..len {
+                            let h_edge = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
+                            u[i] += per * (tb[i] - ta[i]) * id[i] / h_edge;
                         }
                     },
                 );
