@@ -22,6 +22,7 @@ use super::compare::larger;
 use super::face_rows::FaceRows;
 use super::grid::CubeSphere;
 use super::meniscus::MeniscusState;
+use super::sides::CellSides;
 use super::solve::{Hierarchy, SolveReport, Work};
 use super::thermal::{ThermalParams, up_from};
 use super::upwind::UpwindGeometry;
@@ -137,6 +138,8 @@ pub struct FilmFlow {
     pub(super) rows: std::sync::Arc<FaceRows>,
     /// The momentum advection's weights, fixed by the grid.
     advection: std::sync::Arc<AdvectionGeometry>,
+    /// Each cell's sides in its face, for the passes laid out by faces.
+    pub(super) sides: std::sync::Arc<CellSides>,
     /// The thickness transport's weights, fixed by the grid.
     pub(super) transport: std::sync::Arc<UpwindGeometry>,
     pub(crate) params: FlowParams,
@@ -203,13 +206,15 @@ impl FilmFlow {
         let cells = grid.cells();
         let edges = grid.edges().len();
         let rows = FaceRows::new(&grid);
+        let sides = CellSides::new(&grid);
         Self {
             burst: Some(Box::new(BurstState::new(params.burst, cells, params.seed))),
             meniscus: None,
             viscous_bound: viscous_bound(&grid),
             advection: std::sync::Arc::new(AdvectionGeometry::new(&grid, &rows)),
             rows: std::sync::Arc::new(rows),
-            transport: std::sync::Arc::new(UpwindGeometry::new(&grid)),
+            transport: std::sync::Arc::new(UpwindGeometry::new(&grid, &sides)),
+            sides: std::sync::Arc::new(sides),
             params,
             h_m: h,
             gamma: vec![1.0; cells],
@@ -464,7 +469,7 @@ impl FilmFlow {
         outside.clear();
         outside.extend(slopes.iter().map(|slope| 1.5 * air_m_per_s.dot(*slope)));
         let per_layer = p.air_viscosity_pa_s / p.density_kg_per_m3;
-        let sides = &self.transport.sides;
+        let sides = &self.sides;
         sides.for_each_edge_run(
             &ea.cells,
             #[inline(always)]
@@ -500,7 +505,7 @@ impl FilmFlow {
             drainage_viscosity_pa_s: mu,
             radius_m: p.radius_m,
         };
-        let sides = &self.transport.sides;
+        let sides = &self.sides;
         smooth_thickness(&self.grid, sides, c, dt_s, &mut self.h_m, &mut s.capillary);
     }
 }

@@ -84,7 +84,7 @@ impl FilmFlow {
         let substeps = (2.0 * fastest * dt_per_r).ceil().clamp(1.0, 64.0) as u32;
         let sub_dt_per_r = dt_per_r / f64::from(substeps);
         s.edge2.resize(ea.cells.len(), 0.0);
-        let sides = &self.transport.sides;
+        let sides = &self.sides;
         let (areas, per_area) = (g.areas_sr(), g.inverse_areas_per_sr());
         for _ in 0..substeps {
             upwind_fluxes(sides, ea, &self.gamma, &s.u_start, &mut s.edge2);
@@ -138,7 +138,7 @@ impl FilmFlow {
             dt_per_r2: dt_s / (p.radius_m * p.radius_m),
             per_r: 1.0 / p.radius_m,
         };
-        let sides = &self.transport.sides;
+        let sides = &self.sides;
         sides.for_each_edge_run(
             &ea.cells,
             #[inline(always)]
@@ -309,8 +309,8 @@ impl FilmFlow {
     ) {
         let r = self.params.radius_m;
         let g = std::sync::Arc::clone(&self.grid);
-        let transport = std::sync::Arc::clone(&self.transport);
-        let (ea, sides) = (g.edge_arrays(), &transport.sides);
+        let sides = std::sync::Arc::clone(&self.sides);
+        let (ea, sides) = (g.edge_arrays(), &*sides);
         let scale = dt_s / r;
         s.edge2.resize(ea.cells.len(), 0.0);
         sides.for_each_edge_run(

@@ -170,7 +170,7 @@ impl FilmFlow {
             .ceil()
             .clamp(1.0, f64::from(MAX_SUBSTEPS)) as u32;
         let scale = dt_s / (self.params.radius_m * f64::from(substeps));
-        let (sides, ea) = (&self.transport.sides, self.grid.edge_arrays());
+        let (sides, ea) = (&self.sides, self.grid.edge_arrays());
         let per_area = self.grid.inverse_areas_per_sr();
         for _ in 0..substeps {
             before.clear();
@@ -230,7 +230,7 @@ impl FilmFlow {
         let (theta, h) = (&self.temperature_k, &self.h_m);
         match p.gradient {
             FilmGradient::TwoPoint => {
-                let (sides, u) = (&self.transport.sides, &mut self.u_m_per_s);
+                let (sides, u) = (&self.sides, &mut self.u_m_per_s);
                 sides.for_each_edge_run(
                     &ea.cells,
                     #[inline(always)]

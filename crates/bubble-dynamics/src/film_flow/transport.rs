@@ -50,27 +50,27 @@ impl FilmFlow {
     fn courant_number(&self, drain_rate: &[f64], dt_s: f64) -> f64 {
         let ea = self.grid.edge_arrays();
         let (h, u) = (&self.h_m, &self.u_m_per_s);
-        let fastest = with_avx2(
+        // Four running maxima, lane by lane, so the loop vectorises (a maximum is exact in
+        // any order: the same number as one running maximum).
+        let mut lanes = [0.0; 4];
+        self.sides.for_each_edge_run(
+            &ea.cells,
             #[inline(always)]
-            || {
-                // Four running maxima, lane by lane, so the loop vectorises (a maximum
-                // is exact in any order: the same number as one running maximum).
-                let mut lanes = [0.0; 4];
-                for run in self.transport.sides.every_edge_run(&ea.cells) {
-                    let len = run.len;
-                    let (ha, hb) = (&h[run.a_cells()][..len], &h[run.b_cells()][..len]);
-                    let (u, c) = (run.along(u), run.along(drain_rate));
-                    let per_area = run.along(&ea.length_per_smaller_area);
-                    for i in 0..len {
-                        let h = larger(hb[i], ha[i]);
-                        let speed = (u[i].abs() + 3.0 * c[i].abs() * h * h) * per_area[i];
-                        // Skips a NaN speed as `max` does.
-                        lanes[i % 4] = larger(speed, lanes[i % 4]);
-                    }
+            |run| {
+                let len = run.len;
+                let (ha, hb) = run.ends(h);
+                let (ha, hb) = (&ha[..len], &hb[..len]);
+                let (u, c) = (run.along(u), run.along(drain_rate));
+                let per_area = run.along(&ea.length_per_smaller_area);
+                for i in 0..len {
+                    let h = larger(hb[i], ha[i]);
+                    let speed = (u[i].abs() + 3.0 * c[i].abs() * h * h) * per_area[i];
+                    // Skips a NaN speed as `max` does.
+                    lanes[i % 4] = larger(speed, lanes[i % 4]);
                 }
-                lanes.into_iter().fold(0.0, |a, b| larger(b, a))
             },
         );
+        let fastest = lanes.into_iter().fold(0.0, |a, b| larger(b, a));
         fastest * dt_s / self.params.radius_m
     }
 
@@ -80,22 +80,22 @@ impl FilmFlow {
     /// each structured inside the faces ([`super::upwind`]).
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn upwind_substep(&mut self, s: &mut Scratch, dt_s: f64) {
-        let geo = &*self.transport;
+        let (sides, geo) = (&*self.sides, &*self.transport);
         let dt_per_r = dt_s / self.params.radius_m;
         with_avx2(
             #[inline(always)]
             || {
-                upwind::limited_rises(geo, &self.h_m, &mut s.limited_rise);
+                upwind::limited_rises(sides, geo, &self.h_m, &mut s.limited_rise);
                 let speeds = upwind::EdgeSpeeds {
                     u: &self.u_m_per_s,
                     drain_rate: &s.drain_rate,
                     dt_per_r,
                 };
                 let ea = self.grid.edge_arrays();
-                upwind::volumes(geo, ea, &self.h_m, &s.limited_rise, speeds, &mut s.edge2);
+                upwind::volumes(sides, ea, &self.h_m, &s.limited_rise, speeds, &mut s.edge2);
                 let (areas, per_area) = (self.grid.areas_sr(), self.grid.inverse_areas_per_sr());
                 let (volume, h) = (&s.edge2, &mut self.h_m);
-                apply_limited(&geo.sides, areas, per_area, volume, 1.0, h, &mut s.cell);
+                apply_limited(sides, areas, per_area, volume, 1.0, h, &mut s.cell);
             },
         )
     }

@@ -17,8 +17,6 @@ use super::sides::{CellRun, CellSides};
 /// The transport's weights, fixed by the grid.
 #[derive(Clone, Debug)]
 pub(crate) struct UpwindGeometry {
-    /// Each cell's sides.
-    pub(crate) sides: CellSides,
     /// `rise[k][j][c]`: the weight of `h_c + h_j` (`j` the cell across side `j`) in the
     /// rise of cell `c`'s thickness to the midpoint of its side `k`: the Green–Gauss
     /// gradient `Σ ± n l (h_c + h_j)/2 / A`, projected onto the cell's tangent plane and
@@ -29,9 +27,8 @@ pub(crate) struct UpwindGeometry {
 }
 
 impl UpwindGeometry {
-    /// Derives the weights from `grid`.
-    pub(crate) fn new(grid: &CubeSphere) -> Self {
-        let sides = CellSides::new(grid);
+    /// Derives the weights from `grid` and its cells' `sides`.
+    pub(crate) fn new(grid: &CubeSphere, sides: &CellSides) -> Self {
         let ea = grid.edge_arrays();
         let cells = grid.cells();
         let mut rise: [[Vec<f64>; 4]; 4] =
@@ -50,7 +47,7 @@ impl UpwindGeometry {
                 }
             }
         }
-        Self { sides, rise }
+        Self { rise }
     }
 }
 
@@ -96,16 +93,20 @@ fn limiter(h: f64, nb: [f64; 4], rise: [f64; 4]) -> f64 {
 /// Every cell's limited rise to each side, `out[k][c]`, m.
 // Inlined into the sub-step's `with_avx2` closure, so compiled for AVX2 there.
 #[inline(always)]
-pub(crate) fn limited_rises(geo: &UpwindGeometry, h: &[f64], out: &mut [Vec<f64>; 4]) {
+pub(crate) fn limited_rises(
+    sides: &CellSides,
+    geo: &UpwindGeometry,
+    h: &[f64],
+    out: &mut [Vec<f64>; 4],
+) {
     for o in out.iter_mut() {
         o.resize(h.len(), 0.0);
     }
-    for run in &geo.sides.cell_runs {
+    for run in &sides.cell_runs {
         let cells = run.cells();
         let [o0, o1, o2, o3] = out.each_mut().map(|o| &mut o[cells.clone()]);
         rises_run(geo, h, run, [o0, o1, o2, o3]);
     }
-    let sides = &geo.sides;
     for &c in &sides.rim_cells {
         let c = c as usize;
         let nb = sides.neighbour[c].map(|j| h[j as usize]);
@@ -214,7 +215,7 @@ fn edge_volume([ha, hb]: [f64; 2], [ra, rb]: [f64; 2], [u, c, l]: [f64; 3], dt_p
 // Inlined into the sub-step's `with_avx2` closure, so compiled for AVX2 there.
 #[inline(always)]
 pub(crate) fn volumes(
-    geo: &UpwindGeometry,
+    sides: &CellSides,
     ea: &EdgeArrays,
     h: &[f64],
     rise: &[Vec<f64>; 4],
@@ -222,7 +223,7 @@ pub(crate) fn volumes(
     volume: &mut Vec<f64>,
 ) {
     volume.resize(ea.cells.len(), 0.0);
-    for run in &geo.sides.edge_runs {
+    for run in sides.every_edge_run(&ea.cells) {
         let len = run.len;
         let (u, c) = (run.along(speeds.u), run.along(speeds.drain_rate));
         let (l, out) = (run.along(&ea.length), run.along_mut(volume));
@@ -236,13 +237,6 @@ pub(crate) fn volumes(
             out[i] = edge_volume([ha[i], hb[i]], [ra[i], rb[i]], speed, speeds.dt_per_r);
         }
     }
-    let seams = geo.sides.layout.first_seam_edge()..ea.cells.len();
-    for (e, [ka, kb]) in seams.zip(&geo.sides.seam_sides) {
-        let [a, b] = ea.cells[e].map(|c| c as usize);
-        let rises = [rise[*ka as usize][a], rise[*kb as usize][b]];
-        let speed = [speeds.u[e], speeds.drain_rate[e], ea.length[e]];
-        volume[e] = edge_volume([h[a], h[b]], rises, speed, speeds.dt_per_r);
-    }
 }
 
 #[cfg(test)]
@@ -255,7 +249,8 @@ mod tests {
     #[test]
     fn the_rise_weights_give_the_projected_green_gauss_gradient() {
         let grid = CubeSphere::new(6);
-        let geo = UpwindGeometry::new(&grid);
+        let sides = CellSides::new(&grid);
+        let geo = UpwindGeometry::new(&grid, &sides);
         let ea = grid.edge_arrays();
         let h: Vec<f64> = grid
             .centres()
@@ -274,10 +269,10 @@ mod tests {
             let centre = grid.centres()[c];
             let g = gradient[c] * grid.inverse_areas_per_sr()[c];
             let g = g - centre * g.dot(centre);
-            let nb = geo.sides.neighbour[c].map(|j| h[j as usize]);
+            let nb = sides.neighbour[c].map(|j| h[j as usize]);
             for k in 0..4 {
-                let e = geo.sides.edge[c][k] as usize;
-                let want = g.dot(ea.reach[e][usize::from(!geo.sides.is_a[c][k])]);
+                let e = sides.edge[c][k] as usize;
+                let want = g.dot(ea.reach[e][usize::from(!sides.is_a[c][k])]);
                 let got: f64 = (0..4).map(|j| geo.rise[k][j][c] * (h[c] + nb[j])).sum();
                 worst = worst.max((got - want).abs());
             }
