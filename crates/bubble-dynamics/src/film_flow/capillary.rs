@@ -126,7 +126,6 @@ fn substep(
     // ∇²h as the net inflow of the differences `(h_b − h_a) l/d` (their sum out of a
     // cell, with the sign of an inflow: a cell below its neighbours gains).
     sides.for_each_edge_run(
-        &ea.cells,
         #[inline(always)]
         |run| {
             let len = run.len;
@@ -156,7 +155,6 @@ fn substep(
     let (laplacian, Mobility { per_cubed, cap }) = (&s.laplacian[..], mobility);
     let per_length = dt_s / (radius_m * radius_m);
     sides.for_each_edge_run(
-        &ea.cells,
         #[inline(always)]
         |run| {
             let len = run.len;

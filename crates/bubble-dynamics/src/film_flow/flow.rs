@@ -471,7 +471,6 @@ impl FilmFlow {
         let per_layer = p.air_viscosity_pa_s / p.density_kg_per_m3;
         let sides = &self.sides;
         sides.for_each_edge_run(
-            &ea.cells,
             #[inline(always)]
             |run| {
                 let len = run.len;

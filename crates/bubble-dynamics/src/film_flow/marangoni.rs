@@ -140,7 +140,6 @@ impl FilmFlow {
         };
         let sides = &self.sides;
         sides.for_each_edge_run(
-            &ea.cells,
             #[inline(always)]
             |run| {
                 self.central_fluxes_run::<NORMAL>(s, run, edge);
@@ -314,7 +313,6 @@ impl FilmFlow {
         let scale = dt_s / r;
         s.edge2.resize(ea.cells.len(), 0.0);
         sides.for_each_edge_run(
-            &ea.cells,
             #[inline(always)]
             |run| {
                 self.correct_velocity_run::<NORMAL>(s, run, scale);
@@ -404,7 +402,6 @@ struct EdgeConstants {
 /// `out`.
 fn upwind_fluxes(sides: &CellSides, ea: &EdgeArrays, gamma: &[f64], u: &[f64], out: &mut [f64]) {
     sides.for_each_edge_run(
-        &ea.cells,
         #[inline(always)]
         |run| {
             let len = run.len;

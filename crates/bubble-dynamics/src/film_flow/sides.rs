@@ -40,16 +40,15 @@ pub(crate) struct CellSides {
     pub(crate) edge: Vec<[u32; 4]>,
     /// Per cell and side: whether the cell is the edge's `a` cell.
     pub(crate) is_a: Vec<[bool; 4]>,
-    /// Per seam edge: the side it is of its `a` cell and of its `b` cell.
-    pub(crate) seam_sides: Vec<[u8; 2]>,
     /// The cells inside the faces as runs, one a face row ([`CellRun`]).
     pub(crate) cell_runs: Vec<CellRun>,
     /// The cells on the faces' rims (a side on a seam), in increasing order: the runs
     /// leave them out, and passes take them one by one through the tables (as runs of
     /// one they cost as much as the whole inside, each run's slices set up for a cell).
     pub(crate) rim_cells: Vec<u32>,
-    /// The edges inside the faces as runs: each face row's x-edges, each face's y-edges
-    /// ([`EdgeRun`]); the seam edges follow from [`FaceLayout::first_seam_edge`].
+    /// Every edge once, in increasing order, as runs: each face row's x-edges, each
+    /// face's y-edges ([`EdgeRun`]), then each seam edge alone (the seams are few beside
+    /// the faces' edges).
     pub(crate) edge_runs: Vec<EdgeRun>,
 }
 
@@ -145,7 +144,7 @@ impl CellSides {
         let mut neighbour = vec![[u32::MAX; 4]; cells];
         let mut edge = vec![[u32::MAX; 4]; cells];
         let mut is_a = vec![[false; 4]; cells];
-        let mut seam_sides = Vec::new();
+        let mut seams = Vec::new();
         for (e, ge) in grid.edges().iter().enumerate() {
             let mut sides = [0u8; 2];
             for (end, (c, other)) in [(ge.a, ge.b), (ge.b, ge.a)].into_iter().enumerate() {
@@ -156,7 +155,15 @@ impl CellSides {
                 sides[end] = k as u8;
             }
             if e >= layout.first_seam_edge() {
-                seam_sides.push(sides);
+                let (a, b) = (ge.a as usize, ge.b as usize);
+                let sides = sides.map(usize::from);
+                seams.push(EdgeRun {
+                    start: e,
+                    len: 1,
+                    a,
+                    b,
+                    sides,
+                });
             }
         }
         let mut sides = Self {
@@ -164,13 +171,13 @@ impl CellSides {
             neighbour,
             edge,
             is_a,
-            seam_sides,
             cell_runs: Vec::new(),
             rim_cells: Vec::new(),
             edge_runs: Vec::new(),
         };
         (sides.cell_runs, sides.rim_cells) = sides.find_cell_runs();
-        sides.edge_runs = edge_runs(grid);
+        sides.edge_runs = face_edge_runs(grid);
+        sides.edge_runs.extend(seams);
         sides
     }
 
@@ -209,43 +216,24 @@ impl CellSides {
         self.layout.n
     }
 
-    /// Runs `pass` on every edge run ([`Self::every_edge_run`]), compiled for AVX2 where
-    /// the processor has it (a `#[inline(always)]` closure is compiled so with it).
+    /// Runs `pass` on every edge run ([`Self::edge_runs`]), compiled for AVX2 where the
+    /// processor has it (a `#[inline(always)]` closure is compiled so with it).
     #[inline(always)]
-    pub(crate) fn for_each_edge_run(&self, cells: &[[u32; 2]], mut pass: impl FnMut(EdgeRun)) {
+    pub(crate) fn for_each_edge_run(&self, mut pass: impl FnMut(EdgeRun)) {
         with_avx2(
             #[inline(always)]
             || {
-                for run in self.every_edge_run(cells) {
+                for &run in &self.edge_runs {
                     pass(run);
                 }
             },
         )
     }
-
-    /// Every edge as a run, in increasing order: the runs inside the faces, then each
-    /// seam edge alone (`cells` the edges' `[a, b]`). For edge passes, whose seams are
-    /// few beside the faces' edges.
-    pub(crate) fn every_edge_run<'a>(
-        &'a self,
-        cells: &'a [[u32; 2]],
-    ) -> impl Iterator<Item = EdgeRun> + 'a {
-        let first = self.layout.first_seam_edge();
-        let seams = cells[first..].iter().zip(&self.seam_sides).enumerate();
-        let seams = seams.map(move |(i, ([a, b], [ka, kb]))| EdgeRun {
-            start: first + i,
-            len: 1,
-            a: *a as usize,
-            b: *b as usize,
-            sides: [*ka as usize, *kb as usize],
-        });
-        self.edge_runs.iter().copied().chain(seams)
-    }
 }
 
 /// The edges inside the faces as [`EdgeRun`]s: each face row's x-edges, each face's
 /// y-edges.
-fn edge_runs(grid: &CubeSphere) -> Vec<EdgeRun> {
+fn face_edge_runs(grid: &CubeSphere) -> Vec<EdgeRun> {
     let layout = grid.layout();
     let n = layout.n;
     let mut runs = Vec::new();
@@ -327,7 +315,11 @@ mod tests {
                     assert_eq!(sides.inflow(c), INFLOW, "cell {c}");
                 }
             }
-            assert_eq!(sides.seam_sides.len(), 12 * n);
+            let seams = sides
+                .edge_runs
+                .iter()
+                .filter(|r| r.start >= layout.first_seam_edge());
+            assert_eq!(seams.count(), 12 * n);
             runs_cover_everything_once(&grid, &sides);
         }
     }
@@ -350,8 +342,7 @@ mod tests {
             }
         }
         let edges: Vec<usize> = sides.edge_runs.iter().flat_map(|r| r.edges()).collect();
-        let inside = grid.layout().first_seam_edge();
-        assert_eq!(edges, (0..inside).collect::<Vec<_>>());
+        assert_eq!(edges, (0..grid.edges().len()).collect::<Vec<_>>());
         let ea = grid.edge_arrays();
         for run in &sides.edge_runs {
             for (i, e) in run.edges().enumerate() {

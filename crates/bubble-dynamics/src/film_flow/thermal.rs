@@ -232,7 +232,6 @@ impl FilmFlow {
             FilmGradient::TwoPoint => {
                 let (sides, u) = (&self.sides, &mut self.u_m_per_s);
                 sides.for_each_edge_run(
-                    &ea.cells,
                     #[inline(always)]
                     |run| {
                         let len = run.len;

@@ -54,7 +54,6 @@ impl FilmFlow {
         // any order: the same number as one running maximum).
         let mut lanes = [0.0; 4];
         self.sides.for_each_edge_run(
-            &ea.cells,
             #[inline(always)]
             |run| {
                 let len = run.len;

@@ -223,7 +223,7 @@ pub(crate) fn volumes(
     volume: &mut Vec<f64>,
 ) {
     volume.resize(ea.cells.len(), 0.0);
-    for run in sides.every_edge_run(&ea.cells) {
+    for run in &sides.edge_runs {
         let len = run.len;
         let (u, c) = (run.along(speeds.u), run.along(speeds.drain_rate));
         let (l, out) = (run.along(&ea.length), run.along_mut(volume));
