@@ -22,14 +22,15 @@ pub(crate) const TOP: usize = 3;
 /// and top edges): a sign multiplies exactly, so the gathers need no branch.
 pub(crate) const INFLOW: [f64; 4] = [1.0, -1.0, 1.0, -1.0];
 
-/// Every cell's neighbour and edge on each side, and the sides each seam edge joins.
+/// Every cell's neighbour and edge on each side, and every edge in runs.
 ///
 /// # Guarantees
 /// - `neighbour[c][k]` and `edge[c][k]` are the cell across side `k` of cell `c` and the
 ///   edge between them; `is_a[c][k]` says whether `c` is that edge's `a` cell.
 /// - Inside a face these follow [`FaceLayout`]: `c ∓ 1` and `c ∓ n` across the x and y
 ///   sides, with the signs [`INFLOW`].
-/// - `seam_sides[e − first_seam_edge]` is `[side of a, side of b]` of seam edge `e`.
+/// - `edge_runs` holds every edge once, in increasing order, each run with the side it
+///   is of its `a` cells and of its `b` cells.
 #[derive(Clone, Debug)]
 pub(crate) struct CellSides {
     /// The grid's layout.
