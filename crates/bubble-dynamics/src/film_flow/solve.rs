@@ -126,7 +126,7 @@ pub struct Hierarchy {
 /// and the operator `M` they apply) run in `f64`, so a solve still reaches an `f64`
 /// tolerance; the V-cycle that preconditions them runs in `f32` (its stencils, inverse
 /// diagonals, residuals and corrections, rounded once a system in
-/// [`Hierarchy::prepare`]), where an AVX2 instruction takes eight cells, not four, and a
+/// `Hierarchy::prepare`), where an AVX2 instruction takes eight cells, not four, and a
 /// sweep streams half the bytes. Why that is safe: conjugate gradients need of their
 /// preconditioner only a fixed symmetric positive definite map `r ↦ z`, and they take as
 /// few iterations as that map is close to `M⁻¹`. The `f32` V-cycle does the same
