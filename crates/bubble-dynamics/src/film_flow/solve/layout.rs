@@ -1,0 +1,227 @@
+//! A level's cells laid out for the solve: each face padded by a ring of halo cells
+//! (copies of the neighbouring faces' cells), its rows an odd stride apart, and the
+//! whole level split by the parity of the padded index into two colour arrays.
+//!
+//! Why: with an odd stride a cell's four neighbours in the padded level have the other
+//! parity, so they lie in the other colour's array at four offsets that are the same
+//! for every cell of the level. A Gauss–Seidel half-sweep over one colour, the operator
+//! and the residual are then each one loop over contiguous slices (no neighbour
+//! indices, no rim cells taken one by one, no runs to set up), and the restriction and
+//! the coarse correction walk face rows whose children are contiguous too.
+
+use std::ops::Range;
+
+use super::super::sides::{BOTTOM, CellSides, LEFT, RIGHT, TOP};
+
+/// A level's padded, colour-split layout.
+///
+/// # Guarantees
+/// - `stride` is odd, so the padded index `f` of a cell and of each neighbour differ in
+///   parity; colour `f & 1` holds it at [`Layout::index`]`(f)` = `(f & 1)·half + f/2`.
+/// - [`Layout::sweep`]`[c]` covers every interior cell of colour `c`, and its
+///   [`Layout::neighbour_offsets`] stay inside the other colour's array over it.
+#[derive(Clone, Debug)]
+pub(super) struct Layout {
+    /// Cells along a face's side.
+    pub(super) m: usize,
+    /// Padded row length, odd: `m + 2` or `m + 3`.
+    stride: usize,
+    /// Padded cells of one face: `(m + 2)·stride`.
+    face_len: usize,
+    /// Length of each colour's array.
+    pub(super) half: usize,
+    /// Per colour, the positions in its array a sweep computes (its interior cells and
+    /// the halo cells between them, whose results the next halo refresh overwrites).
+    pub(super) sweep: [Range<usize>; 2],
+    /// Each cell's position in the split arrays, in the grid's numbering
+    /// (`face·m² + y·m + x`).
+    pub(super) position: Vec<u32>,
+    /// Per colour of the halo cell: `(halo, source)` positions of the copies that
+    /// refresh the halo cells of that colour.
+    pub(super) halos: [Vec<[u32; 2]>; 2],
+    /// Per cell in the grid's numbering, the cell across each side.
+    pub(super) neighbour: Vec<[u32; 4]>,
+}
+
+impl Layout {
+    /// The layout of a level of `m` cells a face whose cells have the neighbours
+    /// `neighbour` (per cell in the grid's numbering, per side [`LEFT`]…[`TOP`]).
+    ///
+    /// # Panics
+    /// If `neighbour` does not hold `6·m²` cells.
+    pub(super) fn new(m: usize, neighbour: Vec<[u32; 4]>) -> Self {
+        assert_eq!(
+            neighbour.len(),
+            6 * m * m,
+            "neighbours of a level of face {m}"
+        );
+        let stride = if m % 2 == 0 { m + 3 } else { m + 2 };
+        let face_len = (m + 2) * stride;
+        let half = (6 * face_len).div_ceil(2);
+        let first = stride + 1;
+        let last = 5 * face_len + m * stride + m;
+        // Each colour's first and last interior cell (the first two and the last two
+        // interior cells have both parities).
+        let sweep = [0, 1].map(|c| {
+            let lo = if first & 1 == c { first } else { first + 1 };
+            let hi = if last & 1 == c { last } else { last - 1 };
+            (lo >> 1)..(hi >> 1) + 1
+        });
+        let mut layout = Self {
+            m,
+            stride,
+            face_len,
+            half,
+            sweep,
+            position: Vec::with_capacity(6 * m * m),
+            halos: [Vec::new(), Vec::new()],
+            neighbour,
+        };
+        for c in 0..6 * m * m {
+            let p = layout.index(layout.padded(c));
+            layout.position.push(p as u32);
+        }
+        layout.halos = layout.halo_copies();
+        layout
+    }
+
+    /// The layout of the grid `sides` describes.
+    pub(super) fn of_grid(sides: &CellSides) -> Self {
+        Self::new(sides.n(), sides.neighbour.clone())
+    }
+
+    /// The layout of the level coarser than this one (`m` halved).
+    ///
+    /// # Panics
+    /// If `m` is odd.
+    pub(super) fn coarser(&self) -> Self {
+        let (m, half_m) = (self.m, self.m / 2);
+        assert!(
+            m % 2 == 0,
+            "a level of odd face size {m} has no coarser one"
+        );
+        let parent = |c: usize| {
+            let (face, rest) = (c / (m * m), c % (m * m));
+            face * half_m * half_m + (rest / m / 2) * half_m + (rest % m) / 2
+        };
+        let mut neighbour = vec![[0u32; 4]; 6 * half_m * half_m];
+        for (c, sides) in neighbour.iter_mut().enumerate() {
+            let (face, rest) = (c / (half_m * half_m), c % (half_m * half_m));
+            let child = face * m * m + 2 * (rest / half_m) * m + 2 * (rest % half_m);
+            // A child on each side: the bottom-left one for LEFT and BOTTOM, the
+            // top-right one for RIGHT and TOP.
+            let far = child + m + 1;
+            for (k, from) in [(LEFT, child), (BOTTOM, child), (RIGHT, far), (TOP, far)] {
+                sides[k] = parent(self.neighbour[from][k] as usize) as u32;
+            }
+        }
+        Self::new(half_m, neighbour)
+    }
+
+    /// Padded index of cell `c` (grid numbering).
+    fn padded(&self, c: usize) -> usize {
+        let m = self.m;
+        let (face, rest) = (c / (m * m), c % (m * m));
+        face * self.face_len + (rest / m + 1) * self.stride + rest % m + 1
+    }
+
+    /// Position in the split arrays of padded index `f`.
+    pub(super) fn index(&self, f: usize) -> usize {
+        (f & 1) * self.half + (f >> 1)
+    }
+
+    /// Length of a field on the level: both colours' arrays.
+    pub(super) fn len(&self) -> usize {
+        2 * self.half
+    }
+
+    /// For cells of colour `c`, the offsets of their LEFT, RIGHT, BOTTOM and TOP
+    /// neighbours in the other colour's array, relative to their own position in theirs.
+    pub(super) fn neighbour_offsets(&self, c: usize) -> [isize; 4] {
+        let (up, down) = (self.stride.div_ceil(2) as isize, (self.stride / 2) as isize);
+        if c == 0 {
+            [-1, 0, -up, down]
+        } else {
+            [0, 1, -down, up]
+        }
+    }
+
+    /// The halo copies by the colour of the halo cell: each rim cell's halo neighbour on
+    /// a side across a seam takes that neighbour's value.
+    fn halo_copies(&self) -> [Vec<[u32; 2]>; 2] {
+        let m = self.m;
+        let step = [-1, 1, -(self.stride as isize), self.stride as isize];
+        let mut halos = [Vec::new(), Vec::new()];
+        for c in 0..6 * m * m {
+            let (x, y) = (c % m, (c / m) % m);
+            let on_rim = [x == 0, x + 1 == m, y == 0, y + 1 == m];
+            for k in 0..4 {
+                if !on_rim[k] {
+                    continue;
+                }
+                let halo = (self.padded(c) as isize + step[k]) as usize;
+                let source = self.padded(self.neighbour[c][k] as usize);
+                let pair = [self.index(halo) as u32, self.index(source) as u32];
+                halos[halo & 1].push(pair);
+            }
+        }
+        halos
+    }
+
+    /// The first fine row pair of the coarse cells of coarse face `face`, row `y`
+    /// (0-based), as the fine level lays it out: for fine row `2y + j`, the positions of
+    /// the children `(2x, ·)` and `(2x + 1, ·)` of coarse cell `x = 0` (consecutive
+    /// coarse cells' children follow at consecutive positions in each colour).
+    pub(super) fn children_of_row(&self, face: usize, y: usize, j: usize) -> [usize; 2] {
+        let f = face * self.face_len + (2 * y + j + 1) * self.stride + 1;
+        [self.index(f), self.index(f + 1)]
+    }
+
+    /// The positions of coarse face `face`, row `y` (0-based), cells 0 and 1: each
+    /// colour's later cells of the row follow every other cell at consecutive positions.
+    pub(super) fn row_start(&self, face: usize, y: usize) -> [usize; 2] {
+        let f = face * self.face_len + (y + 1) * self.stride + 1;
+        [self.index(f), self.index(f + 1)]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::film_flow::grid::CubeSphere;
+
+    /// Every cell reads, at its four neighbour offsets in the other colour's array, the
+    /// grid's neighbour on that side: the cell itself inside a face, or a halo cell
+    /// whose refresh copies that neighbour; on every level of the hierarchy's sizes.
+    #[test]
+    fn each_cell_reads_its_grid_neighbours_through_the_offsets_and_the_halo() {
+        for n in [1, 2, 3, 6, 16] {
+            let sides = CellSides::new(&CubeSphere::new(n));
+            let mut level = Layout::of_grid(&sides);
+            loop {
+                let mut copies = std::collections::HashMap::new();
+                for &[halo, source] in level.halos.iter().flatten() {
+                    assert!(copies.insert(halo, source).is_none(), "halo {halo} twice");
+                }
+                for (c, &p) in level.position.iter().enumerate() {
+                    let p = p as usize;
+                    let colour = p / level.half;
+                    let at = p % level.half;
+                    assert!(level.sweep[colour].contains(&at), "n {n} cell {c}");
+                    let offsets = level.neighbour_offsets(colour);
+                    for (k, offset) in offsets.into_iter().enumerate() {
+                        let read = (1 - colour) * level.half + (at as isize + offset) as usize;
+                        let read = read as u32;
+                        let value_of = copies.get(&read).copied().unwrap_or(read);
+                        let expected = level.position[level.neighbour[c][k] as usize];
+                        assert_eq!(value_of, expected, "m {} cell {c} side {k}", level.m);
+                    }
+                }
+                if level.m % 2 == 1 || level.m <= 1 {
+                    break;
+                }
+                level = level.coarser();
+            }
+        }
+    }
+}
