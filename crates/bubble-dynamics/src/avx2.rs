@@ -48,3 +48,91 @@ fn run_avx2<R>(f: impl FnOnce() -> R) -> R {
 pub(crate) fn set_portable_only(portable: bool) {
     PORTABLE_ONLY.set(portable);
 }
+
+/// Four running sums of `a[i]·b[i]`, lane `k` over the `i ≡ k (mod 4)` in increasing
+/// order, over the first `4⌊len/4⌋` elements: the same bits with AVX2 (one instruction a
+/// chunk, where the compiler's own vectorisation of the portable loop shuffled two lanes
+/// at a time) as without.
+///
+/// # Panics
+/// If the slices differ in length.
+#[inline(always)]
+pub(crate) fn dot_lanes(a: &[f64], b: &[f64]) -> [f64; 4] {
+    assert_eq!(a.len(), b.len(), "dot of slices of different lengths");
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && !portable_only() {
+        // SAFETY: the processor supports AVX2, checked just above.
+        return unsafe { dot_lanes_avx2(a, b) };
+    }
+    let mut lanes = [0.0; 4];
+    for (x, y) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
+        for k in 0..4 {
+            lanes[k] += x[k] * y[k];
+        }
+    }
+    lanes
+}
+
+/// [`dot_lanes`] in AVX2 registers.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn dot_lanes_avx2(a: &[f64], b: &[f64]) -> [f64; 4] {
+    use std::arch::x86_64::{_mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_setzero_pd};
+    let mut sum = _mm256_setzero_pd();
+    for (x, y) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
+        // SAFETY: each chunk holds four `f64`s, the unaligned loads' width.
+        let (x, y) = unsafe { (_mm256_loadu_pd(x.as_ptr()), _mm256_loadu_pd(y.as_ptr())) };
+        sum = _mm256_add_pd(sum, _mm256_mul_pd(x, y));
+    }
+    let mut lanes = [0.0; 4];
+    // SAFETY: `lanes` holds four `f64`s, the unaligned store's width.
+    unsafe { std::arch::x86_64::_mm256_storeu_pd(lanes.as_mut_ptr(), sum) };
+    lanes
+}
+
+/// `r[i] −= step·q[i]` over the first `4⌊len/4⌋` elements, and four running sums of the
+/// new `r[i]²` as [`dot_lanes`] sums: the same bits with AVX2 as without.
+///
+/// # Panics
+/// If the slices differ in length.
+#[inline(always)]
+pub(crate) fn subtract_and_square_lanes(step: f64, q: &[f64], r: &mut [f64]) -> [f64; 4] {
+    assert_eq!(q.len(), r.len(), "update of slices of different lengths");
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && !portable_only() {
+        // SAFETY: the processor supports AVX2, checked just above.
+        return unsafe { subtract_and_square_lanes_avx2(step, q, r) };
+    }
+    let mut lanes = [0.0; 4];
+    for (rs, qs) in r.chunks_exact_mut(4).zip(q.chunks_exact(4)) {
+        for k in 0..4 {
+            rs[k] -= step * qs[k];
+            lanes[k] += rs[k] * rs[k];
+        }
+    }
+    lanes
+}
+
+/// [`subtract_and_square_lanes`] in AVX2 registers.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn subtract_and_square_lanes_avx2(step: f64, q: &[f64], r: &mut [f64]) -> [f64; 4] {
+    use std::arch::x86_64::{
+        _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_setzero_pd,
+        _mm256_storeu_pd, _mm256_sub_pd,
+    };
+    let (step, mut sum) = (_mm256_set1_pd(step), _mm256_setzero_pd());
+    for (rs, qs) in r.chunks_exact_mut(4).zip(q.chunks_exact(4)) {
+        // SAFETY: each chunk holds four `f64`s, the unaligned loads' and store's width.
+        unsafe {
+            let (ri, qi) = (_mm256_loadu_pd(rs.as_ptr()), _mm256_loadu_pd(qs.as_ptr()));
+            let next = _mm256_sub_pd(ri, _mm256_mul_pd(step, qi));
+            _mm256_storeu_pd(rs.as_mut_ptr(), next);
+            sum = _mm256_add_pd(sum, _mm256_mul_pd(next, next));
+        }
+    }
+    let mut lanes = [0.0; 4];
+    // SAFETY: `lanes` holds four `f64`s, the unaligned store's width.
+    unsafe { _mm256_storeu_pd(lanes.as_mut_ptr(), sum) };
+    lanes
+}

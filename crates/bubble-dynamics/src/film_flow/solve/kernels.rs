@@ -6,6 +6,7 @@
 
 use super::Real;
 use super::layout::Layout;
+use crate::avx2::{dot_lanes, subtract_and_square_lanes};
 
 /// Per side, a level's edge weights as a field: each cell's weight of the edge on that
 /// side (zero at the halo cells).
@@ -310,39 +311,14 @@ pub(super) fn correct(
 /// running sum waits on every add before it), in a fixed order, so results stay the same.
 const LANES: usize = 4;
 
-/// `a·b`, summed in [`LANES`] lanes.
+/// `a·b`, summed in [`LANES`] lanes ([`dot_lanes`]) and then across them, the tail
+/// last.
 #[inline(always)]
 pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut lanes = [0.0; LANES];
-    let (a_main, b_main) = (a.chunks_exact(LANES), b.chunks_exact(LANES));
-    let tail: f64 = a_main
-        .remainder()
-        .iter()
-        .zip(b_main.remainder())
-        .map(|(x, y)| x * y)
-        .sum();
-    for (x, y) in a_main.zip(b_main) {
-        lanes = add_products(lanes, four(x), four(y));
-    }
+    let main = a.len() - a.len() % LANES;
+    let lanes = dot_lanes(&a[..main], &b[..main]);
+    let tail: f64 = a[main..].iter().zip(&b[main..]).map(|(x, y)| x * y).sum();
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
-}
-
-/// A chunk of [`LANES`] as an array.
-#[inline(always)]
-fn four(chunk: &[f64]) -> [f64; LANES] {
-    chunk.try_into().expect("a chunk of LANES")
-}
-
-/// `lanes + x·y`, lane by lane: written as one array expression (a loop over the lanes
-/// was vectorised across chunks, two lanes an instruction with shuffles between).
-#[inline(always)]
-fn add_products(lanes: [f64; LANES], x: [f64; LANES], y: [f64; LANES]) -> [f64; LANES] {
-    [
-        lanes[0] + x[0] * y[0],
-        lanes[1] + x[1] * y[1],
-        lanes[2] + x[2] * y[2],
-        lanes[3] + x[3] * y[3],
-    ]
 }
 
 /// `x += step·p`, `r −= step·q`, and returns `r·r`, summed as [`dot`] sums: each lane's
@@ -363,18 +339,7 @@ pub(super) fn update_and_norm2(
     let main = r.len() - r.len() % LANES;
     let (r, r_tail) = r.split_at_mut(main);
     let (q, q_tail) = q.split_at(main);
-    let mut lanes = [0.0; LANES];
-    for (rs, qs) in r.chunks_exact_mut(LANES).zip(q.chunks_exact(LANES)) {
-        let (ri, qi) = (four(rs), four(qs));
-        let next = [
-            ri[0] - step * qi[0],
-            ri[1] - step * qi[1],
-            ri[2] - step * qi[2],
-            ri[3] - step * qi[3],
-        ];
-        rs.copy_from_slice(&next);
-        lanes = add_products(lanes, next, next);
-    }
+    let lanes = subtract_and_square_lanes(step, &q[..main], r);
     for (ri, qi) in r_tail.iter_mut().zip(q_tail) {
         *ri -= step * qi;
     }
