@@ -26,6 +26,7 @@ mod dense;
 mod kernels;
 mod layout;
 
+use super::compare::larger;
 use super::grid::CubeSphere;
 use super::sides::{BOTTOM, CellSides, LEFT, RIGHT, TOP};
 use crate::avx2::with_avx2;
@@ -69,9 +70,11 @@ fn coarsest_face(mut n: usize) -> usize {
 
 /// Largest number of cells solved directly on the coarsest level.
 const DENSE_CELLS: usize = 6 * 8 * 8;
-/// Face size the hierarchy coarsens down to when it can (a dense Cholesky of 6·4² cells
-/// costs 0.3 M flops a step; of 6·8², 19 M).
-const COARSEST_FACE: usize = 4;
+/// Face size the hierarchy coarsens down to when it can: its dense Cholesky of 6·2² cells
+/// is a few thousand flops a step where 6·4² cells' took 0.4 M instructions, and the
+/// extra level kept the iterations (over `film_profile n 0 9.81`'s 40 steps, 230 at
+/// n = 64, 209 at 32 and 250 at 128, against 227, 204 and 248 down to 6·4² cells).
+const COARSEST_FACE: usize = 2;
 
 /// The multigrid hierarchy of a cube-sphere, built once per grid size.
 #[derive(Clone, Debug)]
@@ -133,6 +136,8 @@ pub struct Work {
     row: Vec<f32>,
     /// One face row of the finest level's numbers.
     row64: Vec<f64>,
+    /// A level's diagonal `α + Σ w`, in `f64`.
+    diagonal: Vec<f64>,
     r: Vec<f64>,
     z: Vec<f64>,
     p: Vec<f64>,
@@ -385,7 +390,9 @@ impl Hierarchy {
         work.scale = if count == 1 {
             1.0
         } else {
-            power_of_two_below(largest_diagonal(&work.mass[0], &work.stencil[0])).recip()
+            diagonal(&work.mass[0], &work.stencil[0], &mut work.diagonal);
+            let largest = work.diagonal.iter().fold(0.0, |m, &d| larger(d, m));
+            power_of_two_below(largest).recip()
         };
         self.round_for_the_v_cycle(work);
         let last = count - 1;
@@ -452,17 +459,15 @@ impl Hierarchy {
                 rounded(scale, w, w32);
             }
             rounded(scale, mass, &mut work.mass32[k]);
+            if k > 0 {
+                diagonal(mass, stencil, &mut work.diagonal);
+            }
             let inv_diag = &mut work.inv_diag[k];
             inv_diag.resize(mass.len(), 0.0);
-            let [w0, w1, w2, w3] = stencil;
-            let sides = w0.iter().zip(w1).zip(w2.iter().zip(w3));
-            for (d, (((w0, w1), (w2, w3)), a)) in inv_diag.iter_mut().zip(sides.zip(mass)) {
-                let diagonal = a + w0 + w1 + w2 + w3;
-                *d = if diagonal > 0.0 {
-                    (1.0 / (scale * diagonal)) as f32
-                } else {
-                    0.0
-                };
+            for (inv, &d) in inv_diag.iter_mut().zip(&work.diagonal) {
+                // The halo's zero diagonal stays a zero inverse.
+                let scaled = if d > 0.0 { scale * d } else { f64::INFINITY };
+                *inv = (1.0 / scaled) as f32;
             }
         }
     }
@@ -605,25 +610,16 @@ fn rounded(scale: f64, values: &[f64], out: &mut Vec<f32>) {
     }
 }
 
-/// Lanes of [`largest_diagonal`]'s running maxima.
-const LANES: usize = 4;
-
-/// The largest diagonal entry `αᵢ + Σ wᵢⱼ` of a level's matrix (in lanes, each a running
-/// maximum), 0 where there is none above 0.
+/// `out` = each cell's diagonal entry `αᵢ + Σ wᵢⱼ` of a level's matrix (zero at the
+/// halo).
 #[inline(always)]
-fn largest_diagonal(alpha: &[f64], [w0, w1, w2, w3]: &Stencil<f64>) -> f64 {
-    let mut lanes = [0.0; LANES];
+fn diagonal(alpha: &[f64], [w0, w1, w2, w3]: &Stencil<f64>, out: &mut Vec<f64>) {
     let n = alpha.len();
-    let (w0, w1, w2, w3) = (&w0[..n], &w1[..n], &w2[..n], &w3[..n]);
-    for i in (0..n).step_by(LANES) {
-        for k in 0..LANES.min(n - i) {
-            let d = alpha[i + k] + w0[i + k] + w1[i + k] + w2[i + k] + w3[i + k];
-            lanes[k] = if d > lanes[k] { d } else { lanes[k] };
-        }
+    out.resize(n, 0.0);
+    let (w0, w1, w2, w3, out) = (&w0[..n], &w1[..n], &w2[..n], &w3[..n], &mut out[..n]);
+    for i in 0..n {
+        out[i] = alpha[i] + w0[i] + w1[i] + w2[i] + w3[i];
     }
-    lanes
-        .into_iter()
-        .fold(0.0, |m, d| if d > m { d } else { m })
 }
 
 /// `2^⌊log₂ x⌋`, `x`'s exponent alone (kept within 2^±1000, so that its reciprocal is a
@@ -718,10 +714,10 @@ mod tests {
     /// converges to 1e-12 from zero in at most 20 iterations at n = 16 and 64 alike (the
     /// multigrid preconditioner keeps the count from growing with the grid), and the
     /// answer satisfies the system: the `f32` V-cycle does not keep the `f64` iterations
-    /// from a tolerance far below `f32`'s rounding. n = 4 is one level, solved densely.
+    /// from a tolerance far below `f32`'s rounding. n = 3 is one level, solved densely.
     #[test]
     fn stiff_system_converges_in_few_iterations() {
-        for n in [4, 16, 64] {
+        for n in [3, 16, 64] {
             let (grid, h, alpha, weight, b) = stiff_system(n, |c| (3.0 * c.x * c.y + c.z).exp());
             let mut x = vec![0.0; grid.cells()];
             let mut work = Work::default();
