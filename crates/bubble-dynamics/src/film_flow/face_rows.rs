@@ -18,6 +18,8 @@
 //! [`FaceRows::irregular_cells`]). So each value is the same sum in the same order as a
 //! pass over the grid's numbering takes it, and the rows give its bits. (A renumbering of
 //! the grid's edges would leave the rows' sums as they are, mathematically the same.)
+//! The one exception: the advection's cell terms, which every cell sums in the local
+//! order, those irregular cells too (`advect::AdvectionGeometry::coriolis` says why).
 
 use glam::DVec3;
 
@@ -78,8 +80,6 @@ pub(crate) struct IrregularCell {
     pub(crate) order: [Side; 4],
     /// The local edge on each of those sides.
     pub(crate) edges: [u32; 4],
-    /// The local vertices at the ends of each.
-    pub(crate) ends: [[u32; 2]; 4],
 }
 
 /// The face-row numbering of a grid of `n` cells a face.
@@ -541,7 +541,6 @@ fn irregular(rows: &FaceRows, c: usize) -> Option<IrregularCell> {
         cell: c as u32,
         order,
         edges: order.map(|side| rows.cell_edge(c, side) as u32),
-        ends: order.map(|side| rows.side_vertices(c, side).map(|v| v as u32)),
     })
 }
 
