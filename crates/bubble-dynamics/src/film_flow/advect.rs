@@ -70,10 +70,13 @@ pub(crate) struct AdvectionGeometry {
     /// `tests::the_rotation_term_does_no_work`). Taken cell by cell, each cell's four
     /// edges are read once for the twelve terms among them. Stored `[k][i]`, one array a
     /// cell of the `k`-th other side's weight for side `i`, so a face's row of cells is
-    /// one slice of each ([`cell_rates`]).
+    /// one slice of each ([`cell_rates`]). Every cell sums its terms in this order, the
+    /// faces' border cells whose edges the grid numbers otherwise too
+    /// ([`FaceRows::irregular_cells`]): taken apart in the grid's order, those cost a
+    /// fifth of the advection's instructions, for sums that differ only in rounding.
     coriolis: [[Vec<f64>; 4]; 3],
-    /// The same two for the [`FaceRows::irregular_cells`], in the order the grid numbers
-    /// their edges.
+    /// [`Self::to_cell`] for the [`FaceRows::irregular_cells`], in the order the grid
+    /// numbers their edges.
     irregular: Vec<IrregularWeights>,
     /// The narrowest dual edge, rad.
     min_dual_length: f64,
@@ -83,11 +86,10 @@ pub(crate) struct AdvectionGeometry {
     speed_bound: f64,
 }
 
-/// An irregular cell's weights, its sides in the grid's order.
+/// An irregular cell's reconstruction weights, its sides in the grid's order.
 #[derive(Clone, Copy, Debug)]
 struct IrregularWeights {
     to_cell: [[f64; 3]; 4],
-    coriolis: [[f64; 4]; 3],
 }
 
 impl AdvectionGeometry {
@@ -146,9 +148,6 @@ impl AdvectionGeometry {
                 let slot = ic.order.map(|s| s as usize);
                 IrregularWeights {
                     to_cell: slot.map(|i| (side(c, i).2 * side(c, i).1).to_array()),
-                    coriolis: std::array::from_fn(|k| {
-                        std::array::from_fn(|i| coriolis(c, slot[i], slot[OTHERS[i][k]]))
-                    }),
                 }
             })
             .collect();
@@ -234,10 +233,19 @@ fn coriolis_stencil(
 /// Buffers of one advection step, reused across steps.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct AdvectionScratch {
-    /// The edge velocities the sub-step started from, in the face rows, m/s.
-    u0: Vec<f64>,
+    /// The first and second stages' edge velocities, in the face rows, m/s (each stage
+    /// writes apart from what it reads: the sub-step's starting velocities stay where
+    /// they are, and no copy of them is taken).
+    stages: [Vec<f64>; 2],
     /// Per cell: its squared speed, m²/s².
     speed_squared: Vec<f64>,
+    /// What a stage keeps besides the velocities.
+    work: StageWork,
+}
+
+/// What a stage reads and writes besides the velocities.
+#[derive(Clone, Debug, Default)]
+struct StageWork {
     /// Per local vertex: the vorticity of the velocities the stage under way starts
     /// from, 1/s.
     vorticity: Vec<f64>,
@@ -249,6 +257,20 @@ pub(crate) struct AdvectionScratch {
     border_rate: [Vec<f64>; 4],
     /// The same for the row of cells under way and the one before (even and odd rows).
     row_rate: [[Vec<f64>; 4]; 2],
+}
+
+impl StageWork {
+    /// Gives every buffer its length (each entry read is written first).
+    fn prepare(&mut self, rows: &FaceRows) {
+        let n = rows.n;
+        self.next_vorticity.resize(rows.vertices(), 0.0);
+        for r in &mut self.border_rate {
+            r.resize(6 * n * n, 0.0);
+        }
+        for r in self.row_rate.iter_mut().flatten() {
+            r.resize(n, 0.0);
+        }
+    }
 }
 
 /// Advances the edge velocities `u` (m/s, in the face rows) by `u·∇u` over `dt_s` on a
@@ -265,14 +287,19 @@ pub(crate) fn advect_momentum(
         return;
     };
     let h = dt_s / f64::from(substeps);
+    for stage in &mut s.stages {
+        stage.resize(u.len(), 0.0);
+    }
+    s.work.prepare(rows);
     with_avx2(
         #[inline(always)]
         || {
-            rows.circulation(u, &mut s.vorticity, &rows.vertex_area, |z, a| {
+            let w = &mut s.work;
+            rows.circulation(u, &mut w.vorticity, &rows.vertex_area, |z, a| {
                 z / (a * radius_m)
             });
             for k in 1..=substeps {
-                ssp_rk3(rows, geo, radius_m, h, u, s, k < substeps);
+                ssp_rk3(rows, geo, radius_m, h, u, &mut s.stages, w, k < substeps);
             }
         },
     );
@@ -297,7 +324,10 @@ fn substeps(
 ) -> Option<u32> {
     let courant = |speed: f64| speed * dt_s / (geo.min_dual_length * radius_m);
     // `f64::max`'s largest: a speed that is not a number is passed over.
-    let fastest_edge = u.iter().fold(0.0, |m, v| larger(v.abs(), m));
+    let fastest_edge = with_avx2(
+        #[inline(always)]
+        || largest_magnitude(u),
+    );
     if fastest_edge == 0.0 {
         return None;
     }
@@ -318,175 +348,281 @@ fn substeps(
 }
 
 /// One Shu–Osher third-order step of `u`: `u₁ = u + hL(u)`, `u₂ = ¾u + ¼(u₁ + hL(u₁))`,
-/// `u ← ⅓u + ⅔(u₂ + hL(u₂))`, from `u`'s vorticity in `s.vorticity`; it leaves the new
-/// `u`'s there where `next` (for the next sub-step).
+/// `u ← ⅓u + ⅔(u₂ + hL(u₂))`, from `u`'s vorticity in `w.vorticity`; it leaves the new
+/// `u`'s there where `next` (for the next sub-step). `u₁` and `u₂` go to `stages`.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)] // the stages' parts, borrowed apart
 fn ssp_rk3(
     rows: &FaceRows,
     geo: &AdvectionGeometry,
     radius_m: f64,
     h: f64,
     u: &mut [f64],
-    s: &mut AdvectionScratch,
+    stages: &mut [Vec<f64>; 2],
+    w: &mut StageWork,
     next: bool,
 ) {
-    s.u0.clear();
-    s.u0.extend_from_slice(u);
-    // Stage 1: u holds u₁.
-    stage(rows, geo, radius_m, u, s, true, |u, _, r| u + h * r);
-    // Stage 2: u holds u₂.
-    stage(rows, geo, radius_m, u, s, true, |u, u0, r| {
-        0.75 * u0 + 0.25 * (u + h * r)
-    });
-    // Stage 3.
-    stage(rows, geo, radius_m, u, s, next, |u, u0, r| {
-        u0 / 3.0 + (2.0 / 3.0) * (u + h * r)
-    });
+    let [u1, u2] = stages;
+    let on = Stage {
+        rows,
+        geo,
+        radius_m,
+    };
+    // Stage 1 (what `u1` held is passed over).
+    let step = |u, _, r| u + h * r;
+    on.stage(u, u1, None, w, true, step);
+    let step = |u, u0, r| 0.75 * u0 + 0.25 * (u + h * r);
+    on.stage(u1, u2, Some(u), w, true, step);
+    // Stage 3, onto `u`: each edge's starting velocity read before it is replaced.
+    let step = |u, u0, r| u0 / 3.0 + (2.0 / 3.0) * (u + h * r);
+    on.stage(u2, u, None, w, next, step);
 }
 
-/// One stage, in one pass over each face's rows: `u ← step(u, s.u0, rate)` on every
-/// local edge, the rate the rotation term `−ζ (k×u)·n` of `u` (with its vorticity in
-/// `s.vorticity`) summed over the edge's two cells (the lower-numbered cell's term
-/// first); where `next`, the new `u`'s vorticity then replaces it.
-///
-/// Row `y` of a face takes its cells' terms (its irregular cells' in the grid's order),
-/// then moves its X-edges (both their cells are in the row) and its Y-edges below it (the
-/// row before holds their other cells), then takes the vorticity of its vertex row `y`,
-/// whose edges have all moved by then. No row reads an edge an earlier row has moved.
-/// The edges on the faces' borders move last, from their two faces' cells' terms, kept
-/// for that in `s.border_rate`.
-#[inline(always)]
-fn stage(
-    rows: &FaceRows,
-    geo: &AdvectionGeometry,
+/// What every stage reads of the grid.
+#[derive(Clone, Copy)]
+struct Stage<'a> {
+    rows: &'a FaceRows,
+    geo: &'a AdvectionGeometry,
     radius_m: f64,
-    u: &mut [f64],
-    s: &mut AdvectionScratch,
-    next: bool,
-    step: impl Fn(f64, f64, f64) -> f64,
-) {
-    let n = rows.n;
-    let cells = 6 * n * n;
-    s.next_vorticity.resize(rows.vertices(), 0.0);
-    for r in &mut s.border_rate {
-        r.resize(cells, 0.0);
-    }
-    for r in s.row_rate.iter_mut().flatten() {
-        r.resize(n, 0.0);
-    }
-    let (vorticity, u0) = (&s.vorticity, &s.u0);
-    let mut irregular = rows.irregular_cells.iter().zip(&geo.irregular).peekable();
-    let [even, odd] = &mut s.row_rate;
-    for f in 0..6 {
-        for y in 0..n {
-            let c = f * n * n + y * n;
-            let (rate, before) = if y % 2 == 0 {
-                (&mut *even, &*odd)
-            } else {
-                (&mut *odd, &*even)
-            };
-            cell_row(rows, geo, u, vorticity, f, y, rate);
-            while let Some((ic, w)) = irregular.next_if(|(ic, _)| (ic.cell as usize) < c + n) {
-                let x = ic.cell as usize - c;
-                let z = ic
-                    .ends
-                    .map(|[v0, v1]| 0.5 * (vorticity[v0 as usize] + vorticity[v1 as usize]));
-                let terms = cell_rates(z, ic.edges.map(|k| u[k as usize]), &w.coriolis);
-                for (side, r) in ic.order.into_iter().zip(terms) {
-                    rate[side as usize][x] = r;
+}
+
+impl Stage<'_> {
+    /// One stage, in one pass over each face's rows: `dst ← step(src, u0, rate)` on every
+    /// local edge, the rate the rotation term `−ζ (k×u)·n` of `src` (with its vorticity
+    /// in `w.vorticity`) summed over the edge's two cells (the lower-numbered cell's term
+    /// first), `u0` the edge's entry of `u0`, or of `dst` before it is written where
+    /// `None`; where `next`, the vorticity of `dst` then replaces it.
+    ///
+    /// Row `y` of a face takes its cells' terms, then moves its X-edges (both their cells are in the row) and its Y-edges
+    /// below it (the row before holds their other cells), then takes the vorticity of its
+    /// vertex row `y`, whose edges have all moved by then. The edges on the faces'
+    /// borders move last, from their two faces' cells' terms, kept for that in
+    /// `w.border_rate`.
+    #[inline(always)]
+    fn stage(
+        self,
+        src: &[f64],
+        dst: &mut [f64],
+        u0: Option<&[f64]>,
+        w: &mut StageWork,
+        next: bool,
+        step: impl Fn(f64, f64, f64) -> f64,
+    ) {
+        let (rows, n) = (self.rows, self.rows.n);
+        let (vorticity, border) = (&w.vorticity, &mut w.border_rate);
+        let [even, odd] = &mut w.row_rate;
+        for f in 0..6 {
+            for y in 0..n {
+                let c = f * n * n + y * n;
+                let (rate, before) = if y % 2 == 0 {
+                    (&mut *even, &*odd)
+                } else {
+                    (&mut *odd, &*even)
+                };
+                self.cell_row(src, vorticity, f, y, rate);
+                keep_border_rates(border, rate, c, n, y);
+                let [_, left, right, _] = &*rate;
+                // The X-edges inside the face: cell (i − 1, y)'s right side and (i, y)'s left.
+                let k = rows.x_edge(f, 1, y)..rows.x_edge(f, n, y);
+                let u0x = u0.map(|u0| &u0[k.clone()]);
+                move_edges(&mut dst[k.clone()], &src[k], u0x, right, &left[1..], &step);
+                if y == 0 {
+                    continue;
+                }
+                // The Y-edges below: cell (x, y − 1)'s top and (x, y)'s bottom.
+                let k = rows.y_edge(f, 0, y)..rows.y_edge(f, n, y);
+                let (top, bottom) = (&before[Side::Top as usize], &rate[Side::Bottom as usize]);
+                let u0y = u0.map(|u0| &u0[k.clone()]);
+                move_edges(&mut dst[k.clone()], &src[k], u0y, top, bottom, &step);
+                if next {
+                    let z = &mut w.next_vorticity;
+                    rows.circulation_row(dst, f, y, z, &rows.vertex_area, |z, a| {
+                        z / (a * self.radius_m)
+                    });
                 }
             }
-            let [bottom, left, right, top] = &*rate;
-            let border = &mut s.border_rate;
-            border[Side::Left as usize][c] = left[0];
-            border[Side::Right as usize][c + n - 1] = right[n - 1];
-            if y == 0 {
-                border[Side::Bottom as usize][c..c + n].copy_from_slice(bottom);
-            }
-            if y == n - 1 {
-                border[Side::Top as usize][c..c + n].copy_from_slice(top);
-            }
-            // The X-edges inside the face: cell (i − 1, y)'s right side and (i, y)'s left.
-            let k = rows.x_edge(f, 1, y);
-            let (ux, u0x) = (&mut u[k..k + n - 1], &u0[k..k + n - 1]);
-            let (ra, rb) = (&right[..n - 1], &left[1..]);
-            for i in 0..n - 1 {
-                ux[i] = step(ux[i], u0x[i], (0.0 + ra[i]) + rb[i]);
-            }
-            if y == 0 {
-                continue;
-            }
-            // The Y-edges below: cell (x, y − 1)'s top and (x, y)'s bottom.
-            let k = rows.y_edge(f, 0, y);
-            let (uy, u0y) = (&mut u[k..k + n], &u0[k..k + n]);
-            let (ra, rb) = (&before[Side::Top as usize][..n], &bottom[..n]);
-            for x in 0..n {
-                uy[x] = step(uy[x], u0y[x], (0.0 + ra[x]) + rb[x]);
-            }
-            if next {
-                rows.circulation_row(u, f, y, &mut s.next_vorticity, &rows.vertex_area, |z, a| {
-                    z / (a * radius_m)
-                });
-            }
+        }
+        self.move_seam_edges(src, dst, u0, &w.border_rate, &step);
+        if next {
+            rows.seam_circulation(dst, &mut w.next_vorticity, &rows.vertex_area, |z, a| {
+                z / (a * self.radius_m)
+            });
+            std::mem::swap(&mut w.vorticity, &mut w.next_vorticity);
         }
     }
-    let border = &s.border_rate;
-    for e in &rows.seam_edges {
-        let [(ca, sa, ka), (cb, sb, kb)] = e.cells;
-        let term =
-            |c: u32, side: Side, k: u32| rows.sign(k as usize) * border[side as usize][c as usize];
-        let r = (0.0 + term(ca, sa, ka)) + term(cb, sb, kb);
-        for k in [ka as usize, kb as usize] {
-            u[k] = step(u[k], u0[k], rows.sign(k) * r);
+
+    /// Row `y` of face `f`'s cells' terms of their sides' rates into `rate` (per side, per
+    /// cell of the row), from the edge velocities `u` and the vertices' `vorticity`.
+    #[inline(always)]
+    fn cell_row(self, u: &[f64], vorticity: &[f64], f: usize, y: usize, rate: &mut [Vec<f64>; 4]) {
+        let (rows, n) = (self.rows, self.rows.n);
+        let c = f * n * n + y * n;
+        let (uy, ux) = (rows.y_edge(f, 0, y), rows.x_edge(f, 0, y));
+        let (vb, vt) = (rows.vertex_at(f, 0, y), rows.vertex_at(f, 0, y + 1));
+        let [w0, w1, w2] = &self.geo.coriolis;
+        let [ob, ol, or, ot] = rate;
+        let row = CellRow {
+            u: [
+                &u[uy..uy + n],
+                &u[ux..ux + n],
+                &u[ux + 1..ux + n + 1],
+                &u[uy + n..uy + 2 * n],
+            ],
+            z: [
+                &vorticity[vb..vb + n],
+                &vorticity[vb + 1..vb + n + 1],
+                &vorticity[vt..vt + n],
+                &vorticity[vt + 1..vt + n + 1],
+            ],
+            w: [
+                four_rows(w0, c..c + n),
+                four_rows(w1, c..c + n),
+                four_rows(w2, c..c + n),
+            ],
+        };
+        // In a multiple of four cells, then the last four again where n is not one.
+        let whole = n & !3;
+        row.cells(0..whole, ob, ol, or, ot);
+        if whole < n {
+            row.cells(n.saturating_sub(4)..n, ob, ol, or, ot);
         }
     }
-    if next {
-        rows.seam_circulation(u, &mut s.next_vorticity, &rows.vertex_area, |z, a| {
-            z / (a * radius_m)
-        });
-        std::mem::swap(&mut s.vorticity, &mut s.next_vorticity);
+
+    /// The edges on the faces' borders: each from its two cells' terms in `border`, both
+    /// copies (`dst ← step(src, u0, rate)` as in [`Self::stage`]).
+    #[inline(always)]
+    fn move_seam_edges(
+        self,
+        src: &[f64],
+        dst: &mut [f64],
+        u0: Option<&[f64]>,
+        border: &[Vec<f64>; 4],
+        step: &impl Fn(f64, f64, f64) -> f64,
+    ) {
+        let rows = self.rows;
+        for e in &rows.seam_edges {
+            let [(ca, sa, ka), (cb, sb, kb)] = e.cells;
+            let term = |c: u32, side: Side, k: u32| {
+                rows.sign(k as usize) * border[side as usize][c as usize]
+            };
+            let r = (0.0 + term(ca, sa, ka)) + term(cb, sb, kb);
+            for k in [ka as usize, kb as usize] {
+                let start = u0.map_or(dst[k], |u0| u0[k]);
+                dst[k] = step(src[k], start, rows.sign(k) * r);
+            }
+        }
     }
 }
 
-/// Row `y` of face `f`'s cells' terms of their sides' rates into `rate` (per side, per
-/// cell of the row), from the edge velocities `u` and the vertices' `vorticity`.
-#[inline(always)]
-fn cell_row(
-    rows: &FaceRows,
-    geo: &AdvectionGeometry,
-    u: &[f64],
-    vorticity: &[f64],
-    f: usize,
-    y: usize,
-    rate: &mut [Vec<f64>; 4],
-) {
-    let n = rows.n;
-    let c = f * n * n + y * n;
-    let (uy, ux) = (rows.y_edge(f, 0, y), rows.x_edge(f, 0, y));
-    let (bottom, top) = (&u[uy..uy + n], &u[uy + n..uy + 2 * n]);
-    let (left, right) = (&u[ux..ux + n], &u[ux + 1..ux + n + 1]);
-    let (vb, vt) = (rows.vertex_at(f, 0, y), rows.vertex_at(f, 0, y + 1));
-    let (zb0, zb1) = (&vorticity[vb..vb + n], &vorticity[vb + 1..vb + n + 1]);
-    let (zt0, zt1) = (&vorticity[vt..vt + n], &vorticity[vt + 1..vt + n + 1]);
-    let [w0, w1, w2] = &geo.coriolis;
-    let [w0, w1, w2] = [w0, w1, w2].map(|w| slices(w, c..c + n));
-    let [ob, ol, or, ot] = rate;
-    let (ob, ol, or, ot) = (&mut ob[..n], &mut ol[..n], &mut or[..n], &mut ot[..n]);
-    for x in 0..n {
-        let z = [
-            0.5 * (zb0[x] + zb1[x]),
-            0.5 * (zb0[x] + zt0[x]),
-            0.5 * (zb1[x] + zt1[x]),
-            0.5 * (zt0[x] + zt1[x]),
-        ];
-        let u = [bottom[x], left[x], right[x], top[x]];
+/// A row of cells' terms of their sides' rates ([`cell_rates`]), read as slices: the
+/// sides' velocities and the four corners' vorticities (bottom left, bottom right, top
+/// left, top right), and the weights as [`AdvectionGeometry::coriolis`] holds them.
+struct CellRow<'a> {
+    u: [&'a [f64]; 4],
+    z: [&'a [f64]; 4],
+    w: [[&'a [f64]; 4]; 3],
+}
+
+impl CellRow<'_> {
+    /// Cells `range` of the row's terms into `ob`, `ol`, `or` and `ot` (per side, from
+    /// `range`'s start), the compiler's vector loop over them. The four go as arguments
+    /// of their own: the compiler then knows that they overlap nothing the loop reads,
+    /// where through a struct it tested each against each input slice on every row.
+    #[inline(always)]
+    fn cells(
+        &self,
+        range: std::ops::Range<usize>,
+        ob: &mut [f64],
+        ol: &mut [f64],
+        or: &mut [f64],
+        ot: &mut [f64],
+    ) {
+        let len = range.len();
+        let [zb0, zb1, zt0, zt1] = four_rows(&self.z, range.clone());
+        let [ub, ul, ur, ut] = four_rows(&self.u, range.clone());
         let w = [
-            [w0[0][x], w0[1][x], w0[2][x], w0[3][x]],
-            [w1[0][x], w1[1][x], w1[2][x], w1[3][x]],
-            [w2[0][x], w2[1][x], w2[2][x], w2[3][x]],
+            four_rows(&self.w[0], range.clone()),
+            four_rows(&self.w[1], range.clone()),
+            four_rows(&self.w[2], range.clone()),
         ];
-        let [b, l, r, t] = cell_rates(z, u, &w);
-        (ob[x], ol[x], or[x], ot[x]) = (b, l, r, t);
+        let (ob, ol) = (&mut ob[range.clone()][..len], &mut ol[range.clone()][..len]);
+        let (or, ot) = (&mut or[range.clone()][..len], &mut ot[range][..len]);
+        for x in 0..len {
+            let z = [
+                0.5 * (zb0[x] + zb1[x]),
+                0.5 * (zb0[x] + zt0[x]),
+                0.5 * (zb1[x] + zt1[x]),
+                0.5 * (zt0[x] + zt1[x]),
+            ];
+            let u = [ub[x], ul[x], ur[x], ut[x]];
+            let w = [
+                [w[0][0][x], w[0][1][x], w[0][2][x], w[0][3][x]],
+                [w[1][0][x], w[1][1][x], w[1][2][x], w[1][3][x]],
+                [w[2][0][x], w[2][1][x], w[2][2][x], w[2][3][x]],
+            ];
+            let [b, l, r, t] = cell_rates(z, u, &w);
+            (ob[x], ol[x], or[x], ot[x]) = (b, l, r, t);
+        }
+    }
+}
+
+/// The same range of each of four arrays (written out: `map` with a closure was kept
+/// out of line).
+#[inline(always)]
+fn four_rows<S: AsRef<[f64]>>(a: &[S; 4], r: std::ops::Range<usize>) -> [&[f64]; 4] {
+    let len = r.len();
+    [
+        &a[0].as_ref()[r.clone()][..len],
+        &a[1].as_ref()[r.clone()][..len],
+        &a[2].as_ref()[r.clone()][..len],
+        &a[3].as_ref()[r][..len],
+    ]
+}
+
+/// Keeps the terms of row `y`'s cells (from cell `c`) on their face's borders: the left
+/// of its first cell, the right of its last, and the bottoms or tops of the first and
+/// last rows.
+#[inline(always)]
+fn keep_border_rates(
+    border: &mut [Vec<f64>; 4],
+    rate: &[Vec<f64>; 4],
+    c: usize,
+    n: usize,
+    y: usize,
+) {
+    let [bottom, left, right, top] = rate;
+    border[Side::Left as usize][c] = left[0];
+    border[Side::Right as usize][c + n - 1] = right[n - 1];
+    if y == 0 {
+        border[Side::Bottom as usize][c..c + n].copy_from_slice(&bottom[..n]);
+    }
+    if y == n - 1 {
+        border[Side::Top as usize][c..c + n].copy_from_slice(&top[..n]);
+    }
+}
+
+/// `dst ← step(src, u0, (0 + ra) + rb)` edge by edge over `dst`, `u0` the edge's entry
+/// of `u0`, or of `dst` before it is written where `None`.
+#[inline(always)]
+fn move_edges(
+    dst: &mut [f64],
+    src: &[f64],
+    u0: Option<&[f64]>,
+    ra: &[f64],
+    rb: &[f64],
+    step: &impl Fn(f64, f64, f64) -> f64,
+) {
+    let len = dst.len();
+    let (src, ra, rb) = (&src[..len], &ra[..len], &rb[..len]);
+    if let Some(u0) = u0 {
+        let u0 = &u0[..len];
+        for i in 0..len {
+            dst[i] = step(src[i], u0[i], (0.0 + ra[i]) + rb[i]);
+        }
+    } else {
+        for i in 0..len {
+            dst[i] = step(src[i], dst[i], (0.0 + ra[i]) + rb[i]);
+        }
     }
 }
 
@@ -559,6 +695,25 @@ fn velocity(w: &[[f64; 3]; 4], u: [f64; 4], c: [f64; 3]) -> [f64; 3] {
 #[inline(always)]
 fn slices<const N: usize>(arrays: &[Vec<f64>; N], r: std::ops::Range<usize>) -> [&[f64]; N] {
     arrays.each_ref().map(|a| &a[r.clone()])
+}
+
+/// The largest `|v|` of `values` (`f64::max`'s: one that is not a number is passed
+/// over), zero for none: in four running maxima, then the largest of them (the same
+/// number: the largest is the largest in any order), so that the loop vectorises.
+#[inline(always)]
+fn largest_magnitude(values: &[f64]) -> f64 {
+    let mut m = [0.0; 4];
+    let chunks = values.chunks_exact(4);
+    let rest = chunks.remainder();
+    for chunk in chunks {
+        for (m, v) in m.iter_mut().zip(chunk) {
+            *m = larger(v.abs(), *m);
+        }
+    }
+    for v in rest {
+        m[0] = larger(v.abs(), m[0]);
+    }
+    m.into_iter().fold(0.0, |a, b| larger(b, a))
 }
 
 /// A cell's terms of its four edges' rates, from the edges' vorticities `z` and
@@ -652,6 +807,15 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn the_largest_magnitude_passes_over_nan() {
+        assert_eq!(largest_magnitude(&[]), 0.0);
+        let v = [1.0, -7.5, f64::NAN, 3.0, -2.0, 7.0, 0.5, -0.25, 6.0];
+        assert_eq!(largest_magnitude(&v), 7.5);
+        assert_eq!(largest_magnitude(&v[3..]), 7.0);
+        assert_eq!(largest_magnitude(&[f64::NAN, -0.5]), 0.5);
     }
 
     #[test]

@@ -18,11 +18,13 @@
 //! [`FaceRows::irregular_cells`]). So each value is the same sum in the same order as a
 //! pass over the grid's numbering takes it, and the rows give its bits. (A renumbering of
 //! the grid's edges would leave the rows' sums as they are, mathematically the same.)
+//! The one exception: the advection's cell terms, which every cell sums in the local
+//! order, those irregular cells too (`advect::AdvectionGeometry::coriolis` says why).
 
 use glam::DVec3;
 
 use super::flow::FilmGradient;
-use super::grid::{CubeSphere, FACE_BASES};
+use super::grid::{CubeSphere, FACE_BASES, FaceLayout};
 
 /// Which side of a cell an edge is: bottom (`t` low), left (`s` low), right, top.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -78,8 +80,6 @@ pub(crate) struct IrregularCell {
     pub(crate) order: [Side; 4],
     /// The local edge on each of those sides.
     pub(crate) edges: [u32; 4],
-    /// The local vertices at the ends of each.
-    pub(crate) ends: [[u32; 2]; 4],
 }
 
 /// The face-row numbering of a grid of `n` cells a face.
@@ -197,20 +197,52 @@ impl FaceRows {
     }
 
     /// The grid's edge values `grid` (in the grid's orientation) into `rows` (each copy
-    /// in its own).
+    /// in its own): each face's inner edges are runs of the grid's ([`FaceLayout`], checked
+    /// in [`Self::new`]), copied; the copies on the faces' borders one by one.
     pub(crate) fn to_rows(&self, grid: &[f64], rows: &mut Vec<f64>) {
         // Every entry is written: the buffer needs its length, not a fill.
         rows.resize(self.edge.len(), 0.0);
-        for ((u, &e), &sign) in rows.iter_mut().zip(&self.edge).zip(&self.signs) {
-            *u = grid[e as usize] * sign;
+        self.for_each_inner_run(|local, at| {
+            rows[local.clone()].copy_from_slice(&grid[at..at + local.len()]);
+        });
+        for b in &self.border_edges {
+            let k = b.edge as usize;
+            rows[k] = grid[self.edge[k] as usize] * self.signs[k];
         }
     }
 
     /// The rows' edge values back into the grid's numbering and orientation (a border
-    /// edge's two copies agree).
+    /// edge's two copies agree: its first is taken).
     pub(crate) fn to_grid(&self, rows: &[f64], grid: &mut [f64]) {
-        for ((&e, &sign), &u) in self.edge.iter().zip(&self.signs).zip(rows) {
-            grid[e as usize] = u * sign;
+        self.for_each_inner_run(|local, at| {
+            grid[at..at + local.len()].copy_from_slice(&rows[local]);
+        });
+        for e in &self.seam_edges {
+            let k = e.cells[0].2 as usize;
+            grid[self.edge[k] as usize] = rows[k] * self.signs[k];
+        }
+    }
+
+    /// `run(local, at)` for each run of inner local edges (a row of a face's X-edges, or
+    /// a row of its Y-edges) and the grid edge its first is: the grid numbers a face's
+    /// inner edges in the same rows, unflipped ([`FaceLayout`]). A row is
+    /// under 2 KiB up to n = 256, which `memcpy` copies with vector moves (`rep movsb`
+    /// above that).
+    #[inline(always)]
+    fn for_each_inner_run(&self, mut run: impl FnMut(std::ops::Range<usize>, usize)) {
+        let (n, layout) = (self.n, FaceLayout { n: self.n });
+        if n < 2 {
+            return; // no inner edges
+        }
+        for f in 0..6 {
+            for y in 0..n {
+                let k = self.x_edge(f, 1, y);
+                run(k..k + n - 1, layout.x_edge_of_cell(f * n * n + y * n + 1));
+            }
+            for j in 1..n {
+                let k = self.y_edge(f, 0, j);
+                run(k..k + n, layout.y_edge_of_cell(f * n * n + j * n));
+            }
         }
     }
 
@@ -296,6 +328,15 @@ impl FaceRows {
             rows.edge.iter().all(|&e| e != u32::MAX),
             "a local edge unset"
         );
+        rows.for_each_inner_run(|local, at| {
+            for (k, e) in local.zip(at..) {
+                assert_eq!(
+                    rows.edge[k] as usize, e,
+                    "local edge {k}: not in the layout"
+                );
+                assert!(!rows.flipped[k], "local edge {k}: an inner edge flipped");
+            }
+        });
         rows.signs = rows
             .flipped
             .iter()
@@ -500,7 +541,6 @@ fn irregular(rows: &FaceRows, c: usize) -> Option<IrregularCell> {
         cell: c as u32,
         order,
         edges: order.map(|side| rows.cell_edge(c, side) as u32),
-        ends: order.map(|side| rows.side_vertices(c, side).map(|v| v as u32)),
     })
 }
 
