@@ -511,10 +511,12 @@ impl Hierarchy {
         work.correction[0] = z32;
     }
 
-    /// One symmetric V-cycle on level `k` for residual `r`, result in `z`, in `f32`: two
-    /// forward sweeps (colour 0 then 1, the first from zero), the coarse correction, two
+    /// One symmetric V-cycle on level `k` for residual `r`, result in `z`, in `f32`: three
+    /// forward sweeps (colour 0 then 1, the first from zero), the coarse correction, three
     /// backward sweeps (colour 1 then 0). Before each half-sweep the halo cells it reads
-    /// are refreshed.
+    /// are refreshed. Three sweeps a side, not two: the swirl film's solves took 176 PCG
+    /// iterations over `film_profile 64 0 9.81`'s 40 steps against 230, for 2 % fewer
+    /// instructions a step (one sweep a side took 531; four, 155 but more instructions).
     fn v_cycle(&self, work: &mut Work, k: usize, r: &[f32], z: &mut [f32]) {
         with_avx2(
             #[inline(always)]
@@ -527,7 +529,7 @@ impl Hierarchy {
                 let (inv_diag, w) = (&work.inv_diag[k], &work.stencil32[k]);
                 relax_from_zero(level, inv_diag, r, z);
                 relax(level, 1, inv_diag, w, r, z);
-                for c in [0, 1] {
+                for c in [0, 1, 0, 1] {
                     refresh(level, 1 - c, z);
                     relax(level, c, inv_diag, w, r, z);
                 }
@@ -547,7 +549,7 @@ impl Hierarchy {
                 correct(level, coarse, &mut zc, z, &mut row);
                 (work.residual[k + 1], work.correction[k + 1], work.row) = (rc, zc, row);
                 let (inv_diag, w) = (&work.inv_diag[k], &work.stencil32[k]);
-                for c in [1, 0, 1, 0] {
+                for c in [1, 0, 1, 0, 1, 0] {
                     refresh(level, 1 - c, z);
                     relax(level, c, inv_diag, w, r, z);
                 }
