@@ -1,6 +1,6 @@
 //! Prints the film step's solver iterations, wall time, thinnest film and fastest edge
 //! for `film_profile [n] [air m/s] [g m/s²] [bottom warming K]` (the bench's film, for
-//! profiling with perf).
+//! profiling with perf; `FILM_STEPS` sets the number of steps, 40 unless set).
 
 #[path = "../benches/common/swirl_film.rs"]
 mod swirl_film;
@@ -18,7 +18,8 @@ fn main() {
     };
     let n = arg(1, 64.0) as usize;
     let mut f = swirl_film_warmed(n, arg(4, 0.0));
-    for k in 0..40 {
+    let steps = std::env::var("FILM_STEPS").map_or(40, |s| s.parse().expect("FILM_STEPS: a count"));
+    for k in 0..steps {
         let t = std::time::Instant::now();
         let r = f.step(1.0 / 60.0, &forcing);
         let hmin = f.thickness_m().iter().cloned().fold(1.0, f64::min);

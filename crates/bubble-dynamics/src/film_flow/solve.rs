@@ -81,8 +81,10 @@ const COARSEST_FACE: usize = 2;
 pub struct Hierarchy {
     /// Each level's layout, finest first.
     levels: Vec<Layout>,
-    /// Per grid cell, its edge on each side: where the finest level's weights come from.
-    edges: Vec<[u32; 4]>,
+    /// The rim cells' seam edges, in the order the finest level's weights are filled
+    /// in (the rest of a face row's edges are a slice): read from a table by cell, each
+    /// was a cache miss.
+    seam_edges: Vec<u32>,
 }
 
 /// The numbers of one system: per level, the mass term and the edge weights.
@@ -182,7 +184,7 @@ impl Hierarchy {
         }
         Self {
             levels,
-            edges: sides.edge,
+            seam_edges: seam_edges(&sides),
         }
     }
 
@@ -227,7 +229,11 @@ impl Hierarchy {
         guess: Option<&[f64]>,
         limits: SolveLimits,
     ) -> SolveReport {
-        assert_eq!(alpha.len(), self.edges.len(), "system size mismatch");
+        assert_eq!(
+            alpha.len(),
+            self.levels[0].position.len(),
+            "system size mismatch"
+        );
         self.prepare(work, alpha, weight);
         self.solve_prepared(work, b, x, guess, limits)
     }
@@ -407,35 +413,24 @@ impl Hierarchy {
     }
 
     /// The finest level's mass term and weights from the grid's cells and edges, a face
-    /// row at a time: inside a face a row's x-edges and y-edges are consecutive
-    /// ([`FaceLayout`](super::grid::FaceLayout)), so a row of weights is a slice but for
-    /// the seam edges at its ends.
+    /// row at a time: a row of weights is a slice ([`inside_a_face`]) but for the seam
+    /// edges at its ends ([`Hierarchy::seam_edges`]).
     #[inline(always)]
     fn fine_numbers(&self, work: &mut Work, alpha: &[f64], weight: &[f64]) {
         let fine = &self.levels[0];
         let n = fine.m;
-        let x_edges = |face: usize, y: usize| face * n * (n - 1) + y * (n - 1);
-        let y_edges = |face: usize, y: usize| 6 * n * (n - 1) + face * n * (n - 1) + (y - 1) * n;
         let mut row = std::mem::take(&mut work.row64);
         row.resize(n, 0.0);
+        let mut seams = self.seam_edges.iter();
         for face in 0..6 {
             for y in 0..n {
-                let cells = face * n * n + y * n;
-                let alpha_row = &alpha[cells..][..n];
+                let alpha_row = &alpha[(face * n + y) * n..][..n];
                 scatter_row(fine, face, y, alpha_row, &mut work.mass[0]);
                 for k in 0..4 {
-                    // The row's edges inside the face as a slice, the seams one by one.
-                    let inside = match k {
-                        LEFT if n > 1 => (1..n, x_edges(face, y)),
-                        RIGHT if n > 1 => (0..n - 1, x_edges(face, y)),
-                        BOTTOM if y > 0 => (0..n, y_edges(face, y)),
-                        TOP if y + 1 < n => (0..n, y_edges(face, y + 1)),
-                        _ => (0..0, 0),
-                    };
-                    let (xs, first) = inside;
+                    let (xs, first) = inside_a_face(n, face, y, k);
                     row[xs.clone()].copy_from_slice(&weight[first..][..xs.len()]);
                     for x in (0..xs.start).chain(xs.end..n) {
-                        row[x] = weight[self.edges[cells + x][k] as usize];
+                        row[x] = weight[*seams.next().expect("a seam edge") as usize];
                     }
                     scatter_row(fine, face, y, &row, &mut work.stencil[0][k]);
                 }
@@ -577,6 +572,39 @@ impl Hierarchy {
         }
         (work.coarse_rhs, work.coarse_x) = (rc, zc);
     }
+}
+
+/// Of face `face`, row `y`, the cells whose side `k` lies inside the face (not on a
+/// seam) and the first of their edges on it: the row's x-edges and y-edges are
+/// consecutive ([`FaceLayout`](super::grid::FaceLayout)).
+fn inside_a_face(n: usize, face: usize, y: usize, k: usize) -> (std::ops::Range<usize>, usize) {
+    let x_edges = face * n * (n - 1) + y * (n - 1);
+    let y_edges = |y: usize| 6 * n * (n - 1) + face * n * (n - 1) + (y - 1) * n;
+    match k {
+        LEFT if n > 1 => (1..n, x_edges),
+        RIGHT if n > 1 => (0..n - 1, x_edges),
+        BOTTOM if y > 0 => (0..n, y_edges(y)),
+        TOP if y + 1 < n => (0..n, y_edges(y + 1)),
+        _ => (0..0, 0),
+    }
+}
+
+/// The seam edges of the cells on the faces' rims, in the order
+/// `Hierarchy::fine_numbers` visits them (face, row, side, cell).
+fn seam_edges(sides: &CellSides) -> Vec<u32> {
+    let n = sides.n();
+    let mut seams = Vec::new();
+    for face in 0..6 {
+        for y in 0..n {
+            for k in 0..4 {
+                let (xs, _) = inside_a_face(n, face, y, k);
+                for x in (0..xs.start).chain(xs.end..n) {
+                    seams.push(sides.edge[(face * n + y) * n + x][k]);
+                }
+            }
+        }
+    }
+    seams
 }
 
 /// `out` = the grid-numbered `values` in `layout`'s split arrays (the halo untouched).
@@ -834,12 +862,13 @@ mod tests {
             let mut work = Work::default();
             h.prepare(&mut work, &alpha, &weight);
             let fine = &h.levels[0];
+            let sides = CellSides::new(&grid);
             let mut expected_mass = vec![0.0; fine.len()];
             let mut expected_w: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; fine.len()]);
             for (c, &p) in fine.position.iter().enumerate() {
                 expected_mass[p as usize] = alpha[c];
                 for k in 0..4 {
-                    expected_w[k][p as usize] = weight[h.edges[c][k] as usize];
+                    expected_w[k][p as usize] = weight[sides.edge[c][k] as usize];
                 }
             }
             assert_eq!(work.mass[0], expected_mass, "n {n}");
