@@ -60,18 +60,6 @@ pub(crate) struct SeamEdge {
     pub(crate) cells: [(u32, Side, u32); 2],
 }
 
-/// A local copy of an edge on a face's border, with its ends and cells in its own
-/// orientation.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct BorderEdge {
-    /// The local edge.
-    pub(crate) edge: u32,
-    /// Its tail and head vertices (local, in its face).
-    pub(crate) ends: [u32; 2],
-    /// The cells its normal points from and into.
-    pub(crate) cells: [u32; 2],
-}
-
 /// A cell whose edges, in the grid's order, are not in the local order [`SIDES`].
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct IrregularCell {
@@ -122,11 +110,15 @@ pub(crate) struct FaceRows {
     pub(crate) seam_vertices: Vec<SeamVertex>,
     /// The edges on the faces' borders.
     pub(crate) seam_edges: Vec<SeamEdge>,
-    /// The local copies of the edges on the faces' borders, each with its ends and cells.
-    pub(crate) border_edges: Vec<BorderEdge>,
+    /// The local copies of the edges on the faces' borders.
+    pub(crate) border_edges: Vec<u32>,
     /// The cells on the faces' borders whose edges the grid numbers out of the local
     /// order.
     pub(crate) irregular_cells: Vec<IrregularCell>,
+    /// Per local copy of an edge on a face's border: the halo slot of the padded cell
+    /// layout ([`Self::padded_cell`]) beyond that copy's cell, and the padded cell across
+    /// the edge (in the other face) whose value the slot takes.
+    pub(crate) cell_halo: Vec<[u32; 2]>,
     /// The grid's centre gradients (two-point, normal) in the rows by component, once
     /// [`Self::add_gradient`] has asked for them.
     gradients: [std::sync::OnceLock<[Vec<f64>; 3]>; 2],
@@ -161,6 +153,23 @@ impl FaceRows {
     /// Local vertex `(i, j)` of face `f`.
     pub(crate) fn vertex_at(&self, f: usize, i: usize, j: usize) -> usize {
         f * self.vertices_per_face() + j * (self.n + 1) + i
+    }
+
+    /// Cells a face in the padded layout: `(n + 2)²`, the face's cells ringed by a halo.
+    pub(crate) fn padded_cells_per_face(&self) -> usize {
+        (self.n + 2) * (self.n + 2)
+    }
+
+    /// The padded layout's slot `(px, py)` of face `f`: cell `(px − 1, py − 1)`, or the
+    /// halo where `px` or `py` is 0 or `n + 1`.
+    pub(crate) fn padded_cell(&self, f: usize, px: usize, py: usize) -> usize {
+        f * self.padded_cells_per_face() + py * (self.n + 2) + px
+    }
+
+    /// Cell `c`'s slot in the padded layout.
+    pub(crate) fn padded_of(&self, c: usize) -> usize {
+        let n = self.n;
+        self.padded_cell(c / (n * n), c % n + 1, (c / n) % n + 1)
     }
 
     /// The local edge on side `side` of cell `c`.
@@ -205,8 +214,8 @@ impl FaceRows {
         self.for_each_inner_run(|local, at| {
             rows[local.clone()].copy_from_slice(&grid[at..at + local.len()]);
         });
-        for b in &self.border_edges {
-            let k = b.edge as usize;
+        for &k in &self.border_edges {
+            let k = k as usize;
             rows[k] = grid[self.edge[k] as usize] * self.signs[k];
         }
     }
@@ -297,6 +306,7 @@ impl FaceRows {
             seam_edges: Vec::new(),
             border_edges: Vec::new(),
             irregular_cells: Vec::new(),
+            cell_halo: Vec::new(),
             gradients: Default::default(),
         };
         let local_edges = 6 * rows.edges_per_face();
@@ -369,6 +379,7 @@ impl FaceRows {
         let inverse = grid.inverse_vertex_areas_per_sr();
         rows.vertex_inverse_area = rows.vertex.iter().map(|&v| inverse[v as usize]).collect();
         rows.border_edges = border_edges(&rows);
+        rows.cell_halo = cell_halo(&rows);
         rows.seam_vertices = seam_vertices(&rows, grid);
         rows.irregular_cells = (0..grid.cells())
             .filter_map(|c| irregular(&rows, c))
@@ -458,20 +469,33 @@ impl FaceRows {
     }
 }
 
-/// Each seam edge's two copies, each with its ends and cells in its own orientation: the
-/// local normal points away from a cell on its right or top side.
-fn border_edges(rows: &FaceRows) -> Vec<BorderEdge> {
+/// Each seam edge's two copies.
+fn border_edges(rows: &FaceRows) -> Vec<u32> {
+    let copies = rows
+        .seam_edges
+        .iter()
+        .flat_map(|e| e.cells.map(|(_, _, k)| k));
+    copies.collect()
+}
+
+/// Each seam edge's two copies' halo slots ([`FaceRows::cell_halo`]): beyond the copy's
+/// cell across its side, the padded slot of the cell in the other face.
+fn cell_halo(rows: &FaceRows) -> Vec<[u32; 2]> {
+    let n = rows.n;
     let mut out = Vec::with_capacity(2 * rows.seam_edges.len());
     for e in &rows.seam_edges {
         for (mine, other) in [(0, 1), (1, 0)] {
-            let (c, side, k) = e.cells[mine];
-            let across = e.cells[other].0;
-            let away = matches!(side, Side::Right | Side::Top);
-            out.push(BorderEdge {
-                edge: k,
-                ends: rows.side_vertices(c as usize, side).map(|v| v as u32),
-                cells: if away { [c, across] } else { [across, c] },
-            });
+            let (c, side, _) = e.cells[mine];
+            let c = c as usize;
+            let (f, px, py) = (c / (n * n), c % n + 1, (c / n) % n + 1);
+            let (hx, hy) = match side {
+                Side::Bottom => (px, py - 1),
+                Side::Left => (px - 1, py),
+                Side::Right => (px + 1, py),
+                Side::Top => (px, py + 1),
+            };
+            let across = rows.padded_of(e.cells[other].0 as usize);
+            out.push([rows.padded_cell(f, hx, hy) as u32, across as u32]);
         }
     }
     out

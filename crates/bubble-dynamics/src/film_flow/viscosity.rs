@@ -25,7 +25,8 @@ pub(super) struct ViscousScratch {
     pub(super) stage: Vec<f64>,
     /// Per local vertex: the vorticity on the unit sphere (m/s per rad).
     vorticity: Vec<f64>,
-    /// Per cell: the divergence on the unit sphere (m/s per rad).
+    /// Per cell, in the padded layout (`FaceRows::padded_cell`): the divergence on the
+    /// unit sphere (m/s per rad), the halo holding the cells across the faces' borders.
     divergence: Vec<f64>,
 }
 
@@ -85,74 +86,105 @@ impl FilmFlow {
         // Vorticity and divergence per R (of the unit sphere's), and each difference of
         // them per R again: every term of the stress carries 1/R², taken once here.
         let r = self.params.radius_m;
-        let rate = dt_s * nu / (r * r);
-        // The first stage (mu 1, nu_prev 0) is a plain forward-Euler step: no blend.
-        let step = |u: &mut f64, y_prev: &mut f64, curl_curl: f64, grad_div: f64| {
-            let y = *u;
-            let change = rate * (4.0 * grad_div - curl_curl + 2.0 * y);
-            *u = if nu_prev == 0.0 {
-                y + change
-            } else {
-                mu * y + nu_prev * *y_prev + change
-            };
-            *y_prev = y;
+        let blend = Blend {
+            rate: dt_s * nu / (r * r),
+            mu,
+            nu_prev,
         };
         let n = rows.n;
         let (il, id) = (&rows.inverse_length, &rows.inverse_dual_length);
+        // Every row of edges whole, the faces' borders' too: their cells across the
+        // border are in the divergence's halo.
         for f in 0..6 {
-            let cells = f * n * n;
             // X-edge (i, y): tail the vertex (i, y + 1), head (i, y); from cell (i − 1, y)
             // into (i, y).
             for y in 0..n {
-                let k = rows.x_edge(f, 1, y)..rows.x_edge(f, n, y);
-                let (u, y_prev) = (&mut u[k.clone()], &mut v.stage[k.clone()]);
-                let (il, id) = (&il[k.clone()], &id[k]);
-                let (head, tail) = (rows.vertex_at(f, 1, y), rows.vertex_at(f, 1, y + 1));
-                let (head, tail) = (
-                    &vorticity[head..head + n - 1],
-                    &vorticity[tail..tail + n - 1],
+                let k = rows.x_edge(f, 0, y)..rows.x_edge(f, n + 1, y);
+                let (head, tail) = (rows.vertex_at(f, 0, y), rows.vertex_at(f, 0, y + 1));
+                let c = rows.padded_cell(f, 0, y + 1);
+                blend.row(
+                    &mut u[k.clone()],
+                    &mut v.stage[k.clone()],
+                    [
+                        &vorticity[head..head + n + 1],
+                        &vorticity[tail..tail + n + 1],
+                    ],
+                    [&divergence[c + 1..c + n + 2], &divergence[c..c + n + 1]],
+                    [&il[k.clone()], &id[k]],
                 );
-                let c = cells + y * n;
-                let (from, into) = (&divergence[c..c + n - 1], &divergence[c + 1..c + n]);
-                for i in 0..n - 1 {
-                    let curl_curl = (head[i] - tail[i]) * il[i];
-                    let grad_div = (into[i] - from[i]) * id[i];
-                    step(&mut u[i], &mut y_prev[i], curl_curl, grad_div);
-                }
             }
             // Y-edge (x, j): tail the vertex (x, j), head (x + 1, j); from cell (x, j − 1)
             // into (x, j).
-            for j in 1..n {
+            for j in 0..=n {
                 let k = rows.y_edge(f, 0, j)..rows.y_edge(f, n, j);
-                let (u, y_prev) = (&mut u[k.clone()], &mut v.stage[k.clone()]);
-                let (il, id) = (&il[k.clone()], &id[k]);
                 let tail = rows.vertex_at(f, 0, j);
-                let (tail, head) = (
-                    &vorticity[tail..tail + n],
-                    &vorticity[tail + 1..tail + n + 1],
+                let (from, into) = (rows.padded_cell(f, 1, j), rows.padded_cell(f, 1, j + 1));
+                blend.row(
+                    &mut u[k.clone()],
+                    &mut v.stage[k.clone()],
+                    [
+                        &vorticity[tail + 1..tail + n + 1],
+                        &vorticity[tail..tail + n],
+                    ],
+                    [&divergence[into..into + n], &divergence[from..from + n]],
+                    [&il[k.clone()], &id[k]],
                 );
-                let c = cells + j * n;
-                let (from, into) = (&divergence[c - n..c], &divergence[c..c + n]);
-                for x in 0..n {
-                    let curl_curl = (head[x] - tail[x]) * il[x];
-                    let grad_div = (into[x] - from[x]) * id[x];
-                    step(&mut u[x], &mut y_prev[x], curl_curl, grad_div);
-                }
             }
         }
-        for b in &rows.border_edges {
-            let k = b.edge as usize;
-            let [tail, head] = b.ends.map(|e| vorticity[e as usize]);
-            let [from, into] = b.cells.map(|c| divergence[c as usize]);
-            let curl_curl = (head - tail) * il[k];
-            let grad_div = (into - from) * id[k];
-            step(&mut u[k], &mut v.stage[k], curl_curl, grad_div);
+    }
+}
+
+/// One stage's update of an edge: `u ← mu·u + nu_prev·y_prev + change`, the change
+/// `rate·(4 grad div − curl curl + 2u)`.
+#[derive(Clone, Copy)]
+struct Blend {
+    rate: f64,
+    mu: f64,
+    nu_prev: f64,
+}
+
+impl Blend {
+    /// One edge, its stage before last `y_prev` replaced by its `u` on entry. The first
+    /// stage (`nu_prev` 0) is a plain forward-Euler step: no blend.
+    #[inline(always)]
+    fn step(self, u: &mut f64, y_prev: &mut f64, curl_curl: f64, grad_div: f64) {
+        let y = *u;
+        let change = self.rate * (4.0 * grad_div - curl_curl + 2.0 * y);
+        *u = if self.nu_prev == 0.0 {
+            y + change
+        } else {
+            self.mu * y + self.nu_prev * *y_prev + change
+        };
+        *y_prev = y;
+    }
+
+    /// A row of edges: the vorticities at their `[head, tail]`, the divergences of the
+    /// cells `[into, from]`, their `[1/length, 1/dual length]`. Each slice is an
+    /// argument of its own: the compiler then knows the outputs overlap no input, where
+    /// slices of the scratch's vectors cost it a run-time test of each pair every row.
+    #[inline(always)]
+    fn row(
+        self,
+        u: &mut [f64],
+        y_prev: &mut [f64],
+        [head, tail]: [&[f64]; 2],
+        [into, from]: [&[f64]; 2],
+        [il, id]: [&[f64]; 2],
+    ) {
+        let len = u.len();
+        let y_prev = &mut y_prev[..len];
+        let (head, tail, into, from) = (&head[..len], &tail[..len], &into[..len], &from[..len]);
+        let (il, id) = (&il[..len], &id[..len]);
+        for i in 0..len {
+            let curl_curl = (head[i] - tail[i]) * il[i];
+            let grad_div = (into[i] - from[i]) * id[i];
+            self.step(&mut u[i], &mut y_prev[i], curl_curl, grad_div);
         }
     }
 }
 
 /// The vorticity at each local vertex into `v.vorticity` and the divergence of each cell
-/// into `v.divergence`, of the edge velocities `u` (in the rows), on the unit sphere
+/// into `v.divergence` (its halo too), of the edge velocities `u` (in the rows), on the unit sphere
 /// (m/s per rad). A cell's divergence sums its edges' `±u l` in the grid's edge order,
 /// `+` where the local normal points out of it (its right and top sides).
 #[inline(always)]
@@ -162,22 +194,18 @@ fn vorticity_and_divergence(grid: &CubeSphere, rows: &FaceRows, u: &[f64], v: &m
     });
     let n = rows.n;
     let divergence = &mut v.divergence;
-    divergence.resize(6 * n * n, 0.0);
+    divergence.resize(6 * rows.padded_cells_per_face(), 0.0);
     let (l, ia) = (&rows.length, grid.inverse_areas_per_sr());
     for f in 0..6 {
         for y in 0..n {
-            let c = f * n * n + y * n;
+            let (c, p) = (f * n * n + y * n, rows.padded_cell(f, 1, y + 1));
             let (ky, kx) = (rows.y_edge(f, 0, y), rows.x_edge(f, 0, y));
-            let (bottom, top) = (&u[ky..ky + n], &u[ky + n..ky + 2 * n]);
-            let (lb, lt) = (&l[ky..ky + n], &l[ky + n..ky + 2 * n]);
-            let (left, right) = (&u[kx..kx + n], &u[kx + 1..kx + n + 1]);
-            let (ll, lr) = (&l[kx..kx + n], &l[kx + 1..kx + n + 1]);
-            let (out, ia) = (&mut divergence[c..c + n], &ia[c..c + n]);
-            for x in 0..n {
-                let d =
-                    0.0 - bottom[x] * lb[x] - left[x] * ll[x] + right[x] * lr[x] + top[x] * lt[x];
-                out[x] = d * ia[x];
-            }
+            divergence_row(
+                &mut divergence[p..p + n],
+                [&u[ky..ky + n], &u[kx..kx + n], &u[kx + 1..], &u[ky + n..]],
+                [&l[ky..ky + n], &l[kx..kx + n], &l[kx + 1..], &l[ky + n..]],
+                &ia[c..c + n],
+            );
         }
     }
     for cell in &rows.irregular_cells {
@@ -191,7 +219,26 @@ fn vorticity_and_divergence(grid: &CubeSphere, rows: &FaceRows, u: &[f64], v: &m
             }
         }
         let c = cell.cell as usize;
-        divergence[c] = d * ia[c];
+        divergence[rows.padded_of(c)] = d * ia[c];
+    }
+    for &[slot, across] in &rows.cell_halo {
+        divergence[slot as usize] = divergence[across as usize];
+    }
+}
+
+/// A row of cells' divergences into `out`, from their sides' velocities and lengths (in
+/// [`SIDES`](super::face_rows::SIDES) order) and inverse areas `ia`. `out` is an argument
+/// of its own: the compiler then knows it overlaps no input (a slice of the scratch's
+/// vector cost a run-time test against each input every row).
+#[inline(always)]
+fn divergence_row(out: &mut [f64], u: [&[f64]; 4], l: [&[f64]; 4], ia: &[f64]) {
+    let len = out.len();
+    let [bottom, left, right, top] = u.map(|u| &u[..len]);
+    let [lb, ll, lr, lt] = l.map(|l| &l[..len]);
+    let ia = &ia[..len];
+    for x in 0..len {
+        let d = 0.0 - bottom[x] * lb[x] - left[x] * ll[x] + right[x] * lr[x] + top[x] * lt[x];
+        out[x] = d * ia[x];
     }
 }
 
