@@ -23,6 +23,8 @@
 
 use glam::DVec3;
 
+use crate::avx2::with_avx2;
+
 use super::flow::FilmGradient;
 use super::grid::{CubeSphere, FACE_BASES, FaceLayout};
 
@@ -278,10 +280,17 @@ impl FaceRows {
                 along.map(|(&e, &s)| per_edge[e as usize][a] * s).collect()
             })
         });
-        for (((u, x), y), z) in u.iter_mut().zip(x).zip(y).zip(z) {
-            // `g.dot(c)` as glam sums it.
-            *u += dt_s * (g.x * x + g.y * y + g.z * z);
-        }
+        let len = u.len();
+        let (x, y, z) = (&x[..len], &y[..len], &z[..len]);
+        with_avx2(
+            #[inline(always)]
+            || {
+                for i in 0..len {
+                    // `g.dot(c)` as glam sums it.
+                    u[i] += dt_s * (g.x * x[i] + g.y * y[i] + g.z * z[i]);
+                }
+            },
+        );
     }
 
     /// Derives the numbering from `grid`'s geometry.
@@ -417,7 +426,10 @@ impl FaceRows {
     }
 
     /// [`Self::circulation`] of row `j` (`1 ≤ j < n`) of face `f`'s inner vertices: it
-    /// reads X-edges `(1..n, j − 1)` and `(1..n, j)` and Y-edges `(0..n, j)`.
+    /// reads X-edges `(0..n, j − 1)` and `(0..n, j)` and Y-edges `(−1..n, j)`. The row
+    /// starts at vertex `(0, j)`, on the border: `n` vertices vectorise without a scalar
+    /// tail where the `n − 1` inner ones left three. That one's value, from the Y-edge
+    /// before the row's first, is junk until [`Self::seam_circulation`] overwrites it.
     #[inline(always)]
     pub(crate) fn circulation_row(
         &self,
@@ -429,19 +441,18 @@ impl FaceRows {
         finish: impl Fn(f64, f64) -> f64,
     ) {
         let (n, d) = (self.n, &self.dual_length);
-        let inner = n - 1;
-        let below = self.x_edge(f, 1, j - 1)..self.x_edge(f, n, j - 1);
-        let left = self.y_edge(f, 0, j)..self.y_edge(f, n - 1, j);
-        let right = self.y_edge(f, 1, j)..self.y_edge(f, n, j);
-        let above = self.x_edge(f, 1, j)..self.x_edge(f, n, j);
+        let below = self.x_edge(f, 0, j - 1)..self.x_edge(f, n, j - 1);
+        let left = self.y_edge(f, 0, j) - 1..self.y_edge(f, n - 1, j);
+        let right = self.y_edge(f, 0, j)..self.y_edge(f, n, j);
+        let above = self.x_edge(f, 0, j)..self.x_edge(f, n, j);
         let (ub, db) = (&u[below.clone()], &d[below]);
         let (ul, dl) = (&u[left.clone()], &d[left]);
         let (ur, dr) = (&u[right.clone()], &d[right]);
         let (ua, da) = (&u[above.clone()], &d[above]);
-        let start = self.vertex_at(f, 1, j);
-        let row = &mut out[start..start + inner];
-        let scale = &scale[start..start + inner];
-        for i in 0..inner {
+        let start = self.vertex_at(f, 0, j);
+        let row = &mut out[start..start + n];
+        let scale = &scale[start..start + n];
+        for i in 0..n {
             let z = 0.0 - ub[i] * db[i] + ul[i] * dl[i] - ur[i] * dr[i] + ua[i] * da[i];
             row[i] = finish(z, scale[i]);
         }
