@@ -18,8 +18,9 @@
 //! [`FaceRows::irregular_cells`]). So each value is the same sum in the same order as a
 //! pass over the grid's numbering takes it, and the rows give its bits. (A renumbering of
 //! the grid's edges would leave the rows' sums as they are, mathematically the same.)
-//! The one exception: the advection's cell terms, which every cell sums in the local
-//! order, those irregular cells too (`advect::AdvectionGeometry::coriolis` says why).
+//! The exceptions: the advection's cell terms and the viscous step's divergences, which
+//! every cell sums in the local order, those irregular cells too
+//! (`advect::AdvectionGeometry::coriolis` says why).
 
 use glam::DVec3;
 
