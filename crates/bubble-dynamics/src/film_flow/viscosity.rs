@@ -92,44 +92,19 @@ impl FilmFlow {
             nu_prev,
         };
         let n = rows.n;
-        let (il, id) = (&rows.inverse_length, &rows.inverse_dual_length);
-        // Every row of edges whole, the faces' borders' too: their cells across the
-        // border are in the divergence's halo.
-        for f in 0..6 {
-            // X-edge (i, y): tail the vertex (i, y + 1), head (i, y); from cell (i − 1, y)
-            // into (i, y).
-            for y in 0..n {
-                let k = rows.x_edge(f, 0, y)..rows.x_edge(f, n + 1, y);
-                let (head, tail) = (rows.vertex_at(f, 0, y), rows.vertex_at(f, 0, y + 1));
-                let c = rows.padded_cell(f, 0, y + 1);
-                blend.row(
-                    &mut u[k.clone()],
-                    &mut v.stage[k.clone()],
-                    [
-                        &vorticity[head..head + n + 1],
-                        &vorticity[tail..tail + n + 1],
-                    ],
-                    [&divergence[c + 1..c + n + 2], &divergence[c..c + n + 1]],
-                    [&il[k.clone()], &id[k]],
-                );
-            }
-            // Y-edge (x, j): tail the vertex (x, j), head (x + 1, j); from cell (x, j − 1)
-            // into (x, j).
-            for j in 0..=n {
-                let k = rows.y_edge(f, 0, j)..rows.y_edge(f, n, j);
-                let tail = rows.vertex_at(f, 0, j);
-                let (from, into) = (rows.padded_cell(f, 1, j), rows.padded_cell(f, 1, j + 1));
-                blend.row(
-                    &mut u[k.clone()],
-                    &mut v.stage[k.clone()],
-                    [
-                        &vorticity[tail + 1..tail + n + 1],
-                        &vorticity[tail..tail + n],
-                    ],
-                    [&divergence[into..into + n], &divergence[from..from + n]],
-                    [&il[k.clone()], &id[k]],
-                );
-            }
+        let (epf, vpf, cpf) = (
+            rows.edges_per_face(),
+            rows.vertices_per_face(),
+            rows.padded_cells_per_face(),
+        );
+        let (il, id) = (&rows.inverse_length[..], &rows.inverse_dual_length[..]);
+        let faces = u.chunks_exact_mut(epf).zip(v.stage.chunks_exact_mut(epf));
+        let metric = il.chunks_exact(epf).zip(id.chunks_exact(epf));
+        let fields = vorticity
+            .chunks_exact(vpf)
+            .zip(divergence.chunks_exact(cpf));
+        for ((u, stage), (metric, fields)) in faces.zip(metric.zip(fields)) {
+            blend.face(n, u, stage, metric, fields);
         }
     }
 }
@@ -156,6 +131,47 @@ impl Blend {
             self.mu * y + self.nu_prev * *y_prev + change
         };
         *y_prev = y;
+    }
+
+    /// One face's edges (`u`, `y_prev` and the metric `[1/length, 1/dual length]` its
+    /// local edges, `fields` its vertices' vorticities and its padded cells'
+    /// divergences), row by row. Every row of edges whole, the faces' borders' too: their
+    /// cells across the border are in the divergence's halo. The rows come from chunk
+    /// iterators over the face, where slicing each from the whole arrays cost bounds
+    /// checks and reloads of every base each row.
+    #[inline(always)]
+    fn face(
+        self,
+        n: usize,
+        u: &mut [f64],
+        y_prev: &mut [f64],
+        (il, id): (&[f64], &[f64]),
+        (vorticity, divergence): (&[f64], &[f64]),
+    ) {
+        let (u_x, u_y) = u.split_at_mut(n * (n + 1));
+        let (y_x, y_y) = y_prev.split_at_mut(n * (n + 1));
+        let ((il_x, il_y), (id_x, id_y)) = (il.split_at(n * (n + 1)), id.split_at(n * (n + 1)));
+        // X-edge (i, y): tail the vertex (i, y + 1), head (i, y); from cell (i − 1, y)
+        // into (i, y) (padded row y + 1).
+        let (w, p) = (n + 1, n + 2);
+        let edges = u_x.chunks_exact_mut(w).zip(y_x.chunks_exact_mut(w));
+        let metric = il_x.chunks_exact(w).zip(id_x.chunks_exact(w));
+        let ends = vorticity
+            .chunks_exact(w)
+            .zip(vorticity[w..].chunks_exact(w));
+        let cells = divergence[p..].chunks_exact(p);
+        for (((u, y_prev), (il, id)), ((head, tail), d)) in edges.zip(metric).zip(ends.zip(cells)) {
+            self.row(u, y_prev, [head, tail], [&d[1..], d], [il, id]);
+        }
+        // Y-edge (x, j): tail the vertex (x, j), head (x + 1, j); from cell (x, j − 1)
+        // (padded row j) into (x, j).
+        let edges = u_y.chunks_exact_mut(n).zip(y_y.chunks_exact_mut(n));
+        let metric = il_y.chunks_exact(n).zip(id_y.chunks_exact(n));
+        let ends = vorticity.chunks_exact(w);
+        let cells = divergence[1..].chunks(p).zip(divergence[p + 1..].chunks(p));
+        for (((u, y_prev), (il, id)), (z, (from, into))) in edges.zip(metric).zip(ends.zip(cells)) {
+            self.row(u, y_prev, [&z[1..], z], [into, from], [il, id]);
+        }
     }
 
     /// A row of edges: the vorticities at their `[head, tail]`, the divergences of the
@@ -198,21 +214,36 @@ fn vorticity_and_divergence(grid: &CubeSphere, rows: &FaceRows, u: &[f64], v: &m
     let n = rows.n;
     let divergence = &mut v.divergence;
     divergence.resize(6 * rows.padded_cells_per_face(), 0.0);
-    let (l, ia) = (&rows.length, grid.inverse_areas_per_sr());
-    for f in 0..6 {
-        for y in 0..n {
-            let (c, p) = (f * n * n + y * n, rows.padded_cell(f, 1, y + 1));
-            let (ky, kx) = (rows.y_edge(f, 0, y), rows.x_edge(f, 0, y));
-            divergence_row(
-                &mut divergence[p..p + n],
-                [&u[ky..ky + n], &u[kx..kx + n], &u[kx + 1..], &u[ky + n..]],
-                [&l[ky..ky + n], &l[kx..kx + n], &l[kx + 1..], &l[ky + n..]],
-                &ia[c..c + n],
-            );
-        }
+    let (l, ia) = (&rows.length[..], grid.inverse_areas_per_sr());
+    let (epf, cpf) = (rows.edges_per_face(), rows.padded_cells_per_face());
+    let faces = u.chunks_exact(epf).zip(l.chunks_exact(epf));
+    let cells = ia.chunks_exact(n * n).zip(divergence.chunks_exact_mut(cpf));
+    for ((u, l), (ia, out)) in faces.zip(cells) {
+        divergence_face(n, u, l, ia, out);
     }
     for &[slot, across] in &rows.cell_halo {
         divergence[slot as usize] = divergence[across as usize];
+    }
+}
+
+/// One face's divergences into its padded cells `out` (the halo left as it is), from
+/// its local edges' velocities `u` and lengths `l` and its cells' inverse areas `ia`, row
+/// by row from chunk iterators over the face (slicing each row from the whole arrays cost
+/// bounds checks and reloads of every base each row).
+#[inline(always)]
+fn divergence_face(n: usize, u: &[f64], l: &[f64], ia: &[f64], out: &mut [f64]) {
+    let ((ux, uy), (lx, ly)) = (u.split_at(n * (n + 1)), l.split_at(n * (n + 1)));
+    let x_sides = ux.chunks_exact(n + 1).zip(lx.chunks_exact(n + 1));
+    let bottoms = uy.chunks_exact(n).zip(ly.chunks_exact(n));
+    let tops = uy[n..].chunks_exact(n).zip(ly[n..].chunks_exact(n));
+    let cells = ia.chunks_exact(n).zip(out[n + 3..].chunks_mut(n + 2));
+    for (((x, b), t), (ia, out)) in x_sides.zip(bottoms).zip(tops).zip(cells) {
+        divergence_row(
+            &mut out[..n],
+            [b.0, x.0, &x.0[1..], t.0],
+            [b.1, x.1, &x.1[1..], t.1],
+            ia,
+        );
     }
 }
 
