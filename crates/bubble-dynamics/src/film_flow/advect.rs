@@ -285,7 +285,9 @@ struct StageWork {
     /// cell's term of that side's rate, m/s², in the rows' orientation, kept for the
     /// cells' sides on the faces' borders.
     border_rate: Vec<f64>,
-    /// The same for the row of cells under way and the one before (even and odd rows).
+    /// The same for the row of cells under way and the one before (even and odd rows),
+    /// and one slot more: the left side of the cell past the row's end, read (unset) for
+    /// the right border copy a row's X-edges move through (junk until the seam pass).
     row_rate: [[Vec<f64>; 4]; 2],
 }
 
@@ -296,7 +298,7 @@ impl StageWork {
         self.next_vorticity.resize(rows.vertices(), 0.0);
         self.border_rate.resize(4 * 6 * n * n, 0.0);
         for r in self.row_rate.iter_mut().flatten() {
-            r.resize(n, 0.0);
+            r.resize(n + 1, 0.0);
         }
     }
 }
@@ -396,9 +398,10 @@ fn ssp_rk3(
         geo,
         radius_m,
     };
-    // Stage 1 (what `u1` held is passed over).
+    // Stage 1 (what `u1` held is passed over). It ignores the starting velocities: given
+    // `u`'s, the rows may move the border copies too (see `Stage::stage`).
     let step = |u, _, r| u + h * r;
-    on.stage(u, u1, None, w, true, step);
+    on.stage(u, u1, Some(u), w, true, step);
     let step = |u, u0, r| 0.75 * u0 + 0.25 * (u + h * r);
     on.stage(u1, u2, Some(u), w, true, step);
     // Stage 3, onto `u`: each edge's starting velocity read before it is replaced.
@@ -451,7 +454,10 @@ impl Stage<'_> {
                 keep_border_rates(border, rate, c, n, y);
                 let [_, left, right, _] = &*rate;
                 // The X-edges inside the face: cell (i − 1, y)'s right side and (i, y)'s left.
-                let k = rows.x_edge(f, 1, y)..rows.x_edge(f, n, y);
+                // Where the seam pass takes the starting velocities from `u0` (not from
+                // `dst`), the row runs on through the right border copy (junk until that
+                // pass moves it): n edges vectorise without the scalar tail of n − 1.
+                let k = rows.x_edge(f, 1, y)..rows.x_edge(f, n + usize::from(u0.is_some()), y);
                 let u0x = u0.map(|u0| &u0[k.clone()]);
                 move_edges(&mut dst[k.clone()], &src[k], u0x, right, &left[1..], &step);
                 if y == 0 {
