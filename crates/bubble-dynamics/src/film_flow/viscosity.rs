@@ -113,8 +113,11 @@ impl FilmFlow {
 /// `rate·(4 grad div − curl curl + 2u)`.
 #[derive(Clone, Copy)]
 struct Blend {
+    /// The stage's `dt·ν/R²` (the stress per unit of the unit sphere's differences).
     rate: f64,
+    /// The weight of the stage before (`μⱼ`).
     mu: f64,
+    /// The weight of the stage before last (`νⱼ`; 0 in the first stage).
     nu_prev: f64,
 }
 
