@@ -61,8 +61,10 @@ pub(crate) struct AdvectionGeometry {
     /// Per component, per cell: the cell's centre.
     centre: [Vec<f64>; 3],
     /// Per cell, per side `i` of it (in [`SIDES`] order): the weights of the cell's three
-    /// other sides (in [`OTHERS`] order) in side `i`'s `ζ k×u` term (times the mean of
-    /// the two edges' vorticities, and times the ½ of that mean: exact, a power of two).
+    /// other sides (in [`OTHERS`] order) in side `i`'s `ζ k×u` term, times ¼: the term
+    /// takes the sum of the two edges' vorticities, each the sum of its two vertices'
+    /// (the ½ of the mean and the ½ of each edge's mean, exact powers of two, folded
+    /// into the weight, for the same bits as halving each sum in the loop).
     /// An edge's term sums over the other edges of its two cells; the weights are the
     /// reconstruction's `½ t·w` made antisymmetric under the energy norm `Σ l d u²`, so
     /// the term does no work, as `ζ k×u ⊥ u` in the continuum (with the reconstruction's
@@ -84,6 +86,21 @@ pub(crate) struct AdvectionGeometry {
     /// a cell's four reconstruction weights' lengths, with a margin of 1e-9 for the
     /// rounding of the velocities' sums.
     speed_bound: f64,
+    /// The edges on the faces' borders, each with what it takes from the kept border
+    /// rates ([`StageWork::border_rate`]).
+    seams: Vec<SeamTerms>,
+}
+
+/// An edge on the faces' borders: its two cells' terms (the lower-numbered cell's
+/// first) and its two local copies.
+#[derive(Clone, Copy, Debug)]
+struct SeamTerms {
+    /// Per cell: the slot of its term of the edge's side in [`StageWork::border_rate`].
+    slots: [u32; 2],
+    /// Per cell: its face's copy of the edge.
+    edges: [u32; 2],
+    /// Per cell: the copy's orientation against the grid's (`±1`).
+    signs: [f64; 2],
 }
 
 /// An irregular cell's reconstruction weights, its sides in the grid's order.
@@ -127,7 +144,7 @@ impl AdvectionGeometry {
                 .copied()
                 .find(|&(id, _)| id as usize == other)
                 .expect("a cell's other edge in its edge's stencil");
-            si * so * (0.5 * w)
+            si * so * (0.25 * w)
         };
         let cells = grid.cells();
         let to_cell = std::array::from_fn(|i| {
@@ -155,8 +172,21 @@ impl AdvectionGeometry {
             .map(|c| (0..4).map(|i| side(c, i).2.length()).sum::<f64>())
             .fold(0.0, f64::max)
             * (1.0 + 1e-9);
+        let seams = rows
+            .seam_edges
+            .iter()
+            .map(|e| {
+                let slot = |(c, side, _): (u32, Side, u32)| (side as usize * cells) as u32 + c;
+                SeamTerms {
+                    slots: e.cells.map(slot),
+                    edges: e.cells.map(|(_, _, k)| k),
+                    signs: e.cells.map(|(_, _, k)| rows.sign(k as usize)),
+                }
+            })
+            .collect();
         Self {
             speed_bound,
+            seams,
             to_cell,
             centre: std::array::from_fn(|a| centres.iter().map(|c| c[a]).collect()),
             coriolis: weights,
@@ -251,11 +281,13 @@ struct StageWork {
     vorticity: Vec<f64>,
     /// Per local vertex: the vorticity of those it ends with.
     next_vorticity: Vec<f64>,
-    /// Per side of a cell (in [`SIDES`] order), per cell: the cell's term of that side's
-    /// rate, m/s², in the rows' orientation, kept for the cells' sides on the faces'
-    /// borders.
-    border_rate: [Vec<f64>; 4],
-    /// The same for the row of cells under way and the one before (even and odd rows).
+    /// Per side of a cell (in [`SIDES`] order), per cell (slot `side·cells + cell`): the
+    /// cell's term of that side's rate, m/s², in the rows' orientation, kept for the
+    /// cells' sides on the faces' borders.
+    border_rate: Vec<f64>,
+    /// The same for the row of cells under way and the one before (even and odd rows),
+    /// and one slot more: the left side of the cell past the row's end, read (unset) for
+    /// the right border copy a row's X-edges move through (junk until the seam pass).
     row_rate: [[Vec<f64>; 4]; 2],
 }
 
@@ -264,11 +296,9 @@ impl StageWork {
     fn prepare(&mut self, rows: &FaceRows) {
         let n = rows.n;
         self.next_vorticity.resize(rows.vertices(), 0.0);
-        for r in &mut self.border_rate {
-            r.resize(6 * n * n, 0.0);
-        }
+        self.border_rate.resize(4 * 6 * n * n, 0.0);
         for r in self.row_rate.iter_mut().flatten() {
-            r.resize(n, 0.0);
+            r.resize(n + 1, 0.0);
         }
     }
 }
@@ -368,9 +398,10 @@ fn ssp_rk3(
         geo,
         radius_m,
     };
-    // Stage 1 (what `u1` held is passed over).
+    // Stage 1 (what `u1` held is passed over). It ignores the starting velocities: given
+    // `u`'s, the rows may move the border copies too (see `Stage::stage`).
     let step = |u, _, r| u + h * r;
-    on.stage(u, u1, None, w, true, step);
+    on.stage(u, u1, Some(u), w, true, step);
     let step = |u, u0, r| 0.75 * u0 + 0.25 * (u + h * r);
     on.stage(u1, u2, Some(u), w, true, step);
     // Stage 3, onto `u`: each edge's starting velocity read before it is replaced.
@@ -423,7 +454,10 @@ impl Stage<'_> {
                 keep_border_rates(border, rate, c, n, y);
                 let [_, left, right, _] = &*rate;
                 // The X-edges inside the face: cell (i − 1, y)'s right side and (i, y)'s left.
-                let k = rows.x_edge(f, 1, y)..rows.x_edge(f, n, y);
+                // Where the seam pass takes the starting velocities from `u0` (not from
+                // `dst`), the row runs on through the right border copy (junk until that
+                // pass moves it): n edges vectorise without the scalar tail of n − 1.
+                let k = rows.x_edge(f, 1, y)..rows.x_edge(f, n + usize::from(u0.is_some()), y);
                 let u0x = u0.map(|u0| &u0[k.clone()]);
                 move_edges(&mut dst[k.clone()], &src[k], u0x, right, &left[1..], &step);
                 if y == 0 {
@@ -496,19 +530,15 @@ impl Stage<'_> {
         src: &[f64],
         dst: &mut [f64],
         u0: Option<&[f64]>,
-        border: &[Vec<f64>; 4],
+        border: &[f64],
         step: &impl Fn(f64, f64, f64) -> f64,
     ) {
-        let rows = self.rows;
-        for e in &rows.seam_edges {
-            let [(ca, sa, ka), (cb, sb, kb)] = e.cells;
-            let term = |c: u32, side: Side, k: u32| {
-                rows.sign(k as usize) * border[side as usize][c as usize]
-            };
-            let r = (0.0 + term(ca, sa, ka)) + term(cb, sb, kb);
-            for k in [ka as usize, kb as usize] {
+        for e in &self.geo.seams {
+            let ([ia, ib], [sa, sb]) = (e.slots.map(|i| i as usize), e.signs);
+            let r = (0.0 + sa * border[ia]) + sb * border[ib];
+            for (k, sign) in [(e.edges[0] as usize, sa), (e.edges[1] as usize, sb)] {
                 let start = u0.map_or(dst[k], |u0| u0[k]);
-                dst[k] = step(src[k], start, rows.sign(k) * r);
+                dst[k] = step(src[k], start, sign * r);
             }
         }
     }
@@ -549,10 +579,10 @@ impl CellRow<'_> {
         let (or, ot) = (&mut or[range.clone()][..len], &mut ot[range][..len]);
         for x in 0..len {
             let z = [
-                0.5 * (zb0[x] + zb1[x]),
-                0.5 * (zb0[x] + zt0[x]),
-                0.5 * (zb1[x] + zt1[x]),
-                0.5 * (zt0[x] + zt1[x]),
+                zb0[x] + zb1[x],
+                zb0[x] + zt0[x],
+                zb1[x] + zt1[x],
+                zt0[x] + zt1[x],
             ];
             let u = [ub[x], ul[x], ur[x], ut[x]];
             let w = [
@@ -583,21 +613,17 @@ fn four_rows<S: AsRef<[f64]>>(a: &[S; 4], r: std::ops::Range<usize>) -> [&[f64];
 /// of its first cell, the right of its last, and the bottoms or tops of the first and
 /// last rows.
 #[inline(always)]
-fn keep_border_rates(
-    border: &mut [Vec<f64>; 4],
-    rate: &[Vec<f64>; 4],
-    c: usize,
-    n: usize,
-    y: usize,
-) {
+fn keep_border_rates(border: &mut [f64], rate: &[Vec<f64>; 4], c: usize, n: usize, y: usize) {
     let [bottom, left, right, top] = rate;
-    border[Side::Left as usize][c] = left[0];
-    border[Side::Right as usize][c + n - 1] = right[n - 1];
+    let cells = border.len() / 4;
+    let at = |side: Side| side as usize * cells + c;
+    border[at(Side::Left)] = left[0];
+    border[at(Side::Right) + n - 1] = right[n - 1];
     if y == 0 {
-        border[Side::Bottom as usize][c..c + n].copy_from_slice(&bottom[..n]);
+        border[at(Side::Bottom)..][..n].copy_from_slice(&bottom[..n]);
     }
     if y == n - 1 {
-        border[Side::Top as usize][c..c + n].copy_from_slice(&top[..n]);
+        border[at(Side::Top)..][..n].copy_from_slice(&top[..n]);
     }
 }
 
@@ -716,10 +742,10 @@ fn largest_magnitude(values: &[f64]) -> f64 {
     m.into_iter().fold(0.0, |a, b| larger(b, a))
 }
 
-/// A cell's terms of its four edges' rates, from the edges' vorticities `z` and
-/// velocities `u` and the cell's weights: `Σ_k w[k][i] (ζ_i + ζ_o) u_o` over the other
-/// edges `o = OTHERS[i][k]`, summed in `k` order: the same operations per edge as edge by
-/// edge, so the same bits, in four independent chains.
+/// A cell's terms of its four edges' rates, from the edges' vorticities `z` (each the sum
+/// of its two vertices') and velocities `u` and the cell's weights: `Σ_k w[k][i] (ζ_i +
+/// ζ_o) u_o` over the other edges `o = OTHERS[i][k]`, summed in `k` order: the same
+/// operations per edge as edge by edge, so the same bits, in four independent chains.
 #[inline(always)]
 fn cell_rates(z: [f64; 4], u: [f64; 4], w: &[[f64; 4]; 3]) -> [f64; 4] {
     let mut rates = [0.0; 4];

@@ -18,10 +18,13 @@
 //! [`FaceRows::irregular_cells`]). So each value is the same sum in the same order as a
 //! pass over the grid's numbering takes it, and the rows give its bits. (A renumbering of
 //! the grid's edges would leave the rows' sums as they are, mathematically the same.)
-//! The one exception: the advection's cell terms, which every cell sums in the local
-//! order, those irregular cells too (`advect::AdvectionGeometry::coriolis` says why).
+//! The exceptions: the advection's cell terms and the viscous step's divergences, which
+//! every cell sums in the local order, those irregular cells too
+//! (`advect::AdvectionGeometry::coriolis` says why).
 
 use glam::DVec3;
+
+use crate::avx2::with_avx2;
 
 use super::flow::FilmGradient;
 use super::grid::{CubeSphere, FACE_BASES, FaceLayout};
@@ -58,18 +61,6 @@ pub(crate) struct SeamEdge {
     /// Its cells, the lower-numbered first, each with the side of it the edge is on and
     /// that cell's face's copy of the edge.
     pub(crate) cells: [(u32, Side, u32); 2],
-}
-
-/// A local copy of an edge on a face's border, with its ends and cells in its own
-/// orientation.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct BorderEdge {
-    /// The local edge.
-    pub(crate) edge: u32,
-    /// Its tail and head vertices (local, in its face).
-    pub(crate) ends: [u32; 2],
-    /// The cells its normal points from and into.
-    pub(crate) cells: [u32; 2],
 }
 
 /// A cell whose edges, in the grid's order, are not in the local order [`SIDES`].
@@ -122,11 +113,15 @@ pub(crate) struct FaceRows {
     pub(crate) seam_vertices: Vec<SeamVertex>,
     /// The edges on the faces' borders.
     pub(crate) seam_edges: Vec<SeamEdge>,
-    /// The local copies of the edges on the faces' borders, each with its ends and cells.
-    pub(crate) border_edges: Vec<BorderEdge>,
+    /// The local copies of the edges on the faces' borders.
+    pub(crate) border_edges: Vec<u32>,
     /// The cells on the faces' borders whose edges the grid numbers out of the local
     /// order.
     pub(crate) irregular_cells: Vec<IrregularCell>,
+    /// Per local copy of an edge on a face's border: the halo slot of the padded cell
+    /// layout ([`Self::padded_cell`]) beyond that copy's cell, and the padded cell across
+    /// the edge (in the other face) whose value the slot takes.
+    pub(crate) cell_halo: Vec<[u32; 2]>,
     /// The grid's centre gradients (two-point, normal) in the rows by component, once
     /// [`Self::add_gradient`] has asked for them.
     gradients: [std::sync::OnceLock<[Vec<f64>; 3]>; 2],
@@ -161,6 +156,23 @@ impl FaceRows {
     /// Local vertex `(i, j)` of face `f`.
     pub(crate) fn vertex_at(&self, f: usize, i: usize, j: usize) -> usize {
         f * self.vertices_per_face() + j * (self.n + 1) + i
+    }
+
+    /// Cells a face in the padded layout: `(n + 2)²`, the face's cells ringed by a halo.
+    pub(crate) fn padded_cells_per_face(&self) -> usize {
+        (self.n + 2) * (self.n + 2)
+    }
+
+    /// The padded layout's slot `(px, py)` of face `f`: cell `(px − 1, py − 1)`, or the
+    /// halo where `px` or `py` is 0 or `n + 1`.
+    pub(crate) fn padded_cell(&self, f: usize, px: usize, py: usize) -> usize {
+        f * self.padded_cells_per_face() + py * (self.n + 2) + px
+    }
+
+    /// Cell `c`'s slot in the padded layout.
+    pub(crate) fn padded_of(&self, c: usize) -> usize {
+        let n = self.n;
+        self.padded_cell(c / (n * n), c % n + 1, (c / n) % n + 1)
     }
 
     /// The local edge on side `side` of cell `c`.
@@ -205,8 +217,8 @@ impl FaceRows {
         self.for_each_inner_run(|local, at| {
             rows[local.clone()].copy_from_slice(&grid[at..at + local.len()]);
         });
-        for b in &self.border_edges {
-            let k = b.edge as usize;
+        for &k in &self.border_edges {
+            let k = k as usize;
             rows[k] = grid[self.edge[k] as usize] * self.signs[k];
         }
     }
@@ -269,10 +281,17 @@ impl FaceRows {
                 along.map(|(&e, &s)| per_edge[e as usize][a] * s).collect()
             })
         });
-        for (((u, x), y), z) in u.iter_mut().zip(x).zip(y).zip(z) {
-            // `g.dot(c)` as glam sums it.
-            *u += dt_s * (g.x * x + g.y * y + g.z * z);
-        }
+        let len = u.len();
+        let (x, y, z) = (&x[..len], &y[..len], &z[..len]);
+        with_avx2(
+            #[inline(always)]
+            || {
+                for i in 0..len {
+                    // `g.dot(c)` as glam sums it.
+                    u[i] += dt_s * (g.x * x[i] + g.y * y[i] + g.z * z[i]);
+                }
+            },
+        );
     }
 
     /// Derives the numbering from `grid`'s geometry.
@@ -297,6 +316,7 @@ impl FaceRows {
             seam_edges: Vec::new(),
             border_edges: Vec::new(),
             irregular_cells: Vec::new(),
+            cell_halo: Vec::new(),
             gradients: Default::default(),
         };
         let local_edges = 6 * rows.edges_per_face();
@@ -369,6 +389,7 @@ impl FaceRows {
         let inverse = grid.inverse_vertex_areas_per_sr();
         rows.vertex_inverse_area = rows.vertex.iter().map(|&v| inverse[v as usize]).collect();
         rows.border_edges = border_edges(&rows);
+        rows.cell_halo = cell_halo(&rows);
         rows.seam_vertices = seam_vertices(&rows, grid);
         rows.irregular_cells = (0..grid.cells())
             .filter_map(|c| irregular(&rows, c))
@@ -406,7 +427,10 @@ impl FaceRows {
     }
 
     /// [`Self::circulation`] of row `j` (`1 ≤ j < n`) of face `f`'s inner vertices: it
-    /// reads X-edges `(1..n, j − 1)` and `(1..n, j)` and Y-edges `(0..n, j)`.
+    /// reads X-edges `(0..n, j − 1)` and `(0..n, j)` and Y-edges `(−1..n, j)`. The row
+    /// starts at vertex `(0, j)`, on the border: `n` vertices vectorise without a scalar
+    /// tail where the `n − 1` inner ones left three. That one's value, from the Y-edge
+    /// before the row's first, is junk until [`Self::seam_circulation`] overwrites it.
     #[inline(always)]
     pub(crate) fn circulation_row(
         &self,
@@ -418,19 +442,18 @@ impl FaceRows {
         finish: impl Fn(f64, f64) -> f64,
     ) {
         let (n, d) = (self.n, &self.dual_length);
-        let inner = n - 1;
-        let below = self.x_edge(f, 1, j - 1)..self.x_edge(f, n, j - 1);
-        let left = self.y_edge(f, 0, j)..self.y_edge(f, n - 1, j);
-        let right = self.y_edge(f, 1, j)..self.y_edge(f, n, j);
-        let above = self.x_edge(f, 1, j)..self.x_edge(f, n, j);
+        let below = self.x_edge(f, 0, j - 1)..self.x_edge(f, n, j - 1);
+        let left = self.y_edge(f, 0, j) - 1..self.y_edge(f, n - 1, j);
+        let right = self.y_edge(f, 0, j)..self.y_edge(f, n, j);
+        let above = self.x_edge(f, 0, j)..self.x_edge(f, n, j);
         let (ub, db) = (&u[below.clone()], &d[below]);
         let (ul, dl) = (&u[left.clone()], &d[left]);
         let (ur, dr) = (&u[right.clone()], &d[right]);
         let (ua, da) = (&u[above.clone()], &d[above]);
-        let start = self.vertex_at(f, 1, j);
-        let row = &mut out[start..start + inner];
-        let scale = &scale[start..start + inner];
-        for i in 0..inner {
+        let start = self.vertex_at(f, 0, j);
+        let row = &mut out[start..start + n];
+        let scale = &scale[start..start + n];
+        for i in 0..n {
             let z = 0.0 - ub[i] * db[i] + ul[i] * dl[i] - ur[i] * dr[i] + ua[i] * da[i];
             row[i] = finish(z, scale[i]);
         }
@@ -446,6 +469,20 @@ impl FaceRows {
         finish: impl Fn(f64, f64) -> f64,
     ) {
         for v in &self.seam_vertices {
+            // All but the cube's corners have four edges and two copies: written out (the
+            // same sum), where the loops over the counts cost half again as much.
+            if v.edge_count == 4 && v.copy_count == 2 {
+                let [(k0, w0), (k1, w1), (k2, w2), (k3, w3)] = v.edges;
+                let t = [
+                    u[k0 as usize] * w0,
+                    u[k1 as usize] * w1,
+                    u[k2 as usize] * w2,
+                ];
+                let z = 0.0 + t[0] + t[1] + t[2] + u[k3 as usize] * w3;
+                let z = finish(z, scale[v.copies[0] as usize]);
+                (out[v.copies[0] as usize], out[v.copies[1] as usize]) = (z, z);
+                continue;
+            }
             let mut z = 0.0;
             for &(k, w) in &v.edges[..usize::from(v.edge_count)] {
                 z += u[k as usize] * w;
@@ -458,20 +495,33 @@ impl FaceRows {
     }
 }
 
-/// Each seam edge's two copies, each with its ends and cells in its own orientation: the
-/// local normal points away from a cell on its right or top side.
-fn border_edges(rows: &FaceRows) -> Vec<BorderEdge> {
+/// Each seam edge's two copies.
+fn border_edges(rows: &FaceRows) -> Vec<u32> {
+    let copies = rows
+        .seam_edges
+        .iter()
+        .flat_map(|e| e.cells.map(|(_, _, k)| k));
+    copies.collect()
+}
+
+/// Each seam edge's two copies' halo slots ([`FaceRows::cell_halo`]): beyond the copy's
+/// cell across its side, the padded slot of the cell in the other face.
+fn cell_halo(rows: &FaceRows) -> Vec<[u32; 2]> {
+    let n = rows.n;
     let mut out = Vec::with_capacity(2 * rows.seam_edges.len());
     for e in &rows.seam_edges {
         for (mine, other) in [(0, 1), (1, 0)] {
-            let (c, side, k) = e.cells[mine];
-            let across = e.cells[other].0;
-            let away = matches!(side, Side::Right | Side::Top);
-            out.push(BorderEdge {
-                edge: k,
-                ends: rows.side_vertices(c as usize, side).map(|v| v as u32),
-                cells: if away { [c, across] } else { [across, c] },
-            });
+            let (c, side, _) = e.cells[mine];
+            let c = c as usize;
+            let (f, px, py) = (c / (n * n), c % n + 1, (c / n) % n + 1);
+            let (hx, hy) = match side {
+                Side::Bottom => (px, py - 1),
+                Side::Left => (px - 1, py),
+                Side::Right => (px + 1, py),
+                Side::Top => (px, py + 1),
+            };
+            let across = rows.padded_of(e.cells[other].0 as usize);
+            out.push([rows.padded_cell(f, hx, hy) as u32, across as u32]);
         }
     }
     out

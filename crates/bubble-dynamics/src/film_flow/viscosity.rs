@@ -10,7 +10,7 @@
 
 use crate::avx2::with_avx2;
 
-use super::face_rows::{FaceRows, Side};
+use super::face_rows::FaceRows;
 use super::flow::FilmFlow;
 use super::grid::CubeSphere;
 
@@ -25,7 +25,8 @@ pub(super) struct ViscousScratch {
     pub(super) stage: Vec<f64>,
     /// Per local vertex: the vorticity on the unit sphere (m/s per rad).
     vorticity: Vec<f64>,
-    /// Per cell: the divergence on the unit sphere (m/s per rad).
+    /// Per cell, in the padded layout (`FaceRows::padded_cell`): the divergence on the
+    /// unit sphere (m/s per rad), the halo holding the cells across the faces' borders.
     divergence: Vec<f64>,
 }
 
@@ -85,76 +86,129 @@ impl FilmFlow {
         // Vorticity and divergence per R (of the unit sphere's), and each difference of
         // them per R again: every term of the stress carries 1/R², taken once here.
         let r = self.params.radius_m;
-        let rate = dt_s * nu / (r * r);
-        // The first stage (mu 1, nu_prev 0) is a plain forward-Euler step: no blend.
-        let step = |u: &mut f64, y_prev: &mut f64, curl_curl: f64, grad_div: f64| {
-            let y = *u;
-            let change = rate * (4.0 * grad_div - curl_curl + 2.0 * y);
-            *u = if nu_prev == 0.0 {
-                y + change
-            } else {
-                mu * y + nu_prev * *y_prev + change
-            };
-            *y_prev = y;
+        let blend = Blend {
+            rate: dt_s * nu / (r * r),
+            mu,
+            nu_prev,
         };
         let n = rows.n;
-        let (il, id) = (&rows.inverse_length, &rows.inverse_dual_length);
-        for f in 0..6 {
-            let cells = f * n * n;
-            // X-edge (i, y): tail the vertex (i, y + 1), head (i, y); from cell (i − 1, y)
-            // into (i, y).
-            for y in 0..n {
-                let k = rows.x_edge(f, 1, y)..rows.x_edge(f, n, y);
-                let (u, y_prev) = (&mut u[k.clone()], &mut v.stage[k.clone()]);
-                let (il, id) = (&il[k.clone()], &id[k]);
-                let (head, tail) = (rows.vertex_at(f, 1, y), rows.vertex_at(f, 1, y + 1));
-                let (head, tail) = (
-                    &vorticity[head..head + n - 1],
-                    &vorticity[tail..tail + n - 1],
-                );
-                let c = cells + y * n;
-                let (from, into) = (&divergence[c..c + n - 1], &divergence[c + 1..c + n]);
-                for i in 0..n - 1 {
-                    let curl_curl = (head[i] - tail[i]) * il[i];
-                    let grad_div = (into[i] - from[i]) * id[i];
-                    step(&mut u[i], &mut y_prev[i], curl_curl, grad_div);
-                }
-            }
-            // Y-edge (x, j): tail the vertex (x, j), head (x + 1, j); from cell (x, j − 1)
-            // into (x, j).
-            for j in 1..n {
-                let k = rows.y_edge(f, 0, j)..rows.y_edge(f, n, j);
-                let (u, y_prev) = (&mut u[k.clone()], &mut v.stage[k.clone()]);
-                let (il, id) = (&il[k.clone()], &id[k]);
-                let tail = rows.vertex_at(f, 0, j);
-                let (tail, head) = (
-                    &vorticity[tail..tail + n],
-                    &vorticity[tail + 1..tail + n + 1],
-                );
-                let c = cells + j * n;
-                let (from, into) = (&divergence[c - n..c], &divergence[c..c + n]);
-                for x in 0..n {
-                    let curl_curl = (head[x] - tail[x]) * il[x];
-                    let grad_div = (into[x] - from[x]) * id[x];
-                    step(&mut u[x], &mut y_prev[x], curl_curl, grad_div);
-                }
-            }
+        let (epf, vpf, cpf) = (
+            rows.edges_per_face(),
+            rows.vertices_per_face(),
+            rows.padded_cells_per_face(),
+        );
+        let (il, id) = (&rows.inverse_length[..], &rows.inverse_dual_length[..]);
+        let faces = u.chunks_exact_mut(epf).zip(v.stage.chunks_exact_mut(epf));
+        let metric = il.chunks_exact(epf).zip(id.chunks_exact(epf));
+        let fields = vorticity
+            .chunks_exact(vpf)
+            .zip(divergence.chunks_exact(cpf));
+        for ((u, stage), (metric, fields)) in faces.zip(metric.zip(fields)) {
+            blend.face(n, u, stage, metric, fields);
         }
-        for b in &rows.border_edges {
-            let k = b.edge as usize;
-            let [tail, head] = b.ends.map(|e| vorticity[e as usize]);
-            let [from, into] = b.cells.map(|c| divergence[c as usize]);
-            let curl_curl = (head - tail) * il[k];
-            let grad_div = (into - from) * id[k];
-            step(&mut u[k], &mut v.stage[k], curl_curl, grad_div);
+    }
+}
+
+/// One stage's update of an edge: `u ← mu·u + nu_prev·y_prev + change`, the change
+/// `rate·(4 grad div − curl curl + 2u)`.
+#[derive(Clone, Copy)]
+struct Blend {
+    /// The stage's `dt·ν/R²` (the stress per unit of the unit sphere's differences).
+    rate: f64,
+    /// The weight of the stage before (`μⱼ`).
+    mu: f64,
+    /// The weight of the stage before last (`νⱼ`; 0 in the first stage).
+    nu_prev: f64,
+}
+
+impl Blend {
+    /// One edge, its stage before last `y_prev` replaced by its `u` on entry. The first
+    /// stage (`nu_prev` 0) is a plain forward-Euler step: no blend.
+    #[inline(always)]
+    fn step(self, u: &mut f64, y_prev: &mut f64, curl_curl: f64, grad_div: f64) {
+        let y = *u;
+        let change = self.rate * (4.0 * grad_div - curl_curl + 2.0 * y);
+        *u = if self.nu_prev == 0.0 {
+            y + change
+        } else {
+            self.mu * y + self.nu_prev * *y_prev + change
+        };
+        *y_prev = y;
+    }
+
+    /// One face's edges (`u`, `y_prev` and the metric `[1/length, 1/dual length]` its
+    /// local edges, `fields` its vertices' vorticities and its padded cells'
+    /// divergences), row by row. Every row of edges whole, the faces' borders' too: their
+    /// cells across the border are in the divergence's halo. The rows come from chunk
+    /// iterators over the face, where slicing each from the whole arrays cost bounds
+    /// checks and reloads of every base each row.
+    #[inline(always)]
+    fn face(
+        self,
+        n: usize,
+        u: &mut [f64],
+        y_prev: &mut [f64],
+        (il, id): (&[f64], &[f64]),
+        (vorticity, divergence): (&[f64], &[f64]),
+    ) {
+        let (u_x, u_y) = u.split_at_mut(n * (n + 1));
+        let (y_x, y_y) = y_prev.split_at_mut(n * (n + 1));
+        let ((il_x, il_y), (id_x, id_y)) = (il.split_at(n * (n + 1)), id.split_at(n * (n + 1)));
+        // X-edge (i, y): tail the vertex (i, y + 1), head (i, y); from cell (i − 1, y)
+        // into (i, y) (padded row y + 1).
+        let (w, p) = (n + 1, n + 2);
+        let edges = u_x.chunks_exact_mut(w).zip(y_x.chunks_exact_mut(w));
+        let metric = il_x.chunks_exact(w).zip(id_x.chunks_exact(w));
+        let ends = vorticity
+            .chunks_exact(w)
+            .zip(vorticity[w..].chunks_exact(w));
+        let cells = divergence[p..].chunks_exact(p);
+        for (((u, y_prev), (il, id)), ((head, tail), d)) in edges.zip(metric).zip(ends.zip(cells)) {
+            self.row(u, y_prev, [head, tail], [&d[1..], d], [il, id]);
+        }
+        // Y-edge (x, j): tail the vertex (x, j), head (x + 1, j); from cell (x, j − 1)
+        // (padded row j) into (x, j).
+        let edges = u_y.chunks_exact_mut(n).zip(y_y.chunks_exact_mut(n));
+        let metric = il_y.chunks_exact(n).zip(id_y.chunks_exact(n));
+        let ends = vorticity.chunks_exact(w);
+        let cells = divergence[1..].chunks(p).zip(divergence[p + 1..].chunks(p));
+        for (((u, y_prev), (il, id)), (z, (from, into))) in edges.zip(metric).zip(ends.zip(cells)) {
+            self.row(u, y_prev, [&z[1..], z], [into, from], [il, id]);
+        }
+    }
+
+    /// A row of edges: the vorticities at their `[head, tail]`, the divergences of the
+    /// cells `[into, from]`, their `[1/length, 1/dual length]`. Each slice is an
+    /// argument of its own: the compiler then knows the outputs overlap no input, where
+    /// slices of the scratch's vectors cost it a run-time test of each pair every row.
+    #[inline(always)]
+    fn row(
+        self,
+        u: &mut [f64],
+        y_prev: &mut [f64],
+        [head, tail]: [&[f64]; 2],
+        [into, from]: [&[f64]; 2],
+        [il, id]: [&[f64]; 2],
+    ) {
+        let len = u.len();
+        let y_prev = &mut y_prev[..len];
+        let (head, tail, into, from) = (&head[..len], &tail[..len], &into[..len], &from[..len]);
+        let (il, id) = (&il[..len], &id[..len]);
+        for i in 0..len {
+            let curl_curl = (head[i] - tail[i]) * il[i];
+            let grad_div = (into[i] - from[i]) * id[i];
+            self.step(&mut u[i], &mut y_prev[i], curl_curl, grad_div);
         }
     }
 }
 
 /// The vorticity at each local vertex into `v.vorticity` and the divergence of each cell
-/// into `v.divergence`, of the edge velocities `u` (in the rows), on the unit sphere
-/// (m/s per rad). A cell's divergence sums its edges' `±u l` in the grid's edge order,
-/// `+` where the local normal points out of it (its right and top sides).
+/// into `v.divergence` (its halo too), of the edge velocities `u` (in the rows), on the unit sphere
+/// (m/s per rad). A cell's divergence sums its edges' `±u l` in the local order
+/// ([`SIDES`](super::face_rows::SIDES)), `+` where the local normal points out of it (its
+/// right and top sides): the faces' border cells whose edges the grid numbers otherwise
+/// too ([`FaceRows::irregular_cells`]), which taken apart in the grid's order cost a tenth
+/// of the viscous step, for sums that differ only in rounding.
 #[inline(always)]
 fn vorticity_and_divergence(grid: &CubeSphere, rows: &FaceRows, u: &[f64], v: &mut ViscousScratch) {
     rows.circulation(u, &mut v.vorticity, &rows.vertex_inverse_area, |z, ia| {
@@ -162,36 +216,53 @@ fn vorticity_and_divergence(grid: &CubeSphere, rows: &FaceRows, u: &[f64], v: &m
     });
     let n = rows.n;
     let divergence = &mut v.divergence;
-    divergence.resize(6 * n * n, 0.0);
-    let (l, ia) = (&rows.length, grid.inverse_areas_per_sr());
-    for f in 0..6 {
-        for y in 0..n {
-            let c = f * n * n + y * n;
-            let (ky, kx) = (rows.y_edge(f, 0, y), rows.x_edge(f, 0, y));
-            let (bottom, top) = (&u[ky..ky + n], &u[ky + n..ky + 2 * n]);
-            let (lb, lt) = (&l[ky..ky + n], &l[ky + n..ky + 2 * n]);
-            let (left, right) = (&u[kx..kx + n], &u[kx + 1..kx + n + 1]);
-            let (ll, lr) = (&l[kx..kx + n], &l[kx + 1..kx + n + 1]);
-            let (out, ia) = (&mut divergence[c..c + n], &ia[c..c + n]);
-            for x in 0..n {
-                let d =
-                    0.0 - bottom[x] * lb[x] - left[x] * ll[x] + right[x] * lr[x] + top[x] * lt[x];
-                out[x] = d * ia[x];
-            }
-        }
+    divergence.resize(6 * rows.padded_cells_per_face(), 0.0);
+    let (l, ia) = (&rows.length[..], grid.inverse_areas_per_sr());
+    let (epf, cpf) = (rows.edges_per_face(), rows.padded_cells_per_face());
+    let faces = u.chunks_exact(epf).zip(l.chunks_exact(epf));
+    let cells = ia.chunks_exact(n * n).zip(divergence.chunks_exact_mut(cpf));
+    for ((u, l), (ia, out)) in faces.zip(cells) {
+        divergence_face(n, u, l, ia, out);
     }
-    for cell in &rows.irregular_cells {
-        let mut d = 0.0;
-        for (side, k) in cell.order.into_iter().zip(cell.edges) {
-            let flux = u[k as usize] * l[k as usize];
-            if matches!(side, Side::Right | Side::Top) {
-                d += flux;
-            } else {
-                d -= flux;
-            }
-        }
-        let c = cell.cell as usize;
-        divergence[c] = d * ia[c];
+    for &[slot, across] in &rows.cell_halo {
+        divergence[slot as usize] = divergence[across as usize];
+    }
+}
+
+/// One face's divergences into its padded cells `out` (the halo left as it is), from
+/// its local edges' velocities `u` and lengths `l` and its cells' inverse areas `ia`, row
+/// by row from chunk iterators over the face (slicing each row from the whole arrays cost
+/// bounds checks and reloads of every base each row).
+#[inline(always)]
+fn divergence_face(n: usize, u: &[f64], l: &[f64], ia: &[f64], out: &mut [f64]) {
+    let ((ux, uy), (lx, ly)) = (u.split_at(n * (n + 1)), l.split_at(n * (n + 1)));
+    let x_sides = ux.chunks_exact(n + 1).zip(lx.chunks_exact(n + 1));
+    let bottoms = uy.chunks_exact(n).zip(ly.chunks_exact(n));
+    let tops = uy[n..].chunks_exact(n).zip(ly[n..].chunks_exact(n));
+    let cells = ia.chunks_exact(n).zip(out[n + 3..].chunks_mut(n + 2));
+    for (((x, b), t), (ia, out)) in x_sides.zip(bottoms).zip(tops).zip(cells) {
+        divergence_row(
+            &mut out[..n],
+            [b.0, x.0, &x.0[1..], t.0],
+            [b.1, x.1, &x.1[1..], t.1],
+            ia,
+        );
+    }
+}
+
+/// A row of cells' divergences into `out`, from their sides' velocities and lengths (in
+/// [`SIDES`](super::face_rows::SIDES) order) and inverse areas `ia`. `out` is an argument
+/// of its own: the compiler then knows it overlaps no input (a slice of the scratch's
+/// vector cost a run-time test against each input every row).
+#[inline(always)]
+fn divergence_row(out: &mut [f64], u: [&[f64]; 4], l: [&[f64]; 4], ia: &[f64]) {
+    let len = out.len();
+    let [bottom, left, right, top] = u.map(|u| &u[..len]);
+    let [lb, ll, lr, lt] = l.map(|l| &l[..len]);
+    let ia = &ia[..len];
+    for x in 0..len {
+        let d = 0.0 - bottom[x] * lb[x] - left[x] * ll[x] + right[x] * lr[x] + top[x] * lt[x];
+        out[x] = d * ia[x];
     }
 }
 
