@@ -26,7 +26,6 @@ mod dense;
 mod kernels;
 mod layout;
 
-use super::compare::larger;
 use super::grid::CubeSphere;
 use super::sides::{BOTTOM, CellSides, LEFT, RIGHT, TOP};
 use crate::avx2::with_avx2;
@@ -103,9 +102,12 @@ pub struct Hierarchy {
 /// in `f64` from the same `f64` direction and its `f64` product with `M`, so the
 /// answer's accuracy does not depend on the preconditioner's. `f32`'s narrower range is
 /// kept away from: the system enters the V-cycle scaled by a power of two that brings
-/// the finest level's largest diagonal entry to `[1, 2)`, and each right-hand side by
-/// one that brings its norm there (a power of two changes the exponent, not the bits of
-/// the rest), so no system or residual underflows or overflows in it.
+/// the first cell's diagonal entry to `[1, 2)`, and each right-hand side by one that
+/// brings its norm there (a power of two changes the exponent, not the bits of the rest,
+/// so which cell sets it changes no result), so no system or residual underflows or
+/// overflows in it: `f32` spans 2^±126, and a film's diagonal entries lie within a few
+/// powers of ten of one another (the cells' areas within 5.2×, their thickness floor
+/// [`H_FLOOR_M`](super::flow::H_FLOOR_M) keeping the weights finite).
 ///
 /// Every field here is in its level's split layout (`layout`); a field's cells outside
 /// the faces stay zero where the conjugate gradients' dot products would see them.
@@ -138,8 +140,6 @@ pub struct Work {
     row: Vec<f32>,
     /// One face row of the finest level's numbers.
     row64: Vec<f64>,
-    /// A level's diagonal `α + Σ w`, in `f64`.
-    diagonal: Vec<f64>,
     r: Vec<f64>,
     z: Vec<f64>,
     p: Vec<f64>,
@@ -396,9 +396,10 @@ impl Hierarchy {
         work.scale = if count == 1 {
             1.0
         } else {
-            diagonal(&work.mass[0], &work.stencil[0], &mut work.diagonal);
-            let largest = work.diagonal.iter().fold(0.0, |m, &d| larger(d, m));
-            power_of_two_below(largest).recip()
+            let first = self.levels[0].position[0] as usize;
+            let [w0, w1, w2, w3] = &work.stencil[0];
+            let diagonal = work.mass[0][first] + w0[first] + w1[first] + w2[first] + w3[first];
+            power_of_two_below(diagonal).recip()
         };
         self.round_for_the_v_cycle(work);
         let last = count - 1;
@@ -450,19 +451,30 @@ impl Hierarchy {
         work.stencil32.resize(smoothed, Stencil::default());
         for k in 0..smoothed {
             let (mass, stencil) = (&work.mass[k], &work.stencil[k]);
-            for (w32, w) in work.stencil32[k].iter_mut().zip(stencil) {
-                rounded(scale, w, w32);
+            let n = mass.len();
+            let mass = &mass[..n];
+            let [w0, w1, w2, w3] = stencil;
+            let (w0, w1, w2, w3) = (&w0[..n], &w1[..n], &w2[..n], &w3[..n]);
+            let [v0, v1, v2, v3] = &mut work.stencil32[k];
+            for v in [&mut *v0, &mut *v1, &mut *v2, &mut *v3] {
+                v.resize(n, 0.0);
             }
-            rounded(scale, mass, &mut work.mass32[k]);
-            if k > 0 {
-                diagonal(mass, stencil, &mut work.diagonal);
-            }
+            let (v0, v1, v2, v3) = (&mut v0[..n], &mut v1[..n], &mut v2[..n], &mut v3[..n]);
+            let mass32 = &mut work.mass32[k];
+            mass32.resize(n, 0.0);
             let inv_diag = &mut work.inv_diag[k];
-            inv_diag.resize(mass.len(), 0.0);
-            for (inv, &d) in inv_diag.iter_mut().zip(&work.diagonal) {
-                // The halo's zero diagonal stays a zero inverse.
-                let scaled = if d > 0.0 { scale * d } else { f64::INFINITY };
-                *inv = (1.0 / scaled) as f32;
+            inv_diag.resize(n, 0.0);
+            let (mass32, inv_diag) = (&mut mass32[..n], &mut inv_diag[..n]);
+            // One pass over the level's numbers (they are read once, not once an array).
+            for i in 0..n {
+                let d = mass[i] + w0[i] + w1[i] + w2[i] + w3[i];
+                (v0[i], v1[i]) = ((scale * w0[i]) as f32, (scale * w1[i]) as f32);
+                (v2[i], v3[i]) = ((scale * w2[i]) as f32, (scale * w3[i]) as f32);
+                mass32[i] = (scale * mass[i]) as f32;
+                // The halo's zero diagonal stays a zero inverse (a select, so the loop
+                // vectorises: the division by zero's infinity is dropped, not trapped).
+                let inv = (1.0 / (scale * d)) as f32;
+                inv_diag[i] = if d > 0.0 { inv } else { 0.0 };
             }
         }
     }
@@ -637,18 +649,6 @@ fn rounded(scale: f64, values: &[f64], out: &mut Vec<f32>) {
     out.resize(values.len(), 0.0);
     for (o, v) in out.iter_mut().zip(values) {
         *o = (scale * v) as f32;
-    }
-}
-
-/// `out` = each cell's diagonal entry `αᵢ + Σ wᵢⱼ` of a level's matrix (zero at the
-/// halo).
-#[inline(always)]
-fn diagonal(alpha: &[f64], [w0, w1, w2, w3]: &Stencil<f64>, out: &mut Vec<f64>) {
-    let n = alpha.len();
-    out.resize(n, 0.0);
-    let (w0, w1, w2, w3, out) = (&w0[..n], &w1[..n], &w2[..n], &w3[..n], &mut out[..n]);
-    for i in 0..n {
-        out[i] = alpha[i] + w0[i] + w1[i] + w2[i] + w3[i];
     }
 }
 
