@@ -81,6 +81,13 @@ pub struct EdgeArrays {
     pub centre_normal_gradient: Vec<DVec3>,
     /// Unit tangent normal to the edge at its midpoint, from `a` towards `b`.
     pub normal: Vec<DVec3>,
+    /// [`Self::normal`]'s x, y and z as arrays of their own, for the edge-run passes (a
+    /// pass that reads them as vectors cannot vectorise).
+    pub normal_xyz: [Vec<f64>; 3],
+    /// [`Self::centre_gradient`]'s components, likewise.
+    pub centre_gradient_xyz: [Vec<f64>; 3],
+    /// [`Self::centre_normal_gradient`]'s components, likewise.
+    pub centre_normal_gradient_xyz: [Vec<f64>; 3],
     /// `midpoint − centre_a` and `midpoint − centre_b`: how far a cell's value is carried
     /// to the edge by its gradient.
     pub reach: Vec<[DVec3; 2]>,
@@ -97,7 +104,7 @@ impl EdgeArrays {
         let smaller_area = |e: &GridEdge| areas_sr[e.a as usize].min(areas_sr[e.b as usize]);
         let skew: Vec<[f64; 2]> = edges.iter().map(|e| skew_weights(e, centres)).collect();
         let at_vertex = |v: u32| to_vertices.apply_vec(v as usize, centres);
-        Self {
+        let mut arrays = Self {
             inverse_normal_dual_length: skew.iter().map(|w| w[0]).collect(),
             cross_per_length: skew.iter().map(|w| w[1]).collect(),
             length_per_smaller_area: edges.iter().map(|e| e.length / smaller_area(e)).collect(),
@@ -124,8 +131,27 @@ impl EdgeArrays {
                 .iter()
                 .map(|e| [e.midpoint - centre(e.a), e.midpoint - centre(e.b)])
                 .collect(),
-        }
+            normal_xyz: Default::default(),
+            centre_gradient_xyz: Default::default(),
+            centre_normal_gradient_xyz: Default::default(),
+        };
+        arrays.normal_xyz = components(&arrays.normal);
+        arrays.centre_gradient_xyz = components(&arrays.centre_gradient);
+        arrays.centre_normal_gradient_xyz = components(&arrays.centre_normal_gradient);
+        arrays
     }
+}
+
+/// The x, y and z of `vectors`, each as an array.
+fn components(vectors: &[DVec3]) -> [Vec<f64>; 3] {
+    std::array::from_fn(|k| vectors.iter().map(|v| v[k]).collect())
+}
+
+/// `g·v` for the vector `v` given by its components `xyz` at index `i`, in the order
+/// of `DVec3::dot` (the same bits).
+#[inline(always)]
+pub(crate) fn dot_at(g: DVec3, [x, y, z]: [&[f64]; 3], i: usize) -> f64 {
+    (g.x * x[i] + g.y * y[i]) + g.z * z[i]
 }
 
 /// A gnomonic cube-sphere of `6·n²` cells on the unit sphere.

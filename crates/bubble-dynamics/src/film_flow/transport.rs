@@ -12,6 +12,7 @@ use glam::DVec3;
 use super::compare::larger;
 use super::flow::{FilmFlow, Scratch};
 use super::fluxes::apply_limited;
+use super::grid::dot_at;
 use super::upwind;
 use crate::avx2::with_avx2;
 
@@ -29,13 +30,7 @@ impl FilmFlow {
         } else {
             0.0
         };
-        // The drainage flux's coefficient `c = drain·g_eff·n` of every edge, fixed over
-        // the step: each sub-step's flux is `u·h + c·h³`.
-        let ea = self.grid.edge_arrays();
-        s.drain_rate.clear();
-        s.drain_rate
-            .extend(ea.normal.iter().map(|normal| drain * g_eff.dot(*normal)));
-        let courant = self.courant_number(&s.drain_rate, dt_s);
+        let courant = self.drain_rates_and_courant(&mut s.drain_rate, drain, g_eff, dt_s);
         // A cell drains through at most two edges of a smooth flow: 2·courant per step, kept
         // within one sub-step's content; the outflow limit guards the rest.
         let substeps = (2.0 * courant).ceil().clamp(1.0, f64::from(MAX_SUBSTEPS)) as u32;
@@ -45,28 +40,51 @@ impl FilmFlow {
         }
     }
 
-    /// The largest fraction of a cell's width any edge's characteristic speed, `|u|` plus
-    /// the drainage's `3|c|h²`, carries over `dt_s`.
-    fn courant_number(&self, drain_rate: &[f64], dt_s: f64) -> f64 {
+    /// Each edge's drainage coefficient `c = drain·g_eff·n` into `drain_rate` (fixed over
+    /// the step: each sub-step's flux is `u·h + c·h³`), and the largest fraction of a
+    /// cell's width any edge's characteristic speed, `|u|` plus the drainage's `3|c|h²`,
+    /// carries over `dt_s`: one pass over the edges.
+    fn drain_rates_and_courant(
+        &self,
+        drain_rate: &mut Vec<f64>,
+        drain: f64,
+        g_eff: DVec3,
+        dt_s: f64,
+    ) -> f64 {
         let ea = self.grid.edge_arrays();
         let (h, u) = (&self.h_m, &self.u_m_per_s);
-        // Four running maxima, lane by lane, so the loop vectorises (a maximum is exact in
-        // any order: the same number as one running maximum).
+        // Every entry is written below: the buffer needs its length, not a fill.
+        drain_rate.resize(u.len(), 0.0);
+        // Four running maxima, lane by lane in chunks of four, so the loop vectorises (a
+        // maximum is exact in any order: the same number as one running maximum).
         let mut lanes = [0.0; 4];
         self.sides.for_each_edge_run(
             #[inline(always)]
             |run| {
                 let len = run.len;
                 let (ha, hb) = run.ends(h);
-                let (ha, hb) = (&ha[..len], &hb[..len]);
-                let (u, c) = (run.along(u), run.along(drain_rate));
-                let per_area = run.along(&ea.length_per_smaller_area);
-                for i in 0..len {
-                    let h = larger(hb[i], ha[i]);
-                    let speed = (u[i].abs() + 3.0 * c[i].abs() * h * h) * per_area[i];
-                    // Skips a NaN speed as `max` does.
-                    lanes[i % 4] = larger(speed, lanes[i % 4]);
+                let (ha, hb, u) = (&ha[..len], &hb[..len], &run.along(u)[..len]);
+                let per_area = &run.along(&ea.length_per_smaller_area)[..len];
+                let normal = ea.normal_xyz.each_ref().map(|x| &run.along(x)[..len]);
+                let c = &mut run.along_mut(drain_rate)[..len];
+                for (i, c) in c.iter_mut().enumerate() {
+                    *c = drain * dot_at(g_eff, normal, i);
                 }
+                // A local copy: kept in registers, where the captured array was stored to
+                // memory edge by edge.
+                let mut acc = lanes;
+                let c: &[f64] = c;
+                let ends = quads(ha).zip(quads(hb));
+                let speeds = quads(u).zip(quads(c)).zip(quads(per_area));
+                for ((ha, hb), ((u, c), pa)) in ends.zip(speeds) {
+                    for (k, lane) in acc.iter_mut().enumerate() {
+                        *lane = larger(edge_speed(u[k], c[k], ha[k], hb[k], pa[k]), *lane);
+                    }
+                }
+                for i in len / 4 * 4..len {
+                    acc[0] = larger(edge_speed(u[i], c[i], ha[i], hb[i], per_area[i]), acc[0]);
+                }
+                lanes = acc;
             },
         );
         let fastest = lanes.into_iter().fold(0.0, |a, b| larger(b, a));
@@ -98,4 +116,19 @@ impl FilmFlow {
             },
         )
     }
+}
+
+/// An edge's characteristic speed over its smaller cell's width: `|u|` plus the
+/// drainage's `3|c|h²` at the thicker end, times `length/smaller area` (NaN skipped by
+/// the maximum that takes it, as `max` does).
+#[inline(always)]
+fn edge_speed(u: f64, c: f64, ha: f64, hb: f64, per_area: f64) -> f64 {
+    let h = larger(hb, ha);
+    (u.abs() + 3.0 * c.abs() * h * h) * per_area
+}
+
+/// A slice in chunks of four (lanes of one AVX2 register).
+#[inline(always)]
+fn quads(x: &[f64]) -> std::slice::ChunksExact<'_, f64> {
+    x.chunks_exact(4)
 }
