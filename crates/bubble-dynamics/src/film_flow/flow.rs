@@ -20,7 +20,7 @@ use super::burst::{BurstParams, BurstState, Hole};
 use super::capillary::{Capillary, CapillaryScratch, smooth_thickness};
 use super::compare::larger;
 use super::face_rows::FaceRows;
-use super::grid::CubeSphere;
+use super::grid::{CubeSphere, dot_at};
 use super::meniscus::MeniscusState;
 use super::sides::CellSides;
 use super::solve::{Hierarchy, SolveReport, Work};
@@ -459,15 +459,9 @@ impl FilmFlow {
         };
         let ea = self.grid.edge_arrays();
         let slopes = match p.gradient {
-            FilmGradient::TwoPoint => &ea.centre_gradient,
-            FilmGradient::Normal => &ea.centre_normal_gradient,
+            FilmGradient::TwoPoint => &ea.centre_gradient_xyz,
+            FilmGradient::Normal => &ea.centre_normal_gradient_xyz,
         };
-        // The potential flow's surface velocity is the gradient of 1.5 U·x: taken as the
-        // discrete gradient between cell centres, curl-free like the real one. (Its own
-        // pass: the slopes are vectors, which the edge runs below would read strided.)
-        let outside = &mut s.edge;
-        outside.clear();
-        outside.extend(slopes.iter().map(|slope| 1.5 * air_m_per_s.dot(*slope)));
         let per_layer = p.air_viscosity_pa_s / p.density_kg_per_m3;
         let sides = &self.sides;
         sides.for_each_edge_run(
@@ -475,16 +469,21 @@ impl FilmFlow {
             |run| {
                 let len = run.len;
                 let (ha, hb) = run.ends(&self.h_m);
-                let (ha, hb, outside) = (&ha[..len], &hb[..len], run.along(&s.edge));
-                let u = run.along_mut(&mut self.u_m_per_s);
-                let factor = run.along_mut(&mut s.drag);
+                let (ha, hb) = (&ha[..len], &hb[..len]);
+                let slopes = slopes.each_ref().map(|x| &run.along(x)[..len]);
+                let u = &mut run.along_mut(&mut self.u_m_per_s)[..len];
+                let factor = &mut run.along_mut(&mut s.drag)[..len];
                 for i in 0..len {
+                    // The potential flow's surface velocity is the gradient of 1.5 U·x:
+                    // taken as the discrete gradient between cell centres, curl-free like
+                    // the real one.
+                    let outside = 1.5 * dot_at(air_m_per_s, slopes, i);
                     let h = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
                     let k = per_layer / h;
-                    let k_out = k * per_layer_depth((u[i] - outside[i]).abs());
+                    let k_out = k * per_layer_depth((u[i] - outside).abs());
                     let k_in = k * per_layer_depth(u[i].abs());
                     factor[i] = 1.0 / (1.0 + dt_s * (k_out + k_in));
-                    u[i] = (u[i] + dt_s * k_out * outside[i]) * factor[i];
+                    u[i] = (u[i] + dt_s * k_out * outside) * factor[i];
                 }
             },
         );
