@@ -13,7 +13,7 @@
 //! keep the exact law. Fluxes that sum to zero keep liquid conserved to rounding, each
 //! donor limited to half its content keeps h ≥ 0.
 
-use super::compare::smaller;
+use super::compare::{largest, pick, smaller};
 use super::fluxes::{apply_limited, net_inflow};
 use super::grid::CubeSphere;
 use super::sides::CellSides;
@@ -70,7 +70,7 @@ pub(crate) fn smooth_thickness(
             norm
         }
     };
-    let thickest = h_m.iter().copied().fold(0.0, f64::max);
+    let thickest = largest(h_m);
     let max_mobility = per_cubed * thickest * thickest * thickest;
     let rate = max_mobility * (norm / (c.radius_m * c.radius_m)).powi(2);
     if rate * dt_s < 1e-3 {
@@ -165,7 +165,7 @@ fn substep(
             let (l, per_d, out) = (&l[..len], &per_d[..len], run.along_mut(&mut s.flux));
             for i in 0..len {
                 let rise = lb[i] - la[i];
-                let donor = if rise >= 0.0 { ha[i] } else { hb[i] };
+                let donor = pick(rise >= 0.0, ha[i], hb[i]);
                 let m = smaller(per_cubed * donor * donor * donor, cap);
                 out[i] = m * rise * per_d[i] * l[i] * per_length;
             }

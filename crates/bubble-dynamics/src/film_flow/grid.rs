@@ -11,6 +11,9 @@ use std::collections::HashMap;
 
 use glam::{DMat3, DVec3, IVec3};
 
+use super::compare::larger;
+use crate::avx2::with_avx2;
+
 /// Major axis, `s` axis and `t` axis of each face (OpenGL cube-map order).
 pub const FACE_BASES: [(IVec3, IVec3, IVec3); 6] = [
     (IVec3::X, IVec3::NEG_Z, IVec3::NEG_Y),
@@ -373,11 +376,25 @@ impl CubeSphere {
     /// (m/s): times a step over the radius, the largest fraction of a cell any edge
     /// carries (a Courant number).
     pub fn fastest_crossing(&self, u_m_per_s: &[f64]) -> f64 {
-        u_m_per_s
-            .iter()
-            .zip(&self.edge_arrays.length_per_smaller_area)
-            .map(|(u, per_area)| u.abs() * per_area)
-            .fold(0.0, f64::max)
+        let per_area = &self.edge_arrays.length_per_smaller_area;
+        let n = u_m_per_s.len().min(per_area.len());
+        let (u, per_area) = (&u_m_per_s[..n], &per_area[..n]);
+        // Four running maxima in chunks of four, which vectorise (a maximum is exact in
+        // any order; NaN skipped, as `f64::max` does).
+        with_avx2(
+            #[inline(always)]
+            || {
+                let mut lanes = [0.0; 4];
+                for (u, a) in u.chunks_exact(4).zip(per_area.chunks_exact(4)) {
+                    for k in 0..4 {
+                        lanes[k] = larger(u[k].abs() * a[k], lanes[k]);
+                    }
+                }
+                let rest = (n / 4 * 4..n).map(|i| u[i].abs() * per_area[i]);
+                let fastest = rest.fold(0.0, |a, b| larger(b, a));
+                lanes.into_iter().fold(fastest, |a, b| larger(b, a))
+            },
+        )
     }
 
     /// Dual area of each grid vertex (a quarter of each cell around it), sr.

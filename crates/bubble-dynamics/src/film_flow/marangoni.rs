@@ -10,7 +10,7 @@
 //! velocity correction with the surfactant's move (into a copy, so the correction still
 //! reads the surfactant the solve started from and the rare redo needs no restore).
 
-use super::compare::larger;
+use super::compare::{larger, pick};
 use super::flow::{
     FilmFlow, FilmGradient, H_FLOOR_M, SOLVE_MAX_ITERATIONS, SOLVE_TOLERANCE, Scratch,
 };
@@ -409,7 +409,7 @@ fn upwind_fluxes(sides: &CellSides, ea: &EdgeArrays, gamma: &[f64], u: &[f64], o
             let (u, l, f) = (run.along(u), run.along(&ea.length), run.along_mut(out));
             let (ga, gb, u, l) = (&ga[..len], &gb[..len], &u[..len], &l[..len]);
             for i in 0..len {
-                f[i] = if u[i] >= 0.0 { ga[i] } else { gb[i] } * u[i] * l[i];
+                f[i] = pick(u[i] >= 0.0, ga[i], gb[i]) * u[i] * l[i];
             }
         },
     )
