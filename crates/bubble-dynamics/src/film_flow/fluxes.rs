@@ -39,9 +39,9 @@ pub(crate) fn net_inflow(sides: &CellSides, volume: &[f64], out: &mut Vec<f64>) 
                     o[i] = net([v0[i], v1[i], v2[i], v3[i]], INFLOW);
                 }
             }
-            for &c in &sides.rim_cells {
-                let c = c as usize;
-                out[c] = net(sides.edge[c].map(|e| volume[e as usize]), sides.inflow(c));
+            let rim = sides.rim();
+            for (i, &c) in rim.cells.iter().enumerate() {
+                out[c as usize] = net(rim.at_edges(i, volume), rim.inflow(i));
             }
         },
     )
@@ -109,10 +109,10 @@ fn outflow_ratios(
             o[i] = outflow_factor([v0[i], v1[i], v2[i], v3[i]], INFLOW, scale, a[i], x[i]);
         }
     }
-    for &c in &sides.rim_cells {
-        let c = c as usize;
-        let v = sides.edge[c].map(|e| volume[e as usize]);
-        out[c] = outflow_factor(v, sides.inflow(c), scale, areas[c], values[c]);
+    let rim = sides.rim();
+    for (i, &c) in rim.cells.iter().enumerate() {
+        let (v, c) = (rim.at_edges(i, volume), c as usize);
+        out[c] = outflow_factor(v, rim.inflow(i), scale, areas[c], values[c]);
     }
 }
 
@@ -153,11 +153,11 @@ fn gather_limited(
             x[i] += scale * gained(v, INFLOW, across, own[i]) * pa[i];
         }
     }
-    for &c in &sides.rim_cells {
+    let rim = sides.rim();
+    for (i, &c) in rim.cells.iter().enumerate() {
+        let (v, across) = (rim.at_edges(i, volume), rim.at_neighbours(i, ratio));
         let c = c as usize;
-        let v = sides.edge[c].map(|e| volume[e as usize]);
-        let across = sides.neighbour[c].map(|j| ratio[j as usize]);
-        values[c] += scale * gained(v, sides.inflow(c), across, ratio[c]) * per_area[c];
+        values[c] += scale * gained(v, rim.inflow(i), across, ratio[c]) * per_area[c];
     }
 }
 

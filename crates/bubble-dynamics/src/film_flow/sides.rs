@@ -47,10 +47,60 @@ pub(crate) struct CellSides {
     /// leave them out, and passes take them one by one through the tables (as runs of
     /// one they cost as much as the whole inside, each run's slices set up for a cell).
     pub(crate) rim_cells: Vec<u32>,
+    /// The rim cells' tables side by side, in the order of `rim_cells` ([`Rim`]).
+    rim_tables: RimTables,
     /// Every edge once, in increasing order, as runs: each face row's x-edges, each
     /// face's y-edges ([`EdgeRun`]), then each seam edge alone (the seams are few beside
     /// the faces' edges).
     pub(crate) edge_runs: Vec<EdgeRun>,
+}
+
+/// The rim cells' neighbours, edges and inflow signs, one array a side in the order of
+/// [`CellSides::rim_cells`]: a rim pass reads each in order (the per-cell tables put a
+/// cell's four sides together, which a pass over the rim strides through).
+#[derive(Clone, Debug, Default)]
+struct RimTables {
+    neighbour: [Vec<u32>; 4],
+    edge: [Vec<u32>; 4],
+    inflow: [Vec<f64>; 4],
+}
+
+/// [`RimTables`] as slices of one length, so that a pass indexes them without checks.
+#[derive(Clone, Copy)]
+pub(crate) struct Rim<'a> {
+    /// The rim cells.
+    pub(crate) cells: &'a [u32],
+    /// Per side: each rim cell's neighbour.
+    neighbour: [&'a [u32]; 4],
+    /// Per side: each rim cell's edge.
+    edge: [&'a [u32]; 4],
+    /// Per side: the sign of a volume across it in the cell's inflow.
+    inflow: [&'a [f64]; 4],
+}
+
+impl Rim<'_> {
+    /// A per-edge array's values on rim cell `i`'s four sides.
+    #[inline(always)]
+    pub(crate) fn at_edges(&self, i: usize, per_edge: &[f64]) -> [f64; 4] {
+        let e = &self.edge;
+        let at = |k: usize| per_edge[e[k][i] as usize];
+        [at(0), at(1), at(2), at(3)]
+    }
+
+    /// A cell field's values at rim cell `i`'s four neighbours.
+    #[inline(always)]
+    pub(crate) fn at_neighbours(&self, i: usize, per_cell: &[f64]) -> [f64; 4] {
+        let nb = &self.neighbour;
+        let at = |k: usize| per_cell[nb[k][i] as usize];
+        [at(0), at(1), at(2), at(3)]
+    }
+
+    /// The signs of rim cell `i`'s sides' volumes in its inflow.
+    #[inline(always)]
+    pub(crate) fn inflow(&self, i: usize) -> [f64; 4] {
+        let s = &self.inflow;
+        [s[0][i], s[1][i], s[2][i], s[3][i]]
+    }
 }
 
 /// Consecutive cells inside a face: their neighbours and edges on each side are
@@ -174,9 +224,11 @@ impl CellSides {
             is_a,
             cell_runs: Vec::new(),
             rim_cells: Vec::new(),
+            rim_tables: RimTables::default(),
             edge_runs: Vec::new(),
         };
         (sides.cell_runs, sides.rim_cells) = sides.find_cell_runs();
+        sides.rim_tables = sides.rim_tables();
         sides.edge_runs = face_edge_runs(grid);
         sides.edge_runs.extend(seams);
         sides
@@ -205,6 +257,36 @@ impl CellSides {
             }
         }
         (runs, rim)
+    }
+
+    /// The rim cells' tables side by side ([`RimTables`]).
+    fn rim_tables(&self) -> RimTables {
+        let rim = &self.rim_cells;
+        let side = |table: &[[u32; 4]], k: usize| -> Vec<u32> {
+            rim.iter().map(|&c| table[c as usize][k]).collect()
+        };
+        RimTables {
+            neighbour: std::array::from_fn(|k| side(&self.neighbour, k)),
+            edge: std::array::from_fn(|k| side(&self.edge, k)),
+            inflow: std::array::from_fn(|k| {
+                rim.iter().map(|&c| self.inflow(c as usize)[k]).collect()
+            }),
+        }
+    }
+
+    /// The rim cells and their tables as slices of one length ([`Rim`]).
+    #[inline(always)]
+    pub(crate) fn rim(&self) -> Rim<'_> {
+        let (t, m) = (&self.rim_tables, self.rim_cells.len());
+        let [n0, n1, n2, n3] = &t.neighbour;
+        let [e0, e1, e2, e3] = &t.edge;
+        let [s0, s1, s2, s3] = &t.inflow;
+        Rim {
+            cells: &self.rim_cells[..m],
+            neighbour: [&n0[..m], &n1[..m], &n2[..m], &n3[..m]],
+            edge: [&e0[..m], &e1[..m], &e2[..m], &e3[..m]],
+            inflow: [&s0[..m], &s1[..m], &s2[..m], &s3[..m]],
+        }
     }
 
     /// The sign of each side's volume in cell `c`'s inflow (as [`INFLOW`] inside a face).

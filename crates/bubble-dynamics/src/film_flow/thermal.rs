@@ -173,9 +173,11 @@ impl FilmFlow {
         let (sides, ea) = (&self.sides, self.grid.edge_arrays());
         let per_area = self.grid.inverse_areas_per_sr();
         for _ in 0..substeps {
-            before.clear();
-            before.extend_from_slice(&self.temperature_k);
-            let theta = &mut self.temperature_k;
+            // Every cell is written below from `before`: the two buffers trade places
+            // where the temperature was copied.
+            before.resize(self.temperature_k.len(), 0.0);
+            std::mem::swap(before, &mut self.temperature_k);
+            let (theta, before) = (&mut self.temperature_k, &*before);
             // Each cell gathers what flows in over its four sides (the edges scattered
             // into their downwind cells before: the same terms, summed cell by cell).
             with_avx2(
@@ -199,14 +201,15 @@ impl FilmFlow {
                             out[i] = own[i] + sides.warming(scale * pa[i], across, own[i]);
                         }
                     }
-                    for &c in &sides.rim_cells {
+                    let rim = sides.rim();
+                    for (i, &c) in rim.cells.iter().enumerate() {
                         let c = c as usize;
                         let inflow = Inflow {
-                            u: sides.edge[c].map(|e| u[e as usize]),
-                            length: sides.edge[c].map(|e| ea.length[e as usize]),
-                            inflow: sides.inflow(c),
+                            u: rim.at_edges(i, u),
+                            length: rim.at_edges(i, &ea.length),
+                            inflow: rim.inflow(i),
                         };
-                        let across = sides.neighbour[c].map(|j| before[j as usize]);
+                        let across = rim.at_neighbours(i, before);
                         theta[c] =
                             before[c] + inflow.warming(scale * per_area[c], across, before[c]);
                     }
