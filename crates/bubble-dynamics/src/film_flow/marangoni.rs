@@ -18,6 +18,7 @@ use super::fluxes::{apply_limited, net_inflow};
 use super::grid::EdgeArrays;
 use super::sides::{CellSides, EdgeRun};
 use super::solve::{SolveLimits, SolveReport};
+use crate::avx2::with_avx2;
 
 /// Most solves a step's defect correction of the cross term takes (it takes about 11 on
 /// the swirl film at n = 64: each cuts the error by about 0.35, the cross operator's
@@ -51,10 +52,6 @@ impl FilmFlow {
                 self.correct_the_cross_term(s, dt_s, first)
             }
         };
-        // The step's change of Γ: the next step's first guess.
-        self.surfactant_change.clear();
-        let changes = s.cell2.iter().zip(&self.gamma).map(|(x, gm)| x - gm);
-        self.surfactant_change.extend(changes);
         match self.params.gradient {
             FilmGradient::TwoPoint => self.correct_velocity_and_move_surfactant::<false>(s, dt_s),
             FilmGradient::Normal => self.correct_velocity_and_move_surfactant::<true>(s, dt_s),
@@ -148,10 +145,16 @@ impl FilmFlow {
         // `A Γ − dt Σ F/R`: each cell's net inflow of the fluxes, gathered.
         net_inflow(sides, &s.edge, &mut s.rhs);
         let dt_per_r = dt_s / p.radius_m;
-        let cells = s.rhs.iter_mut().zip(g.areas_sr()).zip(&self.gamma);
-        for ((rhs, area), gamma) in cells {
-            *rhs = area * gamma + dt_per_r * *rhs;
-        }
+        let n = s.rhs.len();
+        let (rhs, areas, gamma) = (&mut s.rhs[..], &g.areas_sr()[..n], &self.gamma[..n]);
+        with_avx2(
+            #[inline(always)]
+            || {
+                for i in 0..n {
+                    rhs[i] = areas[i] * gamma[i] + dt_per_r * rhs[i];
+                }
+            },
+        );
     }
 
     /// [`Self::fluxes_weights_and_right_hand_side`]'s edge pass over one run of edges.
@@ -204,13 +207,8 @@ impl FilmFlow {
     /// to step; the tolerance stays relative to Γⁿ's residual).
     fn solve_surfactant(&self, s: &mut Scratch) -> SolveReport {
         let g = &self.grid;
-        let guess = &mut s.guess;
-        guess.clear();
-        let change = &self.surfactant_change;
-        guess.extend(self.gamma.iter().zip(change).map(|(gm, d)| gm + d));
-        let solution = &mut s.cell2;
-        solution.clear();
-        solution.extend_from_slice(&self.gamma);
+        let (guess, solution) = (&mut s.guess, &mut s.cell2);
+        start_and_guess(&self.gamma, &self.surfactant_change, solution, guess);
         self.hierarchy.solve_with_guess(
             &mut s.work,
             g.areas_sr(),
@@ -319,15 +317,9 @@ impl FilmFlow {
             },
         );
         net_inflow(sides, &s.edge2, &mut s.rhs);
-        let cells = s
-            .rhs
-            .iter_mut()
-            .zip(&self.gamma)
-            .zip(g.inverse_areas_per_sr());
-        for ((next, gamma), per_area) in cells {
-            *next = gamma + *next * per_area;
-        }
-        if !s.rhs.iter().any(|&x| x < 0.0) {
+        let per_area = g.inverse_areas_per_sr();
+        let change = &mut self.surfactant_change;
+        if !next_surfactant(&self.gamma, &s.cell2, per_area, &mut s.rhs, change) {
             std::mem::swap(&mut self.gamma, &mut s.rhs);
             return;
         }
@@ -385,6 +377,59 @@ impl FilmFlow {
             moved[i] = scale * (f_adv[i] + gamma_c * du * l[i]);
         }
     }
+}
+
+/// The surfactant a solve starts from (`gamma`, into `solution`) and its first guess, the
+/// start plus the last step's `change` (none before the first step), in one pass.
+fn start_and_guess(gamma: &[f64], change: &[f64], solution: &mut Vec<f64>, guess: &mut Vec<f64>) {
+    let n = gamma.len();
+    // Every entry is written below: the buffers need their lengths, not a fill.
+    solution.resize(n, 0.0);
+    if change.len() != n {
+        guess.clear();
+        solution.copy_from_slice(gamma);
+        return;
+    }
+    guess.resize(n, 0.0);
+    let (solution, guess, change) = (&mut solution[..n], &mut guess[..n], &change[..n]);
+    with_avx2(
+        #[inline(always)]
+        || {
+            for i in 0..n {
+                solution[i] = gamma[i];
+                guess[i] = gamma[i] + change[i];
+            }
+        },
+    );
+}
+
+/// Each cell's surfactant after the step, `Γ + inflow/area` (`next` holds the inflows and
+/// takes the result), and the step's change of the solve, `solution − Γ` (the next
+/// step's first guess), in one pass; returns whether any cell went negative.
+fn next_surfactant(
+    gamma: &[f64],
+    solution: &[f64],
+    per_area: &[f64],
+    next: &mut [f64],
+    change: &mut Vec<f64>,
+) -> bool {
+    let n = gamma.len();
+    // Every entry is written below: the buffer needs its length, not a fill.
+    change.resize(n, 0.0);
+    let (solution, per_area) = (&solution[..n], &per_area[..n]);
+    let (next, change) = (&mut next[..n], &mut change[..n]);
+    with_avx2(
+        #[inline(always)]
+        || {
+            let mut negative = false;
+            for i in 0..n {
+                change[i] = solution[i] - gamma[i];
+                next[i] = gamma[i] + next[i] * per_area[i];
+                negative |= next[i] < 0.0;
+            }
+            negative
+        },
+    )
 }
 
 /// The constants of the Marangoni step's edge pass.
