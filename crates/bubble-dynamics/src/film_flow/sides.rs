@@ -134,6 +134,40 @@ impl CellRun {
     }
 }
 
+/// A face's interior rows as one stretch of consecutive cells, from its first interior
+/// cell to its last: the rim cells at the rows' ends lie among them. Inside the stretch
+/// every cell's neighbours sit at `∓1` and `∓n` (for a rim cell those are not its
+/// neighbours but are cells), so a pass that reads only its cells' neighbours, not their
+/// edges (the x-edges are `n − 1` a row), can take a face as one run and then redo the
+/// rim through the tables: one run a face instead of one a row.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct CellSpan {
+    /// The first cell.
+    pub(crate) start: usize,
+    /// How many cells.
+    pub(crate) len: usize,
+    /// Cells along a face edge.
+    n: usize,
+}
+
+impl CellSpan {
+    /// The span's cells.
+    pub(crate) fn cells(&self) -> std::ops::Range<usize> {
+        self.start..self.start + self.len
+    }
+
+    /// The cells at the layout's offset on side `k` from the span's cells.
+    pub(crate) fn neighbours(&self, k: usize) -> std::ops::Range<usize> {
+        let first = match k {
+            LEFT => self.start - 1,
+            RIGHT => self.start + 1,
+            BOTTOM => self.start - self.n,
+            _ => self.start + self.n,
+        };
+        first..first + self.len
+    }
+}
+
 /// Consecutive edges whose `a` cells and `b` cells are consecutive too.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct EdgeRun {
@@ -289,6 +323,18 @@ impl CellSides {
         }
     }
 
+    /// Each face's [`CellSpan`] (none where a face has no interior, `n < 3`).
+    pub(crate) fn face_spans(&self) -> impl Iterator<Item = CellSpan> {
+        let n = self.n();
+        let len = (n * n).saturating_sub(2 * n + 2);
+        let spans = (0..6).map(move |face| CellSpan {
+            start: face * n * n + n + 1,
+            len,
+            n,
+        });
+        spans.filter(|span| span.len > 0)
+    }
+
     /// The sign of each side's volume in cell `c`'s inflow (as [`INFLOW`] inside a face).
     pub(crate) fn inflow(&self, c: usize) -> [f64; 4] {
         self.is_a[c].map(|a| if a { -1.0 } else { 1.0 })
@@ -404,7 +450,31 @@ mod tests {
                 .filter(|r| r.start >= layout.first_seam_edge());
             assert_eq!(seams.count(), 12 * n);
             runs_cover_everything_once(&grid, &sides);
+            spans_hold_every_inside_cell_with_its_neighbours(&sides);
         }
+    }
+
+    /// Every cell of a row run lies in a face span, with the neighbours the span gives it
+    /// its own, and whatever else a span holds is on the rim.
+    fn spans_hold_every_inside_cell_with_its_neighbours(sides: &CellSides) {
+        let spans: Vec<CellSpan> = sides.face_spans().collect();
+        let mut inside = 0;
+        for span in &spans {
+            for (i, c) in span.cells().enumerate() {
+                let in_run = sides.cell_runs.iter().any(|r| r.cells().contains(&c));
+                if !in_run {
+                    assert!(sides.rim_cells.contains(&(c as u32)), "cell {c}");
+                    continue;
+                }
+                inside += 1;
+                for k in 0..4 {
+                    let nb = span.neighbours(k).start + i;
+                    assert_eq!(nb, sides.neighbour[c][k] as usize, "cell {c} side {k}");
+                }
+            }
+        }
+        let runs: usize = sides.cell_runs.iter().map(|r| r.len).sum();
+        assert_eq!(inside, runs);
     }
 
     /// Every cell lies in exactly one run or on the rim, every edge inside a face in

@@ -12,7 +12,7 @@
 
 use super::compare::{larger, smaller};
 use super::grid::{CubeSphere, EdgeArrays};
-use super::sides::{CellRun, CellSides};
+use super::sides::{CellSides, CellSpan};
 
 /// The transport's weights, fixed by the grid.
 #[derive(Clone, Debug)]
@@ -111,10 +111,12 @@ pub(crate) fn limited_rises(
     for o in out.iter_mut() {
         o.resize(h.len(), 0.0);
     }
-    for run in &sides.cell_runs {
-        let cells = run.cells();
+    // A face at a time, its rim cells among the rest ([`CellSpan`]): they are redone
+    // below, and the runs' set-up and odd ends, row by row, cost a third of the pass.
+    for span in sides.face_spans() {
+        let cells = span.cells();
         let [o0, o1, o2, o3] = out.each_mut().map(|o| &mut o[cells.clone()]);
-        rises_run(geo, h, run, [o0, o1, o2, o3]);
+        rises_run(geo, h, span, [o0, o1, o2, o3]);
     }
     let rim = sides.rim();
     let weights = &geo.rim_rise[..rim.cells.len()];
@@ -144,7 +146,7 @@ fn rise_of(w: [f64; 4], h: f64, nb: [f64; 4]) -> f64 {
 /// their own, then the limit (one loop over all sixteen weights kept the compiler from
 /// vectorising it: it spilled them to the stack cell by cell).
 #[inline(always)]
-fn rises_run(geo: &UpwindGeometry, h: &[f64], run: &CellRun, mut out: [&mut [f64]; 4]) {
+fn rises_run(geo: &UpwindGeometry, h: &[f64], run: CellSpan, mut out: [&mut [f64]; 4]) {
     let (len, cells) = (run.len, run.cells());
     let centre = &h[cells.clone()];
     let nb: [&[f64]; 4] = std::array::from_fn(|j| &h[run.neighbours(j)]);
