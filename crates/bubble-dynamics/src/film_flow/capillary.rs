@@ -14,7 +14,7 @@
 //! donor limited to half its content keeps h ≥ 0.
 
 use super::compare::{largest, pick, smaller};
-use super::fluxes::{apply_limited, net_inflow};
+use super::fluxes::{GatherScratch, apply_limited, net_inflow};
 use super::grid::CubeSphere;
 use super::sides::CellSides;
 
@@ -47,7 +47,7 @@ pub(crate) struct CapillaryScratch {
     laplacian_norm: Option<(usize, f64)>,
     laplacian: Vec<f64>,
     flux: Vec<f64>,
-    outflow: Vec<f64>,
+    gather: GatherScratch,
 }
 
 /// Moves liquid by the capillary pressure over `dt_s`; `h_m` per cell.
@@ -138,7 +138,7 @@ fn substep(
             }
         },
     );
-    net_inflow(sides, &s.flux, &mut s.laplacian);
+    net_inflow(sides, &s.flux, &mut s.laplacian, &mut s.gather);
     let per_r2 = 1.0 / (radius_m * radius_m);
     for (lap, per_area) in s.laplacian.iter_mut().zip(grid.inverse_areas_per_sr()) {
         *lap *= per_area * per_r2;
@@ -173,5 +173,5 @@ fn substep(
     );
     // Each donor gives at most half its content: h stays ≥ 0.
     let (areas, per_area) = (grid.areas_sr(), grid.inverse_areas_per_sr());
-    apply_limited(sides, areas, per_area, &s.flux, 1.0, h_m, &mut s.outflow);
+    apply_limited(sides, areas, per_area, &s.flux, 1.0, h_m, &mut s.gather);
 }

@@ -20,6 +20,7 @@ use super::burst::{BurstParams, BurstState, Hole};
 use super::capillary::{Capillary, CapillaryScratch, smooth_thickness};
 use super::compare::larger;
 use super::face_rows::FaceRows;
+use super::fluxes::GatherScratch;
 use super::grid::{CubeSphere, dot_at};
 use super::meniscus::MeniscusState;
 use super::sides::CellSides;
@@ -189,6 +190,8 @@ pub(super) struct Scratch {
     pub(super) rhs: Vec<f64>,
     advect: AdvectionScratch,
     capillary: CapillaryScratch,
+    /// The cell-by-cell gathers' buffers ([`GatherScratch`]).
+    pub(super) gather: GatherScratch,
 }
 
 impl FilmFlow {

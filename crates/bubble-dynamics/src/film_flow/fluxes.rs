@@ -1,13 +1,61 @@
 //! Per-edge volumes applied to the cells, cell by cell: each cell gathers its four
 //! sides' volumes, where an edge-by-edge pass scattered each volume into both its cells
 //! through index arrays (which no compiler vectorises). Inside the faces the cells come
-//! in runs ([`CellRun`]) read as slices; the rim's cells take the same arithmetic
-//! through [`CellSides`]' tables. Every edge's volume is still one number, taken from
-//! one cell and given to the other, so what moves is conserved to rounding.
+//! a face at a time ([`CellSpan`]) read as slices, the x-edges' volumes first spread to
+//! one a cell ([`GatherScratch`]); the rim's cells take the same arithmetic through
+//! [`CellSides`]' tables. Every edge's volume is still one number, taken from one cell
+//! and given to the other, so what moves is conserved to rounding.
 
 use super::flow::MAX_OUTFLOW_FRACTION;
-use super::sides::{CellRun, CellSides, INFLOW};
+use super::sides::{CellRun, CellSides, CellSpan, INFLOW};
 use crate::avx2::with_avx2;
+
+/// Buffers of the gathers, kept from pass to pass.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct GatherScratch {
+    /// Per cell: the volume on its left x-edge (its right one is the next cell's), for
+    /// the cells inside the faces: a face's x-edges are `n − 1` a row, so only so do they
+    /// read as one slice along a [`CellSpan`].
+    x_volume: Vec<f64>,
+    /// Per cell: its factor as a donor ([`apply_limited`]).
+    pub(crate) ratio: Vec<f64>,
+    /// The rim cells' values before a span's gather overwrote those among its cells.
+    rim: Vec<f64>,
+}
+
+/// Spreads the x-edges' volumes of the faces' inside rows to one a cell (each cell's
+/// left edge), into `x_volume`.
+#[inline(always)]
+fn spread_x_volumes(sides: &CellSides, volume: &[f64], x_volume: &mut Vec<f64>) {
+    let n = sides.n();
+    x_volume.resize(6 * n * n, 0.0);
+    for face in 0..6 {
+        for y in 1..n.saturating_sub(1) {
+            let row = face * n * n + y * n;
+            let first = face * n * (n - 1) + y * (n - 1);
+            x_volume[row + 1..row + n].copy_from_slice(&volume[first..first + n - 1]);
+        }
+    }
+}
+
+/// The four sides' volumes along a span (with [`INFLOW`]'s signs), each `span.len` long:
+/// the x-edges' from `x_volume` ([`spread_x_volumes`]), the y-edges' from `volume`.
+#[inline(always)]
+fn span_sides<'a>(
+    sides: &CellSides,
+    span: &CellSpan,
+    x_volume: &'a [f64],
+    volume: &'a [f64],
+) -> [&'a [f64]; 4] {
+    let (start, len, n) = (span.start, span.len, span.n());
+    let bottom = sides.layout.y_edge_of_cell(start);
+    [
+        &x_volume[start..start + len],
+        &x_volume[start + 1..start + 1 + len],
+        &volume[bottom..bottom + len],
+        &volume[bottom + n..bottom + n + len],
+    ]
+}
 
 /// The four sides' slices of a per-edge array for a run, each `run.len` long.
 #[inline(always)]
@@ -24,15 +72,23 @@ fn net(v: [f64; 4], inflow: [f64; 4]) -> f64 {
 /// Each cell's net inflow of the per-edge volumes `volume` (positive from an edge's `a`
 /// cell to its `b` cell), into `out`: `Σ volume` over the edges it is `b` of, less over
 /// those it is `a` of.
-pub(crate) fn net_inflow(sides: &CellSides, volume: &[f64], out: &mut Vec<f64>) {
+pub(crate) fn net_inflow(
+    sides: &CellSides,
+    volume: &[f64],
+    out: &mut Vec<f64>,
+    scratch: &mut GatherScratch,
+) {
     // Every entry is written below: the buffer needs its length, not a fill.
     out.resize(6 * sides.n() * sides.n(), 0.0);
+    let x_volume = &mut scratch.x_volume;
     with_avx2(
         #[inline(always)]
         || {
-            for run in &sides.cell_runs {
-                let [v0, v1, v2, v3] = side_slices(run, volume);
-                let o = &mut out[run.cells()];
+            spread_x_volumes(sides, volume, x_volume);
+            // A face at a time; its rim cells, among the span's, are redone below.
+            for span in sides.face_spans() {
+                let [v0, v1, v2, v3] = span_sides(sides, &span, x_volume, volume);
+                let o = &mut out[span.cells()];
                 let len = o.len();
                 let (v0, v1, v2, v3) = (&v0[..len], &v1[..len], &v2[..len], &v3[..len]);
                 for i in 0..len {
@@ -58,14 +114,21 @@ pub(crate) fn apply_limited(
     volume: &[f64],
     scale: f64,
     values: &mut [f64],
-    ratio: &mut Vec<f64>,
+    scratch: &mut GatherScratch,
 ) {
+    let GatherScratch {
+        x_volume,
+        ratio,
+        rim,
+    } = scratch;
     ratio.resize(values.len(), 0.0);
     with_avx2(
         #[inline(always)]
         || {
-            outflow_ratios(sides, areas, values, volume, scale, ratio);
-            gather_limited(sides, per_area, volume, scale, ratio, values);
+            spread_x_volumes(sides, volume, x_volume);
+            let volumes = (&x_volume[..], volume);
+            outflow_ratios(sides, areas, values, volumes, scale, ratio);
+            gather_limited(sides, per_area, volumes, scale, ratio, (values, rim));
         },
     )
 }
@@ -94,16 +157,17 @@ fn outflow_ratios(
     sides: &CellSides,
     areas: &[f64],
     values: &[f64],
-    volume: &[f64],
+    (x_volume, volume): (&[f64], &[f64]),
     scale: f64,
     out: &mut [f64],
 ) {
-    for run in &sides.cell_runs {
-        let [v0, v1, v2, v3] = side_slices(run, volume);
-        let o = &mut out[run.cells()];
+    // A face at a time; its rim cells, among the span's, are redone below.
+    for span in sides.face_spans() {
+        let [v0, v1, v2, v3] = span_sides(sides, &span, x_volume, volume);
+        let o = &mut out[span.cells()];
         let len = o.len();
         let (v0, v1, v2, v3) = (&v0[..len], &v1[..len], &v2[..len], &v3[..len]);
-        let (a, x) = (&areas[run.cells()], &values[run.cells()]);
+        let (a, x) = (&areas[span.cells()], &values[span.cells()]);
         let (a, x) = (&a[..len], &x[..len]);
         for i in 0..len {
             o[i] = outflow_factor([v0[i], v1[i], v2[i], v3[i]], INFLOW, scale, a[i], x[i]);
@@ -133,31 +197,36 @@ fn gained(v: [f64; 4], inflow: [f64; 4], across: [f64; 4], own: f64) -> f64 {
 fn gather_limited(
     sides: &CellSides,
     per_area: &[f64],
-    volume: &[f64],
+    (x_volume, volume): (&[f64], &[f64]),
     scale: f64,
     ratio: &[f64],
-    values: &mut [f64],
+    (values, before): (&mut [f64], &mut Vec<f64>),
 ) {
-    for run in &sides.cell_runs {
-        let len = run.len;
-        let [v0, v1, v2, v3] = side_slices(run, volume);
+    // The rim's values as they were: the spans below add to those among their cells what
+    // is not theirs, and the rim's own gains are added to these.
+    let rim = sides.rim();
+    before.clear();
+    before.extend(rim.cells.iter().map(|&c| values[c as usize]));
+    for span in sides.face_spans() {
+        let len = span.len;
+        let [v0, v1, v2, v3] = span_sides(sides, &span, x_volume, volume);
         let (v0, v1, v2, v3) = (&v0[..len], &v1[..len], &v2[..len], &v3[..len]);
-        let [r0, r1, r2, r3]: [&[f64]; 4] = std::array::from_fn(|k| &ratio[run.neighbours(k)]);
+        let [r0, r1, r2, r3]: [&[f64]; 4] = std::array::from_fn(|k| &ratio[span.neighbours(k)]);
         let (r0, r1, r2, r3) = (&r0[..len], &r1[..len], &r2[..len], &r3[..len]);
-        let (own, pa) = (&ratio[run.cells()], &per_area[run.cells()]);
+        let (own, pa) = (&ratio[span.cells()], &per_area[span.cells()]);
         let (own, pa) = (&own[..len], &pa[..len]);
-        let x = &mut values[run.cells()];
+        let x = &mut values[span.cells()];
         for i in 0..len {
             let v = [v0[i], v1[i], v2[i], v3[i]];
             let across = [r0[i], r1[i], r2[i], r3[i]];
             x[i] += scale * gained(v, INFLOW, across, own[i]) * pa[i];
         }
     }
-    let rim = sides.rim();
+    let before = &before[..rim.cells.len()];
     for (i, &c) in rim.cells.iter().enumerate() {
         let (v, across) = (rim.at_edges(i, volume), rim.at_neighbours(i, ratio));
         let c = c as usize;
-        values[c] += scale * gained(v, rim.inflow(i), across, ratio[c]) * per_area[c];
+        values[c] = before[i] + scale * gained(v, rim.inflow(i), across, ratio[c]) * per_area[c];
     }
 }
 
@@ -181,8 +250,65 @@ mod tests {
             want[*b as usize] += v;
         }
         let mut got = vec![f64::NAN; 3];
-        net_inflow(&sides, &volume, &mut got);
+        net_inflow(&sides, &volume, &mut got, &mut GatherScratch::default());
         assert_eq!(got, want);
+    }
+
+    /// Against the edge-by-edge scatter of the limited volumes: each donor's factor from
+    /// its summed outflow, each volume cut by its donor's factor.
+    #[test]
+    fn apply_limited_is_the_scatter_of_the_limited_volumes() {
+        for n in [3, 6] {
+            let grid = CubeSphere::new(n);
+            let sides = CellSides::new(&grid);
+            let ea = grid.edge_arrays();
+            let (areas, per_area) = (grid.areas_sr(), grid.inverse_areas_per_sr());
+            let volume: Vec<f64> = (0..ea.cells.len())
+                .map(|e| (((e * 53) % 17) as f64 - 8.0) * 1e-1)
+                .collect();
+            let values: Vec<f64> = (0..grid.cells()).map(|c| 1.0 + (c % 7) as f64).collect();
+            let scale = 0.3;
+            let mut outflow = vec![0.0; grid.cells()];
+            for ([a, b], v) in ea.cells.iter().zip(&volume) {
+                let donor = if *v > 0.0 { *a } else { *b } as usize;
+                outflow[donor] += scale * v.abs();
+            }
+            let factor: Vec<f64> = (0..grid.cells())
+                .map(|c| {
+                    let budget = MAX_OUTFLOW_FRACTION * areas[c] * values[c];
+                    if outflow[c] > budget {
+                        budget / outflow[c]
+                    } else {
+                        1.0
+                    }
+                })
+                .collect();
+            assert!(factor.iter().any(|&f| f < 1.0), "n {n}: no donor limited");
+            let mut want = values.clone();
+            for ([a, b], v) in ea.cells.iter().zip(&volume) {
+                let (a, b) = (*a as usize, *b as usize);
+                let moved = scale * v * factor[if *v > 0.0 { a } else { b }];
+                want[a] -= moved * per_area[a];
+                want[b] += moved * per_area[b];
+            }
+            let mut got = values.clone();
+            let mut scratch = GatherScratch::default();
+            apply_limited(
+                &sides,
+                areas,
+                per_area,
+                &volume,
+                scale,
+                &mut got,
+                &mut scratch,
+            );
+            for (c, (g, w)) in got.iter().zip(&want).enumerate() {
+                assert!(
+                    (g - w).abs() < 1e-12 * w.abs(),
+                    "n {n} cell {c}: {g} against {w}"
+                );
+            }
+        }
     }
 
     /// The limited apply conserves the content and keeps it ≥ 0 however large the
@@ -203,7 +329,7 @@ mod tests {
                 .sum::<f64>()
         };
         let before = content(&values);
-        let mut ratio = Vec::new();
+        let mut scratch = GatherScratch::default();
         let (areas, per_area) = (grid.areas_sr(), grid.inverse_areas_per_sr());
         apply_limited(
             &sides,
@@ -212,14 +338,14 @@ mod tests {
             &volume,
             0.3,
             &mut values,
-            &mut ratio,
+            &mut scratch,
         );
         let change = (content(&values) - before) / before;
         assert!(change.abs() < 1e-14, "content changed by {change:.3e}");
         let least = values.iter().copied().fold(f64::INFINITY, f64::min);
         assert!(least >= 0.0, "a cell went to {least}");
         assert!(
-            ratio.iter().any(|&r| r < 1.0),
+            scratch.ratio.iter().any(|&r| r < 1.0),
             "no donor was limited: the test is idle"
         );
     }

@@ -93,7 +93,7 @@ impl FilmFlow {
                 flux,
                 sub_dt_per_r,
                 gamma,
-                &mut s.cell,
+                &mut s.gather,
             );
         }
     }
@@ -143,7 +143,7 @@ impl FilmFlow {
             },
         );
         // `A Γ − dt Σ F/R`: each cell's net inflow of the fluxes, gathered.
-        net_inflow(sides, &s.edge, &mut s.rhs);
+        net_inflow(sides, &s.edge, &mut s.rhs, &mut s.gather);
         let dt_per_r = dt_s / p.radius_m;
         let n = s.rhs.len();
         let (rhs, areas, gamma) = (&mut s.rhs[..], &g.areas_sr()[..n], &self.gamma[..n]);
@@ -316,7 +316,7 @@ impl FilmFlow {
                 self.correct_velocity_run::<NORMAL>(s, run, scale);
             },
         );
-        net_inflow(sides, &s.edge2, &mut s.rhs);
+        net_inflow(sides, &s.edge2, &mut s.rhs, &mut s.gather);
         let per_area = g.inverse_areas_per_sr();
         let change = &mut self.surfactant_change;
         if !next_surfactant(&self.gamma, &s.cell2, per_area, &mut s.rhs, change) {
@@ -333,7 +333,7 @@ impl FilmFlow {
         upwind_fluxes(sides, ea, &self.gamma, change, &mut s.edge2);
         let (areas, per_area) = (g.areas_sr(), g.inverse_areas_per_sr());
         let (flux, gamma) = (&s.edge2, &mut self.gamma);
-        apply_limited(sides, areas, per_area, flux, scale, gamma, &mut s.cell);
+        apply_limited(sides, areas, per_area, flux, scale, gamma, &mut s.gather);
     }
 
     /// [`Self::correct_velocity_and_move_surfactant`]'s edge pass over one run: the

@@ -156,6 +156,11 @@ impl CellSpan {
         self.start..self.start + self.len
     }
 
+    /// Cells along a face edge.
+    pub(crate) fn n(&self) -> usize {
+        self.n
+    }
+
     /// The cells at the layout's offset on side `k` from the span's cells.
     pub(crate) fn neighbours(&self, k: usize) -> std::ops::Range<usize> {
         let first = match k {

@@ -112,7 +112,7 @@ impl FilmFlow {
                 upwind::volumes(sides, ea, &self.h_m, &s.limited_rise, speeds, &mut s.edge2);
                 let (areas, per_area) = (self.grid.areas_sr(), self.grid.inverse_areas_per_sr());
                 let (volume, h) = (&s.edge2, &mut self.h_m);
-                apply_limited(sides, areas, per_area, volume, 1.0, h, &mut s.cell);
+                apply_limited(sides, areas, per_area, volume, 1.0, h, &mut s.gather);
             },
         )
     }
