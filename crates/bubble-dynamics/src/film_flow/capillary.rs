@@ -15,8 +15,9 @@
 
 use super::compare::{largest, pick, smaller};
 use super::fluxes::{GatherScratch, apply_limited, net_inflow};
-use super::grid::CubeSphere;
-use super::sides::CellSides;
+use super::grid::{CubeSphere, EdgeArrays};
+use super::sides::{CellSides, EdgeBlock, SeamEnds};
+use crate::avx2::with_avx2;
 
 /// Most explicit sub-steps a film step spends on capillary smoothing.
 pub(crate) const MAX_SUBSTEPS: u32 = 64;
@@ -48,6 +49,7 @@ pub(crate) struct CapillaryScratch {
     laplacian: Vec<f64>,
     flux: Vec<f64>,
     gather: GatherScratch,
+    seam_ends: SeamEnds,
 }
 
 /// Moves liquid by the capillary pressure over `dt_s`; `h_m` per cell.
@@ -128,15 +130,15 @@ fn substep(
     sides.for_each_edge_run(
         #[inline(always)]
         |run| {
-            let len = run.len;
             let (ha, hb) = run.ends(h_m);
-            let (l, per_d) = (run.along(&ea.length), run.along(&ea.inverse_dual_length));
-            let (ha, hb, l, per_d) = (&ha[..len], &hb[..len], &l[..len], &per_d[..len]);
-            let out = run.along_mut(&mut s.flux);
-            for i in 0..len {
-                out[i] = (ha[i] - hb[i]) * l[i] * per_d[i];
-            }
+            differences_block(run, [ha, hb], ea, &mut s.flux);
         },
+    );
+    let seams = sides.seams();
+    let ends = s.seam_ends.gather(seams, h_m);
+    with_avx2(
+        #[inline(always)]
+        || differences_block(seams, ends, ea, &mut s.flux),
     );
     net_inflow(sides, &s.flux, &mut s.laplacian, &mut s.gather);
     let per_r2 = 1.0 / (radius_m * radius_m);
@@ -152,26 +154,66 @@ fn substep(
     // a mean-thickness mobility drew liquid out of the thin film one cell further at the
     // pool's rate, emptying it in a step (bubbles resting on the ground burst within a
     // second). At the donor's, a thin cell gives at its own slow rate.
-    let (laplacian, Mobility { per_cubed, cap }) = (&s.laplacian[..], mobility);
+    let laplacian = &s.laplacian[..];
     let per_length = dt_s / (radius_m * radius_m);
+    let volumes = Volumes {
+        ea,
+        mobility,
+        per_length,
+    };
     sides.for_each_edge_run(
         #[inline(always)]
         |run| {
-            let len = run.len;
-            let (ha, hb) = run.ends(h_m);
-            let (la, lb) = run.ends(laplacian);
-            let (l, per_d) = (run.along(&ea.length), run.along(&ea.inverse_dual_length));
-            let (ha, hb, la, lb) = (&ha[..len], &hb[..len], &la[..len], &lb[..len]);
-            let (l, per_d, out) = (&l[..len], &per_d[..len], run.along_mut(&mut s.flux));
-            for i in 0..len {
-                let rise = lb[i] - la[i];
-                let donor = pick(rise >= 0.0, ha[i], hb[i]);
-                let m = smaller(per_cubed * donor * donor * donor, cap);
-                out[i] = m * rise * per_d[i] * l[i] * per_length;
-            }
+            let ((ha, hb), (la, lb)) = (run.ends(h_m), run.ends(laplacian));
+            volumes.block(run, [ha, hb, la, lb], &mut s.flux);
         },
+    );
+    let seams = sides.seams();
+    let [[ha, hb], [la, lb]] = s.seam_ends.gather_many(seams, [h_m, laplacian]);
+    with_avx2(
+        #[inline(always)]
+        || volumes.block(seams, [ha, hb, la, lb], &mut s.flux),
     );
     // Each donor gives at most half its content: h stays ≥ 0.
     let (areas, per_area) = (grid.areas_sr(), grid.inverse_areas_per_sr());
     apply_limited(sides, areas, per_area, &s.flux, 1.0, h_m, &mut s.gather);
+}
+
+/// `(h_a − h_b) l/d` over a block of edges with thicknesses `[ha, hb]` at their ends,
+/// into `out` (the Laplacian's differences, [`substep`]).
+#[inline(always)]
+fn differences_block(run: impl EdgeBlock, [ha, hb]: [&[f64]; 2], ea: &EdgeArrays, out: &mut [f64]) {
+    let len = run.count();
+    let (l, per_d) = (run.values(&ea.length), run.values(&ea.inverse_dual_length));
+    let (ha, hb, out) = (&ha[..len], &hb[..len], run.values_mut(out));
+    for i in 0..len {
+        out[i] = (ha[i] - hb[i]) * l[i] * per_d[i];
+    }
+}
+
+/// The sub-step's volumes across the edges ([`substep`]).
+struct Volumes<'a> {
+    ea: &'a EdgeArrays,
+    mobility: Mobility,
+    /// The sub-step over `R²`.
+    per_length: f64,
+}
+
+impl Volumes<'_> {
+    /// The volumes over a block of edges with thicknesses and Laplacians `[ha, hb, la,
+    /// lb]` at their ends, into `out`.
+    #[inline(always)]
+    fn block(&self, run: impl EdgeBlock, [ha, hb, la, lb]: [&[f64]; 4], out: &mut [f64]) {
+        let len = run.count();
+        let (ea, Mobility { per_cubed, cap }) = (self.ea, self.mobility);
+        let (l, per_d) = (run.values(&ea.length), run.values(&ea.inverse_dual_length));
+        let (ha, hb, la, lb) = (&ha[..len], &hb[..len], &la[..len], &lb[..len]);
+        let out = run.values_mut(out);
+        for i in 0..len {
+            let rise = lb[i] - la[i];
+            let donor = pick(rise >= 0.0, ha[i], hb[i]);
+            let m = smaller(per_cubed * donor * donor * donor, cap);
+            out[i] = m * rise * per_d[i] * l[i] * self.per_length;
+        }
+    }
 }

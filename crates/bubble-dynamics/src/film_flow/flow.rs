@@ -23,11 +23,12 @@ use super::face_rows::FaceRows;
 use super::fluxes::GatherScratch;
 use super::grid::{CubeSphere, dot_at};
 use super::meniscus::MeniscusState;
-use super::sides::CellSides;
+use super::sides::{CellSides, EdgeBlock, SeamEnds};
 use super::solve::{Hierarchy, SolveReport, Work};
 use super::thermal::{ThermalParams, up_from};
 use super::upwind::UpwindGeometry;
 use super::viscosity::{ViscousScratch, viscous_bound};
+use crate::avx2::with_avx2;
 
 /// Thickness floor of the Marangoni coefficient `E_f/(ρh)`, m: a hole or a Newton black
 /// film keeps a finite (if huge) stiffness.
@@ -192,6 +193,8 @@ pub(super) struct Scratch {
     capillary: CapillaryScratch,
     /// The cell-by-cell gathers' buffers ([`GatherScratch`]).
     pub(super) gather: GatherScratch,
+    /// The seam edges' end values for the edge passes ([`SeamEnds`]).
+    pub(super) seam_ends: SeamEnds,
 }
 
 impl FilmFlow {
@@ -455,40 +458,31 @@ impl FilmFlow {
         s.drag.resize(self.u_m_per_s.len(), 1.0);
         let nu_air = p.air_viscosity_pa_s / p.air_density_kg_per_m3.max(f64::MIN_POSITIVE);
         let (r, eddy) = (p.radius_m, 0.25 * p.radius_m);
-        // 1/δ = max(√(|Δu|/(ν_air ℓ)), 1/R): a multiply where 1/δ was a division.
-        let per_layer_depth = {
-            let (per_slip, floor) = (1.0 / (nu_air * eddy), 1.0 / r);
-            move |slip: f64| larger((slip * per_slip).sqrt(), floor)
-        };
         let ea = self.grid.edge_arrays();
-        let slopes = match p.gradient {
-            FilmGradient::TwoPoint => &ea.centre_gradient_xyz,
-            FilmGradient::Normal => &ea.centre_normal_gradient_xyz,
+        let shear = AirShear {
+            per_slip: 1.0 / (nu_air * eddy),
+            floor: 1.0 / r,
+            per_layer: p.air_viscosity_pa_s / p.density_kg_per_m3,
+            dt_s,
+            air: air_m_per_s,
+            slopes: match p.gradient {
+                FilmGradient::TwoPoint => &ea.centre_gradient_xyz,
+                FilmGradient::Normal => &ea.centre_normal_gradient_xyz,
+            },
         };
-        let per_layer = p.air_viscosity_pa_s / p.density_kg_per_m3;
-        let sides = &self.sides;
+        let (sides, u, drag) = (&self.sides, &mut self.u_m_per_s, &mut s.drag);
         sides.for_each_edge_run(
             #[inline(always)]
             |run| {
-                let len = run.len;
                 let (ha, hb) = run.ends(&self.h_m);
-                let (ha, hb) = (&ha[..len], &hb[..len]);
-                let slopes = slopes.each_ref().map(|x| &run.along(x)[..len]);
-                let u = &mut run.along_mut(&mut self.u_m_per_s)[..len];
-                let factor = &mut run.along_mut(&mut s.drag)[..len];
-                for i in 0..len {
-                    // The potential flow's surface velocity is the gradient of 1.5 U·x:
-                    // taken as the discrete gradient between cell centres, curl-free like
-                    // the real one.
-                    let outside = 1.5 * dot_at(air_m_per_s, slopes, i);
-                    let h = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
-                    let k = per_layer / h;
-                    let k_out = k * per_layer_depth((u[i] - outside).abs());
-                    let k_in = k * per_layer_depth(u[i].abs());
-                    factor[i] = 1.0 / (1.0 + dt_s * (k_out + k_in));
-                    u[i] = (u[i] + dt_s * k_out * outside) * factor[i];
-                }
+                shear.block(run, [ha, hb], u, drag);
             },
+        );
+        let seams = sides.seams();
+        let ends = s.seam_ends.gather(seams, &self.h_m);
+        with_avx2(
+            #[inline(always)]
+            || shear.block(seams, ends, u, drag),
         );
     }
 
@@ -508,5 +502,53 @@ impl FilmFlow {
         };
         let sides = &self.sides;
         smooth_thickness(&self.grid, sides, c, dt_s, &mut self.h_m, &mut s.capillary);
+    }
+}
+
+/// The air shear's constants ([`FilmFlow::air_shear`]).
+struct AirShear<'a> {
+    /// `1/(ν_air ℓ)`: the slip times this is `1/δ²`.
+    per_slip: f64,
+    /// `1/R`, the least `1/δ`.
+    floor: f64,
+    /// `μ_air/ρ`: over the film's thickness and δ, the drag's rate.
+    per_layer: f64,
+    /// The step, s.
+    dt_s: f64,
+    /// The air's velocity far from the bubble, m/s.
+    air: DVec3,
+    /// The slopes of a linear potential across the edges, as components.
+    slopes: &'a [Vec<f64>; 3],
+}
+
+impl AirShear<'_> {
+    /// `1/δ = max(√(|Δu|/(ν_air ℓ)), 1/R)` at slip `slip`: a multiply where `1/δ` was a
+    /// division.
+    #[inline(always)]
+    fn per_layer_depth(&self, slip: f64) -> f64 {
+        larger((slip * self.per_slip).sqrt(), self.floor)
+    }
+
+    /// The shear over a block of edges with thicknesses `[ha, hb]` at their ends: each
+    /// edge's velocity `u` dragged, its implicit factor into `drag`.
+    #[inline(always)]
+    fn block(&self, block: impl EdgeBlock, [ha, hb]: [&[f64]; 2], u: &mut [f64], drag: &mut [f64]) {
+        let len = block.count();
+        let (ha, hb) = (&ha[..len], &hb[..len]);
+        let [sx, sy, sz] = self.slopes;
+        let slopes = [block.values(sx), block.values(sy), block.values(sz)];
+        let (u, factor) = (block.values_mut(u), block.values_mut(drag));
+        let dt_s = self.dt_s;
+        for i in 0..len {
+            // The potential flow's surface velocity is the gradient of 1.5 U·x: taken as
+            // the discrete gradient between cell centres, curl-free like the real one.
+            let outside = 1.5 * dot_at(self.air, slopes, i);
+            let h = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
+            let k = self.per_layer / h;
+            let k_out = k * self.per_layer_depth((u[i] - outside).abs());
+            let k_in = k * self.per_layer_depth(u[i].abs());
+            factor[i] = 1.0 / (1.0 + dt_s * (k_out + k_in));
+            u[i] = (u[i] + dt_s * k_out * outside) * factor[i];
+        }
     }
 }

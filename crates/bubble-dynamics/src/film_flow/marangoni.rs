@@ -16,7 +16,7 @@ use super::flow::{
 };
 use super::fluxes::{apply_limited, net_inflow};
 use super::grid::EdgeArrays;
-use super::sides::{CellSides, EdgeRun};
+use super::sides::{CellSides, EdgeBlock, SeamEnds};
 use super::solve::{SolveLimits, SolveReport};
 use crate::avx2::with_avx2;
 
@@ -84,7 +84,8 @@ impl FilmFlow {
         let sides = &self.sides;
         let (areas, per_area) = (g.areas_sr(), g.inverse_areas_per_sr());
         for _ in 0..substeps {
-            upwind_fluxes(sides, ea, &self.gamma, &s.u_start, &mut s.edge2);
+            let fields = (&self.gamma[..], &s.u_start[..]);
+            upwind_fluxes(sides, ea, fields, (&mut s.edge2, &mut s.seam_ends));
             let (flux, gamma) = (&s.edge2, &mut self.gamma);
             apply_limited(
                 sides,
@@ -139,9 +140,18 @@ impl FilmFlow {
         sides.for_each_edge_run(
             #[inline(always)]
             |run| {
-                self.central_fluxes_run::<NORMAL>(s, run, edge);
+                let ((ga, gb), (ha, hb)) = (run.ends(&self.gamma), run.ends(&self.h_m));
+                self.central_fluxes_block::<NORMAL>(s, run, [ga, gb, ha, hb], edge);
             },
         );
+        let seams = sides.seams();
+        let mut seam_ends = std::mem::take(&mut s.seam_ends);
+        let [[ga, gb], [ha, hb]] = seam_ends.gather_many(seams, [&self.gamma, &self.h_m]);
+        with_avx2(
+            #[inline(always)]
+            || self.central_fluxes_block::<NORMAL>(s, seams, [ga, gb, ha, hb], edge),
+        );
+        s.seam_ends = seam_ends;
         // `A Γ − dt Σ F/R`: each cell's net inflow of the fluxes, gathered.
         net_inflow(sides, &s.edge, &mut s.rhs, &mut s.gather);
         let dt_per_r = dt_s / p.radius_m;
@@ -157,37 +167,37 @@ impl FilmFlow {
         );
     }
 
-    /// [`Self::fluxes_weights_and_right_hand_side`]'s edge pass over one run of edges.
+    /// [`Self::fluxes_weights_and_right_hand_side`]'s edge pass over a block of edges,
+    /// with the surfactant and thickness at their ends.
     #[inline(always)]
-    fn central_fluxes_run<const NORMAL: bool>(
+    fn central_fluxes_block<const NORMAL: bool>(
         &self,
         s: &mut Scratch,
-        run: EdgeRun,
+        run: impl EdgeBlock,
+        [ga, gb, ha, hb]: [&[f64]; 4],
         c: EdgeConstants,
     ) {
         let ea = self.grid.edge_arrays();
-        let len = run.len;
-        let (ga, gb) = run.ends(&self.gamma);
-        let (ha, hb) = run.ends(&self.h_m);
+        let len = run.count();
         let (ga, gb, ha, hb) = (&ga[..len], &gb[..len], &ha[..len], &hb[..len]);
-        let (u, u0) = (run.along(&self.u_m_per_s), run.along(&s.u_start));
-        let (drag, l) = (run.along(&s.drag), run.along(&ea.length));
+        let (u, u0) = (run.values(&self.u_m_per_s), run.values(&s.u_start));
+        let (drag, l) = (run.values(&s.drag), run.values(&ea.length));
         let inverse_dual = if NORMAL {
             &ea.inverse_normal_dual_length
         } else {
             &ea.inverse_dual_length
         };
-        let id = run.along(inverse_dual);
+        let id = run.values(inverse_dual);
         let (u, u0, drag, l, id) = (&u[..len], &u0[..len], &drag[..len], &l[..len], &id[..len]);
-        let flux = run.along_mut(&mut s.edge);
-        let stiffness = run.along_mut(&mut s.stiffness);
-        let weight = run.along_mut(&mut s.weight);
+        let flux = run.values_mut(&mut s.edge);
+        let stiffness = run.values_mut(&mut s.stiffness);
+        let weight = run.values_mut(&mut s.weight);
         for i in 0..len {
             let gamma_c = 0.5 * (ga[i] + gb[i]);
             let h_edge = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
             let k = c.dt_e_per_rho / h_edge * drag[i];
             let u = if NORMAL {
-                let e = run.start + i;
+                let e = run.first() + i;
                 let [v0, v1] = ea.vertices[e];
                 let along = s.vertex[v1 as usize] - s.vertex[v0 as usize];
                 let du = k * ea.cross_per_length[e] * along * c.per_r;
@@ -310,12 +320,43 @@ impl FilmFlow {
         let (ea, sides) = (g.edge_arrays(), &*sides);
         let scale = dt_s / r;
         s.edge2.resize(ea.cells.len(), 0.0);
+        let constants = (1.0 / r, scale);
+        let inverse_dual = if NORMAL {
+            &ea.inverse_normal_dual_length
+        } else {
+            &ea.inverse_dual_length
+        };
         sides.for_each_edge_run(
             #[inline(always)]
             |run| {
-                self.correct_velocity_run::<NORMAL>(s, run, scale);
+                let ((ga, gb), (xa, xb)) = (run.ends(&self.gamma), run.ends(&s.cell2));
+                let inputs = CorrectionInputs {
+                    inverse_dual,
+                    length: &ea.length,
+                    flux: &s.edge,
+                    stiffness: &s.stiffness,
+                    cross: &s.cross,
+                };
+                let out = (&mut self.u_m_per_s[..], &mut s.edge2[..]);
+                correct_velocity_block::<NORMAL>(run, [ga, gb, xa, xb], inputs, out, constants);
             },
         );
+        let seams = sides.seams();
+        let mut seam_ends = std::mem::take(&mut s.seam_ends);
+        let [[ga, gb], [xa, xb]] = seam_ends.gather_many(seams, [&self.gamma, &s.cell2]);
+        let inputs = CorrectionInputs {
+            inverse_dual,
+            length: &ea.length,
+            flux: &s.edge,
+            stiffness: &s.stiffness,
+            cross: &s.cross,
+        };
+        let out = (&mut self.u_m_per_s[..], &mut s.edge2[..]);
+        with_avx2(
+            #[inline(always)]
+            || correct_velocity_block::<NORMAL>(seams, [ga, gb, xa, xb], inputs, out, constants),
+        );
+        s.seam_ends = seam_ends;
         net_inflow(sides, &s.edge2, &mut s.rhs, &mut s.gather);
         let per_area = g.inverse_areas_per_sr();
         let change = &mut self.surfactant_change;
@@ -330,52 +371,56 @@ impl FilmFlow {
         let change = &mut s.edge;
         change.clear();
         change.extend(self.u_m_per_s.iter().zip(&s.u_start).map(|(u, u0)| u - u0));
-        upwind_fluxes(sides, ea, &self.gamma, change, &mut s.edge2);
+        let out = (&mut s.edge2[..], &mut s.seam_ends);
+        upwind_fluxes(sides, ea, (&self.gamma, change), out);
         let (areas, per_area) = (g.areas_sr(), g.inverse_areas_per_sr());
         let (flux, gamma) = (&s.edge2, &mut self.gamma);
         apply_limited(sides, areas, per_area, flux, scale, gamma, &mut s.gather);
     }
+}
 
-    /// [`Self::correct_velocity_and_move_surfactant`]'s edge pass over one run: the
-    /// velocity corrected, and the volume of surfactant it and the transport flux move
-    /// into `s.edge2`.
-    #[inline(always)]
-    fn correct_velocity_run<const NORMAL: bool>(
-        &mut self,
-        s: &mut Scratch,
-        run: EdgeRun,
-        scale: f64,
-    ) {
-        let ea = self.grid.edge_arrays();
-        let per_r = 1.0 / self.params.radius_m;
-        let len = run.len;
-        let (ga, gb) = run.ends(&self.gamma);
-        let (xa, xb) = run.ends(&s.cell2);
-        let (ga, gb, xa, xb) = (&ga[..len], &gb[..len], &xa[..len], &xb[..len]);
-        let inverse_dual = if NORMAL {
-            &ea.inverse_normal_dual_length
+/// What the velocity correction reads per edge besides the cells' values: full per-edge
+/// arrays.
+#[derive(Clone, Copy)]
+struct CorrectionInputs<'a> {
+    /// `1/d` (`1/(d cos θ)` with the normal gradient), per rad.
+    inverse_dual: &'a [f64],
+    /// The edges' lengths, rad.
+    length: &'a [f64],
+    /// The transport flux from the central pass.
+    flux: &'a [f64],
+    /// Each edge's stiffness `k`.
+    stiffness: &'a [f64],
+    /// The cross term's velocity (with the normal gradient only).
+    cross: &'a [f64],
+}
+
+/// [`FilmFlow::correct_velocity_and_move_surfactant`]'s edge pass over a block of edges,
+/// with the surfactant before (`g`) and after (`x`) at their ends: the velocity `u`
+/// corrected, and the volume of surfactant it and the transport flux move into `moved`.
+#[inline(always)]
+fn correct_velocity_block<const NORMAL: bool>(
+    run: impl EdgeBlock,
+    [ga, gb, xa, xb]: [&[f64]; 4],
+    e: CorrectionInputs,
+    (u, moved): (&mut [f64], &mut [f64]),
+    (per_r, scale): (f64, f64),
+) {
+    let len = run.count();
+    let (ga, gb, xa, xb) = (&ga[..len], &gb[..len], &xa[..len], &xb[..len]);
+    let (id, l) = (run.values(e.inverse_dual), run.values(e.length));
+    let (f_adv, k) = (run.values(e.flux), run.values(e.stiffness));
+    let (u, moved) = (run.values_mut(u), run.values_mut(moved));
+    for i in 0..len {
+        let gamma_c = 0.5 * (ga[i] + gb[i]);
+        let slope = (xb[i] - xa[i]) * id[i] * per_r;
+        let du = -k[i] * slope / larger(gamma_c, f64::MIN_POSITIVE);
+        u[i] += if NORMAL {
+            du + e.cross[run.first() + i]
         } else {
-            &ea.inverse_dual_length
+            du
         };
-        let (id, l) = (run.along(inverse_dual), run.along(&ea.length));
-        let (f_adv, k) = (run.along(&s.edge), run.along(&s.stiffness));
-        let (id, l, f_adv, k) = (&id[..len], &l[..len], &f_adv[..len], &k[..len]);
-        let (u, moved) = (
-            run.along_mut(&mut self.u_m_per_s),
-            run.along_mut(&mut s.edge2),
-        );
-        let (u, moved) = (&mut u[..len], &mut moved[..len]);
-        for i in 0..len {
-            let gamma_c = 0.5 * (ga[i] + gb[i]);
-            let slope = (xb[i] - xa[i]) * id[i] * per_r;
-            let du = -k[i] * slope / larger(gamma_c, f64::MIN_POSITIVE);
-            u[i] += if NORMAL {
-                du + s.cross[run.start + i]
-            } else {
-                du
-            };
-            moved[i] = scale * (f_adv[i] + gamma_c * du * l[i]);
-        }
+        moved[i] = scale * (f_adv[i] + gamma_c * du * l[i]);
     }
 }
 
@@ -444,18 +489,40 @@ struct EdgeConstants {
 }
 
 /// The upwind volume `Γ_up·u·l` (per R and time) across every edge at speeds `u`, into
-/// `out`.
-fn upwind_fluxes(sides: &CellSides, ea: &EdgeArrays, gamma: &[f64], u: &[f64], out: &mut [f64]) {
+/// `out` (the seams' ends gathered into `seam_ends`).
+fn upwind_fluxes(
+    sides: &CellSides,
+    ea: &EdgeArrays,
+    (gamma, u): (&[f64], &[f64]),
+    (out, seam_ends): (&mut [f64], &mut SeamEnds),
+) {
     sides.for_each_edge_run(
         #[inline(always)]
         |run| {
-            let len = run.len;
             let (ga, gb) = run.ends(gamma);
-            let (u, l, f) = (run.along(u), run.along(&ea.length), run.along_mut(out));
-            let (ga, gb, u, l) = (&ga[..len], &gb[..len], &u[..len], &l[..len]);
-            for i in 0..len {
-                f[i] = pick(u[i] >= 0.0, ga[i], gb[i]) * u[i] * l[i];
-            }
+            upwind_fluxes_block(run, [ga, gb], (ea, u), out);
         },
-    )
+    );
+    let seams = sides.seams();
+    let ends = seam_ends.gather(seams, gamma);
+    with_avx2(
+        #[inline(always)]
+        || upwind_fluxes_block(seams, ends, (ea, u), out),
+    );
+}
+
+/// [`upwind_fluxes`] over a block of edges, with the surfactant `[ga, gb]` at their ends.
+#[inline(always)]
+fn upwind_fluxes_block(
+    run: impl EdgeBlock,
+    [ga, gb]: [&[f64]; 2],
+    (ea, u): (&EdgeArrays, &[f64]),
+    out: &mut [f64],
+) {
+    let len = run.count();
+    let (u, l, f) = (run.values(u), run.values(&ea.length), run.values_mut(out));
+    let (ga, gb) = (&ga[..len], &gb[..len]);
+    for i in 0..len {
+        f[i] = pick(u[i] >= 0.0, ga[i], gb[i]) * u[i] * l[i];
+    }
 }

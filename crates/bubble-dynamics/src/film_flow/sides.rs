@@ -29,8 +29,9 @@ pub(crate) const INFLOW: [f64; 4] = [1.0, -1.0, 1.0, -1.0];
 ///   edge between them; `is_a[c][k]` says whether `c` is that edge's `a` cell.
 /// - Inside a face these follow [`FaceLayout`]: `c ∓ 1` and `c ∓ n` across the x and y
 ///   sides, with the signs [`INFLOW`].
-/// - `edge_runs` holds every edge once, in increasing order, each run with the side it
-///   is of its `a` cells and of its `b` cells.
+/// - `edge_runs` holds every edge inside a face once, in increasing order, each run with
+///   the side it is of its `a` cells and of its `b` cells; [`CellSides::seams`] the seam
+///   edges, from [`FaceLayout::first_seam_edge`] on.
 #[derive(Clone, Debug)]
 pub(crate) struct CellSides {
     /// The grid's layout.
@@ -49,10 +50,153 @@ pub(crate) struct CellSides {
     pub(crate) rim_cells: Vec<u32>,
     /// The rim cells' tables side by side, in the order of `rim_cells` ([`Rim`]).
     rim_tables: RimTables,
-    /// Every edge once, in increasing order, as runs: each face row's x-edges, each
-    /// face's y-edges ([`EdgeRun`]), then each seam edge alone (the seams are few beside
-    /// the faces' edges).
+    /// Every edge inside a face once, in increasing order, as runs: each face row's
+    /// x-edges, each face's y-edges ([`EdgeRun`]).
     pub(crate) edge_runs: Vec<EdgeRun>,
+    /// The seam edges' cells and sides ([`Seams`]).
+    seam_tables: SeamTables,
+}
+
+/// Per seam edge, in the edges' order: its `a` and `b` cells and the side it is of each.
+#[derive(Clone, Debug, Default)]
+struct SeamTables {
+    a: Vec<u32>,
+    b: Vec<u32>,
+    sides: Vec<[u8; 2]>,
+}
+
+/// The seam edges as one block, numbered on from `start`, their cells through tables:
+/// as runs of one edge each they cost a pass about a hundred instructions an edge, its
+/// slices set up for one edge; a pass now walks them in one loop, per-edge arrays cut
+/// to the block once.
+#[derive(Clone, Copy)]
+pub(crate) struct Seams<'a> {
+    /// The first seam edge.
+    pub(crate) start: usize,
+    /// How many.
+    pub(crate) len: usize,
+    a: &'a [u32],
+    b: &'a [u32],
+    sides: &'a [[u8; 2]],
+}
+
+/// A stretch of edges an edge pass walks in one loop, its per-edge arrays as slices: a
+/// face's run ([`EdgeRun`]) or the seams ([`Seams`], their cells' values gathered first,
+/// [`SeamEnds`]).
+pub(crate) trait EdgeBlock: Copy {
+    /// The first edge (the others follow it).
+    fn first(&self) -> usize;
+    /// How many edges.
+    fn count(&self) -> usize;
+    /// A per-edge array's values along the block, `count()` long.
+    #[inline(always)]
+    fn values<'a>(&self, per_edge: &'a [f64]) -> &'a [f64] {
+        &per_edge[self.first()..self.first() + self.count()]
+    }
+    /// A per-edge array's values along the block, to write.
+    #[inline(always)]
+    fn values_mut<'a>(&self, per_edge: &'a mut [f64]) -> &'a mut [f64] {
+        &mut per_edge[self.first()..self.first() + self.count()]
+    }
+}
+
+impl EdgeBlock for EdgeRun {
+    #[inline(always)]
+    fn first(&self) -> usize {
+        self.start
+    }
+    #[inline(always)]
+    fn count(&self) -> usize {
+        self.len
+    }
+}
+
+impl EdgeBlock for Seams<'_> {
+    #[inline(always)]
+    fn first(&self) -> usize {
+        self.start
+    }
+    #[inline(always)]
+    fn count(&self) -> usize {
+        self.len
+    }
+}
+
+/// Buffers of the seam edges' end values: a cell field's values at their `a` cells and
+/// at their `b` cells, gathered so that a pass takes the seams as one run.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct SeamEnds {
+    /// Per field: the values at the `a` cells.
+    a: [Vec<f64>; 2],
+    /// Per field: the values at the `b` cells.
+    b: [Vec<f64>; 2],
+}
+
+impl SeamEnds {
+    /// `field`'s values at the seams' `a` and `b` cells.
+    pub(crate) fn gather(&mut self, seams: Seams, field: &[f64]) -> [&[f64]; 2] {
+        let [a] = self.gather_many(seams, [field]);
+        a
+    }
+
+    /// Each of `fields`' values at the seams' `a` and `b` cells (at most two fields).
+    pub(crate) fn gather_many<const K: usize>(
+        &mut self,
+        seams: Seams,
+        fields: [&[f64]; K],
+    ) -> [[&[f64]; 2]; K] {
+        let (a, b) = (&mut self.a, &mut self.b);
+        for (k, field) in fields.iter().enumerate() {
+            a[k].clear();
+            a[k].extend(seams.a.iter().map(|&c| field[c as usize]));
+            b[k].clear();
+            b[k].extend(seams.b.iter().map(|&c| field[c as usize]));
+        }
+        std::array::from_fn(|k| [&a[k][..], &b[k][..]])
+    }
+
+    /// `field`'s values at the seams' `a` and `b` cells, and those of the fields
+    /// `per_side[k]` for the side `k` each edge is of that cell (the transport's limited
+    /// rises).
+    pub(crate) fn gather_with_sides(
+        &mut self,
+        seams: Seams,
+        field: &[f64],
+        per_side: &[Vec<f64>; 4],
+    ) -> [[&[f64]; 2]; 2] {
+        let ([a0, a1], [b0, b1]) = (&mut self.a, &mut self.b);
+        for v in [&mut *a0, &mut *a1, &mut *b0, &mut *b1] {
+            v.clear();
+        }
+        for i in 0..seams.len {
+            let ([ca, cb], [ka, kb]) = (seams.cells(i), seams.sides(i));
+            a0.push(field[ca]);
+            b0.push(field[cb]);
+            a1.push(per_side[ka][ca]);
+            b1.push(per_side[kb][cb]);
+        }
+        [[&a0[..], &b0[..]], [&a1[..], &b1[..]]]
+    }
+}
+
+impl Seams<'_> {
+    /// Seam edge `i`'s `a` and `b` cells.
+    #[inline(always)]
+    pub(crate) fn cells(&self, i: usize) -> [usize; 2] {
+        [self.a[i] as usize, self.b[i] as usize]
+    }
+
+    /// A cell field's values at seam edge `i`'s `a` and `b` cells.
+    #[inline(always)]
+    pub(crate) fn ends(&self, i: usize, cells: &[f64]) -> [f64; 2] {
+        [cells[self.a[i] as usize], cells[self.b[i] as usize]]
+    }
+
+    /// The side seam edge `i` is of its `a` cell and of its `b` cell.
+    #[inline(always)]
+    pub(crate) fn sides(&self, i: usize) -> [usize; 2] {
+        self.sides[i].map(usize::from)
+    }
 }
 
 /// The rim cells' neighbours, edges and inflow signs, one array a side in the order of
@@ -234,7 +378,7 @@ impl CellSides {
         let mut neighbour = vec![[u32::MAX; 4]; cells];
         let mut edge = vec![[u32::MAX; 4]; cells];
         let mut is_a = vec![[false; 4]; cells];
-        let mut seams = Vec::new();
+        let mut seams = SeamTables::default();
         for (e, ge) in grid.edges().iter().enumerate() {
             let mut sides = [0u8; 2];
             for (end, (c, other)) in [(ge.a, ge.b), (ge.b, ge.a)].into_iter().enumerate() {
@@ -245,15 +389,9 @@ impl CellSides {
                 sides[end] = k as u8;
             }
             if e >= layout.first_seam_edge() {
-                let (a, b) = (ge.a as usize, ge.b as usize);
-                let sides = sides.map(usize::from);
-                seams.push(EdgeRun {
-                    start: e,
-                    len: 1,
-                    a,
-                    b,
-                    sides,
-                });
+                seams.a.push(ge.a);
+                seams.b.push(ge.b);
+                seams.sides.push(sides);
             }
         }
         let mut sides = Self {
@@ -265,11 +403,11 @@ impl CellSides {
             rim_cells: Vec::new(),
             rim_tables: RimTables::default(),
             edge_runs: Vec::new(),
+            seam_tables: seams,
         };
         (sides.cell_runs, sides.rim_cells) = sides.find_cell_runs();
         sides.rim_tables = sides.rim_tables();
         sides.edge_runs = face_edge_runs(grid);
-        sides.edge_runs.extend(seams);
         sides
     }
 
@@ -350,7 +488,21 @@ impl CellSides {
         self.layout.n
     }
 
-    /// Runs `pass` on every edge run ([`Self::edge_runs`]), compiled for AVX2 where the
+    /// The seam edges as one block ([`Seams`]).
+    #[inline(always)]
+    pub(crate) fn seams(&self) -> Seams<'_> {
+        let (t, len) = (&self.seam_tables, self.seam_tables.a.len());
+        Seams {
+            start: self.layout.first_seam_edge(),
+            len,
+            a: &t.a[..len],
+            b: &t.b[..len],
+            sides: &t.sides[..len],
+        }
+    }
+
+    /// Runs `pass` on every edge run ([`Self::edge_runs`]: the seams are not among
+    /// them, [`Self::seams`]), compiled for AVX2 where the
     /// processor has it (a `#[inline(always)]` closure is compiled so with it).
     #[inline(always)]
     pub(crate) fn for_each_edge_run(&self, mut pass: impl FnMut(EdgeRun)) {
@@ -449,11 +601,8 @@ mod tests {
                     assert_eq!(sides.inflow(c), INFLOW, "cell {c}");
                 }
             }
-            let seams = sides
-                .edge_runs
-                .iter()
-                .filter(|r| r.start >= layout.first_seam_edge());
-            assert_eq!(seams.count(), 12 * n);
+            assert_eq!(sides.seams().len, 12 * n);
+            assert_eq!(sides.seams().start, layout.first_seam_edge());
             runs_cover_everything_once(&grid, &sides);
             spans_hold_every_inside_cell_with_its_neighbours(&sides);
         }
@@ -499,9 +648,19 @@ mod tests {
                 assert_eq!(sides.inflow(c), INFLOW, "cell {c}");
             }
         }
-        let edges: Vec<usize> = sides.edge_runs.iter().flat_map(|r| r.edges()).collect();
+        let mut edges: Vec<usize> = sides.edge_runs.iter().flat_map(|r| r.edges()).collect();
+        let seams = sides.seams();
+        edges.extend(seams.start..seams.start + seams.len);
         assert_eq!(edges, (0..grid.edges().len()).collect::<Vec<_>>());
         let ea = grid.edge_arrays();
+        for i in 0..seams.len {
+            let e = seams.start + i;
+            let [a, b] = seams.cells(i);
+            assert_eq!(ea.cells[e], [a as u32, b as u32], "seam edge {e}");
+            let [ka, kb] = seams.sides(i);
+            assert_eq!(sides.edge[a][ka] as usize, e, "seam edge {e}: side of a");
+            assert_eq!(sides.edge[b][kb] as usize, e, "seam edge {e}: side of b");
+        }
         for run in &sides.edge_runs {
             for (i, e) in run.edges().enumerate() {
                 assert_eq!(

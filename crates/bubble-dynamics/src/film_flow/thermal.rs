@@ -28,7 +28,7 @@ use glam::DVec3;
 use super::compare::{larger, smaller};
 use super::flow::{FilmFlow, FilmGradient, H_FLOOR_M};
 use super::fluxes::side_slices;
-use super::sides::INFLOW;
+use super::sides::{EdgeBlock, INFLOW};
 use crate::avx2::with_avx2;
 use crate::params::GAS_CONSTANT_J_PER_MOL_K;
 
@@ -98,7 +98,6 @@ impl ThermalParams {
     }
 }
 
-/// The unit direction against `g` (+Y where there is no gravity).
 /// A cell's four sides as the temperature's upwind transport sees them.
 struct Inflow {
     /// Each side's surface speed, m/s (positive from the edge's `a` cell to its `b`).
@@ -131,6 +130,15 @@ impl Inflow {
     }
 }
 
+/// The thermal Marangoni stress's change of an edge's velocity, `per·(θ_b − θ_a)/(d h)`
+/// at its ends' temperatures `t` and thicknesses `h`, `per_d = 1/d`.
+#[inline(always)]
+fn push(per: f64, [ta, tb]: [f64; 2], [ha, hb]: [f64; 2], per_d: f64) -> f64 {
+    let h_edge = larger(0.5 * (ha + hb), H_FLOOR_M);
+    per * (tb - ta) * per_d / h_edge
+}
+
+/// The unit direction against `g` (+Y where there is no gravity).
 pub(super) fn up_from(g_eff_m_per_s2: DVec3) -> DVec3 {
     (-g_eff_m_per_s2).try_normalize().unwrap_or(DVec3::Y)
 }
@@ -243,11 +251,18 @@ impl FilmFlow {
                         let id = &run.along(&ea.inverse_dual_length)[..len];
                         let u = run.along_mut(u);
                         for i in 0..len {
-                            let h_edge = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
-                            u[i] += per * (tb[i] - ta[i]) * id[i] / h_edge;
+                            u[i] += push(per, [ta[i], tb[i]], [ha[i], hb[i]], id[i]);
                         }
                     },
                 );
+                // The seams one by one (the thermal film's own pass, not worth gathering).
+                let seams = sides.seams();
+                let id = seams.values(&ea.inverse_dual_length);
+                let u = seams.values_mut(u);
+                for (i, u) in u.iter_mut().enumerate() {
+                    let (t, h) = (seams.ends(i, theta), seams.ends(i, h));
+                    *u += push(per, t, h, id[i]);
+                }
             }
             FilmGradient::Normal => {
                 g.cells_to_vertices(theta, at_vertex);

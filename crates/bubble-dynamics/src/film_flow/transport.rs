@@ -12,7 +12,8 @@ use glam::DVec3;
 use super::compare::larger;
 use super::flow::{FilmFlow, Scratch};
 use super::fluxes::apply_limited;
-use super::grid::dot_at;
+use super::grid::{EdgeArrays, dot_at};
+use super::sides::{EdgeBlock, SeamEnds};
 use super::upwind;
 use crate::avx2::with_avx2;
 
@@ -30,7 +31,8 @@ impl FilmFlow {
         } else {
             0.0
         };
-        let courant = self.drain_rates_and_courant(&mut s.drain_rate, drain, g_eff, dt_s);
+        let buffers = (&mut s.drain_rate, &mut s.seam_ends);
+        let courant = self.drain_rates_and_courant(buffers, drain, g_eff, dt_s);
         // A cell drains through at most two edges of a smooth flow: 2·courant per step, kept
         // within one sub-step's content; the outflow limit guards the rest.
         let substeps = (2.0 * courant).ceil().clamp(1.0, f64::from(MAX_SUBSTEPS)) as u32;
@@ -46,7 +48,7 @@ impl FilmFlow {
     /// carries over `dt_s`: one pass over the edges.
     fn drain_rates_and_courant(
         &self,
-        drain_rate: &mut Vec<f64>,
+        (drain_rate, seam_ends): (&mut Vec<f64>, &mut SeamEnds),
         drain: f64,
         g_eff: DVec3,
         dt_s: f64,
@@ -58,34 +60,20 @@ impl FilmFlow {
         // Four running maxima, lane by lane in chunks of four, so the loop vectorises (a
         // maximum is exact in any order: the same number as one running maximum).
         let mut lanes = [0.0; 4];
+        let drain = (drain, g_eff);
         self.sides.for_each_edge_run(
             #[inline(always)]
             |run| {
-                let len = run.len;
                 let (ha, hb) = run.ends(h);
-                let (ha, hb, u) = (&ha[..len], &hb[..len], &run.along(u)[..len]);
-                let per_area = &run.along(&ea.length_per_smaller_area)[..len];
-                let normal = ea.normal_xyz.each_ref().map(|x| &run.along(x)[..len]);
-                let c = &mut run.along_mut(drain_rate)[..len];
-                for (i, c) in c.iter_mut().enumerate() {
-                    *c = drain * dot_at(g_eff, normal, i);
-                }
-                // A local copy: kept in registers, where the captured array was stored to
-                // memory edge by edge.
-                let mut acc = lanes;
-                let c: &[f64] = c;
-                let ends = quads(ha).zip(quads(hb));
-                let speeds = quads(u).zip(quads(c)).zip(quads(per_area));
-                for ((ha, hb), ((u, c), pa)) in ends.zip(speeds) {
-                    for (k, lane) in acc.iter_mut().enumerate() {
-                        *lane = larger(edge_speed(u[k], c[k], ha[k], hb[k], pa[k]), *lane);
-                    }
-                }
-                for i in len / 4 * 4..len {
-                    acc[0] = larger(edge_speed(u[i], c[i], ha[i], hb[i], per_area[i]), acc[0]);
-                }
-                lanes = acc;
+                let c = &mut *drain_rate;
+                lanes = courant_block(run, [ha, hb], (ea, u, c), drain, lanes);
             },
+        );
+        let seams = self.sides.seams();
+        let ends = seam_ends.gather(seams, h);
+        lanes = with_avx2(
+            #[inline(always)]
+            || courant_block(seams, ends, (ea, u, drain_rate), drain, lanes),
         );
         let fastest = lanes.into_iter().fold(0.0, |a, b| larger(b, a));
         fastest * dt_s / self.params.radius_m
@@ -109,13 +97,51 @@ impl FilmFlow {
                     dt_per_r,
                 };
                 let ea = self.grid.edge_arrays();
-                upwind::volumes(sides, ea, &self.h_m, &s.limited_rise, speeds, &mut s.edge2);
+                let volume = (&mut s.edge2, &mut s.seam_ends);
+                upwind::volumes(sides, ea, &self.h_m, &s.limited_rise, speeds, volume);
                 let (areas, per_area) = (self.grid.areas_sr(), self.grid.inverse_areas_per_sr());
                 let (volume, h) = (&s.edge2, &mut self.h_m);
                 apply_limited(sides, areas, per_area, volume, 1.0, h, &mut s.gather);
             },
         )
     }
+}
+
+/// [`FilmFlow::drain_rates_and_courant`]'s pass over a block of edges with thicknesses
+/// `[ha, hb]` at their ends: the drainage coefficients into `c`, and `lanes` raised to
+/// the edges' speeds.
+#[inline(always)]
+fn courant_block(
+    block: impl EdgeBlock,
+    [ha, hb]: [&[f64]; 2],
+    (ea, u, c): (&EdgeArrays, &[f64], &mut [f64]),
+    (drain, g_eff): (f64, DVec3),
+    lanes: [f64; 4],
+) -> [f64; 4] {
+    let len = block.count();
+    let (ha, hb, u) = (&ha[..len], &hb[..len], block.values(u));
+    let per_area = block.values(&ea.length_per_smaller_area);
+    let [nx, ny, nz] = &ea.normal_xyz;
+    let normal = [block.values(nx), block.values(ny), block.values(nz)];
+    let c = block.values_mut(c);
+    for (i, c) in c.iter_mut().enumerate() {
+        *c = drain * dot_at(g_eff, normal, i);
+    }
+    // A local copy: kept in registers, where the captured array was stored to memory
+    // edge by edge.
+    let mut acc = lanes;
+    let c: &[f64] = c;
+    let ends = quads(ha).zip(quads(hb));
+    let speeds = quads(u).zip(quads(c)).zip(quads(per_area));
+    for ((ha, hb), ((u, c), pa)) in ends.zip(speeds) {
+        for (k, lane) in acc.iter_mut().enumerate() {
+            *lane = larger(edge_speed(u[k], c[k], ha[k], hb[k], pa[k]), *lane);
+        }
+    }
+    for i in len / 4 * 4..len {
+        acc[0] = larger(edge_speed(u[i], c[i], ha[i], hb[i], per_area[i]), acc[0]);
+    }
+    acc
 }
 
 /// An edge's characteristic speed over its smaller cell's width: `|u|` plus the

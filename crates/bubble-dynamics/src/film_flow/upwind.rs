@@ -12,7 +12,7 @@
 
 use super::compare::{larger, smaller};
 use super::grid::{CubeSphere, EdgeArrays};
-use super::sides::{CellSides, CellSpan};
+use super::sides::{CellSides, CellSpan, EdgeBlock, SeamEnds};
 
 /// The transport's weights, fixed by the grid.
 #[derive(Clone, Debug)]
@@ -225,7 +225,8 @@ fn edge_volume([ha, hb]: [f64; 2], [ra, rb]: [f64; 2], [u, c, l]: [f64; 3], dt_p
     (u * plug + c * drain * drain * drain) * l * dt_per_r
 }
 
-/// The volume across every edge over the sub-step, into `volume` (per R², m × sr).
+/// The volume across every edge over the sub-step, into `volume` (per R² m × sr; the
+/// seams' ends gathered into `seam_ends`).
 // Inlined into the sub-step's `with_avx2` closure, so compiled for AVX2 there.
 #[inline(always)]
 pub(crate) fn volumes(
@@ -234,22 +235,36 @@ pub(crate) fn volumes(
     h: &[f64],
     rise: &[Vec<f64>; 4],
     speeds: EdgeSpeeds,
-    volume: &mut Vec<f64>,
+    (volume, seam_ends): (&mut Vec<f64>, &mut SeamEnds),
 ) {
     volume.resize(ea.cells.len(), 0.0);
     for run in &sides.edge_runs {
-        let len = run.len;
-        let (u, c) = (run.along(speeds.u), run.along(speeds.drain_rate));
-        let (l, out) = (run.along(&ea.length), run.along_mut(volume));
-        let (u, c, l) = (&u[..len], &c[..len], &l[..len]);
-        let (ha, hb) = run.ends(h);
         let [ka, kb] = run.sides;
         let (ra, rb) = (&rise[ka][run.a_cells()], &rise[kb][run.b_cells()]);
-        let (ha, hb, ra, rb) = (&ha[..len], &hb[..len], &ra[..len], &rb[..len]);
-        for i in 0..len {
-            let speed = [u[i], c[i], l[i]];
-            out[i] = edge_volume([ha[i], hb[i]], [ra[i], rb[i]], speed, speeds.dt_per_r);
-        }
+        let (ha, hb) = run.ends(h);
+        volumes_block(*run, [ha, hb], [ra, rb], (ea, speeds), volume);
+    }
+    let seams = sides.seams();
+    let [h_ends, rises] = seam_ends.gather_with_sides(seams, h, rise);
+    volumes_block(seams, h_ends, rises, (ea, speeds), volume);
+}
+
+/// [`volumes`] over a block of edges, with their ends' thicknesses and rises.
+#[inline(always)]
+fn volumes_block(
+    block: impl EdgeBlock,
+    [ha, hb]: [&[f64]; 2],
+    [ra, rb]: [&[f64]; 2],
+    (ea, speeds): (&EdgeArrays, EdgeSpeeds),
+    volume: &mut [f64],
+) {
+    let len = block.count();
+    let (u, c) = (block.values(speeds.u), block.values(speeds.drain_rate));
+    let (l, out) = (block.values(&ea.length), block.values_mut(volume));
+    let (ha, hb, ra, rb) = (&ha[..len], &hb[..len], &ra[..len], &rb[..len]);
+    for i in 0..len {
+        let speed = [u[i], c[i], l[i]];
+        out[i] = edge_volume([ha[i], hb[i]], [ra[i], rb[i]], speed, speeds.dt_per_r);
     }
 }
 
