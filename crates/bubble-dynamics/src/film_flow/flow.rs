@@ -195,6 +195,9 @@ pub(super) struct Scratch {
     pub(super) gather: GatherScratch,
     /// The seam edges' end values for the edge passes ([`SeamEnds`]).
     pub(super) seam_ends: SeamEnds,
+    /// Per cell: a per-edge array's value on its left x-edge, two of them (the
+    /// temperature's transport, [`super::fluxes::spread_x_volumes`]).
+    pub(super) spread: [Vec<f64>; 2],
 }
 
 impl FilmFlow {
@@ -357,7 +360,7 @@ impl FilmFlow {
         s.u_start.clear();
         s.u_start.extend_from_slice(&self.u_m_per_s);
         let up = up_from(forcing.g_eff_m_per_s2);
-        self.exchange_heat(&s.u_start, &mut s.cell, dt_s, up);
+        self.exchange_heat(&s.u_start, (&mut s.cell, &mut s.spread), dt_s, up);
         self.momentum_explicit(&mut s, dt_s, forcing);
         self.air_shear(&mut s, dt_s, forcing.air_m_per_s);
         if let Some(m) = &self.meniscus {

@@ -7,7 +7,7 @@
 //! and given to the other, so what moves is conserved to rounding.
 
 use super::flow::MAX_OUTFLOW_FRACTION;
-use super::sides::{CellRun, CellSides, CellSpan, INFLOW};
+use super::sides::{CellSides, CellSpan, INFLOW};
 use crate::avx2::with_avx2;
 
 /// Buffers of the gathers, kept from pass to pass.
@@ -23,10 +23,10 @@ pub(crate) struct GatherScratch {
     rim: Vec<f64>,
 }
 
-/// Spreads the x-edges' volumes of the faces' inside rows to one a cell (each cell's
-/// left edge), into `x_volume`.
+/// Spreads a per-edge array's values on the x-edges of the faces' inside rows to one a
+/// cell (each cell's left edge), into `x_volume`.
 #[inline(always)]
-fn spread_x_volumes(sides: &CellSides, volume: &[f64], x_volume: &mut Vec<f64>) {
+pub(crate) fn spread_x_volumes(sides: &CellSides, volume: &[f64], x_volume: &mut Vec<f64>) {
     let n = sides.n();
     x_volume.resize(6 * n * n, 0.0);
     for face in 0..6 {
@@ -38,10 +38,11 @@ fn spread_x_volumes(sides: &CellSides, volume: &[f64], x_volume: &mut Vec<f64>) 
     }
 }
 
-/// The four sides' volumes along a span (with [`INFLOW`]'s signs), each `span.len` long:
-/// the x-edges' from `x_volume` ([`spread_x_volumes`]), the y-edges' from `volume`.
+/// A per-edge array's values on the four sides along a span (a volume's with
+/// [`INFLOW`]'s signs), each `span.len` long: the x-edges' from `x_volume`
+/// ([`spread_x_volumes`]), the y-edges' from `volume`.
 #[inline(always)]
-fn span_sides<'a>(
+pub(crate) fn span_sides<'a>(
     sides: &CellSides,
     span: &CellSpan,
     x_volume: &'a [f64],
@@ -55,12 +56,6 @@ fn span_sides<'a>(
         &volume[bottom..bottom + len],
         &volume[bottom + n..bottom + n + len],
     ]
-}
-
-/// The four sides' slices of a per-edge array for a run, each `run.len` long.
-#[inline(always)]
-pub(crate) fn side_slices<'a>(run: &CellRun, per_edge: &'a [f64]) -> [&'a [f64]; 4] {
-    std::array::from_fn(|k| &per_edge[run.edges(k)])
 }
 
 /// A cell's net inflow from its sides' volumes `v` with signs `inflow`.

@@ -167,6 +167,8 @@ pub(crate) fn dot_at(g: DVec3, [x, y, z]: [&[f64]; 3], i: usize) -> f64 {
 pub struct CubeSphere {
     n: usize,
     centres: Vec<DVec3>,
+    /// The centres' x, y and z as arrays of their own, for passes that vectorise.
+    centres_xyz: [Vec<f64>; 3],
     areas_sr: Vec<f64>,
     edges: Vec<GridEdge>,
     edge_arrays: EdgeArrays,
@@ -309,6 +311,7 @@ impl CubeSphere {
             n,
             inverse_areas_per_sr: inverse(&areas_sr),
             inverse_vertex_areas_per_sr: inverse(&vertex_areas_sr),
+            centres_xyz: components(&centres),
             centres,
             areas_sr,
             edges,
@@ -355,6 +358,11 @@ impl CubeSphere {
     /// Unit direction of each cell's centre.
     pub fn centres(&self) -> &[DVec3] {
         &self.centres
+    }
+
+    /// The cell centres' x, y and z, each as an array.
+    pub(crate) fn centres_xyz(&self) -> &[Vec<f64>; 3] {
+        &self.centres_xyz
     }
 
     /// Area of each cell on the unit sphere, sr.

@@ -261,20 +261,13 @@ pub(crate) struct CellRun {
     pub(crate) edge: [usize; 4],
 }
 
+// The passes take the inside a face at a time ([`CellSpan`]); the runs stay to tell the
+// rim from the inside, and the tests check the tables against them.
+#[cfg(test)]
 impl CellRun {
     /// The run's cells.
     pub(crate) fn cells(&self) -> std::ops::Range<usize> {
         self.start..self.start + self.len
-    }
-
-    /// The run's neighbours on side `k`.
-    pub(crate) fn neighbours(&self, k: usize) -> std::ops::Range<usize> {
-        self.neighbour[k]..self.neighbour[k] + self.len
-    }
-
-    /// The run's edges on side `k`.
-    pub(crate) fn edges(&self, k: usize) -> std::ops::Range<usize> {
-        self.edge[k]..self.edge[k] + self.len
     }
 }
 
