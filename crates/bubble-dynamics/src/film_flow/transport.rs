@@ -9,7 +9,7 @@
 
 use glam::DVec3;
 
-use super::compare::larger;
+use super::compare::{larger, largest};
 use super::flow::{FilmFlow, Scratch};
 use super::fluxes::apply_limited;
 use super::grid::{EdgeArrays, dot_at};
@@ -31,7 +31,8 @@ impl FilmFlow {
         } else {
             0.0
         };
-        let buffers = (&mut s.drain_rate, &mut s.seam_ends);
+        // `edge2` is the sub-steps' volumes: free until they start.
+        let buffers = (&mut s.drain_rate, &mut s.edge2, &mut s.seam_ends);
         let courant = self.drain_rates_and_courant(buffers, drain, g_eff, dt_s);
         // A cell drains through at most two edges of a smooth flow: 2·courant per step, kept
         // within one sub-step's content; the outflow limit guards the rest.
@@ -48,35 +49,33 @@ impl FilmFlow {
     /// carries over `dt_s`: one pass over the edges.
     fn drain_rates_and_courant(
         &self,
-        (drain_rate, seam_ends): (&mut Vec<f64>, &mut SeamEnds),
+        (drain_rate, speed, seam_ends): (&mut Vec<f64>, &mut Vec<f64>, &mut SeamEnds),
         drain: f64,
         g_eff: DVec3,
         dt_s: f64,
     ) -> f64 {
         let ea = self.grid.edge_arrays();
         let (h, u) = (&self.h_m, &self.u_m_per_s);
-        // Every entry is written below: the buffer needs its length, not a fill.
+        // Every entry is written below: the buffers need their lengths, not a fill.
         drain_rate.resize(u.len(), 0.0);
-        // Four running maxima, lane by lane in chunks of four, so the loop vectorises (a
-        // maximum is exact in any order: the same number as one running maximum).
-        let mut lanes = [0.0; 4];
+        speed.resize(u.len(), 0.0);
         let drain = (drain, g_eff);
         self.sides.for_each_edge_run(
             #[inline(always)]
             |run| {
                 let (ha, hb) = run.ends(h);
-                let c = &mut *drain_rate;
-                lanes = courant_block(run, [ha, hb], (ea, u, c), drain, lanes);
+                courant_block(run, [ha, hb], (ea, u), drain, (drain_rate, speed));
             },
         );
         let seams = self.sides.seams();
         let ends = seam_ends.gather(seams, h);
-        lanes = with_avx2(
+        with_avx2(
             #[inline(always)]
-            || courant_block(seams, ends, (ea, u, drain_rate), drain, lanes),
+            || courant_block(seams, ends, (ea, u), drain, (drain_rate, speed)),
         );
-        let fastest = lanes.into_iter().fold(0.0, |a, b| larger(b, a));
-        fastest * dt_s / self.params.radius_m
+        // The speeds' maximum in a pass of its own: taken in the loop above, the
+        // compiler vectorised neither.
+        largest(speed) * dt_s / self.params.radius_m
     }
 
     /// One transport of `h` over `dt_s`: second-order upwind (the upwind cell's
@@ -108,40 +107,26 @@ impl FilmFlow {
 }
 
 /// [`FilmFlow::drain_rates_and_courant`]'s pass over a block of edges with thicknesses
-/// `[ha, hb]` at their ends: the drainage coefficients into `c`, and `lanes` raised to
-/// the edges' speeds.
+/// `[ha, hb]` at their ends: the drainage coefficients into `c`, the edges' speeds into
+/// `speed`.
 #[inline(always)]
 fn courant_block(
     block: impl EdgeBlock,
     [ha, hb]: [&[f64]; 2],
-    (ea, u, c): (&EdgeArrays, &[f64], &mut [f64]),
+    (ea, u): (&EdgeArrays, &[f64]),
     (drain, g_eff): (f64, DVec3),
-    lanes: [f64; 4],
-) -> [f64; 4] {
+    (c, speed): (&mut [f64], &mut [f64]),
+) {
     let len = block.count();
     let (ha, hb, u) = (&ha[..len], &hb[..len], block.values(u));
     let per_area = block.values(&ea.length_per_smaller_area);
     let [nx, ny, nz] = &ea.normal_xyz;
     let normal = [block.values(nx), block.values(ny), block.values(nz)];
-    let c = block.values_mut(c);
-    for (i, c) in c.iter_mut().enumerate() {
-        *c = drain * dot_at(g_eff, normal, i);
+    let (c, speed) = (block.values_mut(c), block.values_mut(speed));
+    for i in 0..len {
+        c[i] = drain * dot_at(g_eff, normal, i);
+        speed[i] = edge_speed(u[i], c[i], ha[i], hb[i], per_area[i]);
     }
-    // A local copy: kept in registers, where the captured array was stored to memory
-    // edge by edge.
-    let mut acc = lanes;
-    let c: &[f64] = c;
-    let ends = quads(ha).zip(quads(hb));
-    let speeds = quads(u).zip(quads(c)).zip(quads(per_area));
-    for ((ha, hb), ((u, c), pa)) in ends.zip(speeds) {
-        for (k, lane) in acc.iter_mut().enumerate() {
-            *lane = larger(edge_speed(u[k], c[k], ha[k], hb[k], pa[k]), *lane);
-        }
-    }
-    for i in len / 4 * 4..len {
-        acc[0] = larger(edge_speed(u[i], c[i], ha[i], hb[i], per_area[i]), acc[0]);
-    }
-    acc
 }
 
 /// An edge's characteristic speed over its smaller cell's width: `|u|` plus the
@@ -151,10 +136,4 @@ fn courant_block(
 fn edge_speed(u: f64, c: f64, ha: f64, hb: f64, per_area: f64) -> f64 {
     let h = larger(hb, ha);
     (u.abs() + 3.0 * c.abs() * h * h) * per_area
-}
-
-/// A slice in chunks of four (lanes of one AVX2 register).
-#[inline(always)]
-fn quads(x: &[f64]) -> std::slice::ChunksExact<'_, f64> {
-    x.chunks_exact(4)
 }
