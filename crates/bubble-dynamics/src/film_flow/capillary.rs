@@ -48,7 +48,9 @@ pub(crate) struct CapillaryScratch {
     laplacian_norm: Option<(usize, f64)>,
     laplacian: Vec<f64>,
     flux: Vec<f64>,
+    /// The gathers' buffers.
     gather: GatherScratch,
+    /// The seam edges' end values.
     seam_ends: SeamEnds,
 }
 
@@ -193,7 +195,9 @@ fn differences_block(run: impl EdgeBlock, [ha, hb]: [&[f64]; 2], ea: &EdgeArrays
 
 /// The sub-step's volumes across the edges ([`substep`]).
 struct Volumes<'a> {
+    /// The grid's per-edge arrays.
     ea: &'a EdgeArrays,
+    /// Each edge's mobility from its donor's thickness.
     mobility: Mobility,
     /// The sub-step over `R²`.
     per_length: f64,

@@ -32,8 +32,9 @@ struct RimValues {
     volume: [Vec<f64>; 4],
     /// Per side: the neighbour's factor as a donor.
     across: [Vec<f64>; 4],
-    /// The cells' areas and their inverses.
+    /// The cells' areas.
     area: Vec<f64>,
+    /// The cells' inverse areas.
     per_area: Vec<f64>,
     /// The cells' values before the apply (the spans overwrite those among theirs).
     value: Vec<f64>,

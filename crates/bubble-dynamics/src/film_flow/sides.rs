@@ -60,8 +60,11 @@ pub(crate) struct CellSides {
 /// Per seam edge, in the edges' order: its `a` and `b` cells and the side it is of each.
 #[derive(Clone, Debug, Default)]
 struct SeamTables {
+    /// Each seam edge's `a` cell.
     a: Vec<u32>,
+    /// Each seam edge's `b` cell.
     b: Vec<u32>,
+    /// The side each seam edge is of its `a` cell and of its `b` cell.
     sides: Vec<[u8; 2]>,
 }
 
@@ -75,8 +78,11 @@ pub(crate) struct Seams<'a> {
     pub(crate) start: usize,
     /// How many.
     pub(crate) len: usize,
+    /// Each seam edge's `a` cell.
     a: &'a [u32],
+    /// Each seam edge's `b` cell.
     b: &'a [u32],
+    /// The side each is of its `a` cell and of its `b` cell.
     sides: &'a [[u8; 2]],
 }
 
@@ -202,8 +208,11 @@ impl Seams<'_> {
 /// cell's four sides together, which a pass over the rim strides through).
 #[derive(Clone, Debug, Default)]
 struct RimTables {
+    /// Per side: each rim cell's neighbour.
     neighbour: [Vec<u32>; 4],
+    /// Per side: each rim cell's edge.
     edge: [Vec<u32>; 4],
+    /// Per side: the sign of a volume across it in the cell's inflow.
     inflow: [Vec<f64>; 4],
 }
 
