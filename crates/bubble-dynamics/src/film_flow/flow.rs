@@ -26,7 +26,7 @@ use super::meniscus::MeniscusState;
 use super::sides::{CellSides, EdgeBlock, SeamEnds};
 use super::solve::{Hierarchy, SolveReport, Work};
 use super::thermal::{ThermalParams, up_from};
-use super::upwind::UpwindGeometry;
+use super::upwind::{RimRises, UpwindGeometry};
 use super::viscosity::{ViscousScratch, viscous_bound};
 use crate::avx2::with_avx2;
 
@@ -177,6 +177,8 @@ pub(super) struct Scratch {
     /// Per side `k` and cell: how far the cell's limited gradient carries its thickness
     /// to that side's midpoint, m.
     pub(super) limited_rise: [Vec<f64>; 4],
+    /// The rim's values for the limited rises ([`RimRises`]).
+    pub(super) rim_rises: RimRises,
     pub(super) drag: Vec<f64>,
     /// Per edge: the drainage speed's coefficient over `h²`, s⁻¹·m⁻¹.
     pub(super) drain_rate: Vec<f64>,

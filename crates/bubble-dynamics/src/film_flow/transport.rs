@@ -89,7 +89,8 @@ impl FilmFlow {
         with_avx2(
             #[inline(always)]
             || {
-                upwind::limited_rises(sides, geo, &self.h_m, &mut s.limited_rise);
+                let rises = (&mut s.limited_rise, &mut s.rim_rises);
+                upwind::limited_rises(sides, geo, &self.h_m, rises);
                 let speeds = upwind::EdgeSpeeds {
                     u: &self.u_m_per_s,
                     drain_rate: &s.drain_rate,

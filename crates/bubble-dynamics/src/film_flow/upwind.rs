@@ -12,7 +12,7 @@
 
 use super::compare::{larger, smaller};
 use super::grid::{CubeSphere, EdgeArrays};
-use super::sides::{CellSides, CellSpan, EdgeBlock, SeamEnds};
+use super::sides::{CellSides, EdgeBlock, SeamEnds};
 
 /// The transport's weights, fixed by the grid.
 #[derive(Clone, Debug)]
@@ -24,10 +24,21 @@ pub(crate) struct UpwindGeometry {
     /// weight per pair of sides stands for the gradient's three components and its
     /// projection.
     rise: [[Vec<f64>; 4]; 4],
-    /// The same weights of the rim cells, `rim_rise[i][k][j]` for
-    /// [`CellSides::rim_cells`]`[i]`: one cell's sixteen together, where the per-cell
-    /// arrays take sixteen loads from as many arrays and a check each.
-    rim_rise: Vec<[[f64; 4]; 4]>,
+    /// The same weights of the rim cells in the rim's order ([`CellSides::rim_cells`]),
+    /// so that the rim's rises run on slices like the faces' (its cells' values gathered
+    /// first, [`RimRises`]).
+    rim_rise: [[Vec<f64>; 4]; 4],
+}
+
+/// The rim's thicknesses and rises in the rim's order ([`limited_rises`]).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct RimRises {
+    /// The rim cells' thicknesses.
+    own: Vec<f64>,
+    /// Per side: their neighbours'.
+    neighbour: [Vec<f64>; 4],
+    /// Per side: their limited rises.
+    rise: [Vec<f64>; 4],
 }
 
 impl UpwindGeometry {
@@ -51,11 +62,8 @@ impl UpwindGeometry {
                 }
             }
         }
-        let rim_rise = sides.rim_cells.iter().map(|&c| {
-            let c = c as usize;
-            std::array::from_fn(|k| std::array::from_fn(|j| rise[k][j][c]))
-        });
-        let rim_rise = rim_rise.collect();
+        let rim = |w: &Vec<f64>| sides.rim_cells.iter().map(|&c| w[c as usize]).collect();
+        let rim_rise = std::array::from_fn(|k| std::array::from_fn(|j| rim(&rise[k][j])));
         Self { rise, rim_rise }
     }
 }
@@ -106,7 +114,7 @@ pub(crate) fn limited_rises(
     sides: &CellSides,
     geo: &UpwindGeometry,
     h: &[f64],
-    out: &mut [Vec<f64>; 4],
+    (out, rim_rises): (&mut [Vec<f64>; 4], &mut RimRises),
 ) {
     for o in out.iter_mut() {
         o.resize(h.len(), 0.0);
@@ -116,22 +124,40 @@ pub(crate) fn limited_rises(
     for span in sides.face_spans() {
         let cells = span.cells();
         let [o0, o1, o2, o3] = out.each_mut().map(|o| &mut o[cells.clone()]);
-        rises_run(geo, h, span, [o0, o1, o2, o3]);
+        let w = |k: usize, j: usize| &geo.rise[k][j][cells.clone()];
+        let w = [0, 1, 2, 3].map(|k| [w(k, 0), w(k, 1), w(k, 2), w(k, 3)]);
+        let nb = [0, 1, 2, 3].map(|j| &h[span.neighbours(j)]);
+        rises_run(w, &h[cells.clone()], nb, [o0, o1, o2, o3]);
     }
+    // The rim: its values gathered, the same arithmetic on slices, the rises scattered.
     let rim = sides.rim();
-    let weights = &geo.rim_rise[..rim.cells.len()];
-    let [o0, o1, o2, o3] = out;
-    for (i, (&c, w)) in rim.cells.iter().zip(weights).enumerate() {
-        let (c, nb) = (c as usize, rim.at_neighbours(i, h));
-        let hc = h[c];
-        let rise = [
-            rise_of(w[0], hc, nb),
-            rise_of(w[1], hc, nb),
-            rise_of(w[2], hc, nb),
-            rise_of(w[3], hc, nb),
-        ];
-        let phi = limiter(hc, nb, rise);
-        (o0[c], o1[c], o2[c], o3[c]) = (rise[0] * phi, rise[1] * phi, rise[2] * phi, rise[3] * phi);
+    let m = rim.cells.len();
+    let RimRises {
+        own,
+        neighbour,
+        rise,
+    } = rim_rises;
+    rim.gather_cells(h, own);
+    rim.gather_neighbours(h, neighbour);
+    for r in rise.iter_mut() {
+        r.resize(m, 0.0);
+    }
+    let w = geo
+        .rim_rise
+        .each_ref()
+        .map(|w| w.each_ref().map(|w| &w[..m]));
+    let nb = neighbour.each_ref().map(|x| &x[..m]);
+    let [r0, r1, r2, r3] = rise;
+    rises_run(
+        w,
+        &own[..m],
+        nb,
+        [&mut r0[..m], &mut r1[..m], &mut r2[..m], &mut r3[..m]],
+    );
+    for (o, r) in out.iter_mut().zip([&*r0, &*r1, &*r2, &*r3]) {
+        for (&c, &r) in rim.cells.iter().zip(r) {
+            o[c as usize] = r;
+        }
     }
 }
 
@@ -142,16 +168,14 @@ fn rise_of(w: [f64; 4], h: f64, nb: [f64; 4]) -> f64 {
     (w[0] * (h + nb[0]) + w[1] * (h + nb[1])) + (w[2] * (h + nb[2]) + w[3] * (h + nb[3]))
 }
 
-/// The limited rises of a run of cells, as slices: each side's rises in a loop of
-/// their own, then the limit (one loop over all sixteen weights kept the compiler from
-/// vectorising it: it spilled them to the stack cell by cell).
+/// The limited rises of a stretch of cells from their weights `w[k][j]`, thicknesses
+/// `centre` and neighbours' `nb`, as slices: each side's rises in a loop of their own,
+/// then the limit (one loop over all sixteen weights kept the compiler from vectorising
+/// it: it spilled them to the stack cell by cell).
 #[inline(always)]
-fn rises_run(geo: &UpwindGeometry, h: &[f64], run: CellSpan, mut out: [&mut [f64]; 4]) {
-    let (len, cells) = (run.len, run.cells());
-    let centre = &h[cells.clone()];
-    let nb: [&[f64]; 4] = std::array::from_fn(|j| &h[run.neighbours(j)]);
-    for (k, o) in out.iter_mut().enumerate() {
-        let w: [&[f64]; 4] = std::array::from_fn(|j| &geo.rise[k][j][cells.clone()]);
+fn rises_run(w: [[&[f64]; 4]; 4], centre: &[f64], nb: [&[f64]; 4], mut out: [&mut [f64]; 4]) {
+    let len = centre.len();
+    for (w, o) in w.into_iter().zip(out.iter_mut()) {
         rise_run(w, centre, nb, o);
     }
     let [o0, o1, o2, o3] = out;
