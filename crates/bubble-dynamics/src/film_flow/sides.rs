@@ -169,15 +169,16 @@ impl SeamEnds {
         per_side: &[Vec<f64>; 4],
     ) -> [[&[f64]; 2]; 2] {
         let ([a0, a1], [b0, b1]) = (&mut self.a, &mut self.b);
-        for v in [&mut *a0, &mut *a1, &mut *b0, &mut *b1] {
-            v.clear();
-        }
-        for i in 0..seams.len {
+        gather(field, seams.a, a0);
+        gather(field, seams.b, b0);
+        // Written in place (pushed, they took four times the instructions).
+        let m = seams.len;
+        a1.resize(m, 0.0);
+        b1.resize(m, 0.0);
+        let (a1, b1) = (&mut a1[..m], &mut b1[..m]);
+        for i in 0..m {
             let ([ca, cb], [ka, kb]) = (seams.cells(i), seams.sides(i));
-            a0.push(field[ca]);
-            b0.push(field[cb]);
-            a1.push(per_side[ka][ca]);
-            b1.push(per_side[kb][cb]);
+            (a1[i], b1[i]) = (per_side[ka][ca], per_side[kb][cb]);
         }
         [[&a0[..], &b0[..]], [&a1[..], &b1[..]]]
     }
