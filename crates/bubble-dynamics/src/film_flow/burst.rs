@@ -22,7 +22,9 @@
 use glam::DVec3;
 
 use super::FilmFlow;
+use super::compare::smaller;
 use super::grid::{CubeSphere, arc};
+use crate::avx2::with_avx2;
 use crate::rng::SplitMix64;
 
 /// Time for a film that fell under the black threshold to reach the black film, s.
@@ -103,6 +105,29 @@ struct BlackScratch {
     border_weight: Vec<f64>,
     /// Per cell: the thickness the spots around it give it this step, m.
     gain: Vec<f64>,
+}
+
+/// The least thickness `h` of a cell with film (`coverage > 0`; NaN skipped, infinite
+/// where none), in four lanes that vectorise.
+fn thinnest_covered(h: &[f64], coverage: &[f64]) -> f64 {
+    with_avx2(
+        #[inline(always)]
+        || {
+            let covered = |h: f64, c: f64| if c > 0.0 { h } else { f64::INFINITY };
+            let coverage = &coverage[..h.len()];
+            let mut lanes = [f64::INFINITY; 4];
+            for (h, c) in h.chunks_exact(4).zip(coverage.chunks_exact(4)) {
+                for k in 0..4 {
+                    lanes[k] = smaller(covered(h[k], c[k]), lanes[k]);
+                }
+            }
+            let whole = h.len() / 4 * 4;
+            let (h_rest, c_rest) = (&h[whole..], &coverage[whole..]);
+            let rest = h_rest.iter().zip(c_rest).map(|(&h, &c)| covered(h, c));
+            let least = rest.fold(f64::INFINITY, |a, b| smaller(b, a));
+            lanes.into_iter().fold(least, |a, b| smaller(b, a))
+        },
+    )
 }
 
 /// The root of `cell`'s spot, halving the path to it on the way.
@@ -349,7 +374,8 @@ impl BurstState {
             black: p.black_film_nm * 1e-9,
             coverage: &self.coverage,
         };
-        if !(0..flow.h_m.len()).any(|k| film.is_black(&flow.h_m, k)) {
+        // Some cell is black exactly where the thinnest covered one is.
+        if thinnest_covered(&flow.h_m, &self.coverage) >= film.threshold {
             return;
         }
         let fraction = 1.0 - (-dt_s / BLACK_RELAX_S).exp();
@@ -369,14 +395,12 @@ impl BurstState {
                 .iter()
                 .any(|h| arc(h.site, d) * flow.params.radius_m <= h.radius_m)
         };
-        let thinnest = flow
-            .h_m
-            .iter()
-            .enumerate()
-            .filter(|&(i, _)| self.coverage[i] > 0.0)
-            .min_by(|a, b| a.1.total_cmp(b.1));
-        if let Some((i, &h)) = thinnest
-            && h < p.rupture_thickness_nm * 1e-9
+        // The search for the thinnest cell (the first of them) runs only where a pass
+        // that vectorises finds one under the rupture thickness.
+        let rupture_m = p.rupture_thickness_nm * 1e-9;
+        if thinnest_covered(&flow.h_m, &self.coverage) < rupture_m
+            && let Some((i, h)) = self.thinnest_cell(flow)
+            && h < rupture_m
             && !inside(&self.holes, grid.centres()[i])
         {
             self.first_hole_thickness_m.get_or_insert(h);
@@ -395,6 +419,15 @@ impl BurstState {
                 }
             }
         }
+    }
+
+    /// The covered cell with the least thickness (the first of them), and its thickness.
+    fn thinnest_cell(&self, flow: &FilmFlow) -> Option<(usize, f64)> {
+        let covered = flow.h_m.iter().enumerate();
+        let covered = covered.filter(|&(i, _)| self.coverage[i] > 0.0);
+        covered
+            .min_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(i, &h)| (i, h))
     }
 
     /// The Taylor–Culick speed of every rim over the mean thickness of the film within

@@ -13,10 +13,11 @@
 //! keep the exact law. Fluxes that sum to zero keep liquid conserved to rounding, each
 //! donor limited to half its content keeps h ≥ 0.
 
-use super::compare::smaller;
-use super::fluxes::{apply_limited, net_inflow};
-use super::grid::CubeSphere;
-use super::sides::CellSides;
+use super::compare::{largest, pick, smaller};
+use super::fluxes::{GatherScratch, apply_limited, net_inflow};
+use super::grid::{CubeSphere, EdgeArrays};
+use super::sides::{CellSides, EdgeBlock, SeamEnds};
+use crate::avx2::with_avx2;
 
 /// Most explicit sub-steps a film step spends on capillary smoothing.
 pub(crate) const MAX_SUBSTEPS: u32 = 64;
@@ -47,7 +48,10 @@ pub(crate) struct CapillaryScratch {
     laplacian_norm: Option<(usize, f64)>,
     laplacian: Vec<f64>,
     flux: Vec<f64>,
-    outflow: Vec<f64>,
+    /// The gathers' buffers.
+    gather: GatherScratch,
+    /// The seam edges' end values.
+    seam_ends: SeamEnds,
 }
 
 /// Moves liquid by the capillary pressure over `dt_s`; `h_m` per cell.
@@ -70,7 +74,7 @@ pub(crate) fn smooth_thickness(
             norm
         }
     };
-    let thickest = h_m.iter().copied().fold(0.0, f64::max);
+    let thickest = largest(h_m);
     let max_mobility = per_cubed * thickest * thickest * thickest;
     let rate = max_mobility * (norm / (c.radius_m * c.radius_m)).powi(2);
     if rate * dt_s < 1e-3 {
@@ -128,17 +132,17 @@ fn substep(
     sides.for_each_edge_run(
         #[inline(always)]
         |run| {
-            let len = run.len;
             let (ha, hb) = run.ends(h_m);
-            let (l, per_d) = (run.along(&ea.length), run.along(&ea.inverse_dual_length));
-            let (ha, hb, l, per_d) = (&ha[..len], &hb[..len], &l[..len], &per_d[..len]);
-            let out = run.along_mut(&mut s.flux);
-            for i in 0..len {
-                out[i] = (ha[i] - hb[i]) * l[i] * per_d[i];
-            }
+            differences_block(run, [ha, hb], ea, &mut s.flux);
         },
     );
-    net_inflow(sides, &s.flux, &mut s.laplacian);
+    let seams = sides.seams();
+    let ends = s.seam_ends.gather(seams, h_m);
+    with_avx2(
+        #[inline(always)]
+        || differences_block(seams, ends, ea, &mut s.flux),
+    );
+    net_inflow(sides, &s.flux, &mut s.laplacian, &mut s.gather);
     let per_r2 = 1.0 / (radius_m * radius_m);
     for (lap, per_area) in s.laplacian.iter_mut().zip(grid.inverse_areas_per_sr()) {
         *lap *= per_area * per_r2;
@@ -152,26 +156,68 @@ fn substep(
     // a mean-thickness mobility drew liquid out of the thin film one cell further at the
     // pool's rate, emptying it in a step (bubbles resting on the ground burst within a
     // second). At the donor's, a thin cell gives at its own slow rate.
-    let (laplacian, Mobility { per_cubed, cap }) = (&s.laplacian[..], mobility);
+    let laplacian = &s.laplacian[..];
     let per_length = dt_s / (radius_m * radius_m);
+    let volumes = Volumes {
+        ea,
+        mobility,
+        per_length,
+    };
     sides.for_each_edge_run(
         #[inline(always)]
         |run| {
-            let len = run.len;
-            let (ha, hb) = run.ends(h_m);
-            let (la, lb) = run.ends(laplacian);
-            let (l, per_d) = (run.along(&ea.length), run.along(&ea.inverse_dual_length));
-            let (ha, hb, la, lb) = (&ha[..len], &hb[..len], &la[..len], &lb[..len]);
-            let (l, per_d, out) = (&l[..len], &per_d[..len], run.along_mut(&mut s.flux));
-            for i in 0..len {
-                let rise = lb[i] - la[i];
-                let donor = if rise >= 0.0 { ha[i] } else { hb[i] };
-                let m = smaller(per_cubed * donor * donor * donor, cap);
-                out[i] = m * rise * per_d[i] * l[i] * per_length;
-            }
+            let ((ha, hb), (la, lb)) = (run.ends(h_m), run.ends(laplacian));
+            volumes.block(run, [ha, hb, la, lb], &mut s.flux);
         },
+    );
+    let seams = sides.seams();
+    let [[ha, hb], [la, lb]] = s.seam_ends.gather_many(seams, [h_m, laplacian]);
+    with_avx2(
+        #[inline(always)]
+        || volumes.block(seams, [ha, hb, la, lb], &mut s.flux),
     );
     // Each donor gives at most half its content: h stays ≥ 0.
     let (areas, per_area) = (grid.areas_sr(), grid.inverse_areas_per_sr());
-    apply_limited(sides, areas, per_area, &s.flux, 1.0, h_m, &mut s.outflow);
+    apply_limited(sides, areas, per_area, &s.flux, 1.0, h_m, &mut s.gather);
+}
+
+/// `(h_a − h_b) l/d` over a block of edges with thicknesses `[ha, hb]` at their ends,
+/// into `out` (the Laplacian's differences, [`substep`]).
+#[inline(always)]
+fn differences_block(run: impl EdgeBlock, [ha, hb]: [&[f64]; 2], ea: &EdgeArrays, out: &mut [f64]) {
+    let len = run.count();
+    let (l, per_d) = (run.values(&ea.length), run.values(&ea.inverse_dual_length));
+    let (ha, hb, out) = (&ha[..len], &hb[..len], run.values_mut(out));
+    for i in 0..len {
+        out[i] = (ha[i] - hb[i]) * l[i] * per_d[i];
+    }
+}
+
+/// The sub-step's volumes across the edges ([`substep`]).
+struct Volumes<'a> {
+    /// The grid's per-edge arrays.
+    ea: &'a EdgeArrays,
+    /// Each edge's mobility from its donor's thickness.
+    mobility: Mobility,
+    /// The sub-step over `R²`.
+    per_length: f64,
+}
+
+impl Volumes<'_> {
+    /// The volumes over a block of edges with thicknesses and Laplacians `[ha, hb, la,
+    /// lb]` at their ends, into `out`.
+    #[inline(always)]
+    fn block(&self, run: impl EdgeBlock, [ha, hb, la, lb]: [&[f64]; 4], out: &mut [f64]) {
+        let len = run.count();
+        let (ea, Mobility { per_cubed, cap }) = (self.ea, self.mobility);
+        let (l, per_d) = (run.values(&ea.length), run.values(&ea.inverse_dual_length));
+        let (ha, hb, la, lb) = (&ha[..len], &hb[..len], &la[..len], &lb[..len]);
+        let out = run.values_mut(out);
+        for i in 0..len {
+            let rise = lb[i] - la[i];
+            let donor = pick(rise >= 0.0, ha[i], hb[i]);
+            let m = smaller(per_cubed * donor * donor * donor, cap);
+            out[i] = m * rise * per_d[i] * l[i] * self.per_length;
+        }
+    }
 }

@@ -20,13 +20,15 @@ use super::burst::{BurstParams, BurstState, Hole};
 use super::capillary::{Capillary, CapillaryScratch, smooth_thickness};
 use super::compare::larger;
 use super::face_rows::FaceRows;
-use super::grid::CubeSphere;
+use super::fluxes::GatherScratch;
+use super::grid::{CubeSphere, dot_at};
 use super::meniscus::MeniscusState;
-use super::sides::CellSides;
+use super::sides::{CellSides, EdgeBlock, SeamEnds};
 use super::solve::{Hierarchy, SolveReport, Work};
 use super::thermal::{ThermalParams, up_from};
-use super::upwind::UpwindGeometry;
+use super::upwind::{RimRises, UpwindGeometry};
 use super::viscosity::{ViscousScratch, viscous_bound};
+use crate::avx2::with_avx2;
 
 /// Thickness floor of the Marangoni coefficient `E_f/(ρh)`, m: a hole or a Newton black
 /// film keeps a finite (if huge) stiffness.
@@ -175,6 +177,8 @@ pub(super) struct Scratch {
     /// Per side `k` and cell: how far the cell's limited gradient carries its thickness
     /// to that side's midpoint, m.
     pub(super) limited_rise: [Vec<f64>; 4],
+    /// The rim's values for the limited rises ([`RimRises`]).
+    pub(super) rim_rises: RimRises,
     pub(super) drag: Vec<f64>,
     /// Per edge: the drainage speed's coefficient over `h²`, s⁻¹·m⁻¹.
     pub(super) drain_rate: Vec<f64>,
@@ -189,6 +193,13 @@ pub(super) struct Scratch {
     pub(super) rhs: Vec<f64>,
     advect: AdvectionScratch,
     capillary: CapillaryScratch,
+    /// The cell-by-cell gathers' buffers ([`GatherScratch`]).
+    pub(super) gather: GatherScratch,
+    /// The seam edges' end values for the edge passes ([`SeamEnds`]).
+    pub(super) seam_ends: SeamEnds,
+    /// Per cell: a per-edge array's value on its left x-edge, two of them (the
+    /// temperature's transport, [`super::fluxes::spread_x_volumes`]).
+    pub(super) spread: [Vec<f64>; 2],
 }
 
 impl FilmFlow {
@@ -351,7 +362,7 @@ impl FilmFlow {
         s.u_start.clear();
         s.u_start.extend_from_slice(&self.u_m_per_s);
         let up = up_from(forcing.g_eff_m_per_s2);
-        self.exchange_heat(&s.u_start, &mut s.cell, dt_s, up);
+        self.exchange_heat(&s.u_start, (&mut s.cell, &mut s.spread), dt_s, up);
         self.momentum_explicit(&mut s, dt_s, forcing);
         self.air_shear(&mut s, dt_s, forcing.air_m_per_s);
         if let Some(m) = &self.meniscus {
@@ -452,41 +463,31 @@ impl FilmFlow {
         s.drag.resize(self.u_m_per_s.len(), 1.0);
         let nu_air = p.air_viscosity_pa_s / p.air_density_kg_per_m3.max(f64::MIN_POSITIVE);
         let (r, eddy) = (p.radius_m, 0.25 * p.radius_m);
-        // 1/δ = max(√(|Δu|/(ν_air ℓ)), 1/R): a multiply where 1/δ was a division.
-        let per_layer_depth = {
-            let (per_slip, floor) = (1.0 / (nu_air * eddy), 1.0 / r);
-            move |slip: f64| larger((slip * per_slip).sqrt(), floor)
-        };
         let ea = self.grid.edge_arrays();
-        let slopes = match p.gradient {
-            FilmGradient::TwoPoint => &ea.centre_gradient,
-            FilmGradient::Normal => &ea.centre_normal_gradient,
+        let shear = AirShear {
+            per_slip: 1.0 / (nu_air * eddy),
+            floor: 1.0 / r,
+            per_layer: p.air_viscosity_pa_s / p.density_kg_per_m3,
+            dt_s,
+            air: air_m_per_s,
+            slopes: match p.gradient {
+                FilmGradient::TwoPoint => &ea.centre_gradient_xyz,
+                FilmGradient::Normal => &ea.centre_normal_gradient_xyz,
+            },
         };
-        // The potential flow's surface velocity is the gradient of 1.5 U·x: taken as the
-        // discrete gradient between cell centres, curl-free like the real one. (Its own
-        // pass: the slopes are vectors, which the edge runs below would read strided.)
-        let outside = &mut s.edge;
-        outside.clear();
-        outside.extend(slopes.iter().map(|slope| 1.5 * air_m_per_s.dot(*slope)));
-        let per_layer = p.air_viscosity_pa_s / p.density_kg_per_m3;
-        let sides = &self.sides;
+        let (sides, u, drag) = (&self.sides, &mut self.u_m_per_s, &mut s.drag);
         sides.for_each_edge_run(
             #[inline(always)]
             |run| {
-                let len = run.len;
                 let (ha, hb) = run.ends(&self.h_m);
-                let (ha, hb, outside) = (&ha[..len], &hb[..len], run.along(&s.edge));
-                let u = run.along_mut(&mut self.u_m_per_s);
-                let factor = run.along_mut(&mut s.drag);
-                for i in 0..len {
-                    let h = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
-                    let k = per_layer / h;
-                    let k_out = k * per_layer_depth((u[i] - outside[i]).abs());
-                    let k_in = k * per_layer_depth(u[i].abs());
-                    factor[i] = 1.0 / (1.0 + dt_s * (k_out + k_in));
-                    u[i] = (u[i] + dt_s * k_out * outside[i]) * factor[i];
-                }
+                shear.block(run, [ha, hb], u, drag);
             },
+        );
+        let seams = sides.seams();
+        let ends = s.seam_ends.gather(seams, &self.h_m);
+        with_avx2(
+            #[inline(always)]
+            || shear.block(seams, ends, u, drag),
         );
     }
 
@@ -506,5 +507,108 @@ impl FilmFlow {
         };
         let sides = &self.sides;
         smooth_thickness(&self.grid, sides, c, dt_s, &mut self.h_m, &mut s.capillary);
+    }
+}
+
+/// The air shear's constants ([`FilmFlow::air_shear`]).
+struct AirShear<'a> {
+    /// `1/(ν_air ℓ)`: the slip times this is `1/δ²`.
+    per_slip: f64,
+    /// `1/R`, the least `1/δ`.
+    floor: f64,
+    /// `μ_air/ρ`: over the film's thickness and δ, the drag's rate.
+    per_layer: f64,
+    /// The step, s.
+    dt_s: f64,
+    /// The air's velocity far from the bubble, m/s.
+    air: DVec3,
+    /// The slopes of a linear potential across the edges, as components.
+    slopes: &'a [Vec<f64>; 3],
+}
+
+impl AirShear<'_> {
+    /// `1/δ = max(√(|Δu|/(ν_air ℓ)), 1/R)` at slip `slip`: a multiply where `1/δ` was a
+    /// division.
+    #[inline(always)]
+    fn per_layer_depth(&self, slip: f64) -> f64 {
+        larger((slip * self.per_slip).sqrt(), self.floor)
+    }
+
+    /// The shear over a block of edges with thicknesses `[ha, hb]` at their ends: each
+    /// edge's velocity `u` dragged, its implicit factor into `drag`.
+    #[inline(always)]
+    fn block(&self, block: impl EdgeBlock, [ha, hb]: [&[f64]; 2], u: &mut [f64], drag: &mut [f64]) {
+        let len = block.count();
+        let (ha, hb) = (&ha[..len], &hb[..len]);
+        let [sx, sy, sz] = self.slopes;
+        let slopes = [block.values(sx), block.values(sy), block.values(sz)];
+        let (u, factor) = (block.values_mut(u), block.values_mut(drag));
+        let dt_s = self.dt_s;
+        for i in 0..len {
+            // The potential flow's surface velocity is the gradient of 1.5 U·x: taken as
+            // the discrete gradient between cell centres, curl-free like the real one.
+            let outside = 1.5 * dot_at(self.air, slopes, i);
+            let h = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
+            let k = self.per_layer / h;
+            let k_out = k * self.per_layer_depth((u[i] - outside).abs());
+            let k_in = k * self.per_layer_depth(u[i].abs());
+            factor[i] = 1.0 / (1.0 + dt_s * (k_out + k_in));
+            u[i] = (u[i] + dt_s * k_out * outside) * factor[i];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A warmed, draining, evaporating film turning in a wind, at n = 12 (rows of ten
+    /// inside cells: vector chunks and odd ends, the rim, the seams).
+    fn film() -> FilmFlow {
+        let grid = std::sync::Arc::new(CubeSphere::new(12));
+        let hierarchy = std::sync::Arc::new(Hierarchy::new(&grid));
+        let mut params = FlowParams {
+            drainage_viscosity_pa_s: 1e-6,
+            evaporation_nm_per_s: 40.0,
+            ..FlowParams::water_film(0.05)
+        };
+        params.thermal.bottom_warming_k = 5.0;
+        let mut f = FilmFlow::new(grid, hierarchy, params, |d| {
+            20e-6 * (1.0 + 0.3 * (4.0 * d.x + d.y).sin())
+        });
+        f.set_velocity(|d| DVec3::Y.cross(d) * 0.05);
+        f.set_surfactant(|d| 1.0 + 0.1 * d.z);
+        f
+    }
+
+    /// Every pass the step compiles for AVX2 gives the portable build's bits: IEEE
+    /// additions and multiplications in a fixed order, minima and maxima by comparisons.
+    #[test]
+    fn the_avx2_step_gives_the_portable_steps_bits() {
+        let forcing = Forcing {
+            g_eff_m_per_s2: DVec3::new(0.0, -9.81, 0.0),
+            air_m_per_s: DVec3::new(0.3, 0.0, 0.1),
+        };
+        let run = |portable: bool| {
+            crate::avx2::set_portable_only(portable);
+            let mut f = film();
+            for _ in 0..5 {
+                f.step(1.0 / 60.0, &forcing);
+            }
+            crate::avx2::set_portable_only(false);
+            f
+        };
+        let (fast, portable) = (run(false), run(true));
+        let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&fast.h_m), bits(&portable.h_m), "thickness");
+        assert_eq!(bits(&fast.gamma), bits(&portable.gamma), "surfactant");
+        assert_eq!(bits(&fast.u_m_per_s), bits(&portable.u_m_per_s), "velocity");
+        assert_eq!(
+            bits(&fast.temperature_k),
+            bits(&portable.temperature_k),
+            "temperature"
+        );
+        let start = film();
+        assert_ne!(bits(&fast.h_m), bits(&start.h_m), "the film did not move");
     }
 }

@@ -11,6 +11,9 @@ use std::collections::HashMap;
 
 use glam::{DMat3, DVec3, IVec3};
 
+use super::compare::larger;
+use crate::avx2::with_avx2;
+
 /// Major axis, `s` axis and `t` axis of each face (OpenGL cube-map order).
 pub const FACE_BASES: [(IVec3, IVec3, IVec3); 6] = [
     (IVec3::X, IVec3::NEG_Z, IVec3::NEG_Y),
@@ -81,6 +84,13 @@ pub struct EdgeArrays {
     pub centre_normal_gradient: Vec<DVec3>,
     /// Unit tangent normal to the edge at its midpoint, from `a` towards `b`.
     pub normal: Vec<DVec3>,
+    /// [`Self::normal`]'s x, y and z as arrays of their own, for the edge-run passes (a
+    /// pass that reads them as vectors cannot vectorise).
+    pub normal_xyz: [Vec<f64>; 3],
+    /// [`Self::centre_gradient`]'s components, likewise.
+    pub centre_gradient_xyz: [Vec<f64>; 3],
+    /// [`Self::centre_normal_gradient`]'s components, likewise.
+    pub centre_normal_gradient_xyz: [Vec<f64>; 3],
     /// `midpoint − centre_a` and `midpoint − centre_b`: how far a cell's value is carried
     /// to the edge by its gradient.
     pub reach: Vec<[DVec3; 2]>,
@@ -97,7 +107,7 @@ impl EdgeArrays {
         let smaller_area = |e: &GridEdge| areas_sr[e.a as usize].min(areas_sr[e.b as usize]);
         let skew: Vec<[f64; 2]> = edges.iter().map(|e| skew_weights(e, centres)).collect();
         let at_vertex = |v: u32| to_vertices.apply_vec(v as usize, centres);
-        Self {
+        let mut arrays = Self {
             inverse_normal_dual_length: skew.iter().map(|w| w[0]).collect(),
             cross_per_length: skew.iter().map(|w| w[1]).collect(),
             length_per_smaller_area: edges.iter().map(|e| e.length / smaller_area(e)).collect(),
@@ -124,8 +134,27 @@ impl EdgeArrays {
                 .iter()
                 .map(|e| [e.midpoint - centre(e.a), e.midpoint - centre(e.b)])
                 .collect(),
-        }
+            normal_xyz: Default::default(),
+            centre_gradient_xyz: Default::default(),
+            centre_normal_gradient_xyz: Default::default(),
+        };
+        arrays.normal_xyz = components(&arrays.normal);
+        arrays.centre_gradient_xyz = components(&arrays.centre_gradient);
+        arrays.centre_normal_gradient_xyz = components(&arrays.centre_normal_gradient);
+        arrays
     }
+}
+
+/// The x, y and z of `vectors`, each as an array.
+fn components(vectors: &[DVec3]) -> [Vec<f64>; 3] {
+    std::array::from_fn(|k| vectors.iter().map(|v| v[k]).collect())
+}
+
+/// `g·v` for the vector `v` given by its components `xyz` at index `i`, in the order
+/// of `DVec3::dot` (the same bits).
+#[inline(always)]
+pub(crate) fn dot_at(g: DVec3, [x, y, z]: [&[f64]; 3], i: usize) -> f64 {
+    (g.x * x[i] + g.y * y[i]) + g.z * z[i]
 }
 
 /// A gnomonic cube-sphere of `6·n²` cells on the unit sphere.
@@ -138,6 +167,8 @@ impl EdgeArrays {
 pub struct CubeSphere {
     n: usize,
     centres: Vec<DVec3>,
+    /// The centres' x, y and z as arrays of their own, for passes that vectorise.
+    centres_xyz: [Vec<f64>; 3],
     areas_sr: Vec<f64>,
     edges: Vec<GridEdge>,
     edge_arrays: EdgeArrays,
@@ -280,6 +311,7 @@ impl CubeSphere {
             n,
             inverse_areas_per_sr: inverse(&areas_sr),
             inverse_vertex_areas_per_sr: inverse(&vertex_areas_sr),
+            centres_xyz: components(&centres),
             centres,
             areas_sr,
             edges,
@@ -328,6 +360,11 @@ impl CubeSphere {
         &self.centres
     }
 
+    /// The cell centres' x, y and z, each as an array.
+    pub(crate) fn centres_xyz(&self) -> &[Vec<f64>; 3] {
+        &self.centres_xyz
+    }
+
     /// Area of each cell on the unit sphere, sr.
     pub fn areas_sr(&self) -> &[f64] {
         &self.areas_sr
@@ -347,11 +384,25 @@ impl CubeSphere {
     /// (m/s): times a step over the radius, the largest fraction of a cell any edge
     /// carries (a Courant number).
     pub fn fastest_crossing(&self, u_m_per_s: &[f64]) -> f64 {
-        u_m_per_s
-            .iter()
-            .zip(&self.edge_arrays.length_per_smaller_area)
-            .map(|(u, per_area)| u.abs() * per_area)
-            .fold(0.0, f64::max)
+        let per_area = &self.edge_arrays.length_per_smaller_area;
+        let n = u_m_per_s.len().min(per_area.len());
+        let (u, per_area) = (&u_m_per_s[..n], &per_area[..n]);
+        // Four running maxima in chunks of four, which vectorise (a maximum is exact in
+        // any order; NaN skipped, as `f64::max` does).
+        with_avx2(
+            #[inline(always)]
+            || {
+                let mut lanes = [0.0; 4];
+                for (u, a) in u.chunks_exact(4).zip(per_area.chunks_exact(4)) {
+                    for k in 0..4 {
+                        lanes[k] = larger(u[k].abs() * a[k], lanes[k]);
+                    }
+                }
+                let rest = (n / 4 * 4..n).map(|i| u[i].abs() * per_area[i]);
+                let fastest = rest.fold(0.0, |a, b| larger(b, a));
+                lanes.into_iter().fold(fastest, |a, b| larger(b, a))
+            },
+        )
     }
 
     /// Dual area of each grid vertex (a quarter of each cell around it), sr.

@@ -10,14 +10,15 @@
 //! velocity correction with the surfactant's move (into a copy, so the correction still
 //! reads the surfactant the solve started from and the rare redo needs no restore).
 
-use super::compare::larger;
+use super::compare::{larger, pick};
 use super::flow::{
     FilmFlow, FilmGradient, H_FLOOR_M, SOLVE_MAX_ITERATIONS, SOLVE_TOLERANCE, Scratch,
 };
 use super::fluxes::{apply_limited, net_inflow};
 use super::grid::EdgeArrays;
-use super::sides::{CellSides, EdgeRun};
+use super::sides::{CellSides, EdgeBlock, SeamEnds};
 use super::solve::{SolveLimits, SolveReport};
+use crate::avx2::with_avx2;
 
 /// Most solves a step's defect correction of the cross term takes (it takes about 11 on
 /// the swirl film at n = 64: each cuts the error by about 0.35, the cross operator's
@@ -51,10 +52,6 @@ impl FilmFlow {
                 self.correct_the_cross_term(s, dt_s, first)
             }
         };
-        // The step's change of Γ: the next step's first guess.
-        self.surfactant_change.clear();
-        let changes = s.cell2.iter().zip(&self.gamma).map(|(x, gm)| x - gm);
-        self.surfactant_change.extend(changes);
         match self.params.gradient {
             FilmGradient::TwoPoint => self.correct_velocity_and_move_surfactant::<false>(s, dt_s),
             FilmGradient::Normal => self.correct_velocity_and_move_surfactant::<true>(s, dt_s),
@@ -87,7 +84,8 @@ impl FilmFlow {
         let sides = &self.sides;
         let (areas, per_area) = (g.areas_sr(), g.inverse_areas_per_sr());
         for _ in 0..substeps {
-            upwind_fluxes(sides, ea, &self.gamma, &s.u_start, &mut s.edge2);
+            let fields = (&self.gamma[..], &s.u_start[..]);
+            upwind_fluxes(sides, ea, fields, (&mut s.edge2, &mut s.seam_ends));
             let (flux, gamma) = (&s.edge2, &mut self.gamma);
             apply_limited(
                 sides,
@@ -96,7 +94,7 @@ impl FilmFlow {
                 flux,
                 sub_dt_per_r,
                 gamma,
-                &mut s.cell,
+                &mut s.gather,
             );
         }
     }
@@ -142,49 +140,64 @@ impl FilmFlow {
         sides.for_each_edge_run(
             #[inline(always)]
             |run| {
-                self.central_fluxes_run::<NORMAL>(s, run, edge);
+                let ((ga, gb), (ha, hb)) = (run.ends(&self.gamma), run.ends(&self.h_m));
+                self.central_fluxes_block::<NORMAL>(s, run, [ga, gb, ha, hb], edge);
             },
         );
+        let seams = sides.seams();
+        let mut seam_ends = std::mem::take(&mut s.seam_ends);
+        let [[ga, gb], [ha, hb]] = seam_ends.gather_many(seams, [&self.gamma, &self.h_m]);
+        with_avx2(
+            #[inline(always)]
+            || self.central_fluxes_block::<NORMAL>(s, seams, [ga, gb, ha, hb], edge),
+        );
+        s.seam_ends = seam_ends;
         // `A Γ − dt Σ F/R`: each cell's net inflow of the fluxes, gathered.
-        net_inflow(sides, &s.edge, &mut s.rhs);
+        net_inflow(sides, &s.edge, &mut s.rhs, &mut s.gather);
         let dt_per_r = dt_s / p.radius_m;
-        let cells = s.rhs.iter_mut().zip(g.areas_sr()).zip(&self.gamma);
-        for ((rhs, area), gamma) in cells {
-            *rhs = area * gamma + dt_per_r * *rhs;
-        }
+        let n = s.rhs.len();
+        let (rhs, areas, gamma) = (&mut s.rhs[..], &g.areas_sr()[..n], &self.gamma[..n]);
+        with_avx2(
+            #[inline(always)]
+            || {
+                for i in 0..n {
+                    rhs[i] = areas[i] * gamma[i] + dt_per_r * rhs[i];
+                }
+            },
+        );
     }
 
-    /// [`Self::fluxes_weights_and_right_hand_side`]'s edge pass over one run of edges.
+    /// [`Self::fluxes_weights_and_right_hand_side`]'s edge pass over a block of edges,
+    /// with the surfactant and thickness at their ends.
     #[inline(always)]
-    fn central_fluxes_run<const NORMAL: bool>(
+    fn central_fluxes_block<const NORMAL: bool>(
         &self,
         s: &mut Scratch,
-        run: EdgeRun,
+        run: impl EdgeBlock,
+        [ga, gb, ha, hb]: [&[f64]; 4],
         c: EdgeConstants,
     ) {
         let ea = self.grid.edge_arrays();
-        let len = run.len;
-        let (ga, gb) = run.ends(&self.gamma);
-        let (ha, hb) = run.ends(&self.h_m);
+        let len = run.count();
         let (ga, gb, ha, hb) = (&ga[..len], &gb[..len], &ha[..len], &hb[..len]);
-        let (u, u0) = (run.along(&self.u_m_per_s), run.along(&s.u_start));
-        let (drag, l) = (run.along(&s.drag), run.along(&ea.length));
+        let (u, u0) = (run.values(&self.u_m_per_s), run.values(&s.u_start));
+        let (drag, l) = (run.values(&s.drag), run.values(&ea.length));
         let inverse_dual = if NORMAL {
             &ea.inverse_normal_dual_length
         } else {
             &ea.inverse_dual_length
         };
-        let id = run.along(inverse_dual);
+        let id = run.values(inverse_dual);
         let (u, u0, drag, l, id) = (&u[..len], &u0[..len], &drag[..len], &l[..len], &id[..len]);
-        let flux = run.along_mut(&mut s.edge);
-        let stiffness = run.along_mut(&mut s.stiffness);
-        let weight = run.along_mut(&mut s.weight);
+        let flux = run.values_mut(&mut s.edge);
+        let stiffness = run.values_mut(&mut s.stiffness);
+        let weight = run.values_mut(&mut s.weight);
         for i in 0..len {
             let gamma_c = 0.5 * (ga[i] + gb[i]);
             let h_edge = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
             let k = c.dt_e_per_rho / h_edge * drag[i];
             let u = if NORMAL {
-                let e = run.start + i;
+                let e = run.first() + i;
                 let [v0, v1] = ea.vertices[e];
                 let along = s.vertex[v1 as usize] - s.vertex[v0 as usize];
                 let du = k * ea.cross_per_length[e] * along * c.per_r;
@@ -204,13 +217,8 @@ impl FilmFlow {
     /// to step; the tolerance stays relative to Γⁿ's residual).
     fn solve_surfactant(&self, s: &mut Scratch) -> SolveReport {
         let g = &self.grid;
-        let guess = &mut s.guess;
-        guess.clear();
-        let change = &self.surfactant_change;
-        guess.extend(self.gamma.iter().zip(change).map(|(gm, d)| gm + d));
-        let solution = &mut s.cell2;
-        solution.clear();
-        solution.extend_from_slice(&self.gamma);
+        let (guess, solution) = (&mut s.guess, &mut s.cell2);
+        start_and_guess(&self.gamma, &self.surfactant_change, solution, guess);
         self.hierarchy.solve_with_guess(
             &mut s.work,
             g.areas_sr(),
@@ -312,22 +320,47 @@ impl FilmFlow {
         let (ea, sides) = (g.edge_arrays(), &*sides);
         let scale = dt_s / r;
         s.edge2.resize(ea.cells.len(), 0.0);
+        let constants = (1.0 / r, scale);
+        let inverse_dual = if NORMAL {
+            &ea.inverse_normal_dual_length
+        } else {
+            &ea.inverse_dual_length
+        };
         sides.for_each_edge_run(
             #[inline(always)]
             |run| {
-                self.correct_velocity_run::<NORMAL>(s, run, scale);
+                let ((ga, gb), (xa, xb)) = (run.ends(&self.gamma), run.ends(&s.cell2));
+                let inputs = CorrectionInputs {
+                    inverse_dual,
+                    length: &ea.length,
+                    flux: &s.edge,
+                    stiffness: &s.stiffness,
+                    cross: &s.cross,
+                };
+                let out = (&mut self.u_m_per_s[..], &mut s.edge2[..]);
+                correct_velocity_block::<NORMAL>(run, [ga, gb, xa, xb], inputs, out, constants);
             },
         );
-        net_inflow(sides, &s.edge2, &mut s.rhs);
-        let cells = s
-            .rhs
-            .iter_mut()
-            .zip(&self.gamma)
-            .zip(g.inverse_areas_per_sr());
-        for ((next, gamma), per_area) in cells {
-            *next = gamma + *next * per_area;
-        }
-        if !s.rhs.iter().any(|&x| x < 0.0) {
+        let seams = sides.seams();
+        let mut seam_ends = std::mem::take(&mut s.seam_ends);
+        let [[ga, gb], [xa, xb]] = seam_ends.gather_many(seams, [&self.gamma, &s.cell2]);
+        let inputs = CorrectionInputs {
+            inverse_dual,
+            length: &ea.length,
+            flux: &s.edge,
+            stiffness: &s.stiffness,
+            cross: &s.cross,
+        };
+        let out = (&mut self.u_m_per_s[..], &mut s.edge2[..]);
+        with_avx2(
+            #[inline(always)]
+            || correct_velocity_block::<NORMAL>(seams, [ga, gb, xa, xb], inputs, out, constants),
+        );
+        s.seam_ends = seam_ends;
+        net_inflow(sides, &s.edge2, &mut s.rhs, &mut s.gather);
+        let per_area = g.inverse_areas_per_sr();
+        let change = &mut self.surfactant_change;
+        if !next_surfactant(&self.gamma, &s.cell2, per_area, &mut s.rhs, change) {
             std::mem::swap(&mut self.gamma, &mut s.rhs);
             return;
         }
@@ -338,53 +371,110 @@ impl FilmFlow {
         let change = &mut s.edge;
         change.clear();
         change.extend(self.u_m_per_s.iter().zip(&s.u_start).map(|(u, u0)| u - u0));
-        upwind_fluxes(sides, ea, &self.gamma, change, &mut s.edge2);
+        let out = (&mut s.edge2[..], &mut s.seam_ends);
+        upwind_fluxes(sides, ea, (&self.gamma, change), out);
         let (areas, per_area) = (g.areas_sr(), g.inverse_areas_per_sr());
         let (flux, gamma) = (&s.edge2, &mut self.gamma);
-        apply_limited(sides, areas, per_area, flux, scale, gamma, &mut s.cell);
+        apply_limited(sides, areas, per_area, flux, scale, gamma, &mut s.gather);
     }
+}
 
-    /// [`Self::correct_velocity_and_move_surfactant`]'s edge pass over one run: the
-    /// velocity corrected, and the volume of surfactant it and the transport flux move
-    /// into `s.edge2`.
-    #[inline(always)]
-    fn correct_velocity_run<const NORMAL: bool>(
-        &mut self,
-        s: &mut Scratch,
-        run: EdgeRun,
-        scale: f64,
-    ) {
-        let ea = self.grid.edge_arrays();
-        let per_r = 1.0 / self.params.radius_m;
-        let len = run.len;
-        let (ga, gb) = run.ends(&self.gamma);
-        let (xa, xb) = run.ends(&s.cell2);
-        let (ga, gb, xa, xb) = (&ga[..len], &gb[..len], &xa[..len], &xb[..len]);
-        let inverse_dual = if NORMAL {
-            &ea.inverse_normal_dual_length
+/// What the velocity correction reads per edge besides the cells' values: full per-edge
+/// arrays.
+#[derive(Clone, Copy)]
+struct CorrectionInputs<'a> {
+    /// `1/d` (`1/(d cos θ)` with the normal gradient), per rad.
+    inverse_dual: &'a [f64],
+    /// The edges' lengths, rad.
+    length: &'a [f64],
+    /// The transport flux from the central pass.
+    flux: &'a [f64],
+    /// Each edge's stiffness `k`.
+    stiffness: &'a [f64],
+    /// The cross term's velocity (with the normal gradient only).
+    cross: &'a [f64],
+}
+
+/// [`FilmFlow::correct_velocity_and_move_surfactant`]'s edge pass over a block of edges,
+/// with the surfactant before (`g`) and after (`x`) at their ends: the velocity `u`
+/// corrected, and the volume of surfactant it and the transport flux move into `moved`.
+#[inline(always)]
+fn correct_velocity_block<const NORMAL: bool>(
+    run: impl EdgeBlock,
+    [ga, gb, xa, xb]: [&[f64]; 4],
+    e: CorrectionInputs,
+    (u, moved): (&mut [f64], &mut [f64]),
+    (per_r, scale): (f64, f64),
+) {
+    let len = run.count();
+    let (ga, gb, xa, xb) = (&ga[..len], &gb[..len], &xa[..len], &xb[..len]);
+    let (id, l) = (run.values(e.inverse_dual), run.values(e.length));
+    let (f_adv, k) = (run.values(e.flux), run.values(e.stiffness));
+    let (u, moved) = (run.values_mut(u), run.values_mut(moved));
+    for i in 0..len {
+        let gamma_c = 0.5 * (ga[i] + gb[i]);
+        let slope = (xb[i] - xa[i]) * id[i] * per_r;
+        let du = -k[i] * slope / larger(gamma_c, f64::MIN_POSITIVE);
+        u[i] += if NORMAL {
+            du + e.cross[run.first() + i]
         } else {
-            &ea.inverse_dual_length
+            du
         };
-        let (id, l) = (run.along(inverse_dual), run.along(&ea.length));
-        let (f_adv, k) = (run.along(&s.edge), run.along(&s.stiffness));
-        let (id, l, f_adv, k) = (&id[..len], &l[..len], &f_adv[..len], &k[..len]);
-        let (u, moved) = (
-            run.along_mut(&mut self.u_m_per_s),
-            run.along_mut(&mut s.edge2),
-        );
-        let (u, moved) = (&mut u[..len], &mut moved[..len]);
-        for i in 0..len {
-            let gamma_c = 0.5 * (ga[i] + gb[i]);
-            let slope = (xb[i] - xa[i]) * id[i] * per_r;
-            let du = -k[i] * slope / larger(gamma_c, f64::MIN_POSITIVE);
-            u[i] += if NORMAL {
-                du + s.cross[run.start + i]
-            } else {
-                du
-            };
-            moved[i] = scale * (f_adv[i] + gamma_c * du * l[i]);
-        }
+        moved[i] = scale * (f_adv[i] + gamma_c * du * l[i]);
     }
+}
+
+/// The surfactant a solve starts from (`gamma`, into `solution`) and its first guess, the
+/// start plus the last step's `change` (none before the first step), in one pass.
+fn start_and_guess(gamma: &[f64], change: &[f64], solution: &mut Vec<f64>, guess: &mut Vec<f64>) {
+    let n = gamma.len();
+    // Every entry is written below: the buffers need their lengths, not a fill.
+    solution.resize(n, 0.0);
+    if change.len() != n {
+        guess.clear();
+        solution.copy_from_slice(gamma);
+        return;
+    }
+    guess.resize(n, 0.0);
+    let (solution, guess, change) = (&mut solution[..n], &mut guess[..n], &change[..n]);
+    with_avx2(
+        #[inline(always)]
+        || {
+            for i in 0..n {
+                solution[i] = gamma[i];
+                guess[i] = gamma[i] + change[i];
+            }
+        },
+    );
+}
+
+/// Each cell's surfactant after the step, `Γ + inflow/area` (`next` holds the inflows and
+/// takes the result), and the step's change of the solve, `solution − Γ` (the next
+/// step's first guess), in one pass; returns whether any cell went negative.
+fn next_surfactant(
+    gamma: &[f64],
+    solution: &[f64],
+    per_area: &[f64],
+    next: &mut [f64],
+    change: &mut Vec<f64>,
+) -> bool {
+    let n = gamma.len();
+    // Every entry is written below: the buffer needs its length, not a fill.
+    change.resize(n, 0.0);
+    let (solution, per_area) = (&solution[..n], &per_area[..n]);
+    let (next, change) = (&mut next[..n], &mut change[..n]);
+    with_avx2(
+        #[inline(always)]
+        || {
+            let mut negative = false;
+            for i in 0..n {
+                change[i] = solution[i] - gamma[i];
+                next[i] = gamma[i] + next[i] * per_area[i];
+                negative |= next[i] < 0.0;
+            }
+            negative
+        },
+    )
 }
 
 /// The constants of the Marangoni step's edge pass.
@@ -399,18 +489,40 @@ struct EdgeConstants {
 }
 
 /// The upwind volume `Γ_up·u·l` (per R and time) across every edge at speeds `u`, into
-/// `out`.
-fn upwind_fluxes(sides: &CellSides, ea: &EdgeArrays, gamma: &[f64], u: &[f64], out: &mut [f64]) {
+/// `out` (the seams' ends gathered into `seam_ends`).
+fn upwind_fluxes(
+    sides: &CellSides,
+    ea: &EdgeArrays,
+    (gamma, u): (&[f64], &[f64]),
+    (out, seam_ends): (&mut [f64], &mut SeamEnds),
+) {
     sides.for_each_edge_run(
         #[inline(always)]
         |run| {
-            let len = run.len;
             let (ga, gb) = run.ends(gamma);
-            let (u, l, f) = (run.along(u), run.along(&ea.length), run.along_mut(out));
-            let (ga, gb, u, l) = (&ga[..len], &gb[..len], &u[..len], &l[..len]);
-            for i in 0..len {
-                f[i] = if u[i] >= 0.0 { ga[i] } else { gb[i] } * u[i] * l[i];
-            }
+            upwind_fluxes_block(run, [ga, gb], (ea, u), out);
         },
-    )
+    );
+    let seams = sides.seams();
+    let ends = seam_ends.gather(seams, gamma);
+    with_avx2(
+        #[inline(always)]
+        || upwind_fluxes_block(seams, ends, (ea, u), out),
+    );
+}
+
+/// [`upwind_fluxes`] over a block of edges, with the surfactant `[ga, gb]` at their ends.
+#[inline(always)]
+fn upwind_fluxes_block(
+    run: impl EdgeBlock,
+    [ga, gb]: [&[f64]; 2],
+    (ea, u): (&EdgeArrays, &[f64]),
+    out: &mut [f64],
+) {
+    let len = run.count();
+    let (u, l, f) = (run.values(u), run.values(&ea.length), run.values_mut(out));
+    let (ga, gb) = (&ga[..len], &gb[..len]);
+    for i in 0..len {
+        f[i] = pick(u[i] >= 0.0, ga[i], gb[i]) * u[i] * l[i];
+    }
 }

@@ -29,8 +29,9 @@ pub(crate) const INFLOW: [f64; 4] = [1.0, -1.0, 1.0, -1.0];
 ///   edge between them; `is_a[c][k]` says whether `c` is that edge's `a` cell.
 /// - Inside a face these follow [`FaceLayout`]: `c ∓ 1` and `c ∓ n` across the x and y
 ///   sides, with the signs [`INFLOW`].
-/// - `edge_runs` holds every edge once, in increasing order, each run with the side it
-///   is of its `a` cells and of its `b` cells.
+/// - `edge_runs` holds every edge inside a face once, in increasing order, each run with
+///   the side it is of its `a` cells and of its `b` cells; [`CellSides::seams`] the seam
+///   edges, from [`FaceLayout::first_seam_edge`] on.
 #[derive(Clone, Debug)]
 pub(crate) struct CellSides {
     /// The grid's layout.
@@ -47,10 +48,259 @@ pub(crate) struct CellSides {
     /// leave them out, and passes take them one by one through the tables (as runs of
     /// one they cost as much as the whole inside, each run's slices set up for a cell).
     pub(crate) rim_cells: Vec<u32>,
-    /// Every edge once, in increasing order, as runs: each face row's x-edges, each
-    /// face's y-edges ([`EdgeRun`]), then each seam edge alone (the seams are few beside
-    /// the faces' edges).
+    /// The rim cells' tables side by side, in the order of `rim_cells` ([`Rim`]).
+    rim_tables: RimTables,
+    /// Every edge inside a face once, in increasing order, as runs: each face row's
+    /// x-edges, each face's y-edges ([`EdgeRun`]).
     pub(crate) edge_runs: Vec<EdgeRun>,
+    /// The seam edges' cells and sides ([`Seams`]).
+    seam_tables: SeamTables,
+}
+
+/// Per seam edge, in the edges' order: its `a` and `b` cells and the side it is of each.
+#[derive(Clone, Debug, Default)]
+struct SeamTables {
+    /// Each seam edge's `a` cell.
+    a: Vec<u32>,
+    /// Each seam edge's `b` cell.
+    b: Vec<u32>,
+    /// The side each seam edge is of its `a` cell and of its `b` cell.
+    sides: Vec<[u8; 2]>,
+}
+
+/// The seam edges as one block, numbered on from `start`, their cells through tables:
+/// as runs of one edge each they cost a pass about a hundred instructions an edge, its
+/// slices set up for one edge; a pass now walks them in one loop, per-edge arrays cut
+/// to the block once.
+#[derive(Clone, Copy)]
+pub(crate) struct Seams<'a> {
+    /// The first seam edge.
+    pub(crate) start: usize,
+    /// How many.
+    pub(crate) len: usize,
+    /// Each seam edge's `a` cell.
+    a: &'a [u32],
+    /// Each seam edge's `b` cell.
+    b: &'a [u32],
+    /// The side each is of its `a` cell and of its `b` cell.
+    sides: &'a [[u8; 2]],
+}
+
+/// A stretch of edges an edge pass walks in one loop, its per-edge arrays as slices: a
+/// face's run ([`EdgeRun`]) or the seams ([`Seams`], their cells' values gathered first,
+/// [`SeamEnds`]).
+pub(crate) trait EdgeBlock: Copy {
+    /// The first edge (the others follow it).
+    fn first(&self) -> usize;
+    /// How many edges.
+    fn count(&self) -> usize;
+    /// A per-edge array's values along the block, `count()` long.
+    #[inline(always)]
+    fn values<'a>(&self, per_edge: &'a [f64]) -> &'a [f64] {
+        &per_edge[self.first()..self.first() + self.count()]
+    }
+    /// A per-edge array's values along the block, to write.
+    #[inline(always)]
+    fn values_mut<'a>(&self, per_edge: &'a mut [f64]) -> &'a mut [f64] {
+        &mut per_edge[self.first()..self.first() + self.count()]
+    }
+}
+
+impl EdgeBlock for EdgeRun {
+    #[inline(always)]
+    fn first(&self) -> usize {
+        self.start
+    }
+    #[inline(always)]
+    fn count(&self) -> usize {
+        self.len
+    }
+}
+
+impl EdgeBlock for Seams<'_> {
+    #[inline(always)]
+    fn first(&self) -> usize {
+        self.start
+    }
+    #[inline(always)]
+    fn count(&self) -> usize {
+        self.len
+    }
+}
+
+/// Buffers of the seam edges' end values: a cell field's values at their `a` cells and
+/// at their `b` cells, gathered so that a pass takes the seams as one run.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct SeamEnds {
+    /// Per field: the values at the `a` cells.
+    a: [Vec<f64>; 2],
+    /// Per field: the values at the `b` cells.
+    b: [Vec<f64>; 2],
+}
+
+impl SeamEnds {
+    /// `field`'s values at the seams' `a` and `b` cells.
+    pub(crate) fn gather(&mut self, seams: Seams, field: &[f64]) -> [&[f64]; 2] {
+        let [a] = self.gather_many(seams, [field]);
+        a
+    }
+
+    /// Each of `fields`' values at the seams' `a` and `b` cells (at most two fields).
+    pub(crate) fn gather_many<const K: usize>(
+        &mut self,
+        seams: Seams,
+        fields: [&[f64]; K],
+    ) -> [[&[f64]; 2]; K] {
+        let (a, b) = (&mut self.a, &mut self.b);
+        for (k, field) in fields.iter().enumerate() {
+            gather(field, seams.a, &mut a[k]);
+            gather(field, seams.b, &mut b[k]);
+        }
+        std::array::from_fn(|k| [&a[k][..], &b[k][..]])
+    }
+
+    /// `field`'s values at the seams' `a` and `b` cells, and those of the fields
+    /// `per_side[k]` for the side `k` each edge is of that cell (the transport's limited
+    /// rises).
+    pub(crate) fn gather_with_sides(
+        &mut self,
+        seams: Seams,
+        field: &[f64],
+        per_side: &[Vec<f64>; 4],
+    ) -> [[&[f64]; 2]; 2] {
+        let ([a0, a1], [b0, b1]) = (&mut self.a, &mut self.b);
+        gather(field, seams.a, a0);
+        gather(field, seams.b, b0);
+        // Written in place (pushed, they took four times the instructions).
+        let m = seams.len;
+        a1.resize(m, 0.0);
+        b1.resize(m, 0.0);
+        let (a1, b1) = (&mut a1[..m], &mut b1[..m]);
+        for i in 0..m {
+            let ([ca, cb], [ka, kb]) = (seams.cells(i), seams.sides(i));
+            (a1[i], b1[i]) = (per_side[ka][ca], per_side[kb][cb]);
+        }
+        [[&a0[..], &b0[..]], [&a1[..], &b1[..]]]
+    }
+}
+
+impl Seams<'_> {
+    /// Seam edge `i`'s `a` and `b` cells.
+    #[inline(always)]
+    pub(crate) fn cells(&self, i: usize) -> [usize; 2] {
+        [self.a[i] as usize, self.b[i] as usize]
+    }
+
+    /// A cell field's values at seam edge `i`'s `a` and `b` cells.
+    #[inline(always)]
+    pub(crate) fn ends(&self, i: usize, cells: &[f64]) -> [f64; 2] {
+        [cells[self.a[i] as usize], cells[self.b[i] as usize]]
+    }
+
+    /// The side seam edge `i` is of its `a` cell and of its `b` cell.
+    #[inline(always)]
+    pub(crate) fn sides(&self, i: usize) -> [usize; 2] {
+        self.sides[i].map(usize::from)
+    }
+}
+
+/// The rim cells' neighbours, edges and inflow signs, one array a side in the order of
+/// [`CellSides::rim_cells`]: a rim pass reads each in order (the per-cell tables put a
+/// cell's four sides together, which a pass over the rim strides through).
+#[derive(Clone, Debug, Default)]
+struct RimTables {
+    /// Per side: each rim cell's neighbour.
+    neighbour: [Vec<u32>; 4],
+    /// Per side: each rim cell's edge.
+    edge: [Vec<u32>; 4],
+    /// Per side: the sign of a volume across it in the cell's inflow.
+    inflow: [Vec<f64>; 4],
+}
+
+/// [`RimTables`] as slices of one length, so that a pass indexes them without checks.
+#[derive(Clone, Copy)]
+pub(crate) struct Rim<'a> {
+    /// The rim cells.
+    pub(crate) cells: &'a [u32],
+    /// Per side: each rim cell's neighbour.
+    neighbour: [&'a [u32]; 4],
+    /// Per side: each rim cell's edge.
+    edge: [&'a [u32]; 4],
+    /// Per side: the sign of a volume across it in the cell's inflow.
+    inflow: [&'a [f64]; 4],
+}
+
+impl Rim<'_> {
+    /// A per-edge array's values on rim cell `i`'s four sides.
+    #[inline(always)]
+    pub(crate) fn at_edges(&self, i: usize, per_edge: &[f64]) -> [f64; 4] {
+        let e = &self.edge;
+        let at = |k: usize| per_edge[e[k][i] as usize];
+        [at(0), at(1), at(2), at(3)]
+    }
+
+    /// A cell field's values at rim cell `i`'s four neighbours.
+    #[inline(always)]
+    pub(crate) fn at_neighbours(&self, i: usize, per_cell: &[f64]) -> [f64; 4] {
+        let nb = &self.neighbour;
+        let at = |k: usize| per_cell[nb[k][i] as usize];
+        [at(0), at(1), at(2), at(3)]
+    }
+
+    /// The signs of rim cell `i`'s sides' volumes in its inflow.
+    #[inline(always)]
+    pub(crate) fn inflow(&self, i: usize) -> [f64; 4] {
+        let s = &self.inflow;
+        [s[0][i], s[1][i], s[2][i], s[3][i]]
+    }
+
+    /// The signs of the rim cells' sides' volumes in their inflows, a slice a side.
+    #[inline(always)]
+    pub(crate) fn inflows(&self) -> [&[f64]; 4] {
+        self.inflow
+    }
+
+    /// A per-edge array's values on the rim cells' sides, in the rim's order, into
+    /// `out[k]` (a gather each, so that the arithmetic after runs on slices).
+    #[inline(always)]
+    pub(crate) fn gather_edges(&self, per_edge: &[f64], out: &mut [Vec<f64>; 4]) {
+        for (o, edges) in out.iter_mut().zip(self.edge) {
+            gather(per_edge, edges, o);
+        }
+    }
+
+    /// A cell field's values at the rim cells' neighbours, in the rim's order, into
+    /// `out[k]`.
+    #[inline(always)]
+    pub(crate) fn gather_neighbours(&self, per_cell: &[f64], out: &mut [Vec<f64>; 4]) {
+        for (o, cells) in out.iter_mut().zip(self.neighbour) {
+            gather(per_cell, cells, o);
+        }
+    }
+
+    /// A cell field's values at the rim cells, in the rim's order, into `out`.
+    #[inline(always)]
+    pub(crate) fn gather_cells(&self, per_cell: &[f64], out: &mut Vec<f64>) {
+        gather(per_cell, self.cells, out);
+    }
+}
+
+/// `values` at `at`, in order, into `out` (written in place: `extend` took twice the
+/// instructions).
+#[inline(always)]
+fn gather(values: &[f64], at: &[u32], out: &mut Vec<f64>) {
+    out.resize(at.len(), 0.0);
+    // Four at a time: the loop's own count and branch once for four loads.
+    let quads = out.chunks_exact_mut(4).zip(at.chunks_exact(4));
+    for (o, j) in quads {
+        for k in 0..4 {
+            o[k] = values[j[k] as usize];
+        }
+    }
+    let whole = at.len() / 4 * 4;
+    for (o, &j) in out[whole..].iter_mut().zip(&at[whole..]) {
+        *o = values[j as usize];
+    }
 }
 
 /// Consecutive cells inside a face: their neighbours and edges on each side are
@@ -67,20 +317,52 @@ pub(crate) struct CellRun {
     pub(crate) edge: [usize; 4],
 }
 
+// The passes take the inside a face at a time ([`CellSpan`]); the runs stay to tell the
+// rim from the inside, and the tests check the tables against them.
+#[cfg(test)]
 impl CellRun {
     /// The run's cells.
     pub(crate) fn cells(&self) -> std::ops::Range<usize> {
         self.start..self.start + self.len
     }
+}
 
-    /// The run's neighbours on side `k`.
-    pub(crate) fn neighbours(&self, k: usize) -> std::ops::Range<usize> {
-        self.neighbour[k]..self.neighbour[k] + self.len
+/// A face's interior rows as one stretch of consecutive cells, from its first interior
+/// cell to its last: the rim cells at the rows' ends lie among them. Inside the stretch
+/// every cell's neighbours sit at `∓1` and `∓n` (for a rim cell those are not its
+/// neighbours but are cells), so a pass that reads only its cells' neighbours, not their
+/// edges (the x-edges are `n − 1` a row), can take a face as one run and then redo the
+/// rim through the tables: one run a face instead of one a row.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct CellSpan {
+    /// The first cell.
+    pub(crate) start: usize,
+    /// How many cells.
+    pub(crate) len: usize,
+    /// Cells along a face edge.
+    n: usize,
+}
+
+impl CellSpan {
+    /// The span's cells.
+    pub(crate) fn cells(&self) -> std::ops::Range<usize> {
+        self.start..self.start + self.len
     }
 
-    /// The run's edges on side `k`.
-    pub(crate) fn edges(&self, k: usize) -> std::ops::Range<usize> {
-        self.edge[k]..self.edge[k] + self.len
+    /// Cells along a face edge.
+    pub(crate) fn n(&self) -> usize {
+        self.n
+    }
+
+    /// The cells at the layout's offset on side `k` from the span's cells.
+    pub(crate) fn neighbours(&self, k: usize) -> std::ops::Range<usize> {
+        let first = match k {
+            LEFT => self.start - 1,
+            RIGHT => self.start + 1,
+            BOTTOM => self.start - self.n,
+            _ => self.start + self.n,
+        };
+        first..first + self.len
     }
 }
 
@@ -145,7 +427,7 @@ impl CellSides {
         let mut neighbour = vec![[u32::MAX; 4]; cells];
         let mut edge = vec![[u32::MAX; 4]; cells];
         let mut is_a = vec![[false; 4]; cells];
-        let mut seams = Vec::new();
+        let mut seams = SeamTables::default();
         for (e, ge) in grid.edges().iter().enumerate() {
             let mut sides = [0u8; 2];
             for (end, (c, other)) in [(ge.a, ge.b), (ge.b, ge.a)].into_iter().enumerate() {
@@ -156,15 +438,9 @@ impl CellSides {
                 sides[end] = k as u8;
             }
             if e >= layout.first_seam_edge() {
-                let (a, b) = (ge.a as usize, ge.b as usize);
-                let sides = sides.map(usize::from);
-                seams.push(EdgeRun {
-                    start: e,
-                    len: 1,
-                    a,
-                    b,
-                    sides,
-                });
+                seams.a.push(ge.a);
+                seams.b.push(ge.b);
+                seams.sides.push(sides);
             }
         }
         let mut sides = Self {
@@ -174,11 +450,13 @@ impl CellSides {
             is_a,
             cell_runs: Vec::new(),
             rim_cells: Vec::new(),
+            rim_tables: RimTables::default(),
             edge_runs: Vec::new(),
+            seam_tables: seams,
         };
         (sides.cell_runs, sides.rim_cells) = sides.find_cell_runs();
+        sides.rim_tables = sides.rim_tables();
         sides.edge_runs = face_edge_runs(grid);
-        sides.edge_runs.extend(seams);
         sides
     }
 
@@ -207,6 +485,48 @@ impl CellSides {
         (runs, rim)
     }
 
+    /// The rim cells' tables side by side ([`RimTables`]).
+    fn rim_tables(&self) -> RimTables {
+        let rim = &self.rim_cells;
+        let side = |table: &[[u32; 4]], k: usize| -> Vec<u32> {
+            rim.iter().map(|&c| table[c as usize][k]).collect()
+        };
+        RimTables {
+            neighbour: std::array::from_fn(|k| side(&self.neighbour, k)),
+            edge: std::array::from_fn(|k| side(&self.edge, k)),
+            inflow: std::array::from_fn(|k| {
+                rim.iter().map(|&c| self.inflow(c as usize)[k]).collect()
+            }),
+        }
+    }
+
+    /// The rim cells and their tables as slices of one length ([`Rim`]).
+    #[inline(always)]
+    pub(crate) fn rim(&self) -> Rim<'_> {
+        let (t, m) = (&self.rim_tables, self.rim_cells.len());
+        let [n0, n1, n2, n3] = &t.neighbour;
+        let [e0, e1, e2, e3] = &t.edge;
+        let [s0, s1, s2, s3] = &t.inflow;
+        Rim {
+            cells: &self.rim_cells[..m],
+            neighbour: [&n0[..m], &n1[..m], &n2[..m], &n3[..m]],
+            edge: [&e0[..m], &e1[..m], &e2[..m], &e3[..m]],
+            inflow: [&s0[..m], &s1[..m], &s2[..m], &s3[..m]],
+        }
+    }
+
+    /// Each face's [`CellSpan`] (none where a face has no interior, `n < 3`).
+    pub(crate) fn face_spans(&self) -> impl Iterator<Item = CellSpan> {
+        let n = self.n();
+        let len = (n * n).saturating_sub(2 * n + 2);
+        let spans = (0..6).map(move |face| CellSpan {
+            start: face * n * n + n + 1,
+            len,
+            n,
+        });
+        spans.filter(|span| span.len > 0)
+    }
+
     /// The sign of each side's volume in cell `c`'s inflow (as [`INFLOW`] inside a face).
     pub(crate) fn inflow(&self, c: usize) -> [f64; 4] {
         self.is_a[c].map(|a| if a { -1.0 } else { 1.0 })
@@ -217,7 +537,21 @@ impl CellSides {
         self.layout.n
     }
 
-    /// Runs `pass` on every edge run ([`Self::edge_runs`]), compiled for AVX2 where the
+    /// The seam edges as one block ([`Seams`]).
+    #[inline(always)]
+    pub(crate) fn seams(&self) -> Seams<'_> {
+        let (t, len) = (&self.seam_tables, self.seam_tables.a.len());
+        Seams {
+            start: self.layout.first_seam_edge(),
+            len,
+            a: &t.a[..len],
+            b: &t.b[..len],
+            sides: &t.sides[..len],
+        }
+    }
+
+    /// Runs `pass` on every edge run ([`Self::edge_runs`]: the seams are not among
+    /// them, [`Self::seams`]), compiled for AVX2 where the
     /// processor has it (a `#[inline(always)]` closure is compiled so with it).
     #[inline(always)]
     pub(crate) fn for_each_edge_run(&self, mut pass: impl FnMut(EdgeRun)) {
@@ -316,13 +650,34 @@ mod tests {
                     assert_eq!(sides.inflow(c), INFLOW, "cell {c}");
                 }
             }
-            let seams = sides
-                .edge_runs
-                .iter()
-                .filter(|r| r.start >= layout.first_seam_edge());
-            assert_eq!(seams.count(), 12 * n);
+            assert_eq!(sides.seams().len, 12 * n);
+            assert_eq!(sides.seams().start, layout.first_seam_edge());
             runs_cover_everything_once(&grid, &sides);
+            spans_hold_every_inside_cell_with_its_neighbours(&sides);
         }
+    }
+
+    /// Every cell of a row run lies in a face span, with the neighbours the span gives it
+    /// its own, and whatever else a span holds is on the rim.
+    fn spans_hold_every_inside_cell_with_its_neighbours(sides: &CellSides) {
+        let spans: Vec<CellSpan> = sides.face_spans().collect();
+        let mut inside = 0;
+        for span in &spans {
+            for (i, c) in span.cells().enumerate() {
+                let in_run = sides.cell_runs.iter().any(|r| r.cells().contains(&c));
+                if !in_run {
+                    assert!(sides.rim_cells.contains(&(c as u32)), "cell {c}");
+                    continue;
+                }
+                inside += 1;
+                for k in 0..4 {
+                    let nb = span.neighbours(k).start + i;
+                    assert_eq!(nb, sides.neighbour[c][k] as usize, "cell {c} side {k}");
+                }
+            }
+        }
+        let runs: usize = sides.cell_runs.iter().map(|r| r.len).sum();
+        assert_eq!(inside, runs);
     }
 
     /// Every cell lies in exactly one run or on the rim, every edge inside a face in
@@ -342,9 +697,19 @@ mod tests {
                 assert_eq!(sides.inflow(c), INFLOW, "cell {c}");
             }
         }
-        let edges: Vec<usize> = sides.edge_runs.iter().flat_map(|r| r.edges()).collect();
+        let mut edges: Vec<usize> = sides.edge_runs.iter().flat_map(|r| r.edges()).collect();
+        let seams = sides.seams();
+        edges.extend(seams.start..seams.start + seams.len);
         assert_eq!(edges, (0..grid.edges().len()).collect::<Vec<_>>());
         let ea = grid.edge_arrays();
+        for i in 0..seams.len {
+            let e = seams.start + i;
+            let [a, b] = seams.cells(i);
+            assert_eq!(ea.cells[e], [a as u32, b as u32], "seam edge {e}");
+            let [ka, kb] = seams.sides(i);
+            assert_eq!(sides.edge[a][ka] as usize, e, "seam edge {e}: side of a");
+            assert_eq!(sides.edge[b][kb] as usize, e, "seam edge {e}: side of b");
+        }
         for run in &sides.edge_runs {
             for (i, e) in run.edges().enumerate() {
                 assert_eq!(

@@ -27,8 +27,9 @@ use glam::DVec3;
 
 use super::compare::{larger, smaller};
 use super::flow::{FilmFlow, FilmGradient, H_FLOOR_M};
-use super::fluxes::side_slices;
-use super::sides::INFLOW;
+use super::fluxes::{span_sides, spread_x_volumes};
+use super::grid::dot_at;
+use super::sides::{EdgeBlock, INFLOW};
 use crate::avx2::with_avx2;
 use crate::params::GAS_CONSTANT_J_PER_MOL_K;
 
@@ -79,7 +80,13 @@ impl ThermalParams {
     /// `up` the unit direction against gravity: `bottom_warming_k` at the bottom, 0 at
     /// the top, linear in height between.
     pub fn air_excess_k(&self, d: DVec3, up: DVec3) -> f64 {
-        0.5 * self.bottom_warming_k * (1.0 - d.dot(up))
+        self.air_excess_at_height(d.dot(up))
+    }
+
+    /// [`Self::air_excess_k`] at the height `d·up` (in radii above the centre).
+    #[inline(always)]
+    fn air_excess_at_height(&self, height: f64) -> f64 {
+        0.5 * self.bottom_warming_k * (1.0 - height)
     }
 
     /// The evaporation rate of film `excess_k` warmer than the ambient over the
@@ -98,7 +105,6 @@ impl ThermalParams {
     }
 }
 
-/// The unit direction against `g` (+Y where there is no gravity).
 /// A cell's four sides as the temperature's upwind transport sees them.
 struct Inflow {
     /// Each side's surface speed, m/s (positive from the edge's `a` cell to its `b`).
@@ -131,6 +137,35 @@ impl Inflow {
     }
 }
 
+/// The thermal Marangoni stress's change of an edge's velocity, `per·(θ_b − θ_a)/(d h)`
+/// at its ends' temperatures `t` and thicknesses `h`, `per_d = 1/d`.
+#[inline(always)]
+fn push(per: f64, [ta, tb]: [f64; 2], [ha, hb]: [f64; 2], per_d: f64) -> f64 {
+    let h_edge = larger(0.5 * (ha + hb), H_FLOOR_M);
+    per * (tb - ta) * per_d / h_edge
+}
+
+/// Relaxes each cell's temperature `theta` towards the air's over `dt_s`, implicitly:
+/// the centres as components (the dot product in `DVec3::dot`'s order, so the same bits
+/// as [`ThermalParams::air_excess_k`]), four cells at a time.
+#[inline(always)]
+fn relax(
+    theta: &mut [f64],
+    h: &[f64],
+    [x, y, z]: &[Vec<f64>; 3],
+    (th, rho): (ThermalParams, f64),
+    (dt_s, up): (f64, DVec3),
+) {
+    let n = theta.len();
+    let (h, centres) = (&h[..n], [&x[..n], &y[..n], &z[..n]]);
+    for i in 0..n {
+        let r = dt_s * th.relaxation_per_s(h[i].max(H_FLOOR_M), rho);
+        let air = th.air_excess_at_height(dot_at(up, centres, i));
+        theta[i] = (theta[i] + r * air) / (1.0 + r);
+    }
+}
+
+/// The unit direction against `g` (+Y where there is no gravity).
 pub(super) fn up_from(g_eff_m_per_s2: DVec3) -> DVec3 {
     (-g_eff_m_per_s2).try_normalize().unwrap_or(DVec3::Y)
 }
@@ -143,7 +178,7 @@ impl FilmFlow {
     pub(super) fn exchange_heat(
         &mut self,
         u_start: &[f64],
-        scratch: &mut Vec<f64>,
+        scratch: (&mut Vec<f64>, &mut [Vec<f64>; 2]),
         dt_s: f64,
         up: DVec3,
     ) {
@@ -151,17 +186,22 @@ impl FilmFlow {
             return;
         }
         self.advect_temperature(u_start, scratch, dt_s);
-        let th = self.params.thermal;
-        let rho = self.params.density_kg_per_m3;
-        let cells = self.temperature_k.iter_mut().zip(&self.h_m);
-        for ((theta, h), d) in cells.zip(self.grid.centres()) {
-            let r = dt_s * th.relaxation_per_s(h.max(H_FLOOR_M), rho);
-            *theta = (*theta + r * th.air_excess_k(*d, up)) / (1.0 + r);
-        }
+        let (th, rho) = (self.params.thermal, self.params.density_kg_per_m3);
+        let centres = self.grid.centres_xyz();
+        let (theta, h) = (&mut self.temperature_k, &self.h_m);
+        with_avx2(
+            #[inline(always)]
+            || relax(theta, h, centres, (th, rho), (dt_s, up)),
+        );
     }
 
     /// `∂θ/∂t + u·∇θ = 0`, upwind: each cell takes `(θ_up − θ)` times what flows in.
-    fn advect_temperature(&mut self, u: &[f64], before: &mut Vec<f64>, dt_s: f64) {
+    fn advect_temperature(
+        &mut self,
+        u: &[f64],
+        (before, [x_u, x_length]): (&mut Vec<f64>, &mut [Vec<f64>; 2]),
+        dt_s: f64,
+    ) {
         let courant = self.grid.fastest_crossing(u) * dt_s / self.params.radius_m;
         if courant == 0.0 {
             return;
@@ -172,23 +212,30 @@ impl FilmFlow {
         let scale = dt_s / (self.params.radius_m * f64::from(substeps));
         let (sides, ea) = (&self.sides, self.grid.edge_arrays());
         let per_area = self.grid.inverse_areas_per_sr();
+        // The x-edges' speeds and lengths one a cell, so that a face's read as slices.
+        spread_x_volumes(sides, u, x_u);
+        spread_x_volumes(sides, &ea.length, x_length);
+        let (x_u, x_length) = (&x_u[..], &x_length[..]);
         for _ in 0..substeps {
-            before.clear();
-            before.extend_from_slice(&self.temperature_k);
-            let theta = &mut self.temperature_k;
+            // Every cell is written below from `before`: the two buffers trade places
+            // where the temperature was copied.
+            before.resize(self.temperature_k.len(), 0.0);
+            std::mem::swap(before, &mut self.temperature_k);
+            let (theta, before) = (&mut self.temperature_k, &*before);
             // Each cell gathers what flows in over its four sides (the edges scattered
             // into their downwind cells before: the same terms, summed cell by cell).
             with_avx2(
                 #[inline(always)]
                 || {
-                    for run in &sides.cell_runs {
-                        let len = run.len;
-                        let u = side_slices(run, u);
-                        let l = side_slices(run, &ea.length);
+                    // A face at a time ([`CellSpan`]); its rim cells are redone below.
+                    for span in sides.face_spans() {
+                        let len = span.len;
+                        let u = span_sides(sides, &span, x_u, u);
+                        let l = span_sides(sides, &span, x_length, &ea.length);
                         let across: [&[f64]; 4] =
-                            std::array::from_fn(|k| &before[run.neighbours(k)]);
-                        let (own, pa) = (&before[run.cells()], &per_area[run.cells()]);
-                        let out = &mut theta[run.cells()];
+                            std::array::from_fn(|k| &before[span.neighbours(k)]);
+                        let (own, pa) = (&before[span.cells()], &per_area[span.cells()]);
+                        let out = &mut theta[span.cells()];
                         for i in 0..len {
                             let sides = Inflow {
                                 u: u.map(|u| u[i]),
@@ -199,14 +246,15 @@ impl FilmFlow {
                             out[i] = own[i] + sides.warming(scale * pa[i], across, own[i]);
                         }
                     }
-                    for &c in &sides.rim_cells {
+                    let rim = sides.rim();
+                    for (i, &c) in rim.cells.iter().enumerate() {
                         let c = c as usize;
                         let inflow = Inflow {
-                            u: sides.edge[c].map(|e| u[e as usize]),
-                            length: sides.edge[c].map(|e| ea.length[e as usize]),
-                            inflow: sides.inflow(c),
+                            u: rim.at_edges(i, u),
+                            length: rim.at_edges(i, &ea.length),
+                            inflow: rim.inflow(i),
                         };
-                        let across = sides.neighbour[c].map(|j| before[j as usize]);
+                        let across = rim.at_neighbours(i, before);
                         theta[c] =
                             before[c] + inflow.warming(scale * per_area[c], across, before[c]);
                     }
@@ -240,11 +288,18 @@ impl FilmFlow {
                         let id = &run.along(&ea.inverse_dual_length)[..len];
                         let u = run.along_mut(u);
                         for i in 0..len {
-                            let h_edge = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
-                            u[i] += per * (tb[i] - ta[i]) * id[i] / h_edge;
+                            u[i] += push(per, [ta[i], tb[i]], [ha[i], hb[i]], id[i]);
                         }
                     },
                 );
+                // The seams one by one (the thermal film's own pass, not worth gathering).
+                let seams = sides.seams();
+                let id = seams.values(&ea.inverse_dual_length);
+                let u = seams.values_mut(u);
+                for (i, u) in u.iter_mut().enumerate() {
+                    let (t, h) = (seams.ends(i, theta), seams.ends(i, h));
+                    *u += push(per, t, h, id[i]);
+                }
             }
             FilmGradient::Normal => {
                 g.cells_to_vertices(theta, at_vertex);

@@ -9,9 +9,11 @@
 
 use glam::DVec3;
 
-use super::compare::larger;
+use super::compare::{larger, largest};
 use super::flow::{FilmFlow, Scratch};
 use super::fluxes::apply_limited;
+use super::grid::{EdgeArrays, dot_at};
+use super::sides::{EdgeBlock, SeamEnds};
 use super::upwind;
 use crate::avx2::with_avx2;
 
@@ -29,13 +31,9 @@ impl FilmFlow {
         } else {
             0.0
         };
-        // The drainage flux's coefficient `c = drain·g_eff·n` of every edge, fixed over
-        // the step: each sub-step's flux is `u·h + c·h³`.
-        let ea = self.grid.edge_arrays();
-        s.drain_rate.clear();
-        s.drain_rate
-            .extend(ea.normal.iter().map(|normal| drain * g_eff.dot(*normal)));
-        let courant = self.courant_number(&s.drain_rate, dt_s);
+        // `edge2` is the sub-steps' volumes: free until they start.
+        let buffers = (&mut s.drain_rate, &mut s.edge2, &mut s.seam_ends);
+        let courant = self.drain_rates_and_courant(buffers, drain, g_eff, dt_s);
         // A cell drains through at most two edges of a smooth flow: 2·courant per step, kept
         // within one sub-step's content; the outflow limit guards the rest.
         let substeps = (2.0 * courant).ceil().clamp(1.0, f64::from(MAX_SUBSTEPS)) as u32;
@@ -45,32 +43,39 @@ impl FilmFlow {
         }
     }
 
-    /// The largest fraction of a cell's width any edge's characteristic speed, `|u|` plus
-    /// the drainage's `3|c|h²`, carries over `dt_s`.
-    fn courant_number(&self, drain_rate: &[f64], dt_s: f64) -> f64 {
+    /// Each edge's drainage coefficient `c = drain·g_eff·n` into `drain_rate` (fixed over
+    /// the step: each sub-step's flux is `u·h + c·h³`), and the largest fraction of a
+    /// cell's width any edge's characteristic speed, `|u|` plus the drainage's `3|c|h²`,
+    /// carries over `dt_s`: one pass over the edges.
+    fn drain_rates_and_courant(
+        &self,
+        (drain_rate, speed, seam_ends): (&mut Vec<f64>, &mut Vec<f64>, &mut SeamEnds),
+        drain: f64,
+        g_eff: DVec3,
+        dt_s: f64,
+    ) -> f64 {
         let ea = self.grid.edge_arrays();
         let (h, u) = (&self.h_m, &self.u_m_per_s);
-        // Four running maxima, lane by lane, so the loop vectorises (a maximum is exact in
-        // any order: the same number as one running maximum).
-        let mut lanes = [0.0; 4];
+        // Every entry is written below: the buffers need their lengths, not a fill.
+        drain_rate.resize(u.len(), 0.0);
+        speed.resize(u.len(), 0.0);
+        let drain = (drain, g_eff);
         self.sides.for_each_edge_run(
             #[inline(always)]
             |run| {
-                let len = run.len;
                 let (ha, hb) = run.ends(h);
-                let (ha, hb) = (&ha[..len], &hb[..len]);
-                let (u, c) = (run.along(u), run.along(drain_rate));
-                let per_area = run.along(&ea.length_per_smaller_area);
-                for i in 0..len {
-                    let h = larger(hb[i], ha[i]);
-                    let speed = (u[i].abs() + 3.0 * c[i].abs() * h * h) * per_area[i];
-                    // Skips a NaN speed as `max` does.
-                    lanes[i % 4] = larger(speed, lanes[i % 4]);
-                }
+                courant_block(run, [ha, hb], (ea, u), drain, (drain_rate, speed));
             },
         );
-        let fastest = lanes.into_iter().fold(0.0, |a, b| larger(b, a));
-        fastest * dt_s / self.params.radius_m
+        let seams = self.sides.seams();
+        let ends = seam_ends.gather(seams, h);
+        with_avx2(
+            #[inline(always)]
+            || courant_block(seams, ends, (ea, u), drain, (drain_rate, speed)),
+        );
+        // The speeds' maximum in a pass of its own: taken in the loop above, the
+        // compiler vectorised neither.
+        largest(speed) * dt_s / self.params.radius_m
     }
 
     /// One transport of `h` over `dt_s`: second-order upwind (the upwind cell's
@@ -84,18 +89,52 @@ impl FilmFlow {
         with_avx2(
             #[inline(always)]
             || {
-                upwind::limited_rises(sides, geo, &self.h_m, &mut s.limited_rise);
+                let rises = (&mut s.limited_rise, &mut s.rim_rises);
+                upwind::limited_rises(sides, geo, &self.h_m, rises);
                 let speeds = upwind::EdgeSpeeds {
                     u: &self.u_m_per_s,
                     drain_rate: &s.drain_rate,
                     dt_per_r,
                 };
                 let ea = self.grid.edge_arrays();
-                upwind::volumes(sides, ea, &self.h_m, &s.limited_rise, speeds, &mut s.edge2);
+                let volume = (&mut s.edge2, &mut s.seam_ends);
+                upwind::volumes(sides, ea, &self.h_m, &s.limited_rise, speeds, volume);
                 let (areas, per_area) = (self.grid.areas_sr(), self.grid.inverse_areas_per_sr());
                 let (volume, h) = (&s.edge2, &mut self.h_m);
-                apply_limited(sides, areas, per_area, volume, 1.0, h, &mut s.cell);
+                apply_limited(sides, areas, per_area, volume, 1.0, h, &mut s.gather);
             },
         )
     }
+}
+
+/// [`FilmFlow::drain_rates_and_courant`]'s pass over a block of edges with thicknesses
+/// `[ha, hb]` at their ends: the drainage coefficients into `c`, the edges' speeds into
+/// `speed`.
+#[inline(always)]
+fn courant_block(
+    block: impl EdgeBlock,
+    [ha, hb]: [&[f64]; 2],
+    (ea, u): (&EdgeArrays, &[f64]),
+    (drain, g_eff): (f64, DVec3),
+    (c, speed): (&mut [f64], &mut [f64]),
+) {
+    let len = block.count();
+    let (ha, hb, u) = (&ha[..len], &hb[..len], block.values(u));
+    let per_area = block.values(&ea.length_per_smaller_area);
+    let [nx, ny, nz] = &ea.normal_xyz;
+    let normal = [block.values(nx), block.values(ny), block.values(nz)];
+    let (c, speed) = (block.values_mut(c), block.values_mut(speed));
+    for i in 0..len {
+        c[i] = drain * dot_at(g_eff, normal, i);
+        speed[i] = edge_speed(u[i], c[i], ha[i], hb[i], per_area[i]);
+    }
+}
+
+/// An edge's characteristic speed over its smaller cell's width: `|u|` plus the
+/// drainage's `3|c|h²` at the thicker end, times `length/smaller area` (NaN skipped by
+/// the maximum that takes it, as `max` does).
+#[inline(always)]
+fn edge_speed(u: f64, c: f64, ha: f64, hb: f64, per_area: f64) -> f64 {
+    let h = larger(hb, ha);
+    (u.abs() + 3.0 * c.abs() * h * h) * per_area
 }

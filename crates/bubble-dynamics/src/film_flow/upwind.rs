@@ -12,7 +12,7 @@
 
 use super::compare::{larger, smaller};
 use super::grid::{CubeSphere, EdgeArrays};
-use super::sides::{CellRun, CellSides};
+use super::sides::{CellSides, EdgeBlock, SeamEnds};
 
 /// The transport's weights, fixed by the grid.
 #[derive(Clone, Debug)]
@@ -24,6 +24,21 @@ pub(crate) struct UpwindGeometry {
     /// weight per pair of sides stands for the gradient's three components and its
     /// projection.
     rise: [[Vec<f64>; 4]; 4],
+    /// The same weights of the rim cells in the rim's order ([`CellSides::rim_cells`]),
+    /// so that the rim's rises run on slices like the faces' (its cells' values gathered
+    /// first, [`RimRises`]).
+    rim_rise: [[Vec<f64>; 4]; 4],
+}
+
+/// The rim's thicknesses and rises in the rim's order ([`limited_rises`]).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct RimRises {
+    /// The rim cells' thicknesses.
+    own: Vec<f64>,
+    /// Per side: their neighbours'.
+    neighbour: [Vec<f64>; 4],
+    /// Per side: their limited rises.
+    rise: [Vec<f64>; 4],
 }
 
 impl UpwindGeometry {
@@ -47,7 +62,9 @@ impl UpwindGeometry {
                 }
             }
         }
-        Self { rise }
+        let rim = |w: &Vec<f64>| sides.rim_cells.iter().map(|&c| w[c as usize]).collect();
+        let rim_rise = std::array::from_fn(|k| std::array::from_fn(|j| rim(&rise[k][j])));
+        Self { rise, rim_rise }
     }
 }
 
@@ -97,26 +114,49 @@ pub(crate) fn limited_rises(
     sides: &CellSides,
     geo: &UpwindGeometry,
     h: &[f64],
-    out: &mut [Vec<f64>; 4],
+    (out, rim_rises): (&mut [Vec<f64>; 4], &mut RimRises),
 ) {
     for o in out.iter_mut() {
         o.resize(h.len(), 0.0);
     }
-    for run in &sides.cell_runs {
-        let cells = run.cells();
+    // A face at a time, its rim cells among the rest ([`CellSpan`]): they are redone
+    // below, and the runs' set-up and odd ends, row by row, cost a third of the pass.
+    for span in sides.face_spans() {
+        let cells = span.cells();
         let [o0, o1, o2, o3] = out.each_mut().map(|o| &mut o[cells.clone()]);
-        rises_run(geo, h, run, [o0, o1, o2, o3]);
+        let w = |k: usize, j: usize| &geo.rise[k][j][cells.clone()];
+        let w = [0, 1, 2, 3].map(|k| [w(k, 0), w(k, 1), w(k, 2), w(k, 3)]);
+        let nb = [0, 1, 2, 3].map(|j| &h[span.neighbours(j)]);
+        rises_run(w, &h[cells.clone()], nb, [o0, o1, o2, o3]);
     }
-    for &c in &sides.rim_cells {
-        let c = c as usize;
-        let nb = sides.neighbour[c].map(|j| h[j as usize]);
-        let rise: [f64; 4] = std::array::from_fn(|k| {
-            let w = &geo.rise[k];
-            rise_of([w[0][c], w[1][c], w[2][c], w[3][c]], h[c], nb)
-        });
-        let phi = limiter(h[c], nb, rise);
-        for (o, r) in out.iter_mut().zip(rise) {
-            o[c] = r * phi;
+    // The rim: its values gathered, the same arithmetic on slices, the rises scattered.
+    let rim = sides.rim();
+    let m = rim.cells.len();
+    let RimRises {
+        own,
+        neighbour,
+        rise,
+    } = rim_rises;
+    rim.gather_cells(h, own);
+    rim.gather_neighbours(h, neighbour);
+    for r in rise.iter_mut() {
+        r.resize(m, 0.0);
+    }
+    let w = geo
+        .rim_rise
+        .each_ref()
+        .map(|w| w.each_ref().map(|w| &w[..m]));
+    let nb = neighbour.each_ref().map(|x| &x[..m]);
+    let [r0, r1, r2, r3] = rise;
+    rises_run(
+        w,
+        &own[..m],
+        nb,
+        [&mut r0[..m], &mut r1[..m], &mut r2[..m], &mut r3[..m]],
+    );
+    for (o, r) in out.iter_mut().zip([&*r0, &*r1, &*r2, &*r3]) {
+        for (&c, &r) in rim.cells.iter().zip(r) {
+            o[c as usize] = r;
         }
     }
 }
@@ -128,16 +168,14 @@ fn rise_of(w: [f64; 4], h: f64, nb: [f64; 4]) -> f64 {
     (w[0] * (h + nb[0]) + w[1] * (h + nb[1])) + (w[2] * (h + nb[2]) + w[3] * (h + nb[3]))
 }
 
-/// The limited rises of a run of cells, as slices: each side's rises in a loop of
-/// their own, then the limit (one loop over all sixteen weights kept the compiler from
-/// vectorising it: it spilled them to the stack cell by cell).
+/// The limited rises of a stretch of cells from their weights `w[k][j]`, thicknesses
+/// `centre` and neighbours' `nb`, as slices: each side's rises in a loop of their own,
+/// then the limit (one loop over all sixteen weights kept the compiler from vectorising
+/// it: it spilled them to the stack cell by cell).
 #[inline(always)]
-fn rises_run(geo: &UpwindGeometry, h: &[f64], run: &CellRun, mut out: [&mut [f64]; 4]) {
-    let (len, cells) = (run.len, run.cells());
-    let centre = &h[cells.clone()];
-    let nb: [&[f64]; 4] = std::array::from_fn(|j| &h[run.neighbours(j)]);
-    for (k, o) in out.iter_mut().enumerate() {
-        let w: [&[f64]; 4] = std::array::from_fn(|j| &geo.rise[k][j][cells.clone()]);
+fn rises_run(w: [[&[f64]; 4]; 4], centre: &[f64], nb: [&[f64]; 4], mut out: [&mut [f64]; 4]) {
+    let len = centre.len();
+    for (w, o) in w.into_iter().zip(out.iter_mut()) {
         rise_run(w, centre, nb, o);
     }
     let [o0, o1, o2, o3] = out;
@@ -211,7 +249,8 @@ fn edge_volume([ha, hb]: [f64; 2], [ra, rb]: [f64; 2], [u, c, l]: [f64; 3], dt_p
     (u * plug + c * drain * drain * drain) * l * dt_per_r
 }
 
-/// The volume across every edge over the sub-step, into `volume` (per R², m × sr).
+/// The volume across every edge over the sub-step, into `volume` (per R² m × sr; the
+/// seams' ends gathered into `seam_ends`).
 // Inlined into the sub-step's `with_avx2` closure, so compiled for AVX2 there.
 #[inline(always)]
 pub(crate) fn volumes(
@@ -220,22 +259,36 @@ pub(crate) fn volumes(
     h: &[f64],
     rise: &[Vec<f64>; 4],
     speeds: EdgeSpeeds,
-    volume: &mut Vec<f64>,
+    (volume, seam_ends): (&mut Vec<f64>, &mut SeamEnds),
 ) {
     volume.resize(ea.cells.len(), 0.0);
     for run in &sides.edge_runs {
-        let len = run.len;
-        let (u, c) = (run.along(speeds.u), run.along(speeds.drain_rate));
-        let (l, out) = (run.along(&ea.length), run.along_mut(volume));
-        let (u, c, l) = (&u[..len], &c[..len], &l[..len]);
-        let (ha, hb) = run.ends(h);
         let [ka, kb] = run.sides;
         let (ra, rb) = (&rise[ka][run.a_cells()], &rise[kb][run.b_cells()]);
-        let (ha, hb, ra, rb) = (&ha[..len], &hb[..len], &ra[..len], &rb[..len]);
-        for i in 0..len {
-            let speed = [u[i], c[i], l[i]];
-            out[i] = edge_volume([ha[i], hb[i]], [ra[i], rb[i]], speed, speeds.dt_per_r);
-        }
+        let (ha, hb) = run.ends(h);
+        volumes_block(*run, [ha, hb], [ra, rb], (ea, speeds), volume);
+    }
+    let seams = sides.seams();
+    let [h_ends, rises] = seam_ends.gather_with_sides(seams, h, rise);
+    volumes_block(seams, h_ends, rises, (ea, speeds), volume);
+}
+
+/// [`volumes`] over a block of edges, with their ends' thicknesses and rises.
+#[inline(always)]
+fn volumes_block(
+    block: impl EdgeBlock,
+    [ha, hb]: [&[f64]; 2],
+    [ra, rb]: [&[f64]; 2],
+    (ea, speeds): (&EdgeArrays, EdgeSpeeds),
+    volume: &mut [f64],
+) {
+    let len = block.count();
+    let (u, c) = (block.values(speeds.u), block.values(speeds.drain_rate));
+    let (l, out) = (block.values(&ea.length), block.values_mut(volume));
+    let (ha, hb, ra, rb) = (&ha[..len], &hb[..len], &ra[..len], &rb[..len]);
+    for i in 0..len {
+        let speed = [u[i], c[i], l[i]];
+        out[i] = edge_volume([ha[i], hb[i]], [ra[i], rb[i]], speed, speeds.dt_per_r);
     }
 }
 
