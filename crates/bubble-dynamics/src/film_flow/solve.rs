@@ -32,7 +32,7 @@ use crate::avx2::with_avx2;
 use dense::{dense_cholesky, dense_solve};
 use kernels::{
     Stencil, correct, dot, gather_row, operator, refresh, refresh_all, relax, relax_from_zero,
-    restrict, scatter_row, update_and_norm2,
+    restrict, scatter_row, update_and_norm2, widen_and_dot,
 };
 use layout::Layout;
 
@@ -326,9 +326,8 @@ impl Hierarchy {
                     start_residual: b_norm,
                 };
                 if report.relative_residual > limits.tolerance {
-                    self.precondition(work, &r, start_norm, &mut z);
+                    let mut rz = self.precondition(work, &r, start_norm, &mut z);
                     p.copy_from_slice(&z);
-                    let mut rz = dot(&r, &z);
                     while report.iterations < limits.max_iterations {
                         let (mass, stencil) = (&work.mass[0], &work.stencil[0]);
                         refresh_all(fine, &mut p);
@@ -344,8 +343,7 @@ impl Hierarchy {
                         if report.relative_residual <= limits.tolerance {
                             break;
                         }
-                        self.precondition(work, &r, rr.sqrt(), &mut z);
-                        let rz_next = dot(&r, &z);
+                        let rz_next = self.precondition(work, &r, rr.sqrt(), &mut z);
                         let beta = rz_next / rz;
                         rz = rz_next;
                         for (pi, zi) in p.iter_mut().zip(&z) {
@@ -481,9 +479,9 @@ impl Hierarchy {
 
     /// `z` = the preconditioner applied to the conjugate gradients' residual `r`, whose
     /// norm is `norm`: one V-cycle in `f32` (see [`Work`]), or the dense solve where the
-    /// finest level is the coarsest.
+    /// finest level is the coarsest; returns `r·z`.
     #[inline(always)]
-    fn precondition(&self, work: &mut Work, r: &[f64], norm: f64, z: &mut [f64]) {
+    fn precondition(&self, work: &mut Work, r: &[f64], norm: f64, z: &mut [f64]) -> f64 {
         let fine = &self.levels[0];
         if self.levels.len() == 1 {
             let (mut rc, mut zc) = (
@@ -501,7 +499,7 @@ impl Hierarchy {
                 z[p as usize] = *v;
             }
             (work.coarse_rhs, work.coarse_x) = (rc, zc);
-            return;
+            return dot(r, z);
         }
         // `M' = scale·M` is the system the V-cycle holds and `r' = to·r` its right-hand
         // side, so `M⁻¹ r = (scale / to)·M'⁻¹ r'`; each factor a power of two, exact.
@@ -511,11 +509,10 @@ impl Hierarchy {
         rounded(to, r, &mut r32);
         let mut z32 = std::mem::take(&mut work.correction[0]);
         self.v_cycle(work, 0, &r32, &mut z32);
-        for (zi, v) in z.iter_mut().zip(&z32) {
-            *zi = back * f64::from(*v);
-        }
+        let rz = widen_and_dot(back, &z32, r, z);
         work.residual[0] = r32;
         work.correction[0] = z32;
+        rz
     }
 
     /// One symmetric V-cycle on level `k` for residual `r`, result in `z`, in `f32`: three

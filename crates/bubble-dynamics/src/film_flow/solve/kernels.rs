@@ -6,7 +6,7 @@
 
 use super::Real;
 use super::layout::Layout;
-use crate::avx2::{dot_lanes, subtract_and_square_lanes};
+use crate::avx2::{dot_lanes, subtract_and_square_lanes, widen_and_dot_lanes};
 
 /// Per side, a level's edge weights as a field: each cell's weight of the edge on that
 /// side (zero at the halo cells).
@@ -318,6 +318,20 @@ pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
     let main = a.len() - a.len() % LANES;
     let lanes = dot_lanes(&a[..main], &b[..main]);
     let tail: f64 = a[main..].iter().zip(&b[main..]).map(|(x, y)| x * y).sum();
+    (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
+}
+
+/// `z = back·z32` (widened to `f64`) and returns `r·z`, summed as [`dot`] sums, in one
+/// pass.
+#[inline(always)]
+pub(super) fn widen_and_dot(back: f64, z32: &[f32], r: &[f64], z: &mut [f64]) -> f64 {
+    let main = r.len() - r.len() % LANES;
+    let lanes = widen_and_dot_lanes(back, &z32[..main], &r[..main], &mut z[..main]);
+    let mut tail = 0.0;
+    for ((zi, wi), ri) in z[main..].iter_mut().zip(&z32[main..]).zip(&r[main..]) {
+        *zi = back * f64::from(*wi);
+        tail += ri * *zi;
+    }
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
 }
 
