@@ -188,3 +188,107 @@ fn widen_and_dot_lanes_avx2(back: f64, z32: &[f32], r: &[f64], z: &mut [f64]) ->
     unsafe { _mm256_storeu_pd(lanes.as_mut_ptr(), sum) };
     lanes
 }
+
+/// For each of a cell's four sides, the other three, in the order of the four.
+pub(crate) const OTHERS: [[usize; 3]; 4] = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]];
+
+/// The weights of a group of four cells in [`coriolis_row`]: per other side `k`, per
+/// side `i`, per cell (index `(4k + i)·4 + cell`), so that a group's twelve weight
+/// vectors are read from one base.
+pub(crate) const QUAD_WEIGHTS: usize = 48;
+
+/// The first cells of a row of `n` cells' groups of four in [`coriolis_row`]: every
+/// fourth, then the last four again where `n` is not a multiple of four (the cells taken
+/// twice get the same terms twice), or one group of all `n` where `n < 4`.
+pub(crate) fn quad_starts(n: usize) -> impl Iterator<Item = usize> {
+    (0..n / 4)
+        .map(|g| 4 * g)
+        .chain((n % 4 != 0).then(|| n.saturating_sub(4)))
+}
+
+/// A row of `n` cells' terms of their sides' rates into `out` (per side: bottom, left,
+/// right, top): side `i`'s `Σ_k w[k][i] (ζ_i + ζ_o) u_o` over the other sides
+/// `o = OTHERS[i][k]`, summed in `k` order, each side's `ζ` the sum of its two corners'
+/// (from `z`, the row's bottom and top vertices, `n + 1` each), `u` the bottom sides'
+/// velocities, the left and right sides' (`n + 1`: cell `x`'s left is `x`, its right
+/// `x + 1`) and the top sides', `w` the groups' weights as [`QUAD_WEIGHTS`] lays them
+/// out. The same bits with AVX2 (explicit, from five input bases: the compiler's loop
+/// over twelve weight arrays and eight shifted slices ran out of registers) as without.
+///
+/// # Panics
+/// If the slices' lengths do not fit `n`, or `w` is short of the groups' weights.
+#[inline(always)]
+pub(crate) fn coriolis_row(w: &[f64], z: [&[f64]; 2], u: [&[f64]; 3], out: [&mut [f64]; 4]) {
+    let n = u[0].len();
+    let fits = z.iter().all(|s| s.len() == n + 1) && u[1].len() == n + 1 && u[2].len() == n;
+    assert!(
+        fits && out.iter().all(|s| s.len() == n),
+        "row slices do not fit"
+    );
+    assert!(w.len() >= n.div_ceil(4) * QUAD_WEIGHTS, "short of weights");
+    #[cfg(target_arch = "x86_64")]
+    if n >= 4 && std::arch::is_x86_feature_detected!("avx2") && !portable_only() {
+        // SAFETY: the processor supports AVX2, checked just above.
+        return unsafe { coriolis_row_avx2(w, z, u, out) };
+    }
+    let ([zb, zt], [ub, ux, ut]) = (z, u);
+    let [ob, ol, or, ot] = out;
+    for (wq, start) in w.chunks_exact(QUAD_WEIGHTS).zip(quad_starts(n)) {
+        for x in start..(start + 4).min(n) {
+            let c = [zb[x], zb[x + 1], zt[x], zt[x + 1]];
+            let z = [c[0] + c[1], c[0] + c[2], c[1] + c[3], c[2] + c[3]];
+            let v = [ub[x], ux[x], ux[x + 1], ut[x]];
+            let wk = |k: usize, i: usize| wq[(4 * k + i) * 4 + x - start];
+            let rate = |i: usize| {
+                let [a, b, c] = OTHERS[i];
+                let t0 = wk(0, i) * (z[i] + z[a]) * v[a];
+                let t1 = wk(1, i) * (z[i] + z[b]) * v[b];
+                let t2 = wk(2, i) * (z[i] + z[c]) * v[c];
+                t0 + t1 + t2
+            };
+            (ob[x], ol[x], or[x], ot[x]) = (rate(0), rate(1), rate(2), rate(3));
+        }
+    }
+}
+
+/// [`coriolis_row`] in AVX2 registers, four cells an instruction (`n ≥ 4`).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn coriolis_row_avx2(w: &[f64], z: [&[f64]; 2], u: [&[f64]; 3], out: [&mut [f64]; 4]) {
+    use std::arch::x86_64::{_mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_storeu_pd};
+    let n = u[0].len();
+    let ([zb, zt], [ub, ux, ut]) = (z.map(<[f64]>::as_ptr), u.map(<[f64]>::as_ptr));
+    let out = out.map(<[f64]>::as_mut_ptr);
+    let quad = |wq: &[f64], x: usize| {
+        // SAFETY: `x + 4 ≤ n` (`n ≥ 4`), the slices are as long as `coriolis_row` checked
+        // (`n + 1` where read at `x + 1`) and `wq` holds `QUAD_WEIGHTS`: every load and
+        // store is in bounds.
+        unsafe {
+            let ld = |p: *const f64, at: usize| _mm256_loadu_pd(p.wrapping_add(at));
+            let (c0, c1, c2, c3) = (ld(zb, x), ld(zb, x + 1), ld(zt, x), ld(zt, x + 1));
+            let z = [
+                _mm256_add_pd(c0, c1),
+                _mm256_add_pd(c0, c2),
+                _mm256_add_pd(c1, c3),
+                _mm256_add_pd(c2, c3),
+            ];
+            let v = [ld(ub, x), ld(ux, x), ld(ux, x + 1), ld(ut, x)];
+            let wk = |k: usize, i: usize| ld(wq.as_ptr(), (4 * k + i) * 4);
+            for (i, o) in out.iter().enumerate() {
+                let [a, b, d] = OTHERS[i];
+                let t0 = _mm256_mul_pd(_mm256_mul_pd(wk(0, i), _mm256_add_pd(z[i], z[a])), v[a]);
+                let t1 = _mm256_mul_pd(_mm256_mul_pd(wk(1, i), _mm256_add_pd(z[i], z[b])), v[b]);
+                let t2 = _mm256_mul_pd(_mm256_mul_pd(wk(2, i), _mm256_add_pd(z[i], z[d])), v[d]);
+                let rate = _mm256_add_pd(_mm256_add_pd(t0, t1), t2);
+                _mm256_storeu_pd(o.wrapping_add(x), rate);
+            }
+        }
+    };
+    let mut quads = w.chunks_exact(QUAD_WEIGHTS);
+    for (x, wq) in (0..n / 4).map(|g| 4 * g).zip(&mut quads) {
+        quad(wq, x);
+    }
+    if n % 4 != 0 {
+        quad(quads.next().expect("the last group's weights"), n - 4);
+    }
+}

@@ -36,7 +36,7 @@
 
 use glam::DVec3;
 
-use crate::avx2::with_avx2;
+use crate::avx2::{OTHERS, QUAD_WEIGHTS, coriolis_row, quad_starts, with_avx2};
 
 use super::compare::larger;
 use super::face_rows::{FaceRows, SIDES, Side};
@@ -70,13 +70,14 @@ pub(crate) struct AdvectionGeometry {
     /// the term does no work, as `ζ k×u ⊥ u` in the continuum (with the reconstruction's
     /// own weights the advection alone lost 3.3e-4 of a rotating film's energy in 0.25 s:
     /// `tests::the_rotation_term_does_no_work`). Taken cell by cell, each cell's four
-    /// edges are read once for the twelve terms among them. Stored `[k][i]`, one array a
-    /// cell of the `k`-th other side's weight for side `i`, so a face's row of cells is
-    /// one slice of each ([`cell_rates`]). Every cell sums its terms in this order, the
+    /// edges are read once for the twelve terms among them. Stored by rows of cells, in
+    /// each row its groups of four cells ([`quad_starts`]) laid out as [`QUAD_WEIGHTS`]
+    /// says ([`coriolis_row`]): twelve separate arrays a row left the compiler's loop
+    /// short of registers for their bases. Every cell sums its terms in this order, the
     /// faces' border cells whose edges the grid numbers otherwise too
     /// ([`FaceRows::irregular_cells`]): taken apart in the grid's order, those cost a
     /// fifth of the advection's instructions, for sums that differ only in rounding.
-    coriolis: [[Vec<f64>; 4]; 3],
+    coriolis: Vec<f64>,
     /// [`Self::to_cell`] for the [`FaceRows::irregular_cells`], in the order the grid
     /// numbers their edges.
     irregular: Vec<IrregularWeights>,
@@ -189,7 +190,7 @@ impl AdvectionGeometry {
             seams,
             to_cell,
             centre: std::array::from_fn(|a| centres.iter().map(|c| c[a]).collect()),
-            coriolis: weights,
+            coriolis: interleave_quads(&weights, rows.n),
             irregular,
             min_dual_length: edges
                 .iter()
@@ -199,8 +200,20 @@ impl AdvectionGeometry {
     }
 }
 
-/// For each of a cell's four edges, the other three, in the order of the four.
-const OTHERS: [[usize; 3]; 4] = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]];
+/// The Coriolis weights `w[k][i][cell]` laid out by rows of `n` cells, each row by its
+/// groups of four ([`AdvectionGeometry::coriolis`]); zero past a row of fewer than four.
+fn interleave_quads(w: &[[Vec<f64>; 4]; 3], n: usize) -> Vec<f64> {
+    let mut out = Vec::with_capacity(6 * n * n.div_ceil(4) * QUAD_WEIGHTS);
+    for row in 0..6 * n {
+        for start in quad_starts(n) {
+            let cell = |lane: usize| row * n + start + lane;
+            for side in w.iter().flatten() {
+                out.extend((0..4).map(|l| if l < n { side[cell(l)] } else { 0.0 }));
+            }
+        }
+    }
+    out
+}
 
 /// Each cell's four edges, in increasing order.
 ///
@@ -271,6 +284,12 @@ pub(crate) struct AdvectionScratch {
     speed_squared: Vec<f64>,
     /// What a stage keeps besides the velocities.
     work: StageWork,
+    /// Per local vertex: `1/(A R)` for the radius in [`Self::scale_radius_m`], by which
+    /// a circulation becomes a vorticity (a multiplication where a division took several
+    /// times as long, in each stage's pass over the vertices).
+    vorticity_scale: Vec<f64>,
+    /// The radius [`Self::vorticity_scale`] was taken for, m (zero for none).
+    scale_radius_m: f64,
 }
 
 /// What a stage reads and writes besides the velocities.
@@ -321,15 +340,18 @@ pub(crate) fn advect_momentum(
         stage.resize(u.len(), 0.0);
     }
     s.work.prepare(rows);
+    if s.scale_radius_m != radius_m || s.vorticity_scale.len() != rows.vertex_area.len() {
+        let scale = rows.vertex_area.iter().map(|a| 1.0 / (a * radius_m));
+        s.vorticity_scale = scale.collect();
+        s.scale_radius_m = radius_m;
+    }
     with_avx2(
         #[inline(always)]
         || {
-            let w = &mut s.work;
-            rows.circulation(u, &mut w.vorticity, &rows.vertex_area, |z, a| {
-                z / (a * radius_m)
-            });
+            let (w, scale) = (&mut s.work, &s.vorticity_scale);
+            rows.circulation(u, &mut w.vorticity, scale, |z, ia| z * ia);
             for k in 1..=substeps {
-                ssp_rk3(rows, geo, radius_m, h, u, &mut s.stages, w, k < substeps);
+                ssp_rk3(rows, geo, scale, h, u, &mut s.stages, w, k < substeps);
             }
         },
     );
@@ -385,7 +407,7 @@ fn substeps(
 fn ssp_rk3(
     rows: &FaceRows,
     geo: &AdvectionGeometry,
-    radius_m: f64,
+    scale: &[f64],
     h: f64,
     u: &mut [f64],
     stages: &mut [Vec<f64>; 2],
@@ -393,11 +415,7 @@ fn ssp_rk3(
     next: bool,
 ) {
     let [u1, u2] = stages;
-    let on = Stage {
-        rows,
-        geo,
-        radius_m,
-    };
+    let on = Stage { rows, geo, scale };
     // Stage 1 (what `u1` held is passed over). It ignores the starting velocities: given
     // `u`'s, the rows may move the border copies too (see `Stage::stage`).
     let step = |u, _, r| u + h * r;
@@ -405,7 +423,8 @@ fn ssp_rk3(
     let step = |u, u0, r| 0.75 * u0 + 0.25 * (u + h * r);
     on.stage(u1, u2, Some(u), w, true, step);
     // Stage 3, onto `u`: each edge's starting velocity read before it is replaced.
-    let step = |u, u0, r| u0 / 3.0 + (2.0 / 3.0) * (u + h * r);
+    // ⅓ as a multiplication: a division took several times as long.
+    let step = |u, u0, r| (1.0 / 3.0) * u0 + (2.0 / 3.0) * (u + h * r);
     on.stage(u2, u, None, w, next, step);
 }
 
@@ -414,7 +433,8 @@ fn ssp_rk3(
 struct Stage<'a> {
     rows: &'a FaceRows,
     geo: &'a AdvectionGeometry,
-    radius_m: f64,
+    /// Per local vertex: `1/(A R)` ([`AdvectionScratch::vorticity_scale`]).
+    scale: &'a [f64],
 }
 
 impl Stage<'_> {
@@ -470,17 +490,13 @@ impl Stage<'_> {
                 move_edges(&mut dst[k.clone()], &src[k], u0y, top, bottom, &step);
                 if next {
                     let z = &mut w.next_vorticity;
-                    rows.circulation_row(dst, f, y, z, &rows.vertex_area, |z, a| {
-                        z / (a * self.radius_m)
-                    });
+                    rows.circulation_row(dst, f, y, z, self.scale, |z, ia| z * ia);
                 }
             }
         }
         self.move_seam_edges(src, dst, u0, &w.border_rate, &step);
         if next {
-            rows.seam_circulation(dst, &mut w.next_vorticity, &rows.vertex_area, |z, a| {
-                z / (a * self.radius_m)
-            });
+            rows.seam_circulation(dst, &mut w.next_vorticity, self.scale, |z, ia| z * ia);
             std::mem::swap(&mut w.vorticity, &mut w.next_vorticity);
         }
     }
@@ -490,36 +506,17 @@ impl Stage<'_> {
     #[inline(always)]
     fn cell_row(self, u: &[f64], vorticity: &[f64], f: usize, y: usize, rate: &mut [Vec<f64>; 4]) {
         let (rows, n) = (self.rows, self.rows.n);
-        let c = f * n * n + y * n;
         let (uy, ux) = (rows.y_edge(f, 0, y), rows.x_edge(f, 0, y));
         let (vb, vt) = (rows.vertex_at(f, 0, y), rows.vertex_at(f, 0, y + 1));
-        let [w0, w1, w2] = &self.geo.coriolis;
+        let len = n.div_ceil(4) * QUAD_WEIGHTS;
+        let w = &self.geo.coriolis[(f * n + y) * len..][..len];
         let [ob, ol, or, ot] = rate;
-        let row = CellRow {
-            u: [
-                &u[uy..uy + n],
-                &u[ux..ux + n],
-                &u[ux + 1..ux + n + 1],
-                &u[uy + n..uy + 2 * n],
-            ],
-            z: [
-                &vorticity[vb..vb + n],
-                &vorticity[vb + 1..vb + n + 1],
-                &vorticity[vt..vt + n],
-                &vorticity[vt + 1..vt + n + 1],
-            ],
-            w: [
-                four_rows(w0, c..c + n),
-                four_rows(w1, c..c + n),
-                four_rows(w2, c..c + n),
-            ],
-        };
-        // In a multiple of four cells, then the last four again where n is not one.
-        let whole = n & !3;
-        row.cells(0..whole, ob, ol, or, ot);
-        if whole < n {
-            row.cells(n.saturating_sub(4)..n, ob, ol, or, ot);
-        }
+        coriolis_row(
+            w,
+            [&vorticity[vb..vb + n + 1], &vorticity[vt..vt + n + 1]],
+            [&u[uy..uy + n], &u[ux..ux + n + 1], &u[uy + n..uy + 2 * n]],
+            [&mut ob[..n], &mut ol[..n], &mut or[..n], &mut ot[..n]],
+        );
     }
 
     /// The edges on the faces' borders: each from its two cells' terms in `border`, both
@@ -542,71 +539,6 @@ impl Stage<'_> {
             }
         }
     }
-}
-
-/// A row of cells' terms of their sides' rates ([`cell_rates`]), read as slices: the
-/// sides' velocities and the four corners' vorticities (bottom left, bottom right, top
-/// left, top right), and the weights as [`AdvectionGeometry::coriolis`] holds them.
-struct CellRow<'a> {
-    u: [&'a [f64]; 4],
-    z: [&'a [f64]; 4],
-    w: [[&'a [f64]; 4]; 3],
-}
-
-impl CellRow<'_> {
-    /// Cells `range` of the row's terms into `ob`, `ol`, `or` and `ot` (per side, from
-    /// `range`'s start), the compiler's vector loop over them. The four go as arguments
-    /// of their own: the compiler then knows that they overlap nothing the loop reads,
-    /// where through a struct it tested each against each input slice on every row.
-    #[inline(always)]
-    fn cells(
-        &self,
-        range: std::ops::Range<usize>,
-        ob: &mut [f64],
-        ol: &mut [f64],
-        or: &mut [f64],
-        ot: &mut [f64],
-    ) {
-        let len = range.len();
-        let [zb0, zb1, zt0, zt1] = four_rows(&self.z, range.clone());
-        let [ub, ul, ur, ut] = four_rows(&self.u, range.clone());
-        let w = [
-            four_rows(&self.w[0], range.clone()),
-            four_rows(&self.w[1], range.clone()),
-            four_rows(&self.w[2], range.clone()),
-        ];
-        let (ob, ol) = (&mut ob[range.clone()][..len], &mut ol[range.clone()][..len]);
-        let (or, ot) = (&mut or[range.clone()][..len], &mut ot[range][..len]);
-        for x in 0..len {
-            let z = [
-                zb0[x] + zb1[x],
-                zb0[x] + zt0[x],
-                zb1[x] + zt1[x],
-                zt0[x] + zt1[x],
-            ];
-            let u = [ub[x], ul[x], ur[x], ut[x]];
-            let w = [
-                [w[0][0][x], w[0][1][x], w[0][2][x], w[0][3][x]],
-                [w[1][0][x], w[1][1][x], w[1][2][x], w[1][3][x]],
-                [w[2][0][x], w[2][1][x], w[2][2][x], w[2][3][x]],
-            ];
-            let [b, l, r, t] = cell_rates(z, u, &w);
-            (ob[x], ol[x], or[x], ot[x]) = (b, l, r, t);
-        }
-    }
-}
-
-/// The same range of each of four arrays (written out: `map` with a closure was kept
-/// out of line).
-#[inline(always)]
-fn four_rows<S: AsRef<[f64]>>(a: &[S; 4], r: std::ops::Range<usize>) -> [&[f64]; 4] {
-    let len = r.len();
-    [
-        &a[0].as_ref()[r.clone()][..len],
-        &a[1].as_ref()[r.clone()][..len],
-        &a[2].as_ref()[r.clone()][..len],
-        &a[3].as_ref()[r][..len],
-    ]
 }
 
 /// Keeps the terms of row `y`'s cells (from cell `c`) on their face's borders: the left
@@ -742,23 +674,6 @@ fn largest_magnitude(values: &[f64]) -> f64 {
     m.into_iter().fold(0.0, |a, b| larger(b, a))
 }
 
-/// A cell's terms of its four edges' rates, from the edges' vorticities `z` (each the sum
-/// of its two vertices') and velocities `u` and the cell's weights: `Σ_k w[k][i] (ζ_i +
-/// ζ_o) u_o` over the other edges `o = OTHERS[i][k]`, summed in `k` order: the same
-/// operations per edge as edge by edge, so the same bits, in four independent chains.
-#[inline(always)]
-fn cell_rates(z: [f64; 4], u: [f64; 4], w: &[[f64; 4]; 3]) -> [f64; 4] {
-    let mut rates = [0.0; 4];
-    for i in 0..4 {
-        let [a, b, c] = OTHERS[i];
-        let t0 = w[0][i] * (z[i] + z[a]) * u[a];
-        let t1 = w[1][i] * (z[i] + z[b]) * u[b];
-        let t2 = w[2][i] * (z[i] + z[c]) * u[c];
-        rates[i] = t0 + t1 + t2;
-    }
-    rates
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -880,5 +795,55 @@ mod tests {
         rows.to_grid(&in_rows, &mut u);
         let change = energy(&u) / e0 - 1.0;
         assert!(change.abs() < 1e-4, "energy changed by {change:+.3e}");
+    }
+
+    /// The advection with AVX2 gives the portable code's bits: at n = 5 (a row of cells
+    /// in two overlapping groups of four) and 16, a rotation with a rough field on it.
+    #[test]
+    fn the_avx2_advection_gives_the_portable_bits() {
+        for n in [5, 16] {
+            let grid = CubeSphere::new(n);
+            let rows = FaceRows::new(&grid);
+            let geo = AdvectionGeometry::new(&grid, &rows);
+            let rough = grid.edges().iter().enumerate();
+            let field: Vec<f64> = rough
+                .map(|(e, ed)| {
+                    (DVec3::Z * 0.05).cross(ed.midpoint).dot(ed.normal)
+                        + ((e * 7919) % 1000) as f64 * 1e-5
+                })
+                .collect();
+            let run = |portable: bool| {
+                crate::avx2::set_portable_only(portable);
+                let mut u = Vec::new();
+                rows.to_rows(&field, &mut u);
+                advect_momentum(
+                    &rows,
+                    &geo,
+                    0.01,
+                    1.0 / 60.0,
+                    &mut u,
+                    &mut AdvectionScratch::default(),
+                );
+                crate::avx2::set_portable_only(false);
+                u
+            };
+            let (fast, plain) = (run(false), run(true));
+            assert!(
+                fast != run_unchanged(&rows, &field),
+                "n {n}: the field moved"
+            );
+            let differ = fast
+                .iter()
+                .zip(&plain)
+                .filter(|(a, b)| a.to_bits() != b.to_bits());
+            assert_eq!(differ.count(), 0, "n {n}: edges differ");
+        }
+    }
+
+    /// `field` in the face rows, as given.
+    fn run_unchanged(rows: &FaceRows, field: &[f64]) -> Vec<f64> {
+        let mut u = Vec::new();
+        rows.to_rows(field, &mut u);
+        u
     }
 }
