@@ -326,24 +326,6 @@ impl FilmFlow {
         } else {
             &ea.inverse_dual_length
         };
-        sides.for_each_edge_run(
-            #[inline(always)]
-            |run| {
-                let ((ga, gb), (xa, xb)) = (run.ends(&self.gamma), run.ends(&s.cell2));
-                let inputs = CorrectionInputs {
-                    inverse_dual,
-                    length: &ea.length,
-                    flux: &s.edge,
-                    stiffness: &s.stiffness,
-                    cross: &s.cross,
-                };
-                let out = (&mut self.u_m_per_s[..], &mut s.edge2[..]);
-                correct_velocity_block::<NORMAL>(run, [ga, gb, xa, xb], inputs, out, constants);
-            },
-        );
-        let seams = sides.seams();
-        let mut seam_ends = std::mem::take(&mut s.seam_ends);
-        let [[ga, gb], [xa, xb]] = seam_ends.gather_many(seams, [&self.gamma, &s.cell2]);
         let inputs = CorrectionInputs {
             inverse_dual,
             length: &ea.length,
@@ -351,6 +333,17 @@ impl FilmFlow {
             stiffness: &s.stiffness,
             cross: &s.cross,
         };
+        sides.for_each_edge_run(
+            #[inline(always)]
+            |run| {
+                let ((ga, gb), (xa, xb)) = (run.ends(&self.gamma), run.ends(&s.cell2));
+                let out = (&mut self.u_m_per_s[..], &mut s.edge2[..]);
+                correct_velocity_block::<NORMAL>(run, [ga, gb, xa, xb], inputs, out, constants);
+            },
+        );
+        let seams = sides.seams();
+        let mut seam_ends = std::mem::take(&mut s.seam_ends);
+        let [[ga, gb], [xa, xb]] = seam_ends.gather_many(seams, [&self.gamma, &s.cell2]);
         let out = (&mut self.u_m_per_s[..], &mut s.edge2[..]);
         with_avx2(
             #[inline(always)]
