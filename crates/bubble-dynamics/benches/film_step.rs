@@ -7,10 +7,10 @@
 mod swirl_film;
 
 use bubble_dynamics::DVec3;
-use bubble_dynamics::film_flow::Forcing;
+use bubble_dynamics::film_flow::{FilmGradient, Forcing};
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 
-use swirl_film::swirl_film_warmed;
+use swirl_film::swirl_film;
 
 fn bench_film_step(c: &mut Criterion) {
     let forcing = Forcing {
@@ -19,7 +19,7 @@ fn bench_film_step(c: &mut Criterion) {
     };
     let mut group = c.benchmark_group("film_step");
     for n in [32, 64, 128, 256] {
-        let mut f = swirl_film_warmed(n, 0.0);
+        let mut f = swirl_film(n, 0.0, FilmGradient::TwoPoint);
         // Past the start-up transient: the film sags onto its Marangoni balance.
         for _ in 0..30 {
             f.step(1.0 / 60.0, &forcing);

@@ -1,14 +1,15 @@
 //! Prints the film step's solver iterations, wall time, thinnest film and fastest edge
-//! for `film_profile [n] [air m/s] [g m/s²] [bottom warming K]` (the bench's film, for
-//! profiling with perf; `FILM_STEPS` sets the number of steps, 40 unless set).
+//! for `film_profile [n] [air m/s] [g m/s²] [bottom warming K] [normal]` (the bench's
+//! film, for profiling with perf; `normal` drives it through the normal gradient;
+//! `FILM_STEPS` sets the number of steps, 40 unless set).
 
 #[path = "../benches/common/swirl_film.rs"]
 mod swirl_film;
 
 use bubble_dynamics::DVec3;
-use bubble_dynamics::film_flow::Forcing;
+use bubble_dynamics::film_flow::{FilmGradient, Forcing};
 
-use swirl_film::swirl_film_warmed;
+use swirl_film::swirl_film;
 
 fn main() {
     let arg = |k: usize, d: f64| std::env::args().nth(k).map_or(d, |s| s.parse().unwrap());
@@ -17,7 +18,11 @@ fn main() {
         air_m_per_s: DVec3::new(arg(2, 0.3), 0.0, 0.0),
     };
     let n = arg(1, 64.0) as usize;
-    let mut f = swirl_film_warmed(n, arg(4, 0.0));
+    let gradient = match std::env::args().nth(5).as_deref() {
+        Some("normal") => FilmGradient::Normal,
+        _ => FilmGradient::TwoPoint,
+    };
+    let mut f = swirl_film(n, arg(4, 0.0), gradient);
     let steps = std::env::var("FILM_STEPS").map_or(40, |s| s.parse().expect("FILM_STEPS: a count"));
     for k in 0..steps {
         let t = std::time::Instant::now();

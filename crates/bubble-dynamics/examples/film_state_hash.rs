@@ -7,10 +7,10 @@
 #[path = "../benches/common/swirl_film.rs"]
 mod swirl_film;
 
-use bubble_dynamics::film_flow::{FilmFlow, Forcing};
+use bubble_dynamics::film_flow::{FilmFlow, FilmGradient, Forcing};
 use bubble_dynamics::{BubbleParams, DVec3, World, WorldParams};
 
-use swirl_film::swirl_film_warmed;
+use swirl_film::swirl_film;
 
 struct Fnv(u64);
 
@@ -45,7 +45,7 @@ fn main() {
             g_eff_m_per_s2: DVec3::new(0.1, -g, 0.0),
             air_m_per_s: DVec3::new(air, 0.0, 0.1),
         };
-        let mut f = swirl_film_warmed(n, warming_k);
+        let mut f = swirl_film(n, warming_k, FilmGradient::TwoPoint);
         f.set_velocity(|d| DVec3::new(0.0, 0.02, 0.01).cross(d));
         let mut h = Fnv(0xcbf2_9ce4_8422_2325);
         for _ in 0..steps {

@@ -5,10 +5,13 @@
 
 use std::sync::Arc;
 
-use bubble_dynamics::film_flow::{CubeSphere, FilmFlow, FlowParams, Hierarchy, ThermalParams};
+use bubble_dynamics::film_flow::{
+    CubeSphere, FilmFlow, FilmGradient, FlowParams, Hierarchy, ThermalParams,
+};
 
-/// That film on a grid of `n` cells a face, the air `warming_k` warmer at its bottom.
-pub fn swirl_film_warmed(n: usize, warming_k: f64) -> FilmFlow {
+/// That film on a grid of `n` cells a face, the air `warming_k` warmer at its bottom,
+/// driven through `gradient`.
+pub fn swirl_film(n: usize, warming_k: f64, gradient: FilmGradient) -> FilmFlow {
     let grid = Arc::new(CubeSphere::new(n));
     let hierarchy = Arc::new(Hierarchy::new(&grid));
     let mut params = FlowParams {
@@ -17,6 +20,7 @@ pub fn swirl_film_warmed(n: usize, warming_k: f64) -> FilmFlow {
         ..FlowParams::water_film(0.05)
     };
     params.burst.rupture_thickness_nm = 0.0;
+    params.gradient = gradient;
     params.burst.black_threshold_nm = 0.0;
     params.thermal = ThermalParams {
         bottom_warming_k: warming_k,

@@ -48,8 +48,9 @@ pub(super) const SOLVE_MAX_ITERATIONS: u32 = 40;
 /// The trade-off: [`FilmGradient::TwoPoint`] keeps one symmetric solve a step but holds the
 /// Marangoni wave-speed error near 2.7 % at any grid (4.16/3.03/2.77/2.71 % at n =
 /// 8/16/32/64); [`FilmGradient::Normal`] makes it fall at second order (1.73/0.44/0.12/
-/// 0.037 %) at +128 % instructions a step (250.5 M against 110.0 M at n = 64, 16.6 PCG
-/// iterations a step against 5.7), on a step already over its real-time budget
+/// 0.037 %) at 4.9× the instructions a step (95.3 M against 19.4 M at n = 64, 14.8 PCG
+/// iterations a step against 4.4, on 2026-11-29: its defect correction's passes were
+/// not sped up with the rest), on a step already over its real-time budget
 /// (docs/dynamics.md, "Film flow").
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum FilmGradient {
@@ -59,7 +60,8 @@ pub enum FilmGradient {
     #[default]
     TwoPoint,
     /// Along the edge's normal, the cross term along the edge by defect correction
-    /// around the symmetric solve: second-order wave speed at about 2.3× the step's cost.
+    /// around the symmetric solve: second-order wave speed at about 4.9× the step's
+    /// instructions.
     Normal,
 }
 
