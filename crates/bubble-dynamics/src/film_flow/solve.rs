@@ -48,14 +48,30 @@ trait Real:
     + std::ops::AddAssign
 {
     const ZERO: Self;
+    /// The value in `f64` (exact).
+    fn widen(self) -> f64;
+    /// `x` rounded to this precision.
+    fn narrow(x: f64) -> Self;
 }
 
 impl Real for f64 {
     const ZERO: Self = 0.0;
+    fn widen(self) -> f64 {
+        self
+    }
+    fn narrow(x: f64) -> Self {
+        x
+    }
 }
 
 impl Real for f32 {
     const ZERO: Self = 0.0;
+    fn widen(self) -> f64 {
+        f64::from(self)
+    }
+    fn narrow(x: f64) -> Self {
+        x as f32
+    }
 }
 
 /// The face size a grid of `n` coarsens to: halved while even and above
@@ -482,23 +498,8 @@ impl Hierarchy {
     /// finest level is the coarsest; returns `r·z`.
     #[inline(always)]
     fn precondition(&self, work: &mut Work, r: &[f64], norm: f64, z: &mut [f64]) -> f64 {
-        let fine = &self.levels[0];
         if self.levels.len() == 1 {
-            let (mut rc, mut zc) = (
-                std::mem::take(&mut work.coarse_rhs),
-                std::mem::take(&mut work.coarse_x),
-            );
-            let cells = fine.position.len();
-            rc.resize(cells, 0.0);
-            zc.resize(cells, 0.0);
-            for (v, &p) in rc.iter_mut().zip(&fine.position) {
-                *v = r[p as usize];
-            }
-            dense_solve(&work.coarse_factor, cells, &rc, &mut zc);
-            for (v, &p) in zc.iter().zip(&fine.position) {
-                z[p as usize] = *v;
-            }
-            (work.coarse_rhs, work.coarse_x) = (rc, zc);
+            self.coarsest(work, r, z);
             return dot(r, z);
         }
         // `M' = scale·M` is the system the V-cycle holds and `r' = to·r` its right-hand
@@ -561,9 +562,10 @@ impl Hierarchy {
         )
     }
 
-    /// The coarsest level's V-cycle: its dense solve, in `f64`.
+    /// The coarsest level's dense solve, in `f64` (in either precision's fields: the
+    /// V-cycle's last level, or the whole preconditioner where there is one level).
     #[inline(always)]
-    fn coarsest(&self, work: &mut Work, r: &[f32], z: &mut [f32]) {
+    fn coarsest<T: Real>(&self, work: &mut Work, r: &[T], z: &mut [T]) {
         let level = self.levels.last().expect("a level");
         let cells = level.position.len();
         let (mut rc, mut zc) = (
@@ -573,11 +575,11 @@ impl Hierarchy {
         rc.resize(cells, 0.0);
         zc.resize(cells, 0.0);
         for (v, &p) in rc.iter_mut().zip(&level.position) {
-            *v = f64::from(r[p as usize]);
+            *v = r[p as usize].widen();
         }
         dense_solve(&work.coarse_factor, cells, &rc, &mut zc);
         for (v, &p) in zc.iter().zip(&level.position) {
-            z[p as usize] = *v as f32;
+            z[p as usize] = T::narrow(*v);
         }
         (work.coarse_rhs, work.coarse_x) = (rc, zc);
     }
