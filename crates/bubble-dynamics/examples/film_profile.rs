@@ -1,7 +1,9 @@
 //! Prints the film step's solver iterations, wall time, thinnest film and fastest edge
 //! for `film_profile [n] [air m/s] [g m/s²] [bottom warming K] [normal]` (the bench's
 //! film, for profiling with perf; `normal` drives it through the normal gradient;
-//! `FILM_STEPS` sets the number of steps, 40 unless set).
+//! `FILM_STEPS` sets the number of steps, 40 unless set; `FILM_REPEATS` runs those steps
+//! that many times, each from a copy of the same starting film, so a profile of a small
+//! grid is not dominated by building it).
 
 #[path = "../benches/common/swirl_film.rs"]
 mod swirl_film;
@@ -22,11 +24,20 @@ fn main() {
         Some("normal") => FilmGradient::Normal,
         _ => FilmGradient::TwoPoint,
     };
-    let mut f = swirl_film(n, arg(4, 0.0), gradient);
-    let steps = std::env::var("FILM_STEPS").map_or(40, |s| s.parse().expect("FILM_STEPS: a count"));
+    let start = swirl_film(n, arg(4, 0.0), gradient);
+    let count = |name: &str, d: usize| std::env::var(name).map_or(d, |s| s.parse().expect(name));
+    let (steps, repeats) = (count("FILM_STEPS", 40), count("FILM_REPEATS", 1));
+    for _ in 0..repeats {
+        let mut f = start.clone();
+        run(&mut f, steps, &forcing);
+    }
+}
+
+/// Steps `f` `steps` times, printing each step's figures.
+fn run(f: &mut bubble_dynamics::film_flow::FilmFlow, steps: usize, forcing: &Forcing) {
     for k in 0..steps {
         let t = std::time::Instant::now();
-        let r = f.step(1.0 / 60.0, &forcing);
+        let r = f.step(1.0 / 60.0, forcing);
         let hmin = f.thickness_m().iter().cloned().fold(1.0, f64::min);
         let umax = f
             .edge_velocity_m_per_s()
