@@ -3,6 +3,11 @@
 //! films: `film_state_hash [n] [steps]`. Two builds that print the same hashes step the
 //! film bit-identically (how the default gradient was checked against the code before
 //! the normal gradient's option).
+//!
+//! For a change meant to move only rounding: with `FILM_STATE_DUMP=dir` set, each swirl
+//! film's fields are also written to `dir` (raw little-endian `f64`s), and
+//! `film_state_hash compare dir_a dir_b` prints each field's largest difference between
+//! two builds' dumps, relative to the field's largest magnitude.
 
 #[path = "../benches/common/swirl_film.rs"]
 mod swirl_film;
@@ -33,14 +38,68 @@ impl Fnv {
     }
 }
 
+/// The films' fields, in the order they are hashed.
+const FIELDS: [&str; 4] = ["thickness", "surfactant", "temperature", "velocity"];
+
+/// Writes film `index`'s fields to `dir` (one file a field).
+fn dump(dir: &str, index: usize, f: &FilmFlow) {
+    let fields = [
+        f.thickness_m(),
+        f.surfactant(),
+        f.temperature_excess_k(),
+        f.edge_velocity_m_per_s(),
+    ];
+    for (name, values) in FIELDS.iter().zip(fields) {
+        let bytes: Vec<u8> = values.iter().flat_map(|x| x.to_le_bytes()).collect();
+        std::fs::write(format!("{dir}/{index}_{name}.f64"), bytes).expect("writing a dump");
+    }
+}
+
+/// Prints, per film and field, the largest difference of two dumps relative to the
+/// field's largest magnitude.
+fn compare(a: &str, b: &str) {
+    let read = |dir: &str, name: &str| -> Vec<f64> {
+        let bytes = std::fs::read(format!("{dir}/{name}.f64")).expect("reading a dump");
+        let eight = |c: &[u8]| f64::from_le_bytes(c.try_into().expect("8 bytes"));
+        bytes.chunks_exact(8).map(eight).collect()
+    };
+    for index in 0..3 {
+        for field in FIELDS {
+            let name = format!("{index}_{field}");
+            let (x, y) = (read(a, &name), read(b, &name));
+            assert_eq!(x.len(), y.len(), "{name}: the dumps differ in length");
+            let largest = x.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
+            let worst = x
+                .iter()
+                .zip(&y)
+                .fold(0.0, |m: f64, (p, q)| m.max((p - q).abs()));
+            let relative = if largest > 0.0 {
+                worst / largest
+            } else {
+                worst
+            };
+            println!("film {index} {field}: largest difference {relative:.3e} of its largest");
+        }
+    }
+}
+
 fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    if args.get(1).map(String::as_str) == Some("compare") {
+        compare(&args[2], &args[3]);
+        return;
+    }
+    let dump_dir = std::env::var("FILM_STATE_DUMP").ok();
     let arg = |k: usize, d: usize| std::env::args().nth(k).map_or(d, |s| s.parse().unwrap());
     let (n, steps) = (arg(1, 32), arg(2, 40));
-    for (what, warming_k, air, g) in [
+    for (index, (what, warming_k, air, g)) in [
         ("swirl film, isothermal", 0.0, 0.3, 9.81),
         ("swirl film, warmed 5 K", 5.0, 0.3, 9.81),
         ("swirl film, warmed 5 K, no gravity", 5.0, 0.0, 0.0),
-    ] {
+    ]
+    .into_iter()
+    .enumerate()
+    {
         let forcing = Forcing {
             g_eff_m_per_s2: DVec3::new(0.1, -g, 0.0),
             air_m_per_s: DVec3::new(air, 0.0, 0.1),
@@ -55,6 +114,9 @@ fn main() {
         }
         h.film(&f);
         println!("{what}: {:016x}", h.0);
+        if let Some(dir) = &dump_dir {
+            dump(dir, index, &f);
+        }
     }
     // A bubble of the world with a film flow (film_grid 16, warmed 3 K), 4 world steps a
     // film step.
