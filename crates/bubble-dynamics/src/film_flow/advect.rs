@@ -303,9 +303,10 @@ pub(crate) struct AdvectionScratch {
     speed_squared: Vec<f64>,
     /// What a stage keeps besides the velocities.
     work: StageWork,
-    /// Per local vertex: `1/(A R)` for the radius in [`Self::scale_radius_m`], by which
-    /// a circulation becomes a vorticity (a multiplication where a division took several
-    /// times as long, in each stage's pass over the vertices).
+    /// Per local vertex of face 0, which every face reads (as it does face 0's areas,
+    /// [`FaceRows::vertex_area`]): `1/(A R)` for the radius in [`Self::scale_radius_m`],
+    /// by which a circulation becomes a vorticity (a multiplication where a division took
+    /// several times as long, in each stage's pass over the vertices).
     vorticity_scale: Vec<f64>,
     /// The radius [`Self::vorticity_scale`] was taken for, m (zero for none).
     scale_radius_m: f64,
@@ -452,7 +453,7 @@ fn ssp_rk3(
 struct Stage<'a> {
     rows: &'a FaceRows,
     geo: &'a AdvectionGeometry,
-    /// Per local vertex: `1/(A R)` ([`AdvectionScratch::vorticity_scale`]).
+    /// Per local vertex of face 0: `1/(A R)` ([`AdvectionScratch::vorticity_scale`]).
     scale: &'a [f64],
 }
 

@@ -16,11 +16,12 @@
 //! borders, and the cells there whose edges the grid numbers in another order, are taken
 //! one by one from lists in the grid's order ([`FaceRows::seam_vertices`],
 //! [`FaceRows::irregular_cells`]). So each value is the same sum in the same order as a
-//! pass over the grid's numbering takes it, and the rows give its bits. (A renumbering of
-//! the grid's edges would leave the rows' sums as they are, mathematically the same.)
-//! The exceptions: the advection's cell terms and the viscous step's divergences, which
-//! every cell sums in the local order, those irregular cells too
-//! (`advect::AdvectionGeometry::coriolis` says why).
+//! pass over the grid's numbering takes it; the grid's constants in it are face 0's,
+//! which every face reads ([`FaceRows`] says why), so the rows give its bits on face 0
+//! and to rounding on the others. (A renumbering of the grid's edges would leave the
+//! rows' sums as they are, mathematically the same.) The exceptions: the advection's
+//! cell terms and the viscous step's divergences, which every cell sums in the local
+//! order, those irregular cells too (`advect::AdvectionGeometry::coriolis` says why).
 
 use glam::DVec3;
 
@@ -53,6 +54,9 @@ pub(crate) struct SeamVertex {
     pub(crate) copies: [u32; 3],
     /// How many of `copies` there are.
     pub(crate) copy_count: u8,
+    /// Its first copy's place in face 0, whose scale it is finished with
+    /// ([`FaceRows::seam_circulation`]).
+    pub(crate) face_0_copy: u32,
 }
 
 /// An edge between two faces: its two local copies.
@@ -85,6 +89,13 @@ pub(crate) struct IrregularCell {
 /// A local X-edge's tangent (`midpoint × normal`) points towards `−t` (its tail `v0` the
 /// upper vertex), a Y-edge's towards `+s` (its tail the left vertex): the faces' `(s, t)`
 /// are left-handed seen from outside.
+///
+/// The grid's constants the passes read (the dual lengths, the vertices' areas) are face
+/// 0's only, which every face reads at its own local index: the six faces are congruent
+/// under the cube's rotations and each face's rows are in its own frame, so every face's
+/// constants are face 0's to rounding (within 1e-14 of the largest:
+/// `tests::every_faces_constants_are_face_0s`). Six faces' were streamed from beyond the
+/// core's 1 MB L2 in every pass at n = 64; one face's stay in it from face to face.
 #[derive(Clone, Debug)]
 pub(crate) struct FaceRows {
     pub(crate) n: usize,
@@ -95,7 +106,8 @@ pub(crate) struct FaceRows {
     /// Per local edge: `−1` where flipped, else `1` (a value times it is the value or its
     /// negation, exactly).
     pub(crate) signs: Vec<f64>,
-    /// Per local edge: the arc between its cells' centres, rad.
+    /// Per local edge of face 0, which every face reads ([`FaceRows`] says why): the arc
+    /// between its cells' centres, rad.
     pub(crate) dual_length: Vec<f64>,
     /// Per local edge: its arc length, rad.
     pub(crate) length: Vec<f64>,
@@ -105,9 +117,9 @@ pub(crate) struct FaceRows {
     pub(crate) inverse_dual_length: Vec<f64>,
     /// Per local vertex: the grid's vertex.
     pub(crate) vertex: Vec<u32>,
-    /// Per local vertex: its dual area, sr.
+    /// Per local vertex of face 0, which every face reads: its dual area, sr.
     pub(crate) vertex_area: Vec<f64>,
-    /// Per local vertex: `1/area`, per sr.
+    /// Per local vertex of face 0, which every face reads: `1/area`, per sr.
     pub(crate) vertex_inverse_area: Vec<f64>,
     /// The vertices on the faces' borders.
     pub(crate) seam_vertices: Vec<SeamVertex>,
@@ -299,6 +311,12 @@ impl FaceRows {
     /// # Panics
     /// If an edge is not on a side of its cells, or the orientations disagree.
     pub(crate) fn new(grid: &CubeSphere) -> Self {
+        Self::with_constant_faces(grid, 1)
+    }
+
+    /// [`Self::new`], with the grid's constants for the first `faces` faces (one is all
+    /// the passes read; the tests take six to compare them).
+    fn with_constant_faces(grid: &CubeSphere, faces: usize) -> Self {
         let n = grid.face_size();
         let mut rows = Self {
             n,
@@ -364,7 +382,11 @@ impl FaceRows {
             .collect();
         let ea = grid.edge_arrays();
         let local = |a: &[f64]| rows.edge.iter().map(|&e| a[e as usize]).collect();
-        rows.dual_length = local(&ea.dual_length);
+        let face_edges = &rows.edge[..faces * rows.edges_per_face()];
+        rows.dual_length = face_edges
+            .iter()
+            .map(|&e| ea.dual_length[e as usize])
+            .collect();
         rows.length = local(&ea.length);
         rows.inverse_length = local(&ea.inverse_length);
         rows.inverse_dual_length = local(&ea.inverse_dual_length);
@@ -384,10 +406,10 @@ impl FaceRows {
                 }
             }
         }
-        let areas = grid.vertex_areas_sr();
-        rows.vertex_area = rows.vertex.iter().map(|&v| areas[v as usize]).collect();
-        let inverse = grid.inverse_vertex_areas_per_sr();
-        rows.vertex_inverse_area = rows.vertex.iter().map(|&v| inverse[v as usize]).collect();
+        let face_vertices = &rows.vertex[..faces * rows.vertices_per_face()];
+        let at = |a: &[f64]| face_vertices.iter().map(|&v| a[v as usize]).collect();
+        rows.vertex_area = at(grid.vertex_areas_sr());
+        rows.vertex_inverse_area = at(grid.inverse_vertex_areas_per_sr());
         rows.border_edges = border_edges(&rows);
         rows.cell_halo = cell_halo(&rows);
         rows.seam_vertices = seam_vertices(&rows, grid);
@@ -404,7 +426,8 @@ impl FaceRows {
 
     /// The circulation `Σ ±u d` about every local vertex of the local edge velocities
     /// `u`, each then finished by `finish(circulation, scale)` with the vertex's entry of
-    /// `scale` (a per-local-vertex array), into `out`.
+    /// `scale` (per local vertex of face 0, which every face reads, as it does
+    /// [`Self::dual_length`]), into `out`.
     ///
     /// About an inner vertex `(i, j)` the grid's edge order is X-edge `(i, j − 1)`,
     /// Y-edges `(i − 1, j)` and `(i, j)`, X-edge `(i, j)`: the first and third run into
@@ -442,16 +465,18 @@ impl FaceRows {
         finish: impl Fn(f64, f64) -> f64,
     ) {
         let (n, d) = (self.n, &self.dual_length);
-        let below = self.x_edge(f, 0, j - 1)..self.x_edge(f, n, j - 1);
-        let left = self.y_edge(f, 0, j) - 1..self.y_edge(f, n - 1, j);
-        let right = self.y_edge(f, 0, j)..self.y_edge(f, n, j);
-        let above = self.x_edge(f, 0, j)..self.x_edge(f, n, j);
+        // The rows of face 0's constants ([`FaceRows`]), and of face `f`'s velocities.
+        let below = self.x_edge(0, 0, j - 1)..self.x_edge(0, n, j - 1);
+        let left = self.y_edge(0, 0, j) - 1..self.y_edge(0, n - 1, j);
+        let right = self.y_edge(0, 0, j)..self.y_edge(0, n, j);
+        let above = self.x_edge(0, 0, j)..self.x_edge(0, n, j);
+        let u = &u[f * self.edges_per_face()..];
         let (ub, db) = (&u[below.clone()], &d[below]);
         let (ul, dl) = (&u[left.clone()], &d[left]);
         let (ur, dr) = (&u[right.clone()], &d[right]);
         let (ua, da) = (&u[above.clone()], &d[above]);
-        let start = self.vertex_at(f, 0, j);
-        let row = &mut out[start..start + n];
+        let start = self.vertex_at(0, 0, j);
+        let row = &mut out[f * self.vertices_per_face() + start..][..n];
         let scale = &scale[start..start + n];
         for i in 0..n {
             let z = 0.0 - ub[i] * db[i] + ul[i] * dl[i] - ur[i] * dr[i] + ua[i] * da[i];
@@ -459,7 +484,8 @@ impl FaceRows {
         }
     }
 
-    /// [`Self::circulation`] of the vertices on the faces' borders, into each copy.
+    /// [`Self::circulation`] of the vertices on the faces' borders, into each copy: one
+    /// value, finished with the scale of its first copy's place in face 0.
     #[inline(always)]
     pub(crate) fn seam_circulation(
         &self,
@@ -468,6 +494,7 @@ impl FaceRows {
         scale: &[f64],
         finish: impl Fn(f64, f64) -> f64,
     ) {
+        let scale_of = |v: &SeamVertex| scale[v.face_0_copy as usize];
         for v in &self.seam_vertices {
             // All but the cube's corners have four edges and two copies: written out (the
             // same sum), where the loops over the counts cost half again as much.
@@ -479,7 +506,7 @@ impl FaceRows {
                     u[k2 as usize] * w2,
                 ];
                 let z = 0.0 + t[0] + t[1] + t[2] + u[k3 as usize] * w3;
-                let z = finish(z, scale[v.copies[0] as usize]);
+                let z = finish(z, scale_of(v));
                 (out[v.copies[0] as usize], out[v.copies[1] as usize]) = (z, z);
                 continue;
             }
@@ -487,7 +514,7 @@ impl FaceRows {
             for &(k, w) in &v.edges[..usize::from(v.edge_count)] {
                 z += u[k as usize] * w;
             }
-            let z = finish(z, scale[v.copies[0] as usize]);
+            let z = finish(z, scale_of(v));
             for &k in &v.copies[..usize::from(v.copy_count)] {
                 out[k as usize] = z;
             }
@@ -566,6 +593,7 @@ fn seam_vertices(rows: &FaceRows, grid: &CubeSphere) -> Vec<SeamVertex> {
                         edge_count: ring.len() as u8,
                         copies: [0; 3],
                         copy_count: 0,
+                        face_0_copy: rows.vertex_at(0, i, j) as u32,
                     });
                 }
                 let s = &mut seams[index[v]];
@@ -659,8 +687,10 @@ mod tests {
     }
 
     /// The rows' circulation is the grid-numbered scatter's: bit for bit about every
-    /// vertex whose edges the grid numbers in the order the rows sum them (all, as the
-    /// grid numbers them now), to rounding about any other.
+    /// vertex of face 0 inside it whose edges the grid numbers in the order the rows sum
+    /// them (all, as the grid numbers them now), to rounding about any other (the other
+    /// faces read face 0's dual lengths and areas, and a seam vertex its first copy's
+    /// place in face 0's).
     #[test]
     fn the_rows_circulation_is_the_scattered_one() {
         for n in [1, 2, 5, 16] {
@@ -690,7 +720,7 @@ mod tests {
                         let k = rows.vertex_at(f, i, j);
                         let v = rows.vertex[k] as usize;
                         let (z, w) = (got[k], want[v]);
-                        if rows.on_border(i, j) || in_grid_order(&rows, f, i, j) {
+                        if f == 0 && !rows.on_border(i, j) && in_grid_order(&rows, f, i, j) {
                             assert_eq!(z.to_bits(), w.to_bits(), "n {n}: vertex {k}: {z} vs {w}");
                         } else {
                             let tolerance = 1e-14 * scale[v] / (g.vertex_areas_sr()[v] * 0.3);
@@ -700,5 +730,51 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Every face's own constants (at its own local indices) against face 0's, which
+    /// every face reads: within `1e-14` of the largest, at n = 1, 5, 16, 64.
+    #[test]
+    fn every_faces_constants_are_face_0s() {
+        for n in [1, 5, 16, 64] {
+            let grid = CubeSphere::new(n);
+            let (one, six) = (
+                FaceRows::new(&grid),
+                FaceRows::with_constant_faces(&grid, 6),
+            );
+            let arrays = [
+                ("dual length", &one.dual_length, &six.dual_length),
+                ("vertex area", &one.vertex_area, &six.vertex_area),
+                (
+                    "inverse vertex area",
+                    &one.vertex_inverse_area,
+                    &six.vertex_inverse_area,
+                ),
+            ];
+            for (name, face_0, every) in arrays {
+                assert_each_face_is(face_0, every, &format!("n = {n}, {name}"));
+            }
+        }
+    }
+
+    /// Each of the six faces' values in `every` is `face_0`'s at the same index, within
+    /// `1e-14` of the largest.
+    fn assert_each_face_is(face_0: &[f64], every: &[f64], what: &str) {
+        assert_eq!(every.len(), 6 * face_0.len(), "{what}: not six faces");
+        let largest = face_0.iter().fold(0.0, |m: f64, x| m.max(x.abs()));
+        assert!(largest > 0.0, "{what}: all zero");
+        let mut worst = 0.0_f64;
+        for (k, (a, b)) in face_0.iter().cycle().zip(every).enumerate() {
+            let off = (a - b).abs() / largest;
+            worst = worst.max(off);
+            assert!(
+                off <= 1e-14,
+                "{what}, face {}, index {}: {b} against face 0's {a} (off by {off:e} of the \
+                 largest)",
+                k / face_0.len(),
+                k % face_0.len()
+            );
+        }
+        eprintln!("{what}: every face within {worst:.1e} of the largest of face 0's");
     }
 }
