@@ -90,12 +90,16 @@ pub(crate) struct IrregularCell {
 /// upper vertex), a Y-edge's towards `+s` (its tail the left vertex): the faces' `(s, t)`
 /// are left-handed seen from outside.
 ///
-/// The grid's constants the passes read (the dual lengths, the vertices' areas) are face
-/// 0's only, which every face reads at its own local index: the six faces are congruent
-/// under the cube's rotations and each face's rows are in its own frame, so every face's
+/// The grid's constants the passes read (the lengths, the vertices' areas) are face 0's
+/// only, which every face reads at its own local index: the six faces are congruent under
+/// the cube's rotations and each face's rows are in its own frame, so every face's
 /// constants are face 0's to rounding (within 1e-14 of the largest:
 /// `tests::every_faces_constants_are_face_0s`). Six faces' were streamed from beyond the
-/// core's 1 MB L2 in every pass at n = 64; one face's stay in it from face to face.
+/// core's 1 MB L2 in every pass at n = 64; one face's stay in it from face to face. A
+/// border edge's two copies sit at two places on face 0's border, which the face's own
+/// symmetries (quarter turns, mirrors) map onto each other: each such class of places
+/// shares one value ([`share_border_values`]), so the copies read the same bits and stay
+/// negations or equals of each other through the viscous stages.
 #[derive(Clone, Debug)]
 pub(crate) struct FaceRows {
     pub(crate) n: usize,
@@ -109,11 +113,11 @@ pub(crate) struct FaceRows {
     /// Per local edge of face 0, which every face reads ([`FaceRows`] says why): the arc
     /// between its cells' centres, rad.
     pub(crate) dual_length: Vec<f64>,
-    /// Per local edge: its arc length, rad.
+    /// Per local edge of face 0, which every face reads: its arc length, rad.
     pub(crate) length: Vec<f64>,
-    /// Per local edge: `1/length`, per rad.
+    /// Per local edge of face 0, which every face reads: `1/length`, per rad.
     pub(crate) inverse_length: Vec<f64>,
-    /// Per local edge: `1/dual_length`, per rad.
+    /// Per local edge of face 0, which every face reads: `1/dual_length`, per rad.
     pub(crate) inverse_dual_length: Vec<f64>,
     /// Per local vertex: the grid's vertex.
     pub(crate) vertex: Vec<u32>,
@@ -311,7 +315,17 @@ impl FaceRows {
     /// # Panics
     /// If an edge is not on a side of its cells, or the orientations disagree.
     pub(crate) fn new(grid: &CubeSphere) -> Self {
-        Self::with_constant_faces(grid, 1)
+        let mut rows = Self::with_constant_faces(grid, 1);
+        let n = rows.n;
+        for values in [
+            &mut rows.dual_length,
+            &mut rows.length,
+            &mut rows.inverse_length,
+            &mut rows.inverse_dual_length,
+        ] {
+            share_border_values(n, values);
+        }
+        rows
     }
 
     /// [`Self::new`], with the grid's constants for the first `faces` faces (one is all
@@ -381,12 +395,9 @@ impl FaceRows {
             .map(|&f| if f { -1.0 } else { 1.0 })
             .collect();
         let ea = grid.edge_arrays();
-        let local = |a: &[f64]| rows.edge.iter().map(|&e| a[e as usize]).collect();
         let face_edges = &rows.edge[..faces * rows.edges_per_face()];
-        rows.dual_length = face_edges
-            .iter()
-            .map(|&e| ea.dual_length[e as usize])
-            .collect();
+        let local = |a: &[f64]| face_edges.iter().map(|&e| a[e as usize]).collect();
+        rows.dual_length = local(&ea.dual_length);
         rows.length = local(&ea.length);
         rows.inverse_length = local(&ea.inverse_length);
         rows.inverse_dual_length = local(&ea.inverse_dual_length);
@@ -518,6 +529,25 @@ impl FaceRows {
             for &k in &v.copies[..usize::from(v.copy_count)] {
                 out[k as usize] = z;
             }
+        }
+    }
+}
+
+/// `values` (per local edge of face 0) with each edge on the face's border given the
+/// value of its class's place on the left border: the `k`-th edge from either end of any
+/// side is one class under the face's quarter turns and mirrors (the same number to
+/// rounding). A border edge's two copies are in one class: each is as far from either
+/// end of the cube's edge they lie on.
+fn share_border_values(n: usize, values: &mut [f64]) {
+    // Face 0's X-edge (i, y) and Y-edge (x, j), as [`FaceRows::x_edge`] and
+    // [`FaceRows::y_edge`] number them.
+    let x_edge = |i: usize, y: usize| y * (n + 1) + i;
+    let y_edge = |x: usize, j: usize| n * (n + 1) + j * n + x;
+    for k in 0..n {
+        let value = values[x_edge(0, k.min(n - 1 - k))];
+        let places = [x_edge(0, k), x_edge(n, k), y_edge(k, 0), y_edge(k, n)];
+        for place in places {
+            values[place] = value;
         }
     }
 }
@@ -732,8 +762,10 @@ mod tests {
         }
     }
 
-    /// Every face's own constants (at its own local indices) against face 0's, which
-    /// every face reads: within `1e-14` of the largest, at n = 1, 5, 16, 64.
+    /// Every face's own constants (at its own local indices, its border edges' not
+    /// shared) against face 0's, which every face reads (its border edges' shared): within
+    /// `1e-14` of the largest, at n = 1, 5, 16, 64. The viscous step's cells' inverse
+    /// areas too, the grid's.
     #[test]
     fn every_faces_constants_are_face_0s() {
         for n in [1, 5, 16, 64] {
@@ -742,14 +774,23 @@ mod tests {
                 FaceRows::new(&grid),
                 FaceRows::with_constant_faces(&grid, 6),
             );
+            let inverse_areas = grid.inverse_areas_per_sr();
             let arrays = [
-                ("dual length", &one.dual_length, &six.dual_length),
+                ("dual length", &one.dual_length[..], &six.dual_length[..]),
+                ("length", &one.length, &six.length),
+                ("inverse length", &one.inverse_length, &six.inverse_length),
+                (
+                    "inverse dual length",
+                    &one.inverse_dual_length,
+                    &six.inverse_dual_length,
+                ),
                 ("vertex area", &one.vertex_area, &six.vertex_area),
                 (
                     "inverse vertex area",
                     &one.vertex_inverse_area,
                     &six.vertex_inverse_area,
                 ),
+                ("inverse cell area", &inverse_areas[..n * n], inverse_areas),
             ];
             for (name, face_0, every) in arrays {
                 assert_each_face_is(face_0, every, &format!("n = {n}, {name}"));

@@ -66,10 +66,12 @@ impl FilmFlow {
     /// One stage on the rows: `u ← mu·u + nu_prev·stage + dt_s·M(u)` with the stage
     /// before last in `v.stage`, which then holds the `u` this stage started from.
     ///
-    /// Every value is the grid-numbered pass's, in the rows' orientation (module
-    /// `face_rows`): each edge's change is odd in the edge's orientation (a difference
-    /// across it, one along it and its own velocity), so a flipped copy's is the grid's
-    /// negated, exactly.
+    /// Every value is the grid-numbered pass's to rounding (the grid's constants are face
+    /// 0's, [`FaceRows`]), in the rows' orientation (module `face_rows`): each edge's
+    /// change is odd in the edge's orientation (a difference across it, one along it and
+    /// its own velocity), and a border edge's two copies read the same constants, so a
+    /// flipped copy's is the other's negated, exactly
+    /// (`tests::the_stages_keep_a_border_edges_copies_alike`).
     #[inline(always)]
     pub(super) fn viscous_stage(
         &self,
@@ -97,13 +99,13 @@ impl FilmFlow {
             rows.vertices_per_face(),
             rows.padded_cells_per_face(),
         );
-        let (il, id) = (&rows.inverse_length[..], &rows.inverse_dual_length[..]);
+        // Every face reads face 0's metric ([`FaceRows`] says why).
+        let metric = (&rows.inverse_length[..], &rows.inverse_dual_length[..]);
         let faces = u.chunks_exact_mut(epf).zip(v.stage.chunks_exact_mut(epf));
-        let metric = il.chunks_exact(epf).zip(id.chunks_exact(epf));
         let fields = vorticity
             .chunks_exact(vpf)
             .zip(divergence.chunks_exact(cpf));
-        for ((u, stage), (metric, fields)) in faces.zip(metric.zip(fields)) {
+        for ((u, stage), fields) in faces.zip(fields) {
             blend.face(n, u, stage, metric, fields);
         }
     }
@@ -136,9 +138,9 @@ impl Blend {
         *y_prev = y;
     }
 
-    /// One face's edges (`u`, `y_prev` and the metric `[1/length, 1/dual length]` its
-    /// local edges, `fields` its vertices' vorticities and its padded cells'
-    /// divergences), row by row. Every row of edges whole, the faces' borders' too: their
+    /// One face's edges (`u` and `y_prev` its local edges, the metric
+    /// `[1/length, 1/dual length]` face 0's, `fields` its vertices' vorticities and its
+    /// padded cells' divergences), row by row. Every row of edges whole, the faces' borders' too: their
     /// cells across the border are in the divergence's halo. The rows come from chunk
     /// iterators over the face, where slicing each from the whole arrays cost bounds
     /// checks and reloads of every base each row.
@@ -217,11 +219,13 @@ fn vorticity_and_divergence(grid: &CubeSphere, rows: &FaceRows, u: &[f64], v: &m
     let n = rows.n;
     let divergence = &mut v.divergence;
     divergence.resize(6 * rows.padded_cells_per_face(), 0.0);
-    let (l, ia) = (&rows.length[..], grid.inverse_areas_per_sr());
+    // Face 0's lengths and cells' inverse areas, which every face reads ([`FaceRows`]
+    // says why; `face_rows::tests::every_faces_constants_are_face_0s` checks the areas
+    // too).
+    let (l, ia) = (&rows.length[..], &grid.inverse_areas_per_sr()[..n * n]);
     let (epf, cpf) = (rows.edges_per_face(), rows.padded_cells_per_face());
-    let faces = u.chunks_exact(epf).zip(l.chunks_exact(epf));
-    let cells = ia.chunks_exact(n * n).zip(divergence.chunks_exact_mut(cpf));
-    for ((u, l), (ia, out)) in faces.zip(cells) {
+    let faces = u.chunks_exact(epf).zip(divergence.chunks_exact_mut(cpf));
+    for (u, out) in faces {
         divergence_face(n, u, l, ia, out);
     }
     for &[slot, across] in &rows.cell_halo {
@@ -230,7 +234,7 @@ fn vorticity_and_divergence(grid: &CubeSphere, rows: &FaceRows, u: &[f64], v: &m
 }
 
 /// One face's divergences into its padded cells `out` (the halo left as it is), from
-/// its local edges' velocities `u` and lengths `l` and its cells' inverse areas `ia`, row
+/// its local edges' velocities `u`, and face 0's lengths `l` and cells' inverse areas `ia`, row
 /// by row from chunk iterators over the face (slicing each row from the whole arrays cost
 /// bounds checks and reloads of every base each row).
 #[inline(always)]
@@ -335,6 +339,40 @@ mod tests {
         let metric = ea.length.iter().zip(&ea.dual_length);
         let per_edge = f.u_m_per_s.iter().zip(metric);
         per_edge.map(|(u, (l, d))| u * u * l * d).sum()
+    }
+
+    /// The stages keep each edge on the faces' borders the same in both its copies (its
+    /// value, or its negation, bit for bit): they read the same shared constants
+    /// ([`FaceRows`](super::super::face_rows::FaceRows)). A rough field, at n = 5 and 32.
+    #[test]
+    fn the_stages_keep_a_border_edges_copies_alike() {
+        for n in [5, 32] {
+            let grid = Arc::new(CubeSphere::new(n));
+            let hierarchy = Arc::new(Hierarchy::new(&grid));
+            let p = FlowParams {
+                viscosity_pa_s: 0.5,
+                ..FlowParams::water_film(0.01)
+            };
+            let f = FilmFlow::new(grid.clone(), hierarchy, p, |_| 1e-6);
+            let rough: Vec<f64> = (0..grid.edges().len())
+                .map(|e| ((e * 7919) % 1000) as f64 * 1e-6 - 4e-4)
+                .collect();
+            let (mut u, mut start) = (Vec::new(), Vec::new());
+            f.rows.to_rows(&rough, &mut u);
+            f.rows.to_rows(&rough, &mut start);
+            let nu = p.viscosity_pa_s / p.density_kg_per_m3;
+            f.viscous_step(&mut u, &mut ViscousScratch::default(), nu, 0.05);
+            assert_ne!(u, start, "n {n}: nothing moved");
+            for e in &f.rows.seam_edges {
+                let [a, b] = e.cells.map(|(_, _, k)| k as usize);
+                let (ua, ub) = (u[a] * f.rows.sign(a), u[b] * f.rows.sign(b));
+                assert_eq!(
+                    ua.to_bits(),
+                    ub.to_bits(),
+                    "n {n}: copies {a}, {b}: {ua} vs {ub}"
+                );
+            }
+        }
     }
 
     /// A smooth vortex (l = 2) taken in one step of 10 stages (55 forward-Euler sub-steps'
