@@ -17,8 +17,8 @@
 //! one by one from lists in the grid's order ([`FaceRows::seam_vertices`],
 //! [`FaceRows::irregular_cells`]). So each value is the same sum in the same order as a
 //! pass over the grid's numbering takes it; the grid's constants in it are face 0's,
-//! which every face reads ([`FaceRows`] says why), so the rows give its bits on face 0
-//! and to rounding on the others. (A renumbering of the grid's edges would leave the
+//! which every face reads ([`FaceRows`] says why), so the rows give its bits inside
+//! face 0 and to rounding elsewhere. (A renumbering of the grid's edges would leave the
 //! rows' sums as they are, mathematically the same.) The exceptions: the advection's
 //! cell terms and the viscous step's divergences, which every cell sums in the local
 //! order, those irregular cells too (`advect::AdvectionGeometry::coriolis` says why).

@@ -140,10 +140,10 @@ impl Blend {
 
     /// One face's edges (`u` and `y_prev` its local edges, the metric
     /// `[1/length, 1/dual length]` face 0's, `fields` its vertices' vorticities and its
-    /// padded cells' divergences), row by row. Every row of edges whole, the faces' borders' too: their
-    /// cells across the border are in the divergence's halo. The rows come from chunk
-    /// iterators over the face, where slicing each from the whole arrays cost bounds
-    /// checks and reloads of every base each row.
+    /// padded cells' divergences), row by row. Every row of edges whole, the faces'
+    /// borders' too: their cells across the border are in the divergence's halo. The rows
+    /// come from chunk iterators over the face, where slicing each from the whole arrays
+    /// cost bounds checks and reloads of every base each row.
     #[inline(always)]
     fn face(
         self,
@@ -234,9 +234,9 @@ fn vorticity_and_divergence(grid: &CubeSphere, rows: &FaceRows, u: &[f64], v: &m
 }
 
 /// One face's divergences into its padded cells `out` (the halo left as it is), from
-/// its local edges' velocities `u`, and face 0's lengths `l` and cells' inverse areas `ia`, row
-/// by row from chunk iterators over the face (slicing each row from the whole arrays cost
-/// bounds checks and reloads of every base each row).
+/// its local edges' velocities `u`, and face 0's lengths `l` and cells' inverse areas
+/// `ia`, row by row from chunk iterators over the face (slicing each row from the whole
+/// arrays cost bounds checks and reloads of every base each row).
 #[inline(always)]
 fn divergence_face(n: usize, u: &[f64], l: &[f64], ia: &[f64], out: &mut [f64]) {
     let ((ux, uy), (lx, ly)) = (u.split_at(n * (n + 1)), l.split_at(n * (n + 1)));
