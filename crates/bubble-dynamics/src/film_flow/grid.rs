@@ -12,6 +12,7 @@ use std::collections::HashMap;
 use glam::{DMat3, DVec3, IVec3};
 
 use super::compare::larger;
+use super::face_geometry::FaceGeometry;
 use crate::avx2::with_avx2;
 
 /// Major axis, `s` axis and `t` axis of each face (OpenGL cube-map order).
@@ -176,6 +177,8 @@ pub struct CubeSphere {
     inverse_areas_per_sr: Vec<f64>,
     inverse_vertex_areas_per_sr: Vec<f64>,
     to_vertices: VertexInterpolation,
+    /// Face 0's constants, which every face's passes read ([`FaceGeometry`]).
+    face: FaceGeometry,
 }
 
 /// Per grid vertex: the cells around it (three at a cube corner, the first repeated with
@@ -307,7 +310,7 @@ impl CubeSphere {
         let to_vertices = VertexInterpolation::new(&cell_corners, &centres, &vertex_dirs);
         let edge_arrays = EdgeArrays::new(&edges, &centres, &areas_sr, &to_vertices);
         let inverse = |areas: &[f64]| areas.iter().map(|a| 1.0 / a).collect();
-        Self {
+        let mut grid = Self {
             n,
             inverse_areas_per_sr: inverse(&areas_sr),
             inverse_vertex_areas_per_sr: inverse(&vertex_areas_sr),
@@ -318,7 +321,10 @@ impl CubeSphere {
             edge_arrays,
             vertex_areas_sr,
             to_vertices,
-        }
+            face: FaceGeometry::default(),
+        };
+        grid.face = FaceGeometry::new(&grid);
+        grid
     }
 
     /// Each grid vertex's value of the cell field `values`, linear-exact, into `out`.
@@ -378,6 +384,11 @@ impl CubeSphere {
     /// The edges' numbers as compact per-edge arrays.
     pub fn edge_arrays(&self) -> &EdgeArrays {
         &self.edge_arrays
+    }
+
+    /// Face 0's constants, which serve every face ([`FaceGeometry`]).
+    pub(crate) fn face_geometry(&self) -> &FaceGeometry {
+        &self.face
     }
 
     /// The largest `|u|·length/min(area_a, area_b)` over the edges, for edge speeds `u`
@@ -531,6 +542,27 @@ impl FaceLayout {
     pub fn first_seam_edge(self) -> usize {
         12 * self.n * (self.n - 1)
     }
+
+    /// Face `face`'s interior edges, in the order of their places on it
+    /// ([`Self::on_face`]): its x-edges, then its y-edges.
+    pub fn face_edges(self, face: usize) -> impl Iterator<Item = usize> {
+        let m = self.n * (self.n - 1);
+        (face * m..(face + 1) * m).chain(6 * m + face * m..6 * m + (face + 1) * m)
+    }
+
+    /// Interior edge `e`'s face and its place among that face's interior edges: an
+    /// x-edge's place is its number less its face's first x-edge's, a y-edge's that of
+    /// its face's first y-edge plus the face's `n·(n − 1)` x-edges. Edges at one place
+    /// on different faces are the same edge turned by the cube's rotations.
+    pub fn on_face(self, e: usize) -> (usize, usize) {
+        let m = self.n * (self.n - 1);
+        debug_assert!(e < 12 * m, "edge {e} is a seam");
+        if e < 6 * m {
+            (e / m, e % m)
+        } else {
+            ((e - 6 * m) / m, m + (e - 6 * m) % m)
+        }
+    }
 }
 
 fn edge(a: u32, b: u32, (p, q): (u32, u32), centres: &[DVec3], vertices: &[DVec3]) -> GridEdge {
@@ -592,6 +624,26 @@ mod tests {
                 seams
                     .iter()
                     .all(|e| e.a as usize / (n * n) != e.b as usize / (n * n))
+            );
+        }
+    }
+
+    #[test]
+    fn an_interior_edges_place_on_its_face_is_where_face_edges_lists_it() {
+        for n in [1, 2, 5] {
+            let layout = FaceLayout { n };
+            let mut all: Vec<usize> = Vec::new();
+            for face in 0..6 {
+                for (place, e) in layout.face_edges(face).enumerate() {
+                    assert_eq!(layout.on_face(e), (face, place), "n {n} edge {e}");
+                    all.push(e);
+                }
+            }
+            all.sort_unstable();
+            assert_eq!(
+                all,
+                (0..layout.first_seam_edge()).collect::<Vec<_>>(),
+                "n {n}"
             );
         }
     }

@@ -10,9 +10,10 @@
 use glam::DVec3;
 
 use super::compare::{larger, largest};
+use super::face_geometry::FaceGeometry;
 use super::flow::{FilmFlow, Scratch};
 use super::fluxes::apply_limited;
-use super::grid::{EdgeArrays, dot_at};
+use super::grid::dot_at;
 use super::sides::{EdgeBlock, SeamEnds};
 use super::upwind;
 use crate::avx2::with_avx2;
@@ -54,7 +55,7 @@ impl FilmFlow {
         g_eff: DVec3,
         dt_s: f64,
     ) -> f64 {
-        let ea = self.grid.edge_arrays();
+        let fg = self.grid.face_geometry();
         let (h, u) = (&self.h_m, &self.u_m_per_s);
         // Every entry is written below: the buffers need their lengths, not a fill.
         drain_rate.resize(u.len(), 0.0);
@@ -64,14 +65,14 @@ impl FilmFlow {
             #[inline(always)]
             |run| {
                 let (ha, hb) = run.ends(h);
-                courant_block(run, [ha, hb], (ea, u), drain, (drain_rate, speed));
+                courant_block(run, [ha, hb], (fg, u), drain, (drain_rate, speed));
             },
         );
         let seams = self.sides.seams();
         let ends = seam_ends.gather(seams, h);
         with_avx2(
             #[inline(always)]
-            || courant_block(seams, ends, (ea, u), drain, (drain_rate, speed)),
+            || courant_block(seams, ends, (fg, u), drain, (drain_rate, speed)),
         );
         // The speeds' maximum in a pass of its own: taken in the loop above, the
         // compiler vectorised neither.
@@ -96,9 +97,9 @@ impl FilmFlow {
                     drain_rate: &s.drain_rate,
                     dt_per_r,
                 };
-                let ea = self.grid.edge_arrays();
+                let fg = self.grid.face_geometry();
                 let volume = (&mut s.edge2, &mut s.seam_ends);
-                upwind::volumes(sides, ea, &self.h_m, &s.limited_rise, speeds, volume);
+                upwind::volumes(sides, fg, &self.h_m, &s.limited_rise, speeds, volume);
                 let (areas, per_area) = (self.grid.areas_sr(), self.grid.inverse_areas_per_sr());
                 let (volume, h) = (&s.edge2, &mut self.h_m);
                 apply_limited(sides, areas, per_area, volume, 1.0, h, &mut s.gather);
@@ -109,23 +110,22 @@ impl FilmFlow {
 
 /// [`FilmFlow::drain_rates_and_courant`]'s pass over a block of edges with thicknesses
 /// `[ha, hb]` at their ends: the drainage coefficients into `c`, the edges' speeds into
-/// `speed`.
+/// `speed` (the normals in the block's frame, gravity taken into it: [`EdgeBlock::frame`]).
 #[inline(always)]
 fn courant_block(
     block: impl EdgeBlock,
     [ha, hb]: [&[f64]; 2],
-    (ea, u): (&EdgeArrays, &[f64]),
+    (fg, u): (&FaceGeometry, &[f64]),
     (drain, g_eff): (f64, DVec3),
     (c, speed): (&mut [f64], &mut [f64]),
 ) {
     let len = block.count();
     let (ha, hb, u) = (&ha[..len], &hb[..len], block.values(u));
-    let per_area = block.values(&ea.length_per_smaller_area);
-    let [nx, ny, nz] = &ea.normal_xyz;
-    let normal = [block.values(nx), block.values(ny), block.values(nz)];
+    let per_area = block.constant(&fg.length_per_smaller_area);
+    let (normal, g) = (block.vector(&fg.normal), block.frame(g_eff));
     let (c, speed) = (block.values_mut(c), block.values_mut(speed));
     for i in 0..len {
-        c[i] = drain * dot_at(g_eff, normal, i);
+        c[i] = drain * dot_at(g, normal, i);
         speed[i] = edge_speed(u[i], c[i], ha[i], hb[i], per_area[i]);
     }
 }

@@ -11,7 +11,8 @@
 //!    within its budget, and each cell's gathered volumes.
 
 use super::compare::{larger, smaller};
-use super::grid::{CubeSphere, EdgeArrays};
+use super::face_geometry::FaceGeometry;
+use super::grid::CubeSphere;
 use super::sides::{CellSides, EdgeBlock, SeamEnds};
 
 /// The transport's weights, fixed by the grid.
@@ -255,22 +256,22 @@ fn edge_volume([ha, hb]: [f64; 2], [ra, rb]: [f64; 2], [u, c, l]: [f64; 3], dt_p
 #[inline(always)]
 pub(crate) fn volumes(
     sides: &CellSides,
-    ea: &EdgeArrays,
+    fg: &FaceGeometry,
     h: &[f64],
     rise: &[Vec<f64>; 4],
     speeds: EdgeSpeeds,
     (volume, seam_ends): (&mut Vec<f64>, &mut SeamEnds),
 ) {
-    volume.resize(ea.cells.len(), 0.0);
+    volume.resize(speeds.u.len(), 0.0);
     for run in &sides.edge_runs {
         let [ka, kb] = run.sides;
         let (ra, rb) = (&rise[ka][run.a_cells()], &rise[kb][run.b_cells()]);
         let (ha, hb) = run.ends(h);
-        volumes_block(*run, [ha, hb], [ra, rb], (ea, speeds), volume);
+        volumes_block(*run, [ha, hb], [ra, rb], (fg, speeds), volume);
     }
     let seams = sides.seams();
     let [h_ends, rises] = seam_ends.gather_with_sides(seams, h, rise);
-    volumes_block(seams, h_ends, rises, (ea, speeds), volume);
+    volumes_block(seams, h_ends, rises, (fg, speeds), volume);
 }
 
 /// [`volumes`] over a block of edges, with their ends' thicknesses and rises.
@@ -279,12 +280,12 @@ fn volumes_block(
     block: impl EdgeBlock,
     [ha, hb]: [&[f64]; 2],
     [ra, rb]: [&[f64]; 2],
-    (ea, speeds): (&EdgeArrays, EdgeSpeeds),
+    (fg, speeds): (&FaceGeometry, EdgeSpeeds),
     volume: &mut [f64],
 ) {
     let len = block.count();
     let (u, c) = (block.values(speeds.u), block.values(speeds.drain_rate));
-    let (l, out) = (block.values(&ea.length), block.values_mut(volume));
+    let (l, out) = (block.constant(&fg.length), block.values_mut(volume));
     let (ha, hb, ra, rb) = (&ha[..len], &hb[..len], &ra[..len], &rb[..len]);
     for i in 0..len {
         let speed = [u[i], c[i], l[i]];
