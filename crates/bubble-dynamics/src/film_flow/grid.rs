@@ -48,7 +48,9 @@ pub struct GridEdge {
 
 /// The edges' numbers the film step reads every step, as compact arrays (struct of
 /// arrays, index = edge index): a pass over the edges then streams the 8–24 bytes it uses
-/// an edge instead of the 80 of a whole [`GridEdge`]. Derived once from the edges.
+/// an edge instead of the 80 of a whole [`GridEdge`]. Derived once from the edges. The
+/// passes over the edges inside the faces read face 0's share of the ones they use, which
+/// serves every face (module `face_geometry`); the seams and the other passes read these.
 #[derive(Clone, Debug, Default)]
 pub struct EdgeArrays {
     /// `[a, b]`: the cells the edge's normal points from and into.
@@ -85,13 +87,6 @@ pub struct EdgeArrays {
     pub centre_normal_gradient: Vec<DVec3>,
     /// Unit tangent normal to the edge at its midpoint, from `a` towards `b`.
     pub normal: Vec<DVec3>,
-    /// [`Self::normal`]'s x, y and z as arrays of their own, for the edge-run passes (a
-    /// pass that reads them as vectors cannot vectorise).
-    pub normal_xyz: [Vec<f64>; 3],
-    /// [`Self::centre_gradient`]'s components, likewise.
-    pub centre_gradient_xyz: [Vec<f64>; 3],
-    /// [`Self::centre_normal_gradient`]'s components, likewise.
-    pub centre_normal_gradient_xyz: [Vec<f64>; 3],
     /// `midpoint − centre_a` and `midpoint − centre_b`: how far a cell's value is carried
     /// to the edge by its gradient.
     pub reach: Vec<[DVec3; 2]>,
@@ -108,7 +103,7 @@ impl EdgeArrays {
         let smaller_area = |e: &GridEdge| areas_sr[e.a as usize].min(areas_sr[e.b as usize]);
         let skew: Vec<[f64; 2]> = edges.iter().map(|e| skew_weights(e, centres)).collect();
         let at_vertex = |v: u32| to_vertices.apply_vec(v as usize, centres);
-        let mut arrays = Self {
+        Self {
             inverse_normal_dual_length: skew.iter().map(|w| w[0]).collect(),
             cross_per_length: skew.iter().map(|w| w[1]).collect(),
             length_per_smaller_area: edges.iter().map(|e| e.length / smaller_area(e)).collect(),
@@ -135,14 +130,7 @@ impl EdgeArrays {
                 .iter()
                 .map(|e| [e.midpoint - centre(e.a), e.midpoint - centre(e.b)])
                 .collect(),
-            normal_xyz: Default::default(),
-            centre_gradient_xyz: Default::default(),
-            centre_normal_gradient_xyz: Default::default(),
-        };
-        arrays.normal_xyz = components(&arrays.normal);
-        arrays.centre_gradient_xyz = components(&arrays.centre_gradient);
-        arrays.centre_normal_gradient_xyz = components(&arrays.centre_normal_gradient);
-        arrays
+        }
     }
 }
 
