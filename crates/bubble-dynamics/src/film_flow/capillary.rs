@@ -178,8 +178,7 @@ fn substep(
         || volumes.block(seams, [ha, hb, la, lb], &mut s.flux),
     );
     // Each donor gives at most half its content: h stays ≥ 0.
-    let (areas, per_area) = (grid.areas_sr(), grid.inverse_areas_per_sr());
-    apply_limited(sides, areas, per_area, &s.flux, 1.0, h_m, &mut s.gather);
+    apply_limited(sides, grid, &s.flux, 1.0, h_m, &mut s.gather);
 }
 
 /// `(h_a − h_b) l/d` over a block of edges with thicknesses `[ha, hb]` at their ends,

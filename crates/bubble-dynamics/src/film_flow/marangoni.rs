@@ -82,20 +82,11 @@ impl FilmFlow {
         let sub_dt_per_r = dt_per_r / f64::from(substeps);
         s.edge2.resize(s.u_start.len(), 0.0);
         let sides = &self.sides;
-        let (areas, per_area) = (g.areas_sr(), g.inverse_areas_per_sr());
         for _ in 0..substeps {
             let fields = (&self.gamma[..], &s.u_start[..]);
             upwind_fluxes(sides, fg, fields, (&mut s.edge2, &mut s.seam_ends));
             let (flux, gamma) = (&s.edge2, &mut self.gamma);
-            apply_limited(
-                sides,
-                areas,
-                per_area,
-                flux,
-                sub_dt_per_r,
-                gamma,
-                &mut s.gather,
-            );
+            apply_limited(sides, &g, flux, sub_dt_per_r, gamma, &mut s.gather);
         }
     }
 
@@ -366,9 +357,8 @@ impl FilmFlow {
         change.extend(self.u_m_per_s.iter().zip(&s.u_start).map(|(u, u0)| u - u0));
         let out = (&mut s.edge2[..], &mut s.seam_ends);
         upwind_fluxes(sides, fg, (&self.gamma, change), out);
-        let (areas, per_area) = (g.areas_sr(), g.inverse_areas_per_sr());
         let (flux, gamma) = (&s.edge2, &mut self.gamma);
-        apply_limited(sides, areas, per_area, flux, scale, gamma, &mut s.gather);
+        apply_limited(sides, &g, flux, scale, gamma, &mut s.gather);
     }
 }
 

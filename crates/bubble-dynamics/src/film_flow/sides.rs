@@ -255,6 +255,11 @@ struct RimTables {
     edge: [Vec<u32>; 4],
     /// Per side: the sign of a volume across it in the cell's inflow.
     inflow: [Vec<f64>; 4],
+    /// Each rim cell's area, sr: a table in the rim's order instead of a gather from
+    /// the grid's, which touched a cache line a cell down the faces' sides.
+    area: Vec<f64>,
+    /// Each rim cell's inverse area, per sr.
+    inverse_area: Vec<f64>,
 }
 
 /// [`RimTables`] as slices of one length, so that a pass indexes them without checks.
@@ -268,6 +273,10 @@ pub(crate) struct Rim<'a> {
     edge: [&'a [u32]; 4],
     /// Per side: the sign of a volume across it in the cell's inflow.
     inflow: [&'a [f64]; 4],
+    /// Each rim cell's area, sr.
+    pub(crate) area: &'a [f64],
+    /// Each rim cell's inverse area, per sr.
+    pub(crate) inverse_area: &'a [f64],
 }
 
 impl Rim<'_> {
@@ -508,7 +517,7 @@ impl CellSides {
             seam_tables: seams,
         };
         (sides.cell_runs, sides.rim_cells) = sides.find_cell_runs();
-        sides.rim_tables = sides.rim_tables();
+        sides.rim_tables = sides.rim_tables(grid);
         sides.edge_runs = face_edge_runs(grid);
         sides
     }
@@ -538,9 +547,10 @@ impl CellSides {
         (runs, rim)
     }
 
-    /// The rim cells' tables side by side ([`RimTables`]).
-    fn rim_tables(&self) -> RimTables {
+    /// The rim cells' tables side by side ([`RimTables`]), their areas from `grid`.
+    fn rim_tables(&self, grid: &CubeSphere) -> RimTables {
         let rim = &self.rim_cells;
+        let at_rim = |cells: &[f64]| rim.iter().map(|&c| cells[c as usize]).collect();
         let side = |table: &[[u32; 4]], k: usize| -> Vec<u32> {
             rim.iter().map(|&c| table[c as usize][k]).collect()
         };
@@ -550,6 +560,8 @@ impl CellSides {
             inflow: std::array::from_fn(|k| {
                 rim.iter().map(|&c| self.inflow(c as usize)[k]).collect()
             }),
+            area: at_rim(grid.areas_sr()),
+            inverse_area: at_rim(grid.inverse_areas_per_sr()),
         }
     }
 
@@ -565,6 +577,8 @@ impl CellSides {
             neighbour: [&n0[..m], &n1[..m], &n2[..m], &n3[..m]],
             edge: [&e0[..m], &e1[..m], &e2[..m], &e3[..m]],
             inflow: [&s0[..m], &s1[..m], &s2[..m], &s3[..m]],
+            area: &t.area[..m],
+            inverse_area: &t.inverse_area[..m],
         }
     }
 

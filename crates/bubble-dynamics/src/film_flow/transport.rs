@@ -100,9 +100,8 @@ impl FilmFlow {
                 let fg = self.grid.face_geometry();
                 let volume = (&mut s.edge2, &mut s.seam_ends);
                 upwind::volumes(sides, fg, &self.h_m, &s.limited_rise, speeds, volume);
-                let (areas, per_area) = (self.grid.areas_sr(), self.grid.inverse_areas_per_sr());
                 let (volume, h) = (&s.edge2, &mut self.h_m);
-                apply_limited(sides, areas, per_area, volume, 1.0, h, &mut s.gather);
+                apply_limited(sides, &self.grid, volume, 1.0, h, &mut s.gather);
             },
         )
     }
