@@ -145,8 +145,12 @@ fn substep(
     );
     net_inflow(sides, &s.flux, &mut s.laplacian, &mut s.gather);
     let per_r2 = 1.0 / (radius_m * radius_m);
-    for (lap, per_area) in s.laplacian.iter_mut().zip(grid.inverse_areas_per_sr()) {
-        *lap *= per_area * per_r2;
+    // A face at a time, each with face 0's inverse areas (the same on every face).
+    let per_area = &fg.inverse_area_per_sr;
+    for face in s.laplacian.chunks_exact_mut(per_area.len()) {
+        for (lap, per_area) in face.iter_mut().zip(per_area) {
+            *lap *= per_area * per_r2;
+        }
     }
     // Volume from a to b over the sub-step, per R² (m·sr): the flux runs down the
     // pressure −(σ/2)∇²h, i.e. up the gradient of ∇²h (the ½σ is in the mobility), so

@@ -380,26 +380,28 @@ impl CubeSphere {
     }
 
     /// The largest `|u|·length/min(area_a, area_b)` over the edges, for edge speeds `u`
-    /// (m/s): times a step over the radius, the largest fraction of a cell any edge
-    /// carries (a Courant number).
+    /// (m/s, one an edge): times a step over the radius, the largest fraction of a cell
+    /// any edge carries (a Courant number). Each face's x-edges and y-edges read face 0's
+    /// `length/min(area)` (the same on every face, [`FaceGeometry`]), the seams their own.
     pub fn fastest_crossing(&self, u_m_per_s: &[f64]) -> f64 {
-        let per_area = &self.edge_arrays.length_per_smaller_area;
-        let n = u_m_per_s.len().min(per_area.len());
-        let (u, per_area) = (&u_m_per_s[..n], &per_area[..n]);
-        // Four running maxima in chunks of four, which vectorise (a maximum is exact in
-        // any order; NaN skipped, as `f64::max` does).
+        let layout = self.layout();
+        let per_area = &self.face.length_per_smaller_area;
+        let m = layout.n * (layout.n - 1);
+        let (x_edges, y_edges) = per_area.face.split_at(m);
+        let seams = layout.first_seam_edge();
+        // Plain loops: through iterator adaptors the blocks' loop left the AVX2 function
+        // and took twice the instructions.
         with_avx2(
             #[inline(always)]
             || {
-                let mut lanes = [0.0; 4];
-                for (u, a) in u.chunks_exact(4).zip(per_area.chunks_exact(4)) {
-                    for k in 0..4 {
-                        lanes[k] = larger(u[k].abs() * a[k], lanes[k]);
-                    }
+                let u = u_m_per_s;
+                let mut fastest = fastest_of(&u[seams..], &per_area.seams);
+                for f in 0..6 {
+                    let x = fastest_of(&u[f * m..], x_edges);
+                    let y = fastest_of(&u[(6 + f) * m..], y_edges);
+                    fastest = larger(larger(x, y), fastest);
                 }
-                let rest = (n / 4 * 4..n).map(|i| u[i].abs() * per_area[i]);
-                let fastest = rest.fold(0.0, |a, b| larger(b, a));
-                lanes.into_iter().fold(fastest, |a, b| larger(b, a))
+                fastest
             },
         )
     }
@@ -418,6 +420,24 @@ impl CubeSphere {
     pub fn inverse_vertex_areas_per_sr(&self) -> &[f64] {
         &self.inverse_vertex_areas_per_sr
     }
+}
+
+/// The largest `|u[i]|·per_area[i]` over `per_area`'s length, in four running maxima in
+/// chunks of four, which vectorise (a maximum is exact in any order; NaN skipped, as
+/// `f64::max` does).
+#[inline(always)]
+fn fastest_of(u: &[f64], per_area: &[f64]) -> f64 {
+    let n = per_area.len();
+    let u = &u[..n];
+    let mut lanes = [0.0; 4];
+    for (u, a) in u.chunks_exact(4).zip(per_area.chunks_exact(4)) {
+        for k in 0..4 {
+            lanes[k] = larger(u[k].abs() * a[k], lanes[k]);
+        }
+    }
+    let rest = (n / 4 * 4..n).map(|i| u[i].abs() * per_area[i]);
+    let fastest = rest.fold(0.0, |a, b| larger(b, a));
+    lanes.into_iter().fold(fastest, |a, b| larger(b, a))
 }
 
 /// Cell of the `n/2` grid holding cell `cell` of the `n` grid (same face, halved x, y).

@@ -146,13 +146,18 @@ impl FilmFlow {
         // `A Γ − dt Σ F/R`: each cell's net inflow of the fluxes, gathered.
         net_inflow(sides, &s.edge, &mut s.rhs, &mut s.gather);
         let dt_per_r = dt_s / p.radius_m;
-        let n = s.rhs.len();
-        let (rhs, areas, gamma) = (&mut s.rhs[..], &g.areas_sr()[..n], &self.gamma[..n]);
+        // A face at a time, each with face 0's areas (the same on every face).
+        let areas = &g.face_geometry().area_sr[..];
+        let m = areas.len();
+        let faces = s.rhs.chunks_exact_mut(m).zip(self.gamma.chunks_exact(m));
         with_avx2(
             #[inline(always)]
             || {
-                for i in 0..n {
-                    rhs[i] = areas[i] * gamma[i] + dt_per_r * rhs[i];
+                for (rhs, gamma) in faces {
+                    let (rhs, gamma) = (&mut rhs[..m], &gamma[..m]);
+                    for i in 0..m {
+                        rhs[i] = areas[i] * gamma[i] + dt_per_r * rhs[i];
+                    }
                 }
             },
         );
@@ -342,7 +347,7 @@ impl FilmFlow {
         );
         s.seam_ends = seam_ends;
         net_inflow(sides, &s.edge2, &mut s.rhs, &mut s.gather);
-        let per_area = g.inverse_areas_per_sr();
+        let per_area = &g.face_geometry().inverse_area_per_sr;
         let change = &mut self.surfactant_change;
         if !next_surfactant(&self.gamma, &s.cell2, per_area, &mut s.rhs, change) {
             std::mem::swap(&mut self.gamma, &mut s.rhs);
@@ -433,7 +438,8 @@ fn start_and_guess(gamma: &[f64], change: &[f64], solution: &mut Vec<f64>, guess
 
 /// Each cell's surfactant after the step, `Γ + inflow/area` (`next` holds the inflows and
 /// takes the result), and the step's change of the solve, `solution − Γ` (the next
-/// step's first guess), in one pass; returns whether any cell went negative.
+/// step's first guess), in one pass; returns whether any cell went negative. A face at
+/// a time, each with `per_area`, face 0's inverse areas (the same on every face).
 fn next_surfactant(
     gamma: &[f64],
     solution: &[f64],
@@ -441,19 +447,23 @@ fn next_surfactant(
     next: &mut [f64],
     change: &mut Vec<f64>,
 ) -> bool {
-    let n = gamma.len();
+    let (n, m) = (gamma.len(), per_area.len());
     // Every entry is written below: the buffer needs its length, not a fill.
     change.resize(n, 0.0);
-    let (solution, per_area) = (&solution[..n], &per_area[..n]);
-    let (next, change) = (&mut next[..n], &mut change[..n]);
+    let before = gamma.chunks_exact(m).zip(solution.chunks_exact(m));
+    let after = next.chunks_exact_mut(m).zip(change.chunks_exact_mut(m));
     with_avx2(
         #[inline(always)]
         || {
             let mut negative = false;
-            for i in 0..n {
-                change[i] = solution[i] - gamma[i];
-                next[i] = gamma[i] + next[i] * per_area[i];
-                negative |= next[i] < 0.0;
+            for ((gamma, solution), (next, change)) in before.zip(after) {
+                let (gamma, solution) = (&gamma[..m], &solution[..m]);
+                let (next, change) = (&mut next[..m], &mut change[..m]);
+                for i in 0..m {
+                    change[i] = solution[i] - gamma[i];
+                    next[i] = gamma[i] + next[i] * per_area[i];
+                    negative |= next[i] < 0.0;
+                }
             }
             negative
         },
