@@ -183,8 +183,6 @@ pub(super) struct Scratch {
     /// The rim's values for the limited rises ([`RimRises`]).
     pub(super) rim_rises: RimRises,
     pub(super) drag: Vec<f64>,
-    /// Per edge: the drainage speed's coefficient over `h²`, s⁻¹·m⁻¹.
-    pub(super) drain_rate: Vec<f64>,
     /// The edge velocities in the face rows during the explicit momentum step, m/s.
     rows_u: Vec<f64>,
     /// The viscous step's buffers.

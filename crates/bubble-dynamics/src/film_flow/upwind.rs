@@ -14,6 +14,7 @@ use super::compare::{larger, smaller};
 use super::face_geometry::FaceGeometry;
 use super::grid::CubeSphere;
 use super::sides::{CellSides, EdgeBlock, SeamEnds};
+use super::transport::Drain;
 
 /// The transport's weights, fixed by the grid: face 0's, which every face reads.
 ///
@@ -233,8 +234,8 @@ fn rise_run(w: [&[f64]; 4], h: &[f64], nb: [&[f64]; 4], out: &mut [f64]) {
 pub(crate) struct EdgeSpeeds<'a> {
     /// Per edge: the surfaces' speed, m/s.
     pub(crate) u: &'a [f64],
-    /// Per edge: the drainage speed's coefficient over `h²`, s⁻¹·m⁻¹.
-    pub(crate) drain_rate: &'a [f64],
+    /// The drainage ([`Drain`]: its coefficient over `h²` from each edge's normal).
+    pub(crate) drain: Drain,
     /// The sub-step over the sphere's radius, s/m.
     pub(crate) dt_per_r: f64,
 }
@@ -300,11 +301,11 @@ fn volumes_block(
     volume: &mut [f64],
 ) {
     let len = block.count();
-    let (u, c) = (block.values(speeds.u), block.values(speeds.drain_rate));
+    let (u, c) = (block.values(speeds.u), speeds.drain.along(&block, fg));
     let (l, out) = (block.constant(&fg.length), block.values_mut(volume));
     let (ha, hb, ra, rb) = (&ha[..len], &hb[..len], &ra[..len], &rb[..len]);
     for i in 0..len {
-        let speed = [u[i], c[i], l[i]];
+        let speed = [u[i], c.at(i), l[i]];
         out[i] = edge_volume([ha[i], hb[i]], [ra[i], rb[i]], speed, speeds.dt_per_r);
     }
 }
