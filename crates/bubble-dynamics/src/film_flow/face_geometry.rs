@@ -33,6 +33,13 @@ pub(crate) struct FaceGeometry {
     pub(crate) area_sr: Vec<f64>,
     /// Their inverses, per sr.
     pub(crate) inverse_area_per_sr: Vec<f64>,
+    /// Face 0's cells' centres' components along its major, `s` and `t` axes, `y·n + x`
+    /// (against a world vector taken into each face's frame, [`to_face_frame`]).
+    pub(crate) centre: [Vec<f64>; 3],
+    /// Face 0's cells' left x-edges' lengths, rad, one a cell (`y·n + x`, 0 at `x = 0`):
+    /// a face's x-edges are `n − 1` a row, so only so do they read as one slice along a
+    /// [`super::sides::CellSpan`] ([`super::fluxes::span_sides_on_face`]).
+    pub(crate) x_length: Vec<f64>,
     /// [`EdgeArrays::length`](super::grid::EdgeArrays::length).
     pub(crate) length: EdgeConstant,
     /// [`EdgeArrays::inverse_dual_length`](super::grid::EdgeArrays::inverse_dual_length).
@@ -96,10 +103,16 @@ impl FaceGeometry {
         };
         let scalar = |all: &[f64]| EdgeConstant::of_face(layout, face, all);
         let vector = |all: &[DVec3]| EdgeVector::of_face(layout, face, all);
+        let m = layout.n * layout.n;
+        let centres = &grid.centres()[face * m..(face + 1) * m];
+        let centres: Vec<DVec3> = centres.iter().map(|&c| to_face_frame(face, c)).collect();
+        let length = scalar(&ea.length);
         Self {
             area_sr: cells(grid.areas_sr()),
             inverse_area_per_sr: cells(grid.inverse_areas_per_sr()),
-            length: scalar(&ea.length),
+            centre: std::array::from_fn(|k| centres.iter().map(|c| c[k]).collect()),
+            x_length: x_edges_by_cell(layout.n, &length.face),
+            length,
             inverse_dual_length: scalar(&ea.inverse_dual_length),
             inverse_normal_dual_length: scalar(&ea.inverse_normal_dual_length),
             length_per_smaller_area: scalar(&ea.length_per_smaller_area),
@@ -108,6 +121,17 @@ impl FaceGeometry {
             centre_normal_gradient: vector(&ea.centre_normal_gradient),
         }
     }
+}
+
+/// Face 0's x-edges' values of `face_edges` (in the order of [`FaceLayout::on_face`]),
+/// one a cell: its left x-edge's, 0 at `x = 0`.
+fn x_edges_by_cell(n: usize, face_edges: &[f64]) -> Vec<f64> {
+    let mut out = vec![0.0; n * n];
+    for y in 0..n {
+        let row = &face_edges[y * (n - 1)..(y + 1) * (n - 1)];
+        out[y * n + 1..(y + 1) * n].copy_from_slice(row);
+    }
+    out
 }
 
 impl EdgeConstant {
@@ -167,6 +191,7 @@ mod tests {
             [
                 ("area", g.area_sr.clone()),
                 ("inverse area", g.inverse_area_per_sr.clone()),
+                ("x length", g.x_length.clone()),
                 ("length", g.length.face.clone()),
                 ("inverse dual length", g.inverse_dual_length.face.clone()),
                 (
@@ -178,6 +203,7 @@ mod tests {
         };
         let vectors = |g: &FaceGeometry| {
             [
+                ("centre", g.centre.clone()),
                 ("normal", g.normal.face.clone()),
                 ("centre gradient", g.centre_gradient.face.clone()),
                 (

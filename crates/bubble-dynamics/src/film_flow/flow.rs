@@ -198,9 +198,9 @@ pub(super) struct Scratch {
     pub(super) gather: GatherScratch,
     /// The seam edges' end values for the edge passes ([`SeamEnds`]).
     pub(super) seam_ends: SeamEnds,
-    /// Per cell: a per-edge array's value on its left x-edge, two of them (the
-    /// temperature's transport, [`super::fluxes::spread_x_volumes`]).
-    pub(super) spread: [Vec<f64>; 2],
+    /// Per cell: the velocity on its left x-edge (the temperature's transport,
+    /// [`super::fluxes::spread_x_volumes`]).
+    pub(super) spread: Vec<f64>,
 }
 
 impl FilmFlow {

@@ -76,6 +76,28 @@ pub(crate) fn span_sides<'a>(
     ]
 }
 
+/// A per-edge grid constant's values on the four sides along a span, each `span.len`
+/// long, from face 0's ([`super::face_geometry`]): the x-edges' from `x_face`, one a
+/// cell (`FaceGeometry::x_length`'s layout), the y-edges' from `face_edges`, face 0's
+/// interior edges' values ([`super::grid::FaceLayout::on_face`]).
+#[inline(always)]
+pub(crate) fn span_sides_on_face<'a>(
+    span: &CellSpan,
+    x_face: &'a [f64],
+    face_edges: &'a [f64],
+) -> [&'a [f64]; 4] {
+    let (len, n) = (span.len, span.n());
+    let start = span.start % (n * n);
+    // Face 0's y-edge below cell `start`: after its `n·(n − 1)` x-edges.
+    let bottom = n * (n - 1) + start - n;
+    [
+        &x_face[start..start + len],
+        &x_face[start + 1..start + 1 + len],
+        &face_edges[bottom..bottom + len],
+        &face_edges[bottom + n..bottom + n + len],
+    ]
+}
+
 /// A cell's net inflow from its sides' volumes `v` with signs `inflow`.
 #[inline(always)]
 fn net(v: [f64; 4], inflow: [f64; 4]) -> f64 {

@@ -134,11 +134,6 @@ impl EdgeArrays {
     }
 }
 
-/// The x, y and z of `vectors`, each as an array.
-fn components(vectors: &[DVec3]) -> [Vec<f64>; 3] {
-    std::array::from_fn(|k| vectors.iter().map(|v| v[k]).collect())
-}
-
 /// `g·v` for the vector `v` given by its components `xyz` at index `i`, in the order
 /// of `DVec3::dot` (the same bits).
 #[inline(always)]
@@ -156,8 +151,6 @@ pub(crate) fn dot_at(g: DVec3, [x, y, z]: [&[f64]; 3], i: usize) -> f64 {
 pub struct CubeSphere {
     n: usize,
     centres: Vec<DVec3>,
-    /// The centres' x, y and z as arrays of their own, for passes that vectorise.
-    centres_xyz: [Vec<f64>; 3],
     areas_sr: Vec<f64>,
     edges: Vec<GridEdge>,
     edge_arrays: EdgeArrays,
@@ -302,7 +295,6 @@ impl CubeSphere {
             n,
             inverse_areas_per_sr: inverse(&areas_sr),
             inverse_vertex_areas_per_sr: inverse(&vertex_areas_sr),
-            centres_xyz: components(&centres),
             centres,
             areas_sr,
             edges,
@@ -352,11 +344,6 @@ impl CubeSphere {
     /// Unit direction of each cell's centre.
     pub fn centres(&self) -> &[DVec3] {
         &self.centres
-    }
-
-    /// The cell centres' x, y and z, each as an array.
-    pub(crate) fn centres_xyz(&self) -> &[Vec<f64>; 3] {
-        &self.centres_xyz
     }
 
     /// Area of each cell on the unit sphere, sr.

@@ -465,12 +465,6 @@ impl EdgeRun {
         (&cells[self.a_cells()], &cells[self.b_cells()])
     }
 
-    /// A per-edge array's values along the run.
-    #[inline(always)]
-    pub(crate) fn along<'a>(&self, per_edge: &'a [f64]) -> &'a [f64] {
-        &per_edge[self.edges()]
-    }
-
     /// A per-edge array's values along the run, to write.
     #[inline(always)]
     pub(crate) fn along_mut<'a>(&self, per_edge: &'a mut [f64]) -> &'a mut [f64] {
