@@ -369,7 +369,8 @@ impl CubeSphere {
     /// The largest `|u|·length/min(area_a, area_b)` over the edges, for edge speeds `u`
     /// (m/s, one an edge): times a step over the radius, the largest fraction of a cell
     /// any edge carries (a Courant number). Each face's x-edges and y-edges read face 0's
-    /// `length/min(area)` (the same on every face, [`FaceGeometry`]), the seams their own.
+    /// `length/min(area)` (the same on every face, module `face_geometry`), the seams
+    /// their own.
     pub fn fastest_crossing(&self, u_m_per_s: &[f64]) -> f64 {
         let layout = self.layout();
         let per_area = &self.face.length_per_smaller_area;
