@@ -14,8 +14,9 @@
 //! donor limited to half its content keeps h ≥ 0.
 
 use super::compare::{largest, pick, smaller};
+use super::face_geometry::FaceGeometry;
 use super::fluxes::{GatherScratch, apply_limited, net_inflow};
-use super::grid::{CubeSphere, EdgeArrays};
+use super::grid::CubeSphere;
 use super::sides::{CellSides, EdgeBlock, SeamEnds};
 use crate::avx2::with_avx2;
 
@@ -125,27 +126,31 @@ fn substep(
     h_m: &mut [f64],
     s: &mut CapillaryScratch,
 ) {
-    let ea = grid.edge_arrays();
-    s.flux.resize(ea.cells.len(), 0.0);
+    let fg = grid.face_geometry();
+    s.flux.resize(grid.edges().len(), 0.0);
     // ∇²h as the net inflow of the differences `(h_b − h_a) l/d` (their sum out of a
     // cell, with the sign of an inflow: a cell below its neighbours gains).
     sides.for_each_edge_run(
         #[inline(always)]
         |run| {
             let (ha, hb) = run.ends(h_m);
-            differences_block(run, [ha, hb], ea, &mut s.flux);
+            differences_block(run, [ha, hb], fg, &mut s.flux);
         },
     );
     let seams = sides.seams();
     let ends = s.seam_ends.gather(seams, h_m);
     with_avx2(
         #[inline(always)]
-        || differences_block(seams, ends, ea, &mut s.flux),
+        || differences_block(seams, ends, fg, &mut s.flux),
     );
     net_inflow(sides, &s.flux, &mut s.laplacian, &mut s.gather);
     let per_r2 = 1.0 / (radius_m * radius_m);
-    for (lap, per_area) in s.laplacian.iter_mut().zip(grid.inverse_areas_per_sr()) {
-        *lap *= per_area * per_r2;
+    // A face at a time, each with face 0's inverse areas (the same on every face).
+    let per_area = &fg.inverse_area_per_sr;
+    for face in s.laplacian.chunks_exact_mut(per_area.len()) {
+        for (lap, per_area) in face.iter_mut().zip(per_area) {
+            *lap *= per_area * per_r2;
+        }
     }
     // Volume from a to b over the sub-step, per R² (m·sr): the flux runs down the
     // pressure −(σ/2)∇²h, i.e. up the gradient of ∇²h (the ½σ is in the mobility), so
@@ -159,7 +164,7 @@ fn substep(
     let laplacian = &s.laplacian[..];
     let per_length = dt_s / (radius_m * radius_m);
     let volumes = Volumes {
-        ea,
+        fg,
         mobility,
         per_length,
     };
@@ -177,16 +182,23 @@ fn substep(
         || volumes.block(seams, [ha, hb, la, lb], &mut s.flux),
     );
     // Each donor gives at most half its content: h stays ≥ 0.
-    let (areas, per_area) = (grid.areas_sr(), grid.inverse_areas_per_sr());
-    apply_limited(sides, areas, per_area, &s.flux, 1.0, h_m, &mut s.gather);
+    apply_limited(sides, grid, &s.flux, 1.0, h_m, &mut s.gather);
 }
 
 /// `(h_a − h_b) l/d` over a block of edges with thicknesses `[ha, hb]` at their ends,
 /// into `out` (the Laplacian's differences, [`substep`]).
 #[inline(always)]
-fn differences_block(run: impl EdgeBlock, [ha, hb]: [&[f64]; 2], ea: &EdgeArrays, out: &mut [f64]) {
+fn differences_block(
+    run: impl EdgeBlock,
+    [ha, hb]: [&[f64]; 2],
+    fg: &FaceGeometry,
+    out: &mut [f64],
+) {
     let len = run.count();
-    let (l, per_d) = (run.values(&ea.length), run.values(&ea.inverse_dual_length));
+    let (l, per_d) = (
+        run.constant(&fg.length),
+        run.constant(&fg.inverse_dual_length),
+    );
     let (ha, hb, out) = (&ha[..len], &hb[..len], run.values_mut(out));
     for i in 0..len {
         out[i] = (ha[i] - hb[i]) * l[i] * per_d[i];
@@ -195,8 +207,8 @@ fn differences_block(run: impl EdgeBlock, [ha, hb]: [&[f64]; 2], ea: &EdgeArrays
 
 /// The sub-step's volumes across the edges ([`substep`]).
 struct Volumes<'a> {
-    /// The grid's per-edge arrays.
-    ea: &'a EdgeArrays,
+    /// The grid's constants.
+    fg: &'a FaceGeometry,
     /// Each edge's mobility from its donor's thickness.
     mobility: Mobility,
     /// The sub-step over `R²`.
@@ -209,8 +221,11 @@ impl Volumes<'_> {
     #[inline(always)]
     fn block(&self, run: impl EdgeBlock, [ha, hb, la, lb]: [&[f64]; 4], out: &mut [f64]) {
         let len = run.count();
-        let (ea, Mobility { per_cubed, cap }) = (self.ea, self.mobility);
-        let (l, per_d) = (run.values(&ea.length), run.values(&ea.inverse_dual_length));
+        let (fg, Mobility { per_cubed, cap }) = (self.fg, self.mobility);
+        let (l, per_d) = (
+            run.constant(&fg.length),
+            run.constant(&fg.inverse_dual_length),
+        );
         let (ha, hb, la, lb) = (&ha[..len], &hb[..len], &la[..len], &lb[..len]);
         let out = run.values_mut(out);
         for i in 0..len {

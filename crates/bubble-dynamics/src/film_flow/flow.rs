@@ -19,6 +19,7 @@ use super::advect::{AdvectionGeometry, AdvectionScratch, advect_momentum};
 use super::burst::{BurstParams, BurstState, Hole};
 use super::capillary::{Capillary, CapillaryScratch, smooth_thickness};
 use super::compare::larger;
+use super::face_geometry::EdgeVector;
 use super::face_rows::FaceRows;
 use super::fluxes::GatherScratch;
 use super::grid::{CubeSphere, dot_at};
@@ -182,8 +183,6 @@ pub(super) struct Scratch {
     /// The rim's values for the limited rises ([`RimRises`]).
     pub(super) rim_rises: RimRises,
     pub(super) drag: Vec<f64>,
-    /// Per edge: the drainage speed's coefficient over `h²`, s⁻¹·m⁻¹.
-    pub(super) drain_rate: Vec<f64>,
     /// The edge velocities in the face rows during the explicit momentum step, m/s.
     rows_u: Vec<f64>,
     /// The viscous step's buffers.
@@ -199,9 +198,9 @@ pub(super) struct Scratch {
     pub(super) gather: GatherScratch,
     /// The seam edges' end values for the edge passes ([`SeamEnds`]).
     pub(super) seam_ends: SeamEnds,
-    /// Per cell: a per-edge array's value on its left x-edge, two of them (the
-    /// temperature's transport, [`super::fluxes::spread_x_volumes`]).
-    pub(super) spread: [Vec<f64>; 2],
+    /// Per cell: the velocity on its left x-edge (the temperature's transport,
+    /// [`super::fluxes::spread_x_volumes`]).
+    pub(super) spread: Vec<f64>,
 }
 
 impl FilmFlow {
@@ -470,7 +469,7 @@ impl FilmFlow {
         s.drag.resize(self.u_m_per_s.len(), 1.0);
         let nu_air = p.air_viscosity_pa_s / p.air_density_kg_per_m3.max(f64::MIN_POSITIVE);
         let (r, eddy) = (p.radius_m, 0.25 * p.radius_m);
-        let ea = self.grid.edge_arrays();
+        let fg = self.grid.face_geometry();
         let shear = AirShear {
             per_slip: 1.0 / (nu_air * eddy),
             floor: 1.0 / r,
@@ -478,8 +477,8 @@ impl FilmFlow {
             dt_s,
             air: air_m_per_s,
             slopes: match p.gradient {
-                FilmGradient::TwoPoint => &ea.centre_gradient_xyz,
-                FilmGradient::Normal => &ea.centre_normal_gradient_xyz,
+                FilmGradient::TwoPoint => &fg.centre_gradient,
+                FilmGradient::Normal => &fg.centre_normal_gradient,
             },
         };
         let (sides, u, drag) = (&self.sides, &mut self.u_m_per_s, &mut s.drag);
@@ -529,8 +528,9 @@ struct AirShear<'a> {
     dt_s: f64,
     /// The air's velocity far from the bubble, m/s.
     air: DVec3,
-    /// The slopes of a linear potential across the edges, as components.
-    slopes: &'a [Vec<f64>; 3],
+    /// The slopes of a linear potential across the edges, as components in each block's
+    /// frame ([`EdgeBlock::vector`]).
+    slopes: &'a EdgeVector,
 }
 
 impl AirShear<'_> {
@@ -547,14 +547,13 @@ impl AirShear<'_> {
     fn block(&self, block: impl EdgeBlock, [ha, hb]: [&[f64]; 2], u: &mut [f64], drag: &mut [f64]) {
         let len = block.count();
         let (ha, hb) = (&ha[..len], &hb[..len]);
-        let [sx, sy, sz] = self.slopes;
-        let slopes = [block.values(sx), block.values(sy), block.values(sz)];
+        let (slopes, air) = (block.vector(self.slopes), block.frame(self.air));
         let (u, factor) = (block.values_mut(u), block.values_mut(drag));
         let dt_s = self.dt_s;
         for i in 0..len {
             // The potential flow's surface velocity is the gradient of 1.5 U·x: taken as
             // the discrete gradient between cell centres, curl-free like the real one.
-            let outside = 1.5 * dot_at(self.air, slopes, i);
+            let outside = 1.5 * dot_at(air, slopes, i);
             let h = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
             let k = self.per_layer / h;
             let k_out = k * self.per_layer_depth((u[i] - outside).abs());

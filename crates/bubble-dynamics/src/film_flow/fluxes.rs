@@ -7,6 +7,7 @@
 //! and given to the other, so what moves is conserved to rounding.
 
 use super::flow::MAX_OUTFLOW_FRACTION;
+use super::grid::CubeSphere;
 use super::sides::{CellSides, CellSpan, INFLOW};
 use crate::avx2::with_avx2;
 
@@ -32,10 +33,6 @@ struct RimValues {
     volume: [Vec<f64>; 4],
     /// Per side: the neighbour's factor as a donor.
     across: [Vec<f64>; 4],
-    /// The cells' areas.
-    area: Vec<f64>,
-    /// The cells' inverse areas.
-    per_area: Vec<f64>,
     /// The cells' values before the apply (the spans overwrite those among theirs).
     value: Vec<f64>,
     /// The cells' own factors as donors.
@@ -76,6 +73,28 @@ pub(crate) fn span_sides<'a>(
         &x_volume[start + 1..start + 1 + len],
         &volume[bottom..bottom + len],
         &volume[bottom + n..bottom + n + len],
+    ]
+}
+
+/// A per-edge grid constant's values on the four sides along a span, each `span.len`
+/// long, from face 0's ([`super::face_geometry`]): the x-edges' from `x_face`, one a
+/// cell (`FaceGeometry::x_length`'s layout), the y-edges' from `face_edges`, face 0's
+/// interior edges' values ([`super::grid::FaceLayout::on_face`]).
+#[inline(always)]
+pub(crate) fn span_sides_on_face<'a>(
+    span: &CellSpan,
+    x_face: &'a [f64],
+    face_edges: &'a [f64],
+) -> [&'a [f64]; 4] {
+    let (len, n) = (span.len, span.n());
+    let start = span.start % (n * n);
+    // Face 0's y-edge below cell `start`: after its `n·(n − 1)` x-edges.
+    let bottom = n * (n - 1) + start - n;
+    [
+        &x_face[start..start + len],
+        &x_face[start + 1..start + 1 + len],
+        &face_edges[bottom..bottom + len],
+        &face_edges[bottom + n..bottom + n + len],
     ]
 }
 
@@ -122,11 +141,11 @@ pub(crate) fn net_inflow(
 /// Moves `values` (a content per area, per cell) by the per-edge volumes `scale·volume`
 /// (per R², positive from `a` to `b`), each donor giving at most
 /// [`MAX_OUTFLOW_FRACTION`] of its content (`values` then stays ≥ 0); `ratio` is scratch.
-#[allow(clippy::too_many_arguments)] // the grid's two area arrays, the volumes, the field
+/// The faces' cells read face 0's areas, the same on every face
+/// ([`super::face_geometry`]), the rim's its table's.
 pub(crate) fn apply_limited(
     sides: &CellSides,
-    areas: &[f64],
-    per_area: &[f64],
+    grid: &CubeSphere,
     volume: &[f64],
     scale: f64,
     values: &mut [f64],
@@ -138,6 +157,8 @@ pub(crate) fn apply_limited(
         rim,
     } = scratch;
     ratio.resize(values.len(), 0.0);
+    let fg = grid.face_geometry();
+    let (areas, per_area) = (&fg.area_sr[..], &fg.inverse_area_per_sr[..]);
     with_avx2(
         #[inline(always)]
         || {
@@ -167,7 +188,7 @@ fn outflow_factor(v: [f64; 4], inflow: [f64; 4], scale: f64, area: f64, x: f64) 
     }
 }
 
-/// Every cell's [`outflow_factor`] into `out`.
+/// Every cell's [`outflow_factor`] into `out` (`areas`: face 0's).
 #[inline(always)]
 fn outflow_ratios(
     sides: &CellSides,
@@ -183,7 +204,7 @@ fn outflow_ratios(
         let o = &mut out[span.cells()];
         let len = o.len();
         let (v0, v1, v2, v3) = (&v0[..len], &v1[..len], &v2[..len], &v3[..len]);
-        let (a, x) = (&areas[span.cells()], &values[span.cells()]);
+        let (a, x) = (span.on_face(areas), &values[span.cells()]);
         let (a, x) = (&a[..len], &x[..len]);
         for i in 0..len {
             o[i] = outflow_factor([v0[i], v1[i], v2[i], v3[i]], INFLOW, scale, a[i], x[i]);
@@ -191,17 +212,16 @@ fn outflow_ratios(
     }
     let rim = sides.rim();
     let m = rim.cells.len();
-    rim_values.gather(sides, volume, (areas, values));
+    rim_values.gather(sides, volume, values);
     let RimValues {
         volume: [v0, v1, v2, v3],
-        area,
         value,
         ratio,
         ..
     } = rim_values;
     let (v0, v1, v2, v3) = (&v0[..m], &v1[..m], &v2[..m], &v3[..m]);
     let [s0, s1, s2, s3] = rim.inflows();
-    let (area, value) = (&area[..m], &value[..m]);
+    let (area, value) = (&rim.area[..m], &value[..m]);
     ratio.resize(m, 0.0);
     let ratio = &mut ratio[..m];
     for i in 0..m {
@@ -225,7 +245,8 @@ fn gained(v: [f64; 4], inflow: [f64; 4], across: [f64; 4], own: f64) -> f64 {
     (moved(0) + moved(1)) + (moved(2) + moved(3))
 }
 
-/// Every cell gathers its sides' volumes, each cut by its donor's factor.
+/// Every cell gathers its sides' volumes, each cut by its donor's factor (`per_area`:
+/// face 0's).
 #[inline(always)]
 fn gather_limited(
     sides: &CellSides,
@@ -243,7 +264,7 @@ fn gather_limited(
         let (v0, v1, v2, v3) = (&v0[..len], &v1[..len], &v2[..len], &v3[..len]);
         let [r0, r1, r2, r3]: [&[f64]; 4] = std::array::from_fn(|k| &ratio[span.neighbours(k)]);
         let (r0, r1, r2, r3) = (&r0[..len], &r1[..len], &r2[..len], &r3[..len]);
-        let (own, pa) = (&ratio[span.cells()], &per_area[span.cells()]);
+        let (own, pa) = (&ratio[span.cells()], span.on_face(per_area));
         let (own, pa) = (&own[..len], &pa[..len]);
         let x = &mut values[span.cells()];
         for i in 0..len {
@@ -256,13 +277,12 @@ fn gather_limited(
     let m = rim.cells.len();
     let r = rim_values;
     rim.gather_neighbours(ratio, &mut r.across);
-    rim.gather_cells(per_area, &mut r.per_area);
     let [v0, v1, v2, v3] = &r.volume;
     let (v0, v1, v2, v3) = (&v0[..m], &v1[..m], &v2[..m], &v3[..m]);
     let [a0, a1, a2, a3] = &r.across;
     let (a0, a1, a2, a3) = (&a0[..m], &a1[..m], &a2[..m], &a3[..m]);
     let [s0, s1, s2, s3] = rim.inflows();
-    let (own, pa, value) = (&r.ratio[..m], &r.per_area[..m], &r.value[..m]);
+    let (own, pa, value) = (&r.ratio[..m], &rim.inverse_area[..m], &r.value[..m]);
     r.next.resize(m, 0.0);
     let next = &mut r.next[..m];
     for i in 0..m {
@@ -276,12 +296,11 @@ fn gather_limited(
 }
 
 impl RimValues {
-    /// The rim's volumes, areas and values before the apply.
+    /// The rim's volumes and values before the apply.
     #[inline(always)]
-    fn gather(&mut self, sides: &CellSides, volume: &[f64], (areas, values): (&[f64], &[f64])) {
+    fn gather(&mut self, sides: &CellSides, volume: &[f64], values: &[f64]) {
         let rim = sides.rim();
         rim.gather_edges(volume, &mut self.volume);
-        rim.gather_cells(areas, &mut self.area);
         rim.gather_cells(values, &mut self.value);
     }
 }
@@ -349,15 +368,7 @@ mod tests {
             }
             let mut got = values.clone();
             let mut scratch = GatherScratch::default();
-            apply_limited(
-                &sides,
-                areas,
-                per_area,
-                &volume,
-                scale,
-                &mut got,
-                &mut scratch,
-            );
+            apply_limited(&sides, &grid, &volume, scale, &mut got, &mut scratch);
             for (c, (g, w)) in got.iter().zip(&want).enumerate() {
                 assert!(
                     (g - w).abs() < 1e-12 * w.abs(),
@@ -386,16 +397,7 @@ mod tests {
         };
         let before = content(&values);
         let mut scratch = GatherScratch::default();
-        let (areas, per_area) = (grid.areas_sr(), grid.inverse_areas_per_sr());
-        apply_limited(
-            &sides,
-            areas,
-            per_area,
-            &volume,
-            0.3,
-            &mut values,
-            &mut scratch,
-        );
+        apply_limited(&sides, &grid, &volume, 0.3, &mut values, &mut scratch);
         let change = (content(&values) - before) / before;
         assert!(change.abs() < 1e-14, "content changed by {change:.3e}");
         let least = values.iter().copied().fold(f64::INFINITY, f64::min);

@@ -12,6 +12,7 @@ use std::collections::HashMap;
 use glam::{DMat3, DVec3, IVec3};
 
 use super::compare::larger;
+use super::face_geometry::FaceGeometry;
 use crate::avx2::with_avx2;
 
 /// Major axis, `s` axis and `t` axis of each face (OpenGL cube-map order).
@@ -47,7 +48,9 @@ pub struct GridEdge {
 
 /// The edges' numbers the film step reads every step, as compact arrays (struct of
 /// arrays, index = edge index): a pass over the edges then streams the 8–24 bytes it uses
-/// an edge instead of the 80 of a whole [`GridEdge`]. Derived once from the edges.
+/// an edge instead of the 80 of a whole [`GridEdge`]. Derived once from the edges. The
+/// passes over the edges inside the faces read face 0's share of the ones they use, which
+/// serves every face (module `face_geometry`); the seams and the other passes read these.
 #[derive(Clone, Debug, Default)]
 pub struct EdgeArrays {
     /// `[a, b]`: the cells the edge's normal points from and into.
@@ -84,13 +87,6 @@ pub struct EdgeArrays {
     pub centre_normal_gradient: Vec<DVec3>,
     /// Unit tangent normal to the edge at its midpoint, from `a` towards `b`.
     pub normal: Vec<DVec3>,
-    /// [`Self::normal`]'s x, y and z as arrays of their own, for the edge-run passes (a
-    /// pass that reads them as vectors cannot vectorise).
-    pub normal_xyz: [Vec<f64>; 3],
-    /// [`Self::centre_gradient`]'s components, likewise.
-    pub centre_gradient_xyz: [Vec<f64>; 3],
-    /// [`Self::centre_normal_gradient`]'s components, likewise.
-    pub centre_normal_gradient_xyz: [Vec<f64>; 3],
     /// `midpoint − centre_a` and `midpoint − centre_b`: how far a cell's value is carried
     /// to the edge by its gradient.
     pub reach: Vec<[DVec3; 2]>,
@@ -107,7 +103,7 @@ impl EdgeArrays {
         let smaller_area = |e: &GridEdge| areas_sr[e.a as usize].min(areas_sr[e.b as usize]);
         let skew: Vec<[f64; 2]> = edges.iter().map(|e| skew_weights(e, centres)).collect();
         let at_vertex = |v: u32| to_vertices.apply_vec(v as usize, centres);
-        let mut arrays = Self {
+        Self {
             inverse_normal_dual_length: skew.iter().map(|w| w[0]).collect(),
             cross_per_length: skew.iter().map(|w| w[1]).collect(),
             length_per_smaller_area: edges.iter().map(|e| e.length / smaller_area(e)).collect(),
@@ -134,20 +130,8 @@ impl EdgeArrays {
                 .iter()
                 .map(|e| [e.midpoint - centre(e.a), e.midpoint - centre(e.b)])
                 .collect(),
-            normal_xyz: Default::default(),
-            centre_gradient_xyz: Default::default(),
-            centre_normal_gradient_xyz: Default::default(),
-        };
-        arrays.normal_xyz = components(&arrays.normal);
-        arrays.centre_gradient_xyz = components(&arrays.centre_gradient);
-        arrays.centre_normal_gradient_xyz = components(&arrays.centre_normal_gradient);
-        arrays
+        }
     }
-}
-
-/// The x, y and z of `vectors`, each as an array.
-fn components(vectors: &[DVec3]) -> [Vec<f64>; 3] {
-    std::array::from_fn(|k| vectors.iter().map(|v| v[k]).collect())
 }
 
 /// `g·v` for the vector `v` given by its components `xyz` at index `i`, in the order
@@ -167,8 +151,6 @@ pub(crate) fn dot_at(g: DVec3, [x, y, z]: [&[f64]; 3], i: usize) -> f64 {
 pub struct CubeSphere {
     n: usize,
     centres: Vec<DVec3>,
-    /// The centres' x, y and z as arrays of their own, for passes that vectorise.
-    centres_xyz: [Vec<f64>; 3],
     areas_sr: Vec<f64>,
     edges: Vec<GridEdge>,
     edge_arrays: EdgeArrays,
@@ -176,6 +158,8 @@ pub struct CubeSphere {
     inverse_areas_per_sr: Vec<f64>,
     inverse_vertex_areas_per_sr: Vec<f64>,
     to_vertices: VertexInterpolation,
+    /// Face 0's constants, which every face's passes read ([`FaceGeometry`]).
+    face: FaceGeometry,
 }
 
 /// Per grid vertex: the cells around it (three at a cube corner, the first repeated with
@@ -307,18 +291,20 @@ impl CubeSphere {
         let to_vertices = VertexInterpolation::new(&cell_corners, &centres, &vertex_dirs);
         let edge_arrays = EdgeArrays::new(&edges, &centres, &areas_sr, &to_vertices);
         let inverse = |areas: &[f64]| areas.iter().map(|a| 1.0 / a).collect();
-        Self {
+        let mut grid = Self {
             n,
             inverse_areas_per_sr: inverse(&areas_sr),
             inverse_vertex_areas_per_sr: inverse(&vertex_areas_sr),
-            centres_xyz: components(&centres),
             centres,
             areas_sr,
             edges,
             edge_arrays,
             vertex_areas_sr,
             to_vertices,
-        }
+            face: FaceGeometry::default(),
+        };
+        grid.face = FaceGeometry::new(&grid);
+        grid
     }
 
     /// Each grid vertex's value of the cell field `values`, linear-exact, into `out`.
@@ -360,11 +346,6 @@ impl CubeSphere {
         &self.centres
     }
 
-    /// The cell centres' x, y and z, each as an array.
-    pub(crate) fn centres_xyz(&self) -> &[Vec<f64>; 3] {
-        &self.centres_xyz
-    }
-
     /// Area of each cell on the unit sphere, sr.
     pub fn areas_sr(&self) -> &[f64] {
         &self.areas_sr
@@ -380,27 +361,35 @@ impl CubeSphere {
         &self.edge_arrays
     }
 
+    /// Face 0's constants, which serve every face ([`FaceGeometry`]).
+    pub(crate) fn face_geometry(&self) -> &FaceGeometry {
+        &self.face
+    }
+
     /// The largest `|u|·length/min(area_a, area_b)` over the edges, for edge speeds `u`
-    /// (m/s): times a step over the radius, the largest fraction of a cell any edge
-    /// carries (a Courant number).
+    /// (m/s, one an edge): times a step over the radius, the largest fraction of a cell
+    /// any edge carries (a Courant number). Each face's x-edges and y-edges read face 0's
+    /// `length/min(area)` (the same on every face, module `face_geometry`), the seams
+    /// their own.
     pub fn fastest_crossing(&self, u_m_per_s: &[f64]) -> f64 {
-        let per_area = &self.edge_arrays.length_per_smaller_area;
-        let n = u_m_per_s.len().min(per_area.len());
-        let (u, per_area) = (&u_m_per_s[..n], &per_area[..n]);
-        // Four running maxima in chunks of four, which vectorise (a maximum is exact in
-        // any order; NaN skipped, as `f64::max` does).
+        let layout = self.layout();
+        let per_area = &self.face.length_per_smaller_area;
+        let m = layout.n * (layout.n - 1);
+        let (x_edges, y_edges) = per_area.face.split_at(m);
+        let seams = layout.first_seam_edge();
+        // Plain loops: through iterator adaptors the blocks' loop left the AVX2 function
+        // and took twice the instructions.
         with_avx2(
             #[inline(always)]
             || {
-                let mut lanes = [0.0; 4];
-                for (u, a) in u.chunks_exact(4).zip(per_area.chunks_exact(4)) {
-                    for k in 0..4 {
-                        lanes[k] = larger(u[k].abs() * a[k], lanes[k]);
-                    }
+                let u = u_m_per_s;
+                let mut fastest = fastest_of(&u[seams..], &per_area.seams);
+                for f in 0..6 {
+                    let x = fastest_of(&u[f * m..], x_edges);
+                    let y = fastest_of(&u[(6 + f) * m..], y_edges);
+                    fastest = larger(larger(x, y), fastest);
                 }
-                let rest = (n / 4 * 4..n).map(|i| u[i].abs() * per_area[i]);
-                let fastest = rest.fold(0.0, |a, b| larger(b, a));
-                lanes.into_iter().fold(fastest, |a, b| larger(b, a))
+                fastest
             },
         )
     }
@@ -419,6 +408,24 @@ impl CubeSphere {
     pub fn inverse_vertex_areas_per_sr(&self) -> &[f64] {
         &self.inverse_vertex_areas_per_sr
     }
+}
+
+/// The largest `|u[i]|·per_area[i]` over `per_area`'s length, in four running maxima in
+/// chunks of four, which vectorise (a maximum is exact in any order; NaN skipped, as
+/// `f64::max` does).
+#[inline(always)]
+fn fastest_of(u: &[f64], per_area: &[f64]) -> f64 {
+    let n = per_area.len();
+    let u = &u[..n];
+    let mut lanes = [0.0; 4];
+    for (u, a) in u.chunks_exact(4).zip(per_area.chunks_exact(4)) {
+        for k in 0..4 {
+            lanes[k] = larger(u[k].abs() * a[k], lanes[k]);
+        }
+    }
+    let rest = (n / 4 * 4..n).map(|i| u[i].abs() * per_area[i]);
+    let fastest = rest.fold(0.0, |a, b| larger(b, a));
+    lanes.into_iter().fold(fastest, |a, b| larger(b, a))
 }
 
 /// Cell of the `n/2` grid holding cell `cell` of the `n` grid (same face, halved x, y).
@@ -531,6 +538,27 @@ impl FaceLayout {
     pub fn first_seam_edge(self) -> usize {
         12 * self.n * (self.n - 1)
     }
+
+    /// Face `face`'s interior edges, in the order of their places on it
+    /// ([`Self::on_face`]): its x-edges, then its y-edges.
+    pub fn face_edges(self, face: usize) -> impl Iterator<Item = usize> {
+        let m = self.n * (self.n - 1);
+        (face * m..(face + 1) * m).chain(6 * m + face * m..6 * m + (face + 1) * m)
+    }
+
+    /// Interior edge `e`'s face and its place among that face's interior edges: an
+    /// x-edge's place is its number less its face's first x-edge's, a y-edge's that of
+    /// its face's first y-edge plus the face's `n·(n − 1)` x-edges. Edges at one place
+    /// on different faces are the same edge turned by the cube's rotations.
+    pub fn on_face(self, e: usize) -> (usize, usize) {
+        let m = self.n * (self.n - 1);
+        debug_assert!(e < 12 * m, "edge {e} is a seam");
+        if e < 6 * m {
+            (e / m, e % m)
+        } else {
+            ((e - 6 * m) / m, m + (e - 6 * m) % m)
+        }
+    }
 }
 
 fn edge(a: u32, b: u32, (p, q): (u32, u32), centres: &[DVec3], vertices: &[DVec3]) -> GridEdge {
@@ -592,6 +620,26 @@ mod tests {
                 seams
                     .iter()
                     .all(|e| e.a as usize / (n * n) != e.b as usize / (n * n))
+            );
+        }
+    }
+
+    #[test]
+    fn an_interior_edges_place_on_its_face_is_where_face_edges_lists_it() {
+        for n in [1, 2, 5] {
+            let layout = FaceLayout { n };
+            let mut all: Vec<usize> = Vec::new();
+            for face in 0..6 {
+                for (place, e) in layout.face_edges(face).enumerate() {
+                    assert_eq!(layout.on_face(e), (face, place), "n {n} edge {e}");
+                    all.push(e);
+                }
+            }
+            all.sort_unstable();
+            assert_eq!(
+                all,
+                (0..layout.first_seam_edge()).collect::<Vec<_>>(),
+                "n {n}"
             );
         }
     }

@@ -11,11 +11,11 @@
 //! reads the surfactant the solve started from and the rare redo needs no restore).
 
 use super::compare::{larger, pick};
+use super::face_geometry::{EdgeConstant, FaceGeometry};
 use super::flow::{
     FilmFlow, FilmGradient, H_FLOOR_M, SOLVE_MAX_ITERATIONS, SOLVE_TOLERANCE, Scratch,
 };
 use super::fluxes::{apply_limited, net_inflow};
-use super::grid::EdgeArrays;
 use super::sides::{CellSides, EdgeBlock, SeamEnds};
 use super::solve::{SolveLimits, SolveReport};
 use crate::avx2::with_avx2;
@@ -73,29 +73,20 @@ impl FilmFlow {
     fn transport_surfactant(&mut self, s: &mut Scratch, dt_s: f64) {
         let dt_per_r = dt_s / self.params.radius_m;
         let g = std::sync::Arc::clone(&self.grid);
-        let ea = g.edge_arrays();
+        let fg = g.face_geometry();
         let fastest = g.fastest_crossing(&s.u_start);
         if fastest == 0.0 {
             return;
         }
         let substeps = (2.0 * fastest * dt_per_r).ceil().clamp(1.0, 64.0) as u32;
         let sub_dt_per_r = dt_per_r / f64::from(substeps);
-        s.edge2.resize(ea.cells.len(), 0.0);
+        s.edge2.resize(s.u_start.len(), 0.0);
         let sides = &self.sides;
-        let (areas, per_area) = (g.areas_sr(), g.inverse_areas_per_sr());
         for _ in 0..substeps {
             let fields = (&self.gamma[..], &s.u_start[..]);
-            upwind_fluxes(sides, ea, fields, (&mut s.edge2, &mut s.seam_ends));
+            upwind_fluxes(sides, fg, fields, (&mut s.edge2, &mut s.seam_ends));
             let (flux, gamma) = (&s.edge2, &mut self.gamma);
-            apply_limited(
-                sides,
-                areas,
-                per_area,
-                flux,
-                sub_dt_per_r,
-                gamma,
-                &mut s.gather,
-            );
+            apply_limited(sides, &g, flux, sub_dt_per_r, gamma, &mut s.gather);
         }
     }
 
@@ -155,13 +146,18 @@ impl FilmFlow {
         // `A Γ − dt Σ F/R`: each cell's net inflow of the fluxes, gathered.
         net_inflow(sides, &s.edge, &mut s.rhs, &mut s.gather);
         let dt_per_r = dt_s / p.radius_m;
-        let n = s.rhs.len();
-        let (rhs, areas, gamma) = (&mut s.rhs[..], &g.areas_sr()[..n], &self.gamma[..n]);
+        // A face at a time, each with face 0's areas (the same on every face).
+        let areas = &g.face_geometry().area_sr[..];
+        let m = areas.len();
+        let faces = s.rhs.chunks_exact_mut(m).zip(self.gamma.chunks_exact(m));
         with_avx2(
             #[inline(always)]
             || {
-                for i in 0..n {
-                    rhs[i] = areas[i] * gamma[i] + dt_per_r * rhs[i];
+                for (rhs, gamma) in faces {
+                    let (rhs, gamma) = (&mut rhs[..m], &gamma[..m]);
+                    for i in 0..m {
+                        rhs[i] = areas[i] * gamma[i] + dt_per_r * rhs[i];
+                    }
                 }
             },
         );
@@ -177,17 +173,17 @@ impl FilmFlow {
         [ga, gb, ha, hb]: [&[f64]; 4],
         c: EdgeConstants,
     ) {
-        let ea = self.grid.edge_arrays();
+        let (ea, fg) = (self.grid.edge_arrays(), self.grid.face_geometry());
         let len = run.count();
         let (ga, gb, ha, hb) = (&ga[..len], &gb[..len], &ha[..len], &hb[..len]);
         let (u, u0) = (run.values(&self.u_m_per_s), run.values(&s.u_start));
-        let (drag, l) = (run.values(&s.drag), run.values(&ea.length));
+        let (drag, l) = (run.values(&s.drag), run.constant(&fg.length));
         let inverse_dual = if NORMAL {
-            &ea.inverse_normal_dual_length
+            &fg.inverse_normal_dual_length
         } else {
-            &ea.inverse_dual_length
+            &fg.inverse_dual_length
         };
-        let id = run.values(inverse_dual);
+        let id = run.constant(inverse_dual);
         let (u, u0, drag, l, id) = (&u[..len], &u0[..len], &drag[..len], &l[..len], &id[..len]);
         let flux = run.values_mut(&mut s.edge);
         let stiffness = run.values_mut(&mut s.stiffness);
@@ -317,18 +313,18 @@ impl FilmFlow {
         let r = self.params.radius_m;
         let g = std::sync::Arc::clone(&self.grid);
         let sides = std::sync::Arc::clone(&self.sides);
-        let (ea, sides) = (g.edge_arrays(), &*sides);
+        let (fg, sides) = (g.face_geometry(), &*sides);
         let scale = dt_s / r;
-        s.edge2.resize(ea.cells.len(), 0.0);
+        s.edge2.resize(s.edge.len(), 0.0);
         let constants = (1.0 / r, scale);
         let inverse_dual = if NORMAL {
-            &ea.inverse_normal_dual_length
+            &fg.inverse_normal_dual_length
         } else {
-            &ea.inverse_dual_length
+            &fg.inverse_dual_length
         };
         let inputs = CorrectionInputs {
             inverse_dual,
-            length: &ea.length,
+            length: &fg.length,
             flux: &s.edge,
             stiffness: &s.stiffness,
             cross: &s.cross,
@@ -351,7 +347,7 @@ impl FilmFlow {
         );
         s.seam_ends = seam_ends;
         net_inflow(sides, &s.edge2, &mut s.rhs, &mut s.gather);
-        let per_area = g.inverse_areas_per_sr();
+        let per_area = &g.face_geometry().inverse_area_per_sr;
         let change = &mut self.surfactant_change;
         if !next_surfactant(&self.gamma, &s.cell2, per_area, &mut s.rhs, change) {
             std::mem::swap(&mut self.gamma, &mut s.rhs);
@@ -365,21 +361,20 @@ impl FilmFlow {
         change.clear();
         change.extend(self.u_m_per_s.iter().zip(&s.u_start).map(|(u, u0)| u - u0));
         let out = (&mut s.edge2[..], &mut s.seam_ends);
-        upwind_fluxes(sides, ea, (&self.gamma, change), out);
-        let (areas, per_area) = (g.areas_sr(), g.inverse_areas_per_sr());
+        upwind_fluxes(sides, fg, (&self.gamma, change), out);
         let (flux, gamma) = (&s.edge2, &mut self.gamma);
-        apply_limited(sides, areas, per_area, flux, scale, gamma, &mut s.gather);
+        apply_limited(sides, &g, flux, scale, gamma, &mut s.gather);
     }
 }
 
-/// What the velocity correction reads per edge besides the cells' values: full per-edge
-/// arrays.
+/// What the velocity correction reads per edge besides the cells' values: the grid's
+/// constants ([`EdgeBlock::constant`]) and full per-edge arrays.
 #[derive(Clone, Copy)]
 struct CorrectionInputs<'a> {
     /// `1/d` (`1/(d cos θ)` with the normal gradient), per rad.
-    inverse_dual: &'a [f64],
+    inverse_dual: &'a EdgeConstant,
     /// The edges' lengths, rad.
-    length: &'a [f64],
+    length: &'a EdgeConstant,
     /// The transport flux from the central pass.
     flux: &'a [f64],
     /// Each edge's stiffness `k`.
@@ -401,7 +396,7 @@ fn correct_velocity_block<const NORMAL: bool>(
 ) {
     let len = run.count();
     let (ga, gb, xa, xb) = (&ga[..len], &gb[..len], &xa[..len], &xb[..len]);
-    let (id, l) = (run.values(e.inverse_dual), run.values(e.length));
+    let (id, l) = (run.constant(e.inverse_dual), run.constant(e.length));
     let (f_adv, k) = (run.values(e.flux), run.values(e.stiffness));
     let (u, moved) = (run.values_mut(u), run.values_mut(moved));
     for i in 0..len {
@@ -443,7 +438,8 @@ fn start_and_guess(gamma: &[f64], change: &[f64], solution: &mut Vec<f64>, guess
 
 /// Each cell's surfactant after the step, `Γ + inflow/area` (`next` holds the inflows and
 /// takes the result), and the step's change of the solve, `solution − Γ` (the next
-/// step's first guess), in one pass; returns whether any cell went negative.
+/// step's first guess), in one pass; returns whether any cell went negative. A face at
+/// a time, each with `per_area`, face 0's inverse areas (the same on every face).
 fn next_surfactant(
     gamma: &[f64],
     solution: &[f64],
@@ -451,19 +447,23 @@ fn next_surfactant(
     next: &mut [f64],
     change: &mut Vec<f64>,
 ) -> bool {
-    let n = gamma.len();
+    let (n, m) = (gamma.len(), per_area.len());
     // Every entry is written below: the buffer needs its length, not a fill.
     change.resize(n, 0.0);
-    let (solution, per_area) = (&solution[..n], &per_area[..n]);
-    let (next, change) = (&mut next[..n], &mut change[..n]);
+    let before = gamma.chunks_exact(m).zip(solution.chunks_exact(m));
+    let after = next.chunks_exact_mut(m).zip(change.chunks_exact_mut(m));
     with_avx2(
         #[inline(always)]
         || {
             let mut negative = false;
-            for i in 0..n {
-                change[i] = solution[i] - gamma[i];
-                next[i] = gamma[i] + next[i] * per_area[i];
-                negative |= next[i] < 0.0;
+            for ((gamma, solution), (next, change)) in before.zip(after) {
+                let (gamma, solution) = (&gamma[..m], &solution[..m]);
+                let (next, change) = (&mut next[..m], &mut change[..m]);
+                for i in 0..m {
+                    change[i] = solution[i] - gamma[i];
+                    next[i] = gamma[i] + next[i] * per_area[i];
+                    negative |= next[i] < 0.0;
+                }
             }
             negative
         },
@@ -485,7 +485,7 @@ struct EdgeConstants {
 /// `out` (the seams' ends gathered into `seam_ends`).
 fn upwind_fluxes(
     sides: &CellSides,
-    ea: &EdgeArrays,
+    fg: &FaceGeometry,
     (gamma, u): (&[f64], &[f64]),
     (out, seam_ends): (&mut [f64], &mut SeamEnds),
 ) {
@@ -493,14 +493,14 @@ fn upwind_fluxes(
         #[inline(always)]
         |run| {
             let (ga, gb) = run.ends(gamma);
-            upwind_fluxes_block(run, [ga, gb], (ea, u), out);
+            upwind_fluxes_block(run, [ga, gb], (fg, u), out);
         },
     );
     let seams = sides.seams();
     let ends = seam_ends.gather(seams, gamma);
     with_avx2(
         #[inline(always)]
-        || upwind_fluxes_block(seams, ends, (ea, u), out),
+        || upwind_fluxes_block(seams, ends, (fg, u), out),
     );
 }
 
@@ -509,11 +509,11 @@ fn upwind_fluxes(
 fn upwind_fluxes_block(
     run: impl EdgeBlock,
     [ga, gb]: [&[f64]; 2],
-    (ea, u): (&EdgeArrays, &[f64]),
+    (fg, u): (&FaceGeometry, &[f64]),
     out: &mut [f64],
 ) {
     let len = run.count();
-    let (u, l, f) = (run.values(u), run.values(&ea.length), run.values_mut(out));
+    let (u, l, f) = (run.values(u), run.constant(&fg.length), run.values_mut(out));
     let (ga, gb) = (&ga[..len], &gb[..len]);
     for i in 0..len {
         f[i] = pick(u[i] >= 0.0, ga[i], gb[i]) * u[i] * l[i];

@@ -7,6 +7,7 @@ mod burst;
 mod capillary;
 mod cell_map;
 mod compare;
+mod face_geometry;
 mod face_rows;
 mod flow;
 mod fluxes;

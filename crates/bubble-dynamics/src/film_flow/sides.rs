@@ -6,6 +6,9 @@
 //! Why cell by cell: an edge-by-edge pass scatters into both cells through index arrays,
 //! which no compiler vectorises; a cell that gathers its four sides from slices does.
 
+use glam::DVec3;
+
+use super::face_geometry::{EdgeConstant, EdgeVector, to_face_frame};
 use super::grid::{CubeSphere, FACE_BASES, FaceLayout};
 use crate::avx2::with_avx2;
 
@@ -104,6 +107,16 @@ pub(crate) trait EdgeBlock: Copy {
     fn values_mut<'a>(&self, per_edge: &'a mut [f64]) -> &'a mut [f64] {
         &mut per_edge[self.first()..self.first() + self.count()]
     }
+    /// A grid constant's values along the block, `count()` long: a run's from face 0's
+    /// at the run's place on its face (the faces are congruent,
+    /// [`super::face_geometry`]), the seams' their own.
+    fn constant<'a>(&self, c: &'a EdgeConstant) -> &'a [f64];
+    /// A grid vector's components along the block, each `count()` long, in the frame of
+    /// [`Self::frame`]: a run's face 0's in that face's frame, the seams' in the world's.
+    fn vector<'a>(&self, v: &'a EdgeVector) -> [&'a [f64]; 3];
+    /// The world vector `world` in the frame of [`Self::vector`]'s components: a run's
+    /// face's, the world's for the seams.
+    fn frame(&self, world: DVec3) -> DVec3;
 }
 
 impl EdgeBlock for EdgeRun {
@@ -115,6 +128,20 @@ impl EdgeBlock for EdgeRun {
     fn count(&self) -> usize {
         self.len
     }
+    #[inline(always)]
+    fn constant<'a>(&self, c: &'a EdgeConstant) -> &'a [f64] {
+        &c.face[self.on_face..self.on_face + self.len]
+    }
+    #[inline(always)]
+    fn vector<'a>(&self, v: &'a EdgeVector) -> [&'a [f64]; 3] {
+        let [x, y, z] = &v.face;
+        let along = self.on_face..self.on_face + self.len;
+        [&x[along.clone()], &y[along.clone()], &z[along]]
+    }
+    #[inline(always)]
+    fn frame(&self, world: DVec3) -> DVec3 {
+        to_face_frame(self.face, world)
+    }
 }
 
 impl EdgeBlock for Seams<'_> {
@@ -125,6 +152,19 @@ impl EdgeBlock for Seams<'_> {
     #[inline(always)]
     fn count(&self) -> usize {
         self.len
+    }
+    #[inline(always)]
+    fn constant<'a>(&self, c: &'a EdgeConstant) -> &'a [f64] {
+        &c.seams[..self.len]
+    }
+    #[inline(always)]
+    fn vector<'a>(&self, v: &'a EdgeVector) -> [&'a [f64]; 3] {
+        let [x, y, z] = &v.seams;
+        [&x[..self.len], &y[..self.len], &z[..self.len]]
+    }
+    #[inline(always)]
+    fn frame(&self, world: DVec3) -> DVec3 {
+        world
     }
 }
 
@@ -215,6 +255,11 @@ struct RimTables {
     edge: [Vec<u32>; 4],
     /// Per side: the sign of a volume across it in the cell's inflow.
     inflow: [Vec<f64>; 4],
+    /// Each rim cell's area, sr: a table in the rim's order instead of a gather from
+    /// the grid's, which touched a cache line a cell down the faces' sides.
+    area: Vec<f64>,
+    /// Each rim cell's inverse area, per sr.
+    inverse_area: Vec<f64>,
 }
 
 /// [`RimTables`] as slices of one length, so that a pass indexes them without checks.
@@ -228,6 +273,10 @@ pub(crate) struct Rim<'a> {
     edge: [&'a [u32]; 4],
     /// Per side: the sign of a volume across it in the cell's inflow.
     inflow: [&'a [f64]; 4],
+    /// Each rim cell's area, sr.
+    pub(crate) area: &'a [f64],
+    /// Each rim cell's inverse area, per sr.
+    pub(crate) inverse_area: &'a [f64],
 }
 
 impl Rim<'_> {
@@ -354,6 +403,14 @@ impl CellSpan {
         self.n
     }
 
+    /// A per-cell grid constant of face 0 (`n²` long) along the span: the same cells'
+    /// values on every face, to rounding ([`super::face_geometry`]).
+    #[inline(always)]
+    pub(crate) fn on_face<'a>(&self, per_face: &'a [f64]) -> &'a [f64] {
+        let first = self.start % (self.n * self.n);
+        &per_face[first..first + self.len]
+    }
+
     /// The cells at the layout's offset on side `k` from the span's cells.
     pub(crate) fn neighbours(&self, k: usize) -> std::ops::Range<usize> {
         let first = match k {
@@ -379,6 +436,11 @@ pub(crate) struct EdgeRun {
     pub(crate) b: usize,
     /// The side the edges are of their `a` cells and of their `b` cells.
     pub(crate) sides: [usize; 2],
+    /// The face the run lies on.
+    pub(crate) face: usize,
+    /// The first edge's place among its face's interior edges ([`FaceLayout::on_face`]):
+    /// where the run's constants start in face 0's ([`EdgeBlock::constant`]).
+    pub(crate) on_face: usize,
 }
 
 impl EdgeRun {
@@ -401,12 +463,6 @@ impl EdgeRun {
     #[inline(always)]
     pub(crate) fn ends<'a>(&self, cells: &'a [f64]) -> (&'a [f64], &'a [f64]) {
         (&cells[self.a_cells()], &cells[self.b_cells()])
-    }
-
-    /// A per-edge array's values along the run.
-    #[inline(always)]
-    pub(crate) fn along<'a>(&self, per_edge: &'a [f64]) -> &'a [f64] {
-        &per_edge[self.edges()]
     }
 
     /// A per-edge array's values along the run, to write.
@@ -455,7 +511,7 @@ impl CellSides {
             seam_tables: seams,
         };
         (sides.cell_runs, sides.rim_cells) = sides.find_cell_runs();
-        sides.rim_tables = sides.rim_tables();
+        sides.rim_tables = sides.rim_tables(grid);
         sides.edge_runs = face_edge_runs(grid);
         sides
     }
@@ -485,9 +541,10 @@ impl CellSides {
         (runs, rim)
     }
 
-    /// The rim cells' tables side by side ([`RimTables`]).
-    fn rim_tables(&self) -> RimTables {
+    /// The rim cells' tables side by side ([`RimTables`]), their areas from `grid`.
+    fn rim_tables(&self, grid: &CubeSphere) -> RimTables {
         let rim = &self.rim_cells;
+        let at_rim = |cells: &[f64]| rim.iter().map(|&c| cells[c as usize]).collect();
         let side = |table: &[[u32; 4]], k: usize| -> Vec<u32> {
             rim.iter().map(|&c| table[c as usize][k]).collect()
         };
@@ -497,6 +554,8 @@ impl CellSides {
             inflow: std::array::from_fn(|k| {
                 rim.iter().map(|&c| self.inflow(c as usize)[k]).collect()
             }),
+            area: at_rim(grid.areas_sr()),
+            inverse_area: at_rim(grid.inverse_areas_per_sr()),
         }
     }
 
@@ -512,6 +571,8 @@ impl CellSides {
             neighbour: [&n0[..m], &n1[..m], &n2[..m], &n3[..m]],
             edge: [&e0[..m], &e1[..m], &e2[..m], &e3[..m]],
             inflow: [&s0[..m], &s1[..m], &s2[..m], &s3[..m]],
+            area: &t.area[..m],
+            inverse_area: &t.inverse_area[..m],
         }
     }
 
@@ -583,6 +644,8 @@ fn face_edge_runs(grid: &CubeSphere) -> Vec<EdgeRun> {
                 a,
                 b: a + 1,
                 sides,
+                face,
+                on_face: y * (n - 1),
             });
         }
     }
@@ -596,6 +659,8 @@ fn face_edge_runs(grid: &CubeSphere) -> Vec<EdgeRun> {
             a,
             b: a + n,
             sides,
+            face,
+            on_face: n * (n - 1),
         });
     }
     runs.retain(|r| r.len > 0);
@@ -711,6 +776,13 @@ mod tests {
             assert_eq!(sides.edge[b][kb] as usize, e, "seam edge {e}: side of b");
         }
         for run in &sides.edge_runs {
+            let place = (run.face, run.on_face);
+            assert_eq!(
+                grid.layout().on_face(run.start),
+                place,
+                "run at {}",
+                run.start
+            );
             for (i, e) in run.edges().enumerate() {
                 assert_eq!(
                     ea.cells[e],

@@ -26,8 +26,9 @@
 use glam::DVec3;
 
 use super::compare::{larger, smaller};
+use super::face_geometry::to_face_frame;
 use super::flow::{FilmFlow, FilmGradient, H_FLOOR_M};
-use super::fluxes::{span_sides, spread_x_volumes};
+use super::fluxes::{span_sides, span_sides_on_face, spread_x_volumes};
 use super::grid::dot_at;
 use super::sides::{EdgeBlock, INFLOW};
 use crate::avx2::with_avx2;
@@ -145,9 +146,10 @@ fn push(per: f64, [ta, tb]: [f64; 2], [ha, hb]: [f64; 2], per_d: f64) -> f64 {
     per * (tb - ta) * per_d / h_edge
 }
 
-/// Relaxes each cell's temperature `theta` towards the air's over `dt_s`, implicitly:
-/// the centres as components (the dot product in `DVec3::dot`'s order, so the same bits
-/// as [`ThermalParams::air_excess_k`]), four cells at a time.
+/// Relaxes each cell's temperature `theta` towards the air's over `dt_s`, implicitly, a
+/// face at a time: the centres as face 0's components in its frame (`centre`, the same
+/// on every face: [`super::face_geometry`]) against `up` taken into each face's, so
+/// [`ThermalParams::air_excess_k`] to rounding, four cells at a time.
 #[inline(always)]
 fn relax(
     theta: &mut [f64],
@@ -156,12 +158,16 @@ fn relax(
     (th, rho): (ThermalParams, f64),
     (dt_s, up): (f64, DVec3),
 ) {
-    let n = theta.len();
-    let (h, centres) = (&h[..n], [&x[..n], &y[..n], &z[..n]]);
-    for i in 0..n {
-        let r = dt_s * th.relaxation_per_s(h[i].max(H_FLOOR_M), rho);
-        let air = th.air_excess_at_height(dot_at(up, centres, i));
-        theta[i] = (theta[i] + r * air) / (1.0 + r);
+    let m = x.len();
+    let centres = [&x[..m], &y[..m], &z[..m]];
+    let faces = theta.chunks_exact_mut(m).zip(h.chunks_exact(m));
+    for (face, (theta, h)) in faces.enumerate() {
+        let (theta, h, up) = (&mut theta[..m], &h[..m], to_face_frame(face, up));
+        for i in 0..m {
+            let r = dt_s * th.relaxation_per_s(h[i].max(H_FLOOR_M), rho);
+            let air = th.air_excess_at_height(dot_at(up, centres, i));
+            theta[i] = (theta[i] + r * air) / (1.0 + r);
+        }
     }
 }
 
@@ -178,7 +184,7 @@ impl FilmFlow {
     pub(super) fn exchange_heat(
         &mut self,
         u_start: &[f64],
-        scratch: (&mut Vec<f64>, &mut [Vec<f64>; 2]),
+        scratch: (&mut Vec<f64>, &mut Vec<f64>),
         dt_s: f64,
         up: DVec3,
     ) {
@@ -187,7 +193,7 @@ impl FilmFlow {
         }
         self.advect_temperature(u_start, scratch, dt_s);
         let (th, rho) = (self.params.thermal, self.params.density_kg_per_m3);
-        let centres = self.grid.centres_xyz();
+        let centres = &self.grid.face_geometry().centre;
         let (theta, h) = (&mut self.temperature_k, &self.h_m);
         with_avx2(
             #[inline(always)]
@@ -196,10 +202,12 @@ impl FilmFlow {
     }
 
     /// `∂θ/∂t + u·∇θ = 0`, upwind: each cell takes `(θ_up − θ)` times what flows in.
+    /// The faces' cells read face 0's lengths and inverse areas (the same on every face,
+    /// [`super::face_geometry`]), the rim the grid's lengths and its own inverse areas.
     fn advect_temperature(
         &mut self,
         u: &[f64],
-        (before, [x_u, x_length]): (&mut Vec<f64>, &mut [Vec<f64>; 2]),
+        (before, x_u): (&mut Vec<f64>, &mut Vec<f64>),
         dt_s: f64,
     ) {
         let courant = self.grid.fastest_crossing(u) * dt_s / self.params.radius_m;
@@ -211,11 +219,11 @@ impl FilmFlow {
             .clamp(1.0, f64::from(MAX_SUBSTEPS)) as u32;
         let scale = dt_s / (self.params.radius_m * f64::from(substeps));
         let (sides, ea) = (&self.sides, self.grid.edge_arrays());
-        let per_area = self.grid.inverse_areas_per_sr();
-        // The x-edges' speeds and lengths one a cell, so that a face's read as slices.
+        let fg = self.grid.face_geometry();
+        // The x-edges' speeds one a cell, so that a face's read as slices (the lengths
+        // are so already, `FaceGeometry::x_length`).
         spread_x_volumes(sides, u, x_u);
-        spread_x_volumes(sides, &ea.length, x_length);
-        let (x_u, x_length) = (&x_u[..], &x_length[..]);
+        let x_u = &x_u[..];
         for _ in 0..substeps {
             // Every cell is written below from `before`: the two buffers trade places
             // where the temperature was copied.
@@ -231,10 +239,11 @@ impl FilmFlow {
                     for span in sides.face_spans() {
                         let len = span.len;
                         let u = span_sides(sides, &span, x_u, u);
-                        let l = span_sides(sides, &span, x_length, &ea.length);
+                        let l = span_sides_on_face(&span, &fg.x_length, &fg.length.face);
                         let across: [&[f64]; 4] =
                             std::array::from_fn(|k| &before[span.neighbours(k)]);
-                        let (own, pa) = (&before[span.cells()], &per_area[span.cells()]);
+                        let own = &before[span.cells()];
+                        let pa = span.on_face(&fg.inverse_area_per_sr);
                         let out = &mut theta[span.cells()];
                         for i in 0..len {
                             let sides = Inflow {
@@ -255,8 +264,8 @@ impl FilmFlow {
                             inflow: rim.inflow(i),
                         };
                         let across = rim.at_neighbours(i, before);
-                        theta[c] =
-                            before[c] + inflow.warming(scale * per_area[c], across, before[c]);
+                        let per_area = rim.inverse_area[i];
+                        theta[c] = before[c] + inflow.warming(scale * per_area, across, before[c]);
                     }
                 },
             );
@@ -274,7 +283,7 @@ impl FilmFlow {
         let per = 2.0 * p.thermal.tension_per_kelvin_n_per_m_k * dt_s
             / (p.density_kg_per_m3 * p.radius_m);
         let g = &self.grid;
-        let ea = g.edge_arrays();
+        let (ea, fg) = (g.edge_arrays(), g.face_geometry());
         let (theta, h) = (&self.temperature_k, &self.h_m);
         match p.gradient {
             FilmGradient::TwoPoint => {
@@ -285,7 +294,7 @@ impl FilmFlow {
                         let len = run.len;
                         let ((ta, tb), (ha, hb)) = (run.ends(theta), run.ends(h));
                         let (ta, tb, ha, hb) = (&ta[..len], &tb[..len], &ha[..len], &hb[..len]);
-                        let id = &run.along(&ea.inverse_dual_length)[..len];
+                        let id = &run.constant(&fg.inverse_dual_length)[..len];
                         let u = run.along_mut(u);
                         for i in 0..len {
                             u[i] += push(per, [ta[i], tb[i]], [ha[i], hb[i]], id[i]);
@@ -294,7 +303,7 @@ impl FilmFlow {
                 );
                 // The seams one by one (the thermal film's own pass, not worth gathering).
                 let seams = sides.seams();
-                let id = seams.values(&ea.inverse_dual_length);
+                let id = seams.constant(&fg.inverse_dual_length);
                 let u = seams.values_mut(u);
                 for (i, u) in u.iter_mut().enumerate() {
                     let (t, h) = (seams.ends(i, theta), seams.ends(i, h));

@@ -10,9 +10,10 @@
 use glam::DVec3;
 
 use super::compare::{larger, largest};
+use super::face_geometry::FaceGeometry;
 use super::flow::{FilmFlow, Scratch};
 use super::fluxes::apply_limited;
-use super::grid::{EdgeArrays, dot_at};
+use super::grid::dot_at;
 use super::sides::{EdgeBlock, SeamEnds};
 use super::upwind;
 use crate::avx2::with_avx2;
@@ -31,47 +32,43 @@ impl FilmFlow {
         } else {
             0.0
         };
+        let drain = Drain { drain, g_eff };
         // `edge2` is the sub-steps' volumes: free until they start.
-        let buffers = (&mut s.drain_rate, &mut s.edge2, &mut s.seam_ends);
-        let courant = self.drain_rates_and_courant(buffers, drain, g_eff, dt_s);
+        let courant = self.courant((&mut s.edge2, &mut s.seam_ends), drain, dt_s);
         // A cell drains through at most two edges of a smooth flow: 2·courant per step, kept
         // within one sub-step's content; the outflow limit guards the rest.
         let substeps = (2.0 * courant).ceil().clamp(1.0, f64::from(MAX_SUBSTEPS)) as u32;
         let h_dt = dt_s / f64::from(substeps);
         for _ in 0..substeps {
-            self.upwind_substep(s, h_dt);
+            self.upwind_substep(s, h_dt, drain);
         }
     }
 
-    /// Each edge's drainage coefficient `c = drain·g_eff·n` into `drain_rate` (fixed over
-    /// the step: each sub-step's flux is `u·h + c·h³`), and the largest fraction of a
-    /// cell's width any edge's characteristic speed, `|u|` plus the drainage's `3|c|h²`,
-    /// carries over `dt_s`: one pass over the edges.
-    fn drain_rates_and_courant(
+    /// The largest fraction of a cell's width any edge's characteristic speed, `|u|` plus
+    /// the drainage's `3|c|h²` (`c` its coefficient, [`DrainAlong::at`]), carries over
+    /// `dt_s`: one pass over the edges, their speeds into `speed`.
+    fn courant(
         &self,
-        (drain_rate, speed, seam_ends): (&mut Vec<f64>, &mut Vec<f64>, &mut SeamEnds),
-        drain: f64,
-        g_eff: DVec3,
+        (speed, seam_ends): (&mut Vec<f64>, &mut SeamEnds),
+        drain: Drain,
         dt_s: f64,
     ) -> f64 {
-        let ea = self.grid.edge_arrays();
+        let fg = self.grid.face_geometry();
         let (h, u) = (&self.h_m, &self.u_m_per_s);
-        // Every entry is written below: the buffers need their lengths, not a fill.
-        drain_rate.resize(u.len(), 0.0);
+        // Every entry is written below: the buffer needs its length, not a fill.
         speed.resize(u.len(), 0.0);
-        let drain = (drain, g_eff);
         self.sides.for_each_edge_run(
             #[inline(always)]
             |run| {
                 let (ha, hb) = run.ends(h);
-                courant_block(run, [ha, hb], (ea, u), drain, (drain_rate, speed));
+                courant_block(run, [ha, hb], (fg, u), drain, speed);
             },
         );
         let seams = self.sides.seams();
         let ends = seam_ends.gather(seams, h);
         with_avx2(
             #[inline(always)]
-            || courant_block(seams, ends, (ea, u), drain, (drain_rate, speed)),
+            || courant_block(seams, ends, (fg, u), drain, speed),
         );
         // The speeds' maximum in a pass of its own: taken in the loop above, the
         // compiler vectorised neither.
@@ -83,7 +80,7 @@ impl FilmFlow {
     /// midpoint and clamped between the two cells' values), outflow-limited. Four passes,
     /// each structured inside the faces ([`super::upwind`]).
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
-    fn upwind_substep(&mut self, s: &mut Scratch, dt_s: f64) {
+    fn upwind_substep(&mut self, s: &mut Scratch, dt_s: f64, drain: Drain) {
         let (sides, geo) = (&*self.sides, &*self.transport);
         let dt_per_r = dt_s / self.params.radius_m;
         with_avx2(
@@ -93,40 +90,82 @@ impl FilmFlow {
                 upwind::limited_rises(sides, geo, &self.h_m, rises);
                 let speeds = upwind::EdgeSpeeds {
                     u: &self.u_m_per_s,
-                    drain_rate: &s.drain_rate,
+                    drain,
                     dt_per_r,
                 };
-                let ea = self.grid.edge_arrays();
+                let fg = self.grid.face_geometry();
                 let volume = (&mut s.edge2, &mut s.seam_ends);
-                upwind::volumes(sides, ea, &self.h_m, &s.limited_rise, speeds, volume);
-                let (areas, per_area) = (self.grid.areas_sr(), self.grid.inverse_areas_per_sr());
+                upwind::volumes(sides, fg, &self.h_m, &s.limited_rise, speeds, volume);
                 let (volume, h) = (&s.edge2, &mut self.h_m);
-                apply_limited(sides, areas, per_area, volume, 1.0, h, &mut s.gather);
+                apply_limited(sides, &self.grid, volume, 1.0, h, &mut s.gather);
             },
         )
     }
 }
 
-/// [`FilmFlow::drain_rates_and_courant`]'s pass over a block of edges with thicknesses
-/// `[ha, hb]` at their ends: the drainage coefficients into `c`, the edges' speeds into
-/// `speed`.
+/// [`FilmFlow::courant`]'s pass over a block of edges with thicknesses `[ha, hb]` at
+/// their ends: the edges' speeds into `speed`.
 #[inline(always)]
 fn courant_block(
     block: impl EdgeBlock,
     [ha, hb]: [&[f64]; 2],
-    (ea, u): (&EdgeArrays, &[f64]),
-    (drain, g_eff): (f64, DVec3),
-    (c, speed): (&mut [f64], &mut [f64]),
+    (fg, u): (&FaceGeometry, &[f64]),
+    drain: Drain,
+    speed: &mut [f64],
 ) {
     let len = block.count();
     let (ha, hb, u) = (&ha[..len], &hb[..len], block.values(u));
-    let per_area = block.values(&ea.length_per_smaller_area);
-    let [nx, ny, nz] = &ea.normal_xyz;
-    let normal = [block.values(nx), block.values(ny), block.values(nz)];
-    let (c, speed) = (block.values_mut(c), block.values_mut(speed));
+    let per_area = block.constant(&fg.length_per_smaller_area);
+    let rate = drain.along(&block, fg);
+    let speed = block.values_mut(speed);
     for i in 0..len {
-        c[i] = drain * dot_at(g_eff, normal, i);
-        speed[i] = edge_speed(u[i], c[i], ha[i], hb[i], per_area[i]);
+        speed[i] = edge_speed(u[i], rate.at(i), ha[i], hb[i], per_area[i]);
+    }
+}
+
+/// The drainage: its speed `c·h²` and flux `c·h³` along an edge's normal, with
+/// `c = drain·g_eff·n` fixed over the step.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Drain {
+    /// `ρ/(3μ_d)`, s/m² (0 without drainage): times `g_eff·n`, the coefficient `c`.
+    pub(crate) drain: f64,
+    /// Gravity minus the bubble's acceleration, m/s².
+    pub(crate) g_eff: DVec3,
+}
+
+/// [`Drain`]'s coefficients along a block of edges, from their normals in the block's
+/// frame with gravity taken into it ([`EdgeBlock::frame`]).
+#[derive(Clone, Copy)]
+pub(crate) struct DrainAlong<'a> {
+    /// `ρ/(3μ_d)`, s/m².
+    drain: f64,
+    /// Gravity in the block's frame.
+    g: DVec3,
+    /// The edges' normals' components in that frame.
+    normal: [&'a [f64]; 3],
+}
+
+impl Drain {
+    /// The coefficients along `block`.
+    #[inline(always)]
+    pub(crate) fn along<'a>(&self, block: &impl EdgeBlock, fg: &'a FaceGeometry) -> DrainAlong<'a> {
+        let normal = block.vector(&fg.normal);
+        let len = block.count();
+        DrainAlong {
+            drain: self.drain,
+            g: block.frame(self.g_eff),
+            normal: normal.map(|c| &c[..len]),
+        }
+    }
+}
+
+impl DrainAlong<'_> {
+    /// Edge `i`'s `c = drain·g_eff·n`, s⁻¹·m⁻¹: each pass takes it from the normals where
+    /// it read a per-edge array of them (the normals are face 0's, 0.2 MB at n = 64, and
+    /// stay in L2; the array was 0.4 MB, written a step and read every sub-step).
+    #[inline(always)]
+    pub(crate) fn at(&self, i: usize) -> f64 {
+        self.drain * dot_at(self.g, self.normal, i)
     }
 }
 

@@ -11,10 +11,19 @@
 //!    within its budget, and each cell's gathered volumes.
 
 use super::compare::{larger, smaller};
-use super::grid::{CubeSphere, EdgeArrays};
+use super::face_geometry::FaceGeometry;
+use super::grid::CubeSphere;
 use super::sides::{CellSides, EdgeBlock, SeamEnds};
+use super::transport::Drain;
 
-/// The transport's weights, fixed by the grid.
+/// The transport's weights, fixed by the grid: face 0's, which every face reads.
+///
+/// Why face 0's serve every face: the grid is symmetric under the cube's rotations and
+/// the weights are taken side by side in each face's own directions, so every face's are
+/// face 0's to rounding (within 3e-14 of the largest at n = 1, 5, 16 and 64:
+/// `tests::every_faces_rise_weights_are_face_0s`; [`super::face_geometry`]). Six faces'
+/// were 3.1 MB at n = 64, streamed from beyond the core's 1 MB L2 in every sub-step;
+/// one face's are 0.5 MB.
 #[derive(Clone, Debug)]
 pub(crate) struct UpwindGeometry {
     /// `rise[k][j][c]`: the weight of `h_c + h_j` (`j` the cell across side `j`) in the
@@ -22,9 +31,10 @@ pub(crate) struct UpwindGeometry {
     /// gradient `Σ ± n l (h_c + h_j)/2 / A`, projected onto the cell's tangent plane and
     /// dotted with the reach `midpoint − centre`, is linear in the face values, so one
     /// weight per pair of sides stands for the gradient's three components and its
-    /// projection.
+    /// projection. Face 0's cells', `n²` ([`super::sides::CellSpan::on_face`]).
     rise: [[Vec<f64>; 4]; 4],
-    /// The same weights of the rim cells in the rim's order ([`CellSides::rim_cells`]),
+    /// The same weights of face 0's rim cells in the rim's order
+    /// ([`CellSides::rim_cells`]; every face's rim lists its cells at the same places),
     /// so that the rim's rises run on slices like the faces' (its cells' values gathered
     /// first, [`RimRises`]).
     rim_rise: [[Vec<f64>; 4]; 4],
@@ -44,12 +54,19 @@ pub(crate) struct RimRises {
 impl UpwindGeometry {
     /// Derives the weights from `grid` and its cells' `sides`.
     pub(crate) fn new(grid: &CubeSphere, sides: &CellSides) -> Self {
+        Self::with_faces(grid, sides, 1)
+    }
+
+    /// [`Self::new`], with the weights of the first `faces` faces (one is all the
+    /// transport reads; the tests take six to compare them).
+    fn with_faces(grid: &CubeSphere, sides: &CellSides, faces: usize) -> Self {
         let ea = grid.edge_arrays();
-        let cells = grid.cells();
+        let n = grid.face_size();
+        let cells = faces * n * n;
         let mut rise: [[Vec<f64>; 4]; 4] =
             std::array::from_fn(|_| std::array::from_fn(|_| vec![0.0; cells]));
         let inverse_areas = grid.inverse_areas_per_sr();
-        for (c, centre) in grid.centres().iter().enumerate() {
+        for (c, centre) in grid.centres()[..cells].iter().enumerate() {
             let side_edge = |k: usize| sides.edge[c][k] as usize;
             let outward = |k: usize| if sides.is_a[c][k] { 1.0 } else { -1.0 };
             for (k, rise_k) in rise.iter_mut().enumerate() {
@@ -62,7 +79,8 @@ impl UpwindGeometry {
                 }
             }
         }
-        let rim = |w: &Vec<f64>| sides.rim_cells.iter().map(|&c| w[c as usize]).collect();
+        let rim_cells = &sides.rim_cells[..sides.rim_cells.len() / 6 * faces];
+        let rim = |w: &Vec<f64>| rim_cells.iter().map(|&c| w[c as usize]).collect();
         let rim_rise = std::array::from_fn(|k| std::array::from_fn(|j| rim(&rise[k][j])));
         Self { rise, rim_rise }
     }
@@ -124,7 +142,7 @@ pub(crate) fn limited_rises(
     for span in sides.face_spans() {
         let cells = span.cells();
         let [o0, o1, o2, o3] = out.each_mut().map(|o| &mut o[cells.clone()]);
-        let w = |k: usize, j: usize| &geo.rise[k][j][cells.clone()];
+        let w = |k: usize, j: usize| span.on_face(&geo.rise[k][j]);
         let w = [0, 1, 2, 3].map(|k| [w(k, 0), w(k, 1), w(k, 2), w(k, 3)]);
         let nb = [0, 1, 2, 3].map(|j| &h[span.neighbours(j)]);
         rises_run(w, &h[cells.clone()], nb, [o0, o1, o2, o3]);
@@ -142,19 +160,19 @@ pub(crate) fn limited_rises(
     for r in rise.iter_mut() {
         r.resize(m, 0.0);
     }
+    // A face's rim at a time, each with face 0's weights.
+    let per_face = m / 6;
     let w = geo
         .rim_rise
         .each_ref()
-        .map(|w| w.each_ref().map(|w| &w[..m]));
-    let nb = neighbour.each_ref().map(|x| &x[..m]);
-    let [r0, r1, r2, r3] = rise;
-    rises_run(
-        w,
-        &own[..m],
-        nb,
-        [&mut r0[..m], &mut r1[..m], &mut r2[..m], &mut r3[..m]],
-    );
-    for (o, r) in out.iter_mut().zip([&*r0, &*r1, &*r2, &*r3]) {
+        .map(|w| w.each_ref().map(|w| &w[..per_face]));
+    for face in 0..6 {
+        let at = face * per_face..(face + 1) * per_face;
+        let nb = neighbour.each_ref().map(|x| &x[at.clone()]);
+        let out = rise.each_mut().map(|r| &mut r[at.clone()]);
+        rises_run(w, &own[at.clone()], nb, out);
+    }
+    for (o, r) in out.iter_mut().zip(&*rise) {
         for (&c, &r) in rim.cells.iter().zip(r) {
             o[c as usize] = r;
         }
@@ -216,8 +234,8 @@ fn rise_run(w: [&[f64]; 4], h: &[f64], nb: [&[f64]; 4], out: &mut [f64]) {
 pub(crate) struct EdgeSpeeds<'a> {
     /// Per edge: the surfaces' speed, m/s.
     pub(crate) u: &'a [f64],
-    /// Per edge: the drainage speed's coefficient over `h²`, s⁻¹·m⁻¹.
-    pub(crate) drain_rate: &'a [f64],
+    /// The drainage ([`Drain`]: its coefficient over `h²` from each edge's normal).
+    pub(crate) drain: Drain,
     /// The sub-step over the sphere's radius, s/m.
     pub(crate) dt_per_r: f64,
 }
@@ -255,22 +273,22 @@ fn edge_volume([ha, hb]: [f64; 2], [ra, rb]: [f64; 2], [u, c, l]: [f64; 3], dt_p
 #[inline(always)]
 pub(crate) fn volumes(
     sides: &CellSides,
-    ea: &EdgeArrays,
+    fg: &FaceGeometry,
     h: &[f64],
     rise: &[Vec<f64>; 4],
     speeds: EdgeSpeeds,
     (volume, seam_ends): (&mut Vec<f64>, &mut SeamEnds),
 ) {
-    volume.resize(ea.cells.len(), 0.0);
+    volume.resize(speeds.u.len(), 0.0);
     for run in &sides.edge_runs {
         let [ka, kb] = run.sides;
         let (ra, rb) = (&rise[ka][run.a_cells()], &rise[kb][run.b_cells()]);
         let (ha, hb) = run.ends(h);
-        volumes_block(*run, [ha, hb], [ra, rb], (ea, speeds), volume);
+        volumes_block(*run, [ha, hb], [ra, rb], (fg, speeds), volume);
     }
     let seams = sides.seams();
     let [h_ends, rises] = seam_ends.gather_with_sides(seams, h, rise);
-    volumes_block(seams, h_ends, rises, (ea, speeds), volume);
+    volumes_block(seams, h_ends, rises, (fg, speeds), volume);
 }
 
 /// [`volumes`] over a block of edges, with their ends' thicknesses and rises.
@@ -279,15 +297,15 @@ fn volumes_block(
     block: impl EdgeBlock,
     [ha, hb]: [&[f64]; 2],
     [ra, rb]: [&[f64]; 2],
-    (ea, speeds): (&EdgeArrays, EdgeSpeeds),
+    (fg, speeds): (&FaceGeometry, EdgeSpeeds),
     volume: &mut [f64],
 ) {
     let len = block.count();
-    let (u, c) = (block.values(speeds.u), block.values(speeds.drain_rate));
-    let (l, out) = (block.values(&ea.length), block.values_mut(volume));
+    let (u, c) = (block.values(speeds.u), speeds.drain.along(&block, fg));
+    let (l, out) = (block.constant(&fg.length), block.values_mut(volume));
     let (ha, hb, ra, rb) = (&ha[..len], &hb[..len], &ra[..len], &rb[..len]);
     for i in 0..len {
-        let speed = [u[i], c[i], l[i]];
+        let speed = [u[i], c.at(i), l[i]];
         out[i] = edge_volume([ha[i], hb[i]], [ra[i], rb[i]], speed, speeds.dt_per_r);
     }
 }
@@ -303,7 +321,7 @@ mod tests {
     fn the_rise_weights_give_the_projected_green_gauss_gradient() {
         let grid = CubeSphere::new(6);
         let sides = CellSides::new(&grid);
-        let geo = UpwindGeometry::new(&grid, &sides);
+        let geo = UpwindGeometry::with_faces(&grid, &sides, 6);
         let ea = grid.edge_arrays();
         let h: Vec<f64> = grid
             .centres()
@@ -331,5 +349,45 @@ mod tests {
             }
         }
         assert!(worst < 1e-12, "worst rise difference {worst:.3e}");
+    }
+
+    /// Each face's weights against face 0's, within 3e-14 of the largest of the side's
+    /// four (1.4e-14 at n = 64): a rise sums them against like thicknesses, so an error
+    /// in one counts against the largest (the weights across a side are a few hundredths
+    /// of those along it); and each is made from the reach, midpoint less centre, a
+    /// difference of unit vectors half a cell apart, which carries their rounding up by
+    /// the inverse of that distance.
+    #[test]
+    fn every_faces_rise_weights_are_face_0s() {
+        for n in [1, 5, 16, 64] {
+            let grid = CubeSphere::new(n);
+            let sides = CellSides::new(&grid);
+            let geo = UpwindGeometry::with_faces(&grid, &sides, 6);
+            for k in 0..4 {
+                for (what, w) in [("rise", &geo.rise[k]), ("rim rise", &geo.rim_rise[k])] {
+                    let face = w[0].len() / 6;
+                    let largest = w.iter().flat_map(|w| &w[..face]);
+                    let largest = largest.fold(0.0, |m: f64, x| m.max(x.abs()));
+                    for (j, w) in w.iter().enumerate() {
+                        let what = format!("n = {n}, {what}[{k}][{j}]");
+                        assert_faces_alike(&what, w, largest);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Every face's sixth of `w` is the first face's within 3e-14 of `largest`.
+    fn assert_faces_alike(what: &str, w: &[f64], largest: f64) {
+        let face = w.len() / 6;
+        let (first, rest) = w.split_at(face);
+        assert!(largest > 0.0, "{what}: no weights");
+        for (i, (a, b)) in first.iter().cycle().zip(rest).enumerate() {
+            let (f, at) = (1 + i / face, i % face);
+            assert!(
+                (a - b).abs() <= 3e-14 * largest,
+                "{what}: face {f}'s [{at}] {b} against face 0's {a} (largest {largest})"
+            );
+        }
     }
 }
