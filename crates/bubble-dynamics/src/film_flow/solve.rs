@@ -8,7 +8,11 @@
 //!
 //! Every level is held in a padded, colour-split layout (`layout`): each face ringed by
 //! halo copies of its neighbours' cells, and the cells split by parity into two arrays,
-//! so that every loop is one pass over contiguous slices. The smoother is red–black
+//! so that every loop is one pass over contiguous slices. Its edge weights are held once
+//! an edge, each cell's RIGHT and TOP ones (a cell reads its LEFT and BOTTOM ones from
+//! its neighbours' entries, the halo's holding the seams'), and the passes that are not
+//! a half-sweep take both colours a block at a time, so that an entry is streamed in
+//! once for both of its cells. The smoother is red–black
 //! Gauss–Seidel in that layout: each half-sweep updates one colour from the other's
 //! values. Where a seam joins two cells of one colour (the faces' chequerboards do not
 //! all agree across the cube's edges), the half-sweep reads its neighbour's value from
@@ -31,8 +35,8 @@ use super::sides::{BOTTOM, CellSides, LEFT, RIGHT, TOP};
 use crate::avx2::with_avx2;
 use dense::{dense_cholesky, dense_solve};
 use kernels::{
-    Stencil, correct, dot, gather_row, operator, refresh, refresh_all, relax, relax_from_zero,
-    restrict, scatter_row, update_and_norm2, widen_and_dot,
+    NOT_A_CELL, Stencil, correct, dot, gather_row, operator, refresh, refresh_all, relax,
+    relax_from_zero, restrict, rounded_level, scatter_row, update_and_norm2, widen_and_dot,
 };
 use layout::Layout;
 
@@ -41,7 +45,7 @@ use layout::Layout;
 /// generic over it, each an IEEE operation in a fixed order in either.
 trait Real:
     Copy
-    + PartialEq
+    + PartialOrd
     + std::ops::Add<Output = Self>
     + std::ops::Sub<Output = Self>
     + std::ops::Mul<Output = Self>
@@ -96,10 +100,11 @@ const COARSEST_FACE: usize = 2;
 pub struct Hierarchy {
     /// Each level's layout, finest first.
     levels: Vec<Layout>,
-    /// The rim cells' seam edges, in the order the finest level's weights are filled
-    /// in (the rest of a face row's edges are a slice): read from a table by cell, each
-    /// was a cache miss.
-    seam_edges: Vec<u32>,
+    /// Per weight field ([`RIGHT_W`](layout::RIGHT_W), [`TOP_W`](layout::TOP_W)), the finest level's entries that hold a
+    /// seam edge's weight, as `(position, edge)` in increasing position: the rim cells'
+    /// RIGHT or TOP entries and the halo's (the rest of a face row's weights are a slice
+    /// of the grid's edges).
+    seam_weights: [Vec<[u32; 2]>; 2],
 }
 
 /// The numbers of one system: per level, the mass term and the edge weights.
@@ -129,8 +134,9 @@ pub struct Hierarchy {
 /// the faces stay zero where the conjugate gradients' dot products would see them.
 #[derive(Clone, Debug, Default)]
 pub struct Work {
-    /// Per level, the mass term and the edge weights in `f64`: the finest level's the
-    /// conjugate gradients' operator, the others what the V-cycle's are rounded from.
+    /// Per level, the mass term ([`NOT_A_CELL`] outside the cells) and the edge weights
+    /// ([`Stencil`]) in `f64`: the finest level's the conjugate gradients' operator, the
+    /// others what the V-cycle's are rounded from.
     mass: Vec<Vec<f64>>,
     stencil: Vec<Stencil<f64>>,
     /// The coarsest level's Cholesky factor, of the system as scaled for the V-cycle
@@ -142,7 +148,7 @@ pub struct Work {
     /// The power of two the V-cycle's system is scaled by (1 where there is one level).
     scale: f64,
     /// Per level but the coarsest, in `f32` and scaled by [`Work::scale`]: the mass
-    /// term, the inverse diagonal (zero at the halo) and the edge weights.
+    /// term, the inverse diagonal (zero outside the cells) and the edge weights.
     mass32: Vec<Vec<f32>>,
     inv_diag: Vec<Vec<f32>>,
     stencil32: Vec<Stencil<f32>>,
@@ -198,9 +204,10 @@ impl Hierarchy {
             levels.push(coarse);
             n /= 2;
         }
+        let seam_weights = seam_weights(&levels[0], &sides);
         Self {
             levels,
-            seam_edges: seam_edges(&sides),
+            seam_weights,
         }
     }
 
@@ -391,9 +398,9 @@ impl Hierarchy {
         work.residual.resize(count, Vec::new());
         work.correction.resize(count, Vec::new());
         for (k, level) in self.levels.iter().enumerate() {
-            work.mass[k].resize(level.len(), 0.0);
+            sized(&mut work.mass[k], level.len(), NOT_A_CELL);
             for w in &mut work.stencil[k] {
-                w.resize(level.len(), 0.0);
+                sized(w, level.len(), 0.0);
             }
             work.residual[k].resize(level.len(), 0.0);
             work.correction[k].resize(level.len(), 0.0);
@@ -410,9 +417,11 @@ impl Hierarchy {
         work.scale = if count == 1 {
             1.0
         } else {
-            let first = self.levels[0].position[0] as usize;
-            let [w0, w1, w2, w3] = &work.stencil[0];
-            let diagonal = work.mass[0][first] + w0[first] + w1[first] + w2[first] + w3[first];
+            let fine = &self.levels[0];
+            let w = &work.stencil[0];
+            let [w0, w1, w2, w3] = fine.side_weights(0).map(|(field, p)| w[field][p]);
+            let first = work.mass[0][fine.position[0] as usize];
+            let diagonal = first + w0 + w1 + w2 + w3;
             power_of_two_below(diagonal).recip()
         };
         self.round_for_the_v_cycle(work);
@@ -428,27 +437,33 @@ impl Hierarchy {
     }
 
     /// The finest level's mass term and weights from the grid's cells and edges, a face
-    /// row at a time: a row of weights is a slice ([`inside_a_face`]) but for the seam
-    /// edges at its ends ([`Hierarchy::seam_edges`]).
+    /// row at a time: a row's RIGHT weights but the last and its TOP weights (but the top
+    /// row's) are a slice of the grid's edges ([`inside_a_face`]); then the entries that
+    /// hold seam edges ([`Hierarchy::seam_weights`]).
     #[inline(always)]
     fn fine_numbers(&self, work: &mut Work, alpha: &[f64], weight: &[f64]) {
         let fine = &self.levels[0];
         let n = fine.m;
         let mut row = std::mem::take(&mut work.row64);
         row.resize(n, 0.0);
-        let mut seams = self.seam_edges.iter();
+        let [right, top] = &mut work.stencil[0];
         for face in 0..6 {
             for y in 0..n {
                 let alpha_row = &alpha[(face * n + y) * n..][..n];
                 scatter_row(fine, face, y, alpha_row, &mut work.mass[0]);
-                for k in 0..4 {
-                    let (xs, first) = inside_a_face(n, face, y, k);
-                    row[xs.clone()].copy_from_slice(&weight[first..][..xs.len()]);
-                    for x in (0..xs.start).chain(xs.end..n) {
-                        row[x] = weight[*seams.next().expect("a seam edge") as usize];
-                    }
-                    scatter_row(fine, face, y, &row, &mut work.stencil[0][k]);
+                // The last cell's RIGHT entry is a seam's, written below.
+                let (xs, first) = inside_a_face(n, face, y, RIGHT);
+                row[xs.clone()].copy_from_slice(&weight[first..][..xs.len()]);
+                scatter_row(fine, face, y, &row, right);
+                let (xs, first) = inside_a_face(n, face, y, TOP);
+                if !xs.is_empty() {
+                    scatter_row(fine, face, y, &weight[first..][..n], top);
                 }
+            }
+        }
+        for (field, seams) in [right, top].into_iter().zip(&self.seam_weights) {
+            for &[p, e] in seams {
+                field[p as usize] = weight[e as usize];
             }
         }
         work.row64 = row;
@@ -456,40 +471,27 @@ impl Hierarchy {
 
     /// The smoothed levels' numbers scaled by [`Work::scale`] and rounded to `f32`, the
     /// inverse diagonal summed in `f64` from the unrounded numbers and rounded once (zero
-    /// where there is no diagonal: the halo).
+    /// outside the cells: [`rounded_level`]).
     #[inline(always)]
     fn round_for_the_v_cycle(&self, work: &mut Work) {
         let (scale, smoothed) = (work.scale, self.levels.len() - 1);
         work.mass32.resize(smoothed, Vec::new());
         work.inv_diag.resize(smoothed, Vec::new());
         work.stencil32.resize(smoothed, Stencil::default());
-        for k in 0..smoothed {
-            let (mass, stencil) = (&work.mass[k], &work.stencil[k]);
-            let n = mass.len();
-            let mass = &mass[..n];
-            let [w0, w1, w2, w3] = stencil;
-            let (w0, w1, w2, w3) = (&w0[..n], &w1[..n], &w2[..n], &w3[..n]);
-            let [v0, v1, v2, v3] = &mut work.stencil32[k];
-            for v in [&mut *v0, &mut *v1, &mut *v2, &mut *v3] {
-                v.resize(n, 0.0);
+        for (k, level) in self.levels[..smoothed].iter().enumerate() {
+            let n = level.len();
+            work.mass32[k].resize(n, 0.0);
+            work.inv_diag[k].resize(n, 0.0);
+            for w in &mut work.stencil32[k] {
+                w.resize(n, 0.0);
             }
-            let (v0, v1, v2, v3) = (&mut v0[..n], &mut v1[..n], &mut v2[..n], &mut v3[..n]);
-            let mass32 = &mut work.mass32[k];
-            mass32.resize(n, 0.0);
-            let inv_diag = &mut work.inv_diag[k];
-            inv_diag.resize(n, 0.0);
-            let (mass32, inv_diag) = (&mut mass32[..n], &mut inv_diag[..n]);
-            // One pass over the level's numbers (they are read once, not once an array).
-            for i in 0..n {
-                let d = mass[i] + w0[i] + w1[i] + w2[i] + w3[i];
-                (v0[i], v1[i]) = ((scale * w0[i]) as f32, (scale * w1[i]) as f32);
-                (v2[i], v3[i]) = ((scale * w2[i]) as f32, (scale * w3[i]) as f32);
-                mass32[i] = (scale * mass[i]) as f32;
-                // The halo's zero diagonal stays a zero inverse (a select, so the loop
-                // vectorises: the division by zero's infinity is dropped, not trapped).
-                let inv = (1.0 / (scale * d)) as f32;
-                inv_diag[i] = if d > 0.0 { inv } else { 0.0 };
-            }
+            rounded_level(
+                level,
+                scale,
+                (&work.mass[k], &work.stencil[k]),
+                (&mut work.mass32[k], &mut work.stencil32[k]),
+                &mut work.inv_diag[k],
+            );
         }
     }
 
@@ -600,22 +602,32 @@ fn inside_a_face(n: usize, face: usize, y: usize, k: usize) -> (std::ops::Range<
     }
 }
 
-/// The seam edges of the cells on the faces' rims, in the order
-/// `Hierarchy::fine_numbers` visits them (face, row, side, cell).
-fn seam_edges(sides: &CellSides) -> Vec<u32> {
+/// [`Hierarchy::seam_weights`] of the finest level `fine`: each rim cell's sides on a
+/// seam, at the entries [`Layout::side_weights`] names.
+fn seam_weights(fine: &Layout, sides: &CellSides) -> [Vec<[u32; 2]>; 2] {
     let n = sides.n();
-    let mut seams = Vec::new();
-    for face in 0..6 {
-        for y in 0..n {
-            for k in 0..4 {
-                let (xs, _) = inside_a_face(n, face, y, k);
-                for x in (0..xs.start).chain(xs.end..n) {
-                    seams.push(sides.edge[(face * n + y) * n + x][k]);
-                }
+    let mut seams = [Vec::new(), Vec::new()];
+    for (c, edges) in sides.edge.iter().enumerate() {
+        let (x, y, face) = (c % n, (c / n) % n, c / (n * n));
+        for (k, (field, p)) in fine.side_weights(c).into_iter().enumerate() {
+            if !inside_a_face(n, face, y, k).0.contains(&x) {
+                seams[field].push([p as u32, edges[k]]);
             }
         }
     }
+    for s in &mut seams {
+        s.sort_unstable();
+    }
     seams
+}
+
+/// `v` at `len` entries, set to `fill` throughout where its length changes (a field of
+/// another level's size holds nothing this one can keep).
+fn sized<T: Copy>(v: &mut Vec<T>, len: usize, fill: T) {
+    if v.len() != len {
+        v.clear();
+        v.resize(len, fill);
+    }
 }
 
 /// `out` = the grid-numbered `values` in `layout`'s split arrays (the halo untouched).
@@ -664,6 +676,7 @@ fn power_of_two_below(x: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use super::layout::{RIGHT_W, TOP_W};
     use super::*;
     use crate::film_flow::grid::parent_cell;
 
@@ -845,11 +858,13 @@ mod tests {
         assert!(worst < 1e-8, "error {worst}");
     }
 
-    /// Every level's numbers as the grid's cells and edges give them: the finest
-    /// level's mass term and side weights at each cell's position (zero elsewhere), and
-    /// each coarser level's mass the sum of its four children's, its side weights the
-    /// same number seen from both cells of an edge (the matrix symmetric to the bit),
-    /// half the two fine weights along the side.
+    /// Every level's numbers as the grid's cells and edges give them, each side's weight
+    /// read where [`Layout::side_weights`] names: the finest level's mass term and side
+    /// weights at each cell's position, and each coarser level's mass the sum of its four
+    /// children's, its side weights half the two fine weights along the side, and the
+    /// same number seen from both cells of an edge (the matrix symmetric to the bit);
+    /// outside the cells, the mass term [`NOT_A_CELL`] and every weight entry no cell
+    /// reads zero.
     #[test]
     fn each_level_holds_the_grids_numbers_at_its_cells() {
         for n in [3, 6, 16] {
@@ -863,19 +878,23 @@ mod tests {
             h.prepare(&mut work, &alpha, &weight);
             let fine = &h.levels[0];
             let sides = CellSides::new(&grid);
-            let mut expected_mass = vec![0.0; fine.len()];
-            let mut expected_w: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; fine.len()]);
             for (c, &p) in fine.position.iter().enumerate() {
-                expected_mass[p as usize] = alpha[c];
-                for k in 0..4 {
-                    expected_w[k][p as usize] = weight[sides.edge[c][k] as usize];
+                assert_eq!(work.mass[0][p as usize], alpha[c], "n {n} cell {c}");
+                for (k, (field, q)) in fine.side_weights(c).into_iter().enumerate() {
+                    let expected = weight[sides.edge[c][k] as usize];
+                    assert_eq!(work.stencil[0][field][q], expected, "n {n} {c} side {k}");
                 }
             }
-            assert_eq!(work.mass[0], expected_mass, "n {n}");
-            assert_eq!(work.stencil[0], expected_w, "n {n}");
+            for (k, level) in h.levels.iter().enumerate() {
+                outside_the_cells_nothing_is_read(level, &work.mass[k], &work.stencil[k]);
+            }
             for k in 1..h.levels.len() {
                 let (fine, coarse) = (&h.levels[k - 1], &h.levels[k]);
-                let (mass, w) = (&work.mass[k], &work.stencil[k]);
+                let side = |level: &Layout, w: &Stencil<f64>, c: usize, s: usize| {
+                    let (field, q) = level.side_weights(c)[s];
+                    w[field][q]
+                };
+                let mass = &work.mass[k];
                 let mut children = vec![0.0; coarse.position.len()];
                 let mut child_side = vec![[0.0; 4]; coarse.position.len()];
                 let m = fine.m;
@@ -884,25 +903,83 @@ mod tests {
                     children[parent] += work.mass[k - 1][p as usize];
                     let (x, y) = (c % m, (c / m) % m);
                     let on = [x % 2 == 0, x % 2 == 1, y % 2 == 0, y % 2 == 1];
-                    for side in 0..4 {
-                        if on[side] {
-                            child_side[parent][side] += 0.5 * work.stencil[k - 1][side][p as usize];
+                    for s in 0..4 {
+                        if on[s] {
+                            child_side[parent][s] += 0.5 * side(fine, &work.stencil[k - 1], c, s);
                         }
                     }
                 }
+                let w = &work.stencil[k];
                 for (c, &p) in coarse.position.iter().enumerate() {
                     let p = p as usize;
                     let rel = (mass[p] - children[c]).abs() / children[c];
                     assert!(rel < 1e-15, "n {n} level {k} cell {c}: {rel:e}");
-                    for side in 0..4 {
-                        let rel = (w[side][p] - child_side[c][side]).abs() / child_side[c][side];
-                        assert!(rel < 1e-15, "n {n} level {k} cell {c} side {side}: {rel:e}");
-                        let j = coarse.neighbour[c][side] as usize;
-                        let back = (0..4).find(|&s| coarse.neighbour[j][s] as usize == c);
+                    for (s, expected) in child_side[c].into_iter().enumerate() {
+                        let got = side(coarse, w, c, s);
+                        let rel = (got - expected).abs() / expected;
+                        assert!(rel < 1e-15, "n {n} level {k} cell {c} side {s}: {rel:e}");
+                        let j = coarse.neighbour[c][s] as usize;
+                        let back = (0..4).find(|&b| coarse.neighbour[j][b] as usize == c);
                         let back = back.expect("the neighbour's side back");
-                        let q = coarse.position[j] as usize;
-                        assert_eq!(w[side][p].to_bits(), w[back][q].to_bits(), "n {n} {c}-{j}");
+                        let there = side(coarse, w, j, back);
+                        assert_eq!(got.to_bits(), there.to_bits(), "n {n} {c}-{j}");
                     }
+                }
+            }
+        }
+    }
+
+    /// The operator applies the grid's system at every cell, through the halo and the
+    /// weights held once an edge, and gives zero at every other position (there the
+    /// weight entries hold seam weights, the values halo copies).
+    #[test]
+    fn the_operator_applies_the_grids_system_and_gives_zero_outside_the_cells() {
+        for n in [1, 3, 6, 16] {
+            let grid = CubeSphere::new(n);
+            let h = Hierarchy::new(&grid);
+            let cells = grid.cells();
+            let alpha: Vec<f64> = (0..cells).map(|c| 1.0 + (c % 7) as f64).collect();
+            let weight: Vec<f64> = (0..grid.edges().len())
+                .map(|e| 10.0 + (e % 13) as f64)
+                .collect();
+            let x: Vec<f64> = (0..cells).map(|c| ((c * 37) % 11) as f64 - 5.0).collect();
+            let mut work = Work::default();
+            h.prepare(&mut work, &alpha, &weight);
+            let fine = &h.levels[0];
+            let mut xs = Vec::new();
+            to_split(fine, &x, &mut xs);
+            refresh_all(fine, &mut xs);
+            let none = vec![0.0; fine.len()];
+            let mut out = vec![f64::NAN; fine.len()];
+            let (mass, w) = (&work.mass[0], &work.stencil[0]);
+            operator::<f64, false>(fine, mass, w, &none, &xs, &mut out);
+            let expected = grid_apply(&grid, &alpha, &weight, &x);
+            for (c, &p) in fine.position.iter().enumerate() {
+                let err = (out[p as usize] - expected[c]).abs();
+                assert!(err <= 1e-12 * expected[c].abs().max(1.0), "n {n} cell {c}");
+            }
+            for (p, v) in out.iter().enumerate() {
+                assert!(fine.is_cell(p) || *v == 0.0, "n {n} position {p}: {v}");
+            }
+        }
+    }
+
+    /// A level's mass term is [`NOT_A_CELL`] at every position outside its cells, and
+    /// its weight fields zero at every entry that no cell's side reads.
+    fn outside_the_cells_nothing_is_read(level: &Layout, mass: &[f64], w: &Stencil<f64>) {
+        let mut read = [vec![false; level.len()], vec![false; level.len()]];
+        for c in 0..level.position.len() {
+            for (field, q) in level.side_weights(c) {
+                read[field][q] = true;
+            }
+        }
+        for p in 0..level.len() {
+            if !level.is_cell(p) {
+                assert_eq!(mass[p], NOT_A_CELL, "m {} position {p}", level.m);
+            }
+            for field in [RIGHT_W, TOP_W] {
+                if !read[field][p] {
+                    assert_eq!(w[field][p], 0.0, "m {} field {field} at {p}", level.m);
                 }
             }
         }
