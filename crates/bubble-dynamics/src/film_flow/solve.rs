@@ -36,7 +36,8 @@ use crate::avx2::with_avx2;
 use dense::{dense_cholesky, dense_solve};
 use kernels::{
     NOT_A_CELL, Stencil, correct, dot, gather_row, operator, refresh, refresh_all, relax,
-    relax_from_zero, restrict, rounded_level, scatter_row, update_and_norm2, widen_and_dot,
+    relax_from_zero, residuals, restrict, rounded_level, scatter_row, update_and_norm2,
+    update_direction, widened_dot,
 };
 use layout::Layout;
 
@@ -162,10 +163,13 @@ pub struct Work {
     row: Vec<f32>,
     /// One face row of the finest level's numbers.
     row64: Vec<f64>,
+    /// The conjugate gradients' residual, direction and the operator's product with it
+    /// (at the start, the guess's residual).
     r: Vec<f64>,
-    z: Vec<f64>,
     p: Vec<f64>,
     q: Vec<f64>,
+    /// The preconditioned residual where the finest level is solved densely (in `f64`).
+    z: Vec<f64>,
     /// `b`, `x` and the guess in the finest level's layout.
     b: Vec<f64>,
     x: Vec<f64>,
@@ -295,7 +299,7 @@ impl Hierarchy {
                 }
             },
         );
-        let guess = guess.map(|_| gs.as_mut_slice());
+        let guess = guess.map(|_| &mut gs);
         let report = self.solve_split(work, &bs, &mut xs, guess, limits);
         with_avx2(
             #[inline(always)]
@@ -306,13 +310,14 @@ impl Hierarchy {
     }
 
     /// The conjugate gradients in the finest level's split layout, compiled for AVX2
-    /// where the processor has it ([`with_avx2`]).
+    /// where the processor has it ([`with_avx2`]). Where the guess is taken, it and `x`
+    /// trade places (a swap, not a copy of the field).
     fn solve_split(
         &self,
         work: &mut Work,
         b: &[f64],
-        x: &mut [f64],
-        guess: Option<&mut [f64]>,
+        x: &mut Vec<f64>,
+        guess: Option<&mut Vec<f64>>,
         limits: SolveLimits,
     ) -> SolveReport {
         with_avx2(
@@ -321,25 +326,29 @@ impl Hierarchy {
                 let fine = &self.levels[0];
                 let len = fine.len();
                 let mut r = std::mem::take(&mut work.r);
-                let mut z = std::mem::take(&mut work.z);
                 let mut p = std::mem::take(&mut work.p);
                 let mut q = std::mem::take(&mut work.q);
-                for v in [&mut r, &mut z, &mut p, &mut q] {
+                for v in [&mut r, &mut p, &mut q] {
                     v.resize(len, 0.0);
                 }
                 let (mass, stencil) = (&work.mass[0], &work.stencil[0]);
                 refresh_all(fine, x);
-                operator::<f64, true>(fine, mass, stencil, b, x, &mut r);
+                let mut guess = guess;
+                if let Some(g) = guess.as_mut() {
+                    refresh_all(fine, g);
+                }
+                // Both starts' residuals in one pass over the system: `x`'s into `r`, the
+                // guess's into `q`.
+                let starts = [Some(&x[..]), guess.as_deref().map(|g| &g[..])];
+                residuals(fine, (mass, stencil, b), starts, [&mut r, &mut q]);
                 // Relative to the start's residual: the step's change, not the whole field.
                 let mut start_norm = dot(&r, &r).sqrt();
                 let b_norm = if start_norm > 0.0 { start_norm } else { 1.0 };
                 if let Some(guess) = guess.filter(|_| start_norm > 0.0) {
-                    refresh_all(fine, guess);
-                    operator::<f64, true>(fine, mass, stencil, b, guess, &mut z);
-                    let guess_norm = dot(&z, &z).sqrt();
+                    let guess_norm = dot(&q, &q).sqrt();
                     if guess_norm < start_norm {
-                        x.copy_from_slice(guess);
-                        r.copy_from_slice(&z);
+                        std::mem::swap(x, guess);
+                        std::mem::swap(&mut r, &mut q);
                         start_norm = guess_norm;
                     }
                 }
@@ -349,8 +358,8 @@ impl Hierarchy {
                     start_residual: b_norm,
                 };
                 if report.relative_residual > limits.tolerance {
-                    let mut rz = self.precondition(work, &r, start_norm, &mut z);
-                    p.copy_from_slice(&z);
+                    let (mut rz, back) = self.precondition(work, &r, start_norm);
+                    self.next_direction(work, back, None, &mut p);
                     while report.iterations < limits.max_iterations {
                         let (mass, stencil) = (&work.mass[0], &work.stencil[0]);
                         refresh_all(fine, &mut p);
@@ -363,18 +372,17 @@ impl Hierarchy {
                         let rr = update_and_norm2(step, &p, &q, x, &mut r);
                         report.iterations += 1;
                         report.relative_residual = rr.sqrt() / b_norm;
-                        if report.relative_residual <= limits.tolerance {
+                        let done = report.relative_residual <= limits.tolerance;
+                        if done || report.iterations == limits.max_iterations {
                             break;
                         }
-                        let rz_next = self.precondition(work, &r, rr.sqrt(), &mut z);
+                        let (rz_next, back) = self.precondition(work, &r, rr.sqrt());
                         let beta = rz_next / rz;
                         rz = rz_next;
-                        for (pi, zi) in p.iter_mut().zip(&z) {
-                            *pi = *zi + beta * *pi;
-                        }
+                        self.next_direction(work, back, Some(beta), &mut p);
                     }
                 }
-                (work.r, work.z, work.p, work.q) = (r, z, p, q);
+                (work.r, work.p, work.q) = (r, p, q);
                 report
             },
         )
@@ -497,12 +505,20 @@ impl Hierarchy {
 
     /// `z` = the preconditioner applied to the conjugate gradients' residual `r`, whose
     /// norm is `norm`: one V-cycle in `f32` (see [`Work`]), or the dense solve where the
-    /// finest level is the coarsest; returns `r·z`.
+    /// finest level is the coarsest. Returns `r·z` and the factor `back` that `z` is
+    /// held scaled by: `z = back·z'`, `z'` the V-cycle's answer (in
+    /// [`Work::correction`]) or the dense solve's (in [`Work::z`], `back` 1). `z` is not
+    /// stored in `f64`: [`Hierarchy::next_direction`] forms it again as it reads it.
     #[inline(always)]
-    fn precondition(&self, work: &mut Work, r: &[f64], norm: f64, z: &mut [f64]) -> f64 {
+    fn precondition(&self, work: &mut Work, r: &[f64], norm: f64) -> (f64, f64) {
         if self.levels.len() == 1 {
-            self.coarsest(work, r, z);
-            return dot(r, z);
+            let mut z = std::mem::take(&mut work.z);
+            z.resize(r.len(), 0.0);
+            self.coarsest(work, r, &mut z);
+            // `r·(1·z)`, as `widened_dot` would form it: the same bits.
+            let rz = dot(r, &z);
+            work.z = z;
+            return (rz, 1.0);
         }
         // `M' = scale·M` is the system the V-cycle holds and `r' = to·r` its right-hand
         // side, so `M⁻¹ r = (scale / to)·M'⁻¹ r'`; each factor a power of two, exact.
@@ -512,10 +528,22 @@ impl Hierarchy {
         rounded(to, r, &mut r32);
         let mut z32 = std::mem::take(&mut work.correction[0]);
         self.v_cycle(work, 0, &r32, &mut z32);
-        let rz = widen_and_dot(back, &z32, r, z);
+        let rz = widened_dot(back, &z32, r);
         work.residual[0] = r32;
         work.correction[0] = z32;
-        rz
+        (rz, back)
+    }
+
+    /// The next search direction from the last preconditioned residual `z` (held as
+    /// [`Hierarchy::precondition`] left it, scaled by `back`): `p = z + β·p`, or `p = z`
+    /// for the first (`beta` `None`).
+    #[inline(always)]
+    fn next_direction(&self, work: &Work, back: f64, beta: Option<f64>, p: &mut [f64]) {
+        if self.levels.len() == 1 {
+            update_direction(back, &work.z, beta, p);
+        } else {
+            update_direction(back, &work.correction[0], beta, p);
+        }
     }
 
     /// One symmetric V-cycle on level `k` for residual `r`, result in `z`, in `f32`: three
@@ -814,7 +842,8 @@ mod tests {
     }
 
     /// A guess near the answer saves iterations and meets the same residual target as
-    /// the plain solve from `x`; a guess worse than `x` is not taken.
+    /// the plain solve from `x`, whether it is already within it or still iterates from
+    /// there (from the guess's residual); a guess worse than `x` is not taken.
     #[test]
     fn a_good_guess_saves_iterations_and_a_bad_one_is_ignored() {
         let n = 16;
@@ -841,21 +870,26 @@ mod tests {
             let report = h.solve_with_guess(work, &alpha, &weight, &b, &mut x, guess, limits);
             (report, x)
         };
+        let rough: Vec<f64> = answer.iter().map(|a| a + 1e-3 * (a - 1.0)).collect();
+        let worst = |x: &[f64]| {
+            x.iter()
+                .zip(&answer)
+                .map(|(p, q)| (p - q).abs())
+                .fold(0.0, f64::max)
+        };
         let (plain, _) = solve(None, &mut work);
-        let (guessed, x) = solve(Some(&near), &mut work);
         let (ignored, _) = solve(Some(&far), &mut work);
-        assert!(
-            guessed.iterations < plain.iterations,
-            "{guessed:?} vs {plain:?}"
-        );
-        assert!(guessed.relative_residual <= 1e-6, "{guessed:?}");
         assert_eq!(ignored, plain);
-        let worst = x
-            .iter()
-            .zip(&answer)
-            .map(|(p, q)| (p - q).abs())
-            .fold(0.0, f64::max);
-        assert!(worst < 1e-8, "error {worst}");
+        for (guess, iterating) in [(&near, false), (&rough, true)] {
+            let (guessed, x) = solve(Some(guess), &mut work);
+            assert!(
+                guessed.iterations < plain.iterations,
+                "{guessed:?} vs {plain:?}"
+            );
+            assert_eq!(guessed.iterations > 0, iterating, "{guessed:?}");
+            assert!(guessed.relative_residual <= 1e-6, "{guessed:?}");
+            assert!(worst(&x) < 1e-8, "error {}", worst(&x));
+        }
     }
 
     /// Every level's numbers as the grid's cells and edges give them, each side's weight

@@ -6,7 +6,7 @@
 
 use super::Real;
 use super::layout::{Layout, RIGHT_W, TOP_W};
-use crate::avx2::{dot_lanes, subtract_and_square_lanes, widen_and_dot_lanes};
+use crate::avx2::{dot_lanes, subtract_and_square_lanes, widened_dot_lanes};
 
 /// A level's edge weights once an edge: per cell its RIGHT side's weight
 /// ([`RIGHT_W`]) and its TOP side's ([`TOP_W`]), the left halo column and the bottom
@@ -171,6 +171,38 @@ pub(super) fn operator<T: Real, const RESIDUAL: bool>(
         |start, len| {
             for c in 0..2 {
                 operator_run::<T, RESIDUAL>(layout, c, (start, len), (mass, w, r), x, out);
+            }
+        },
+    );
+}
+
+/// `out = b − (diag(mass) + L_w) x` for each start `x` given ([`operator`]'s residual),
+/// in one pass over the system: each block's numbers are read once for every start.
+#[inline(always)]
+pub(super) fn residuals<T: Real>(
+    layout: &Layout,
+    (mass, w, b): (&[T], &Stencil<T>, &[T]),
+    starts: [Option<&[T]>; 2],
+    outs: [&mut [T]; 2],
+) {
+    let range = both_sweeps(layout);
+    let half = layout.half;
+    let mut pairs: Vec<_> = starts.into_iter().zip(outs).collect();
+    for (_, out) in &mut pairs {
+        for colour in out[..layout.len()].chunks_exact_mut(half) {
+            colour[..range.start].fill(T::ZERO);
+            colour[range.end..].fill(T::ZERO);
+        }
+    }
+    in_blocks(
+        range,
+        #[inline(always)]
+        |start, len| {
+            for (x, out) in &mut pairs {
+                let Some(x) = x else { continue };
+                for c in 0..2 {
+                    operator_run::<T, true>(layout, c, (start, len), (mass, w, b), x, out);
+                }
             }
         },
     );
@@ -481,18 +513,37 @@ pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
 }
 
-/// `z = back·z32` (widened to `f64`) and returns `r·z`, summed as [`dot`] sums, in one
-/// pass.
+/// `r·(back·z32)`, `z32` widened to `f64`, summed as [`dot`] sums
+/// ([`widened_dot_lanes`]): the conjugate gradients' `r·z` without `z` stored in `f64`
+/// ([`update_direction`] forms `back·z32` again as it reads it: the same bits).
 #[inline(always)]
-pub(super) fn widen_and_dot(back: f64, z32: &[f32], r: &[f64], z: &mut [f64]) -> f64 {
+pub(super) fn widened_dot(back: f64, z32: &[f32], r: &[f64]) -> f64 {
     let main = r.len() - r.len() % LANES;
-    let lanes = widen_and_dot_lanes(back, &z32[..main], &r[..main], &mut z[..main]);
+    let lanes = widened_dot_lanes(back, &z32[..main], &r[..main]);
     let mut tail = 0.0;
-    for ((zi, wi), ri) in z[main..].iter_mut().zip(&z32[main..]).zip(&r[main..]) {
-        *zi = back * f64::from(*wi);
-        tail += ri * *zi;
+    for (ri, zi) in r[main..].iter().zip(&z32[main..r.len()]) {
+        tail += ri * (back * f64::from(*zi));
     }
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
+}
+
+/// The conjugate gradients' next direction `p = back·z + β·p`, `z` widened to `f64`, or
+/// `p = back·z` for the first (`beta` `None`).
+#[inline(always)]
+pub(super) fn update_direction<T: Real>(back: f64, z: &[T], beta: Option<f64>, p: &mut [f64]) {
+    let z = &z[..p.len()];
+    match beta {
+        Some(beta) => {
+            for (pi, zi) in p.iter_mut().zip(z) {
+                *pi = back * zi.widen() + beta * *pi;
+            }
+        }
+        None => {
+            for (pi, zi) in p.iter_mut().zip(z) {
+                *pi = back * zi.widen();
+            }
+        }
+    }
 }
 
 /// `x += step·p`, `r −= step·q`, and returns `r·r`, summed as [`dot`] sums: each lane's
