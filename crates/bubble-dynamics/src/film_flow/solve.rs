@@ -12,7 +12,9 @@
 //! an edge, each cell's RIGHT and TOP ones (a cell reads its LEFT and BOTTOM ones from
 //! its neighbours' entries, the halo's holding the seams'), and the passes that are not
 //! a half-sweep take both colours a block at a time, so that an entry is streamed in
-//! once for both of its cells. The smoother is red–black
+//! once for both of its cells. Where the system's faces are alike to the bit (the
+//! Marangoni step's mass term is the cells' areas, the same on every face), the finest
+//! level's mass term is held for face 0 alone and read by every face (`LevelField`). The smoother is red–black
 //! Gauss–Seidel in that layout: each half-sweep updates one colour from the other's
 //! values. Where a seam joins two cells of one colour (the faces' chequerboards do not
 //! all agree across the cube's edges), the half-sweep reads its neighbour's value from
@@ -35,9 +37,9 @@ use super::sides::{BOTTOM, CellSides, LEFT, RIGHT, TOP};
 use crate::avx2::with_avx2;
 use dense::{dense_cholesky, dense_solve};
 use kernels::{
-    NOT_A_CELL, Stencil, correct, dot, gather_row, operator, refresh, refresh_all, relax,
-    relax_from_zero, residuals, restrict, rounded_level, scatter_row, update_and_norm2,
-    update_direction, widened_dot,
+    LevelField, NOT_A_CELL, Stencil, correct, dot, gather_row, operator, refresh, refresh_all,
+    relax, relax_from_zero, residuals, restrict, restrict_field, rounded_level, scatter_row,
+    update_and_norm2, update_direction, widened_dot,
 };
 use layout::Layout;
 
@@ -140,6 +142,10 @@ pub struct Work {
     /// others what the V-cycle's are rounded from.
     mass: Vec<Vec<f64>>,
     stencil: Vec<Stencil<f64>>,
+    /// Whether the finest level's mass term (in `f64` and `f32`) is held per face
+    /// ([`LevelField`]): the system's faces are alike to the bit, as the grid's cell
+    /// areas are.
+    mass_per_face: bool,
     /// The coarsest level's Cholesky factor, of the system as scaled for the V-cycle
     /// ([`Work::scale`]), in `f64` (the level is solved in `f64`: its right-hand side
     /// and answer converted, [`Work::coarse_rhs`] and [`Work::coarse_x`]).
@@ -174,6 +180,16 @@ pub struct Work {
     b: Vec<f64>,
     x: Vec<f64>,
     guess: Vec<f64>,
+}
+
+impl Work {
+    /// Level `k`'s mass term in `f64`, as the kernels read it ([`LevelField`]).
+    fn mass_term(&self, k: usize) -> LevelField<'_, f64> {
+        LevelField {
+            values: &self.mass[k],
+            per_face: k == 0 && self.mass_per_face,
+        }
+    }
 }
 
 /// When a solve stops.
@@ -331,7 +347,7 @@ impl Hierarchy {
                 for v in [&mut r, &mut p, &mut q] {
                     v.resize(len, 0.0);
                 }
-                let (mass, stencil) = (&work.mass[0], &work.stencil[0]);
+                let stencil = &work.stencil[0];
                 refresh_all(fine, x);
                 let mut guess = guess;
                 if let Some(g) = guess.as_mut() {
@@ -340,6 +356,7 @@ impl Hierarchy {
                 // Both starts' residuals in one pass over the system: `x`'s into `r`, the
                 // guess's into `q`.
                 let starts = [Some(&x[..]), guess.as_deref().map(|g| &g[..])];
+                let mass = work.mass_term(0);
                 residuals(fine, (mass, stencil, b), starts, [&mut r, &mut q]);
                 // Relative to the start's residual: the step's change, not the whole field.
                 let mut start_norm = dot(&r, &r).sqrt();
@@ -361,7 +378,7 @@ impl Hierarchy {
                     let (mut rz, back) = self.precondition(work, &r, start_norm);
                     self.next_direction(work, back, None, &mut p);
                     while report.iterations < limits.max_iterations {
-                        let (mass, stencil) = (&work.mass[0], &work.stencil[0]);
+                        let (mass, stencil) = (work.mass_term(0), &work.stencil[0]);
                         refresh_all(fine, &mut p);
                         operator::<f64, false>(fine, mass, stencil, &r, &p, &mut q);
                         let pq = dot(&p, &q);
@@ -416,8 +433,13 @@ impl Hierarchy {
         self.fine_numbers(work, alpha, weight);
         for k in 1..count {
             let (fine, coarse) = (&self.levels[k - 1], &self.levels[k]);
+            let per_face = k == 1 && work.mass_per_face;
             let (done, rest) = work.mass.split_at_mut(k);
-            restrict(fine, &done[k - 1], coarse, &mut rest[0], &mut work.row64);
+            let fine_mass = LevelField {
+                values: &done[k - 1],
+                per_face,
+            };
+            restrict_field(fine, fine_mass, coarse, &mut rest[0], &mut work.row64);
             let (done, rest) = work.stencil.split_at_mut(k);
             kernels::restrict_weights(fine, &done[k - 1], coarse, &mut rest[0], &mut work.row64);
         }
@@ -444,7 +466,8 @@ impl Hierarchy {
         );
     }
 
-    /// The finest level's mass term and weights from the grid's cells and edges, a face
+    /// The finest level's mass term (face 0's alone where the system's faces are
+    /// alike: [`Work::mass_per_face`]) and weights from the grid's cells and edges, a face
     /// row at a time: a row's RIGHT weights but the last and its TOP weights (but the top
     /// row's) are a slice of the grid's edges ([`inside_a_face`]); then the entries that
     /// hold seam edges ([`Hierarchy::seam_weights`]).
@@ -455,10 +478,14 @@ impl Hierarchy {
         let mut row = std::mem::take(&mut work.row64);
         row.resize(n, 0.0);
         let [right, top] = &mut work.stencil[0];
+        work.mass_per_face = self.levels.len() > 1 && fine.faces_alike() && faces_alike(alpha);
+        let mass_faces = if work.mass_per_face { 1 } else { 6 };
         for face in 0..6 {
             for y in 0..n {
-                let alpha_row = &alpha[(face * n + y) * n..][..n];
-                scatter_row(fine, face, y, alpha_row, &mut work.mass[0]);
+                if face < mass_faces {
+                    let alpha_row = &alpha[(face * n + y) * n..][..n];
+                    scatter_row(fine, face, y, alpha_row, &mut work.mass[0]);
+                }
                 // The last cell's RIGHT entry is a seam's, written below.
                 let (xs, first) = inside_a_face(n, face, y, RIGHT);
                 row[xs.clone()].copy_from_slice(&weight[first..][..xs.len()]);
@@ -493,10 +520,14 @@ impl Hierarchy {
             for w in &mut work.stencil32[k] {
                 w.resize(n, 0.0);
             }
+            let mass = LevelField {
+                values: &work.mass[k],
+                per_face: k == 0 && work.mass_per_face,
+            };
             rounded_level(
                 level,
                 scale,
-                (&work.mass[k], &work.stencil[k]),
+                (mass, &work.stencil[k]),
                 (&mut work.mass32[k], &mut work.stencil32[k]),
                 &mut work.inv_diag[k],
             );
@@ -574,7 +605,11 @@ impl Hierarchy {
                 // Kept at the finest level's length and sliced: resized to each level's in
                 // turn, it would be zeroed again every V-cycle.
                 d.resize(d.len().max(level.len()), 0.0);
-                operator::<f32, true>(level, &work.mass32[k], w, r, z, &mut d);
+                let mass = LevelField {
+                    values: &work.mass32[k],
+                    per_face: k == 0 && work.mass_per_face,
+                };
+                operator::<f32, true>(level, mass, w, r, z, &mut d);
                 let mut rc = std::mem::take(&mut work.residual[k + 1]);
                 restrict(level, &d, coarse, &mut rc, &mut work.row);
                 work.operator = d;
@@ -647,6 +682,16 @@ fn seam_weights(fine: &Layout, sides: &CellSides) -> [Vec<[u32; 2]>; 2] {
         s.sort_unstable();
     }
     seams
+}
+
+/// Whether every face's values (a sixth of `values` each) are face 0's, to the bit
+/// (without a branch a value, so that the comparison vectorises).
+fn faces_alike(values: &[f64]) -> bool {
+    let (first, rest) = values.split_at(values.len() / 6);
+    rest.chunks_exact(first.len()).all(|face| {
+        let differ = face.iter().zip(first);
+        differ.fold(0, |any, (a, b)| any | (a.to_bits() ^ b.to_bits())) == 0
+    })
 }
 
 /// `v` at `len` entries, set to `fill` throughout where its length changes (a field of
@@ -892,87 +937,139 @@ mod tests {
         }
     }
 
+    /// Level `k`'s mass term at cell `c`, read as the kernels read it ([`LevelField`]).
+    fn mass_at(h: &Hierarchy, work: &Work, k: usize, c: usize) -> f64 {
+        let level = &h.levels[k];
+        let field = if k == 0 {
+            work.mass_term(0)
+        } else {
+            LevelField {
+                values: &work.mass[k],
+                per_face: false,
+            }
+        };
+        let p = level.position[c] as usize;
+        let face = c / (level.m * level.m);
+        let shift = if field.per_face {
+            level.face_start(face)
+        } else {
+            0
+        };
+        field.values[p - shift]
+    }
+
+    /// A mass term whose faces differ (`1 + c mod 7`), and one whose faces are alike
+    /// (`1 + (c mod n²) mod 7`), on `n` cells a face.
+    fn mass_terms(n: usize) -> [(Vec<f64>, bool); 2] {
+        let cells = 6 * n * n;
+        let differ = (0..cells).map(|c| 1.0 + (c % 7) as f64).collect();
+        let alike = (0..cells).map(|c| 1.0 + (c % (n * n) % 7) as f64).collect();
+        [(differ, false), (alike, true)]
+    }
+
     /// Every level's numbers as the grid's cells and edges give them, each side's weight
-    /// read where [`Layout::side_weights`] names: the finest level's mass term and side
-    /// weights at each cell's position, and each coarser level's mass the sum of its four
-    /// children's, its side weights half the two fine weights along the side, and the
-    /// same number seen from both cells of an edge (the matrix symmetric to the bit);
-    /// outside the cells, the mass term [`NOT_A_CELL`] and every weight entry no cell
-    /// reads zero.
+    /// read where [`Layout::side_weights`] names and the mass term as the kernels read
+    /// it (held per face where the faces are alike and there is more than one level): the
+    /// finest level's mass term and side weights at each cell's position, and each
+    /// coarser level's mass the sum of its four children's, its side weights half the
+    /// two fine weights along the side, and the same number seen from both cells of an
+    /// edge (the matrix symmetric to the bit); outside the cells, the mass term
+    /// [`NOT_A_CELL`] and every weight entry no cell reads zero.
     #[test]
     fn each_level_holds_the_grids_numbers_at_its_cells() {
         for n in [3, 6, 16] {
             let grid = CubeSphere::new(n);
             let h = Hierarchy::new(&grid);
-            let alpha: Vec<f64> = (0..grid.cells()).map(|c| 1.0 + (c % 7) as f64).collect();
             let weight: Vec<f64> = (0..grid.edges().len())
                 .map(|e| 10.0 + (e % 13) as f64)
                 .collect();
             let mut work = Work::default();
-            h.prepare(&mut work, &alpha, &weight);
-            let fine = &h.levels[0];
-            let sides = CellSides::new(&grid);
-            for (c, &p) in fine.position.iter().enumerate() {
-                assert_eq!(work.mass[0][p as usize], alpha[c], "n {n} cell {c}");
-                for (k, (field, q)) in fine.side_weights(c).into_iter().enumerate() {
-                    let expected = weight[sides.edge[c][k] as usize];
-                    assert_eq!(work.stencil[0][field][q], expected, "n {n} {c} side {k}");
-                }
+            for (alpha, alike) in mass_terms(n) {
+                h.prepare(&mut work, &alpha, &weight);
+                assert_eq!(work.mass_per_face, alike && n > 3, "n {n}");
+                holds_the_grids_numbers(&h, &work, &alpha, &weight);
             }
-            for (k, level) in h.levels.iter().enumerate() {
-                outside_the_cells_nothing_is_read(level, &work.mass[k], &work.stencil[k]);
+        }
+    }
+
+    /// [`each_level_holds_the_grids_numbers_at_its_cells`] for one system.
+    fn holds_the_grids_numbers(h: &Hierarchy, work: &Work, alpha: &[f64], weight: &[f64]) {
+        let fine = &h.levels[0];
+        let n = fine.m;
+        let sides = CellSides::new(&CubeSphere::new(n));
+        for c in 0..fine.position.len() {
+            assert_eq!(mass_at(h, work, 0, c), alpha[c], "n {n} cell {c}");
+            for (k, (field, q)) in fine.side_weights(c).into_iter().enumerate() {
+                let expected = weight[sides.edge[c][k] as usize];
+                assert_eq!(work.stencil[0][field][q], expected, "n {n} {c} side {k}");
             }
-            for k in 1..h.levels.len() {
-                let (fine, coarse) = (&h.levels[k - 1], &h.levels[k]);
-                let side = |level: &Layout, w: &Stencil<f64>, c: usize, s: usize| {
-                    let (field, q) = level.side_weights(c)[s];
-                    w[field][q]
-                };
-                let mass = &work.mass[k];
-                let mut children = vec![0.0; coarse.position.len()];
-                let mut child_side = vec![[0.0; 4]; coarse.position.len()];
-                let m = fine.m;
-                for (c, &p) in fine.position.iter().enumerate() {
-                    let parent = parent_cell(m, c);
-                    children[parent] += work.mass[k - 1][p as usize];
-                    let (x, y) = (c % m, (c / m) % m);
-                    let on = [x % 2 == 0, x % 2 == 1, y % 2 == 0, y % 2 == 1];
-                    for s in 0..4 {
-                        if on[s] {
-                            child_side[parent][s] += 0.5 * side(fine, &work.stencil[k - 1], c, s);
-                        }
+        }
+        for (k, level) in h.levels.iter().enumerate() {
+            outside_the_cells_nothing_is_read(level, &work.mass[k], &work.stencil[k]);
+        }
+        for k in 1..h.levels.len() {
+            let (fine, coarse) = (&h.levels[k - 1], &h.levels[k]);
+            let side = |level: &Layout, w: &Stencil<f64>, c: usize, s: usize| {
+                let (field, q) = level.side_weights(c)[s];
+                w[field][q]
+            };
+            let mut children = vec![0.0; coarse.position.len()];
+            let mut child_side = vec![[0.0; 4]; coarse.position.len()];
+            let m = fine.m;
+            for c in 0..fine.position.len() {
+                let parent = parent_cell(m, c);
+                children[parent] += mass_at(h, work, k - 1, c);
+                let (x, y) = (c % m, (c / m) % m);
+                let on = [x % 2 == 0, x % 2 == 1, y % 2 == 0, y % 2 == 1];
+                for s in 0..4 {
+                    if on[s] {
+                        child_side[parent][s] += 0.5 * side(fine, &work.stencil[k - 1], c, s);
                     }
                 }
-                let w = &work.stencil[k];
-                for (c, &p) in coarse.position.iter().enumerate() {
-                    let p = p as usize;
-                    let rel = (mass[p] - children[c]).abs() / children[c];
-                    assert!(rel < 1e-15, "n {n} level {k} cell {c}: {rel:e}");
-                    for (s, expected) in child_side[c].into_iter().enumerate() {
-                        let got = side(coarse, w, c, s);
-                        let rel = (got - expected).abs() / expected;
-                        assert!(rel < 1e-15, "n {n} level {k} cell {c} side {s}: {rel:e}");
-                        let j = coarse.neighbour[c][s] as usize;
-                        let back = (0..4).find(|&b| coarse.neighbour[j][b] as usize == c);
-                        let back = back.expect("the neighbour's side back");
-                        let there = side(coarse, w, j, back);
-                        assert_eq!(got.to_bits(), there.to_bits(), "n {n} {c}-{j}");
-                    }
+            }
+            let w = &work.stencil[k];
+            for c in 0..coarse.position.len() {
+                let rel = (mass_at(h, work, k, c) - children[c]).abs() / children[c];
+                assert!(rel < 1e-15, "n {n} level {k} cell {c}: {rel:e}");
+                for (s, expected) in child_side[c].into_iter().enumerate() {
+                    let got = side(coarse, w, c, s);
+                    let rel = (got - expected).abs() / expected;
+                    assert!(rel < 1e-15, "n {n} level {k} cell {c} side {s}: {rel:e}");
+                    let j = coarse.neighbour[c][s] as usize;
+                    let back = (0..4).find(|&b| coarse.neighbour[j][b] as usize == c);
+                    let back = back.expect("the neighbour's side back");
+                    let there = side(coarse, w, j, back);
+                    assert_eq!(got.to_bits(), there.to_bits(), "n {n} {c}-{j}");
                 }
             }
         }
     }
 
-    /// The operator applies the grid's system at every cell, through the halo and the
-    /// weights held once an edge, and gives zero at every other position (there the
-    /// weight entries hold seam weights, the values halo copies).
+    /// The grid's cell areas, the Marangoni step's mass term, are alike on every face to
+    /// the bit, so that its systems' mass terms are held per face.
+    #[test]
+    fn every_faces_areas_are_face_zeros() {
+        for n in [2, 5, 16, 64] {
+            assert!(faces_alike(CubeSphere::new(n).areas_sr()), "n {n}");
+        }
+        let mut areas = CubeSphere::new(16).areas_sr().to_vec();
+        areas[5 * 256 + 17] *= 1.0 + f64::EPSILON;
+        assert!(!faces_alike(&areas));
+    }
+
+    /// The operator applies the grid's system at every cell, through the halo, the
+    /// weights held once an edge and the mass term held whole or per face, and gives zero
+    /// at every other position (there the weight entries hold seam weights, the values
+    /// halo copies).
     #[test]
     fn the_operator_applies_the_grids_system_and_gives_zero_outside_the_cells() {
-        for n in [1, 3, 6, 16] {
+        for (n, (alpha, _)) in [1, 3, 6, 16]
+            .into_iter()
+            .flat_map(|n| mass_terms(n).map(|m| (n, m)))
+        {
             let grid = CubeSphere::new(n);
             let h = Hierarchy::new(&grid);
             let cells = grid.cells();
-            let alpha: Vec<f64> = (0..cells).map(|c| 1.0 + (c % 7) as f64).collect();
             let weight: Vec<f64> = (0..grid.edges().len())
                 .map(|e| 10.0 + (e % 13) as f64)
                 .collect();
@@ -985,7 +1082,7 @@ mod tests {
             refresh_all(fine, &mut xs);
             let none = vec![0.0; fine.len()];
             let mut out = vec![f64::NAN; fine.len()];
-            let (mass, w) = (&work.mass[0], &work.stencil[0]);
+            let (mass, w) = (work.mass_term(0), &work.stencil[0]);
             operator::<f64, false>(fine, mass, w, &none, &xs, &mut out);
             let expected = grid_apply(&grid, &alpha, &weight, &x);
             for (c, &p) in fine.position.iter().enumerate() {

@@ -74,15 +74,59 @@ fn both_sweeps(layout: &Layout) -> std::ops::Range<usize> {
     a.start.min(b.start)..a.end.max(b.end)
 }
 
-/// Runs `pass(start, len)` over `range` in blocks of [`BLOCK`] positions (`pass` marked
-/// `#[inline(always)]`, so that it is built into the caller's AVX2 code).
+/// Runs `pass(face, start, len)` over `range` in blocks of at most [`BLOCK`] positions;
+/// `per_face`, each within one face's positions ([`Layout::face_start`]), so that a
+/// field held per face can be read from face 0's ([`LevelField`]), else `face` 0 (a
+/// block's unvectorised remainder costs as much as a few hundred cells: six blocks a
+/// face on a coarse level cost the V-cycle 5 % more instructions). `pass` is marked
+/// `#[inline(always)]`, so that it is built into the caller's AVX2 code.
 #[inline(always)]
-fn in_blocks(range: std::ops::Range<usize>, mut pass: impl FnMut(usize, usize)) {
-    let mut start = range.start;
-    while start < range.end {
-        let len = BLOCK.min(range.end - start);
-        pass(start, len);
-        start += len;
+fn in_blocks(
+    layout: &Layout,
+    range: std::ops::Range<usize>,
+    per_face: bool,
+    mut pass: impl FnMut(usize, usize, usize),
+) {
+    let faces = if per_face { 6 } else { 1 };
+    for face in 0..faces {
+        let (start, end) = if per_face {
+            (layout.face_start(face), layout.face_start(face + 1))
+        } else {
+            (range.start, range.end)
+        };
+        let end = end.min(range.end);
+        let mut start = start.max(range.start);
+        while start < end {
+            let len = BLOCK.min(end - start);
+            pass(face, start, len);
+            start += len;
+        }
+    }
+}
+
+/// A field of a level as the kernels read it: whole, or `per_face`, face 0's positions
+/// alone, read by every face at its own positions less [`Layout::face_start`]. The
+/// finest level's mass term is held so where the system's faces are alike (every face
+/// holds face 0's cell areas): a pass then streams 1/6 of the field.
+#[derive(Clone, Copy)]
+pub(super) struct LevelField<'a, T> {
+    /// The field ([`NOT_A_CELL`] outside the cells, for a mass term).
+    pub(super) values: &'a [T],
+    /// Whether every face reads face 0's positions.
+    pub(super) per_face: bool,
+}
+
+impl<'a, T> LevelField<'a, T> {
+    /// The field at the `len` positions from split position `base`, all of face
+    /// `face`.
+    #[inline(always)]
+    fn at(&self, layout: &Layout, face: usize, base: usize, len: usize) -> &'a [T] {
+        let shift = if self.per_face {
+            layout.face_start(face)
+        } else {
+            0
+        };
+        &self.values[base - shift..][..len]
     }
 }
 
@@ -153,7 +197,7 @@ pub(super) fn relax_from_zero<T: Real>(layout: &Layout, inv_diag: &[T], r: &[T],
 #[inline(always)]
 pub(super) fn operator<T: Real, const RESIDUAL: bool>(
     layout: &Layout,
-    mass: &[T],
+    mass: LevelField<T>,
     w: &Stencil<T>,
     r: &[T],
     x: &[T],
@@ -166,11 +210,14 @@ pub(super) fn operator<T: Real, const RESIDUAL: bool>(
         colour[range.end..].fill(T::ZERO);
     }
     in_blocks(
+        layout,
         range,
+        mass.per_face,
         #[inline(always)]
-        |start, len| {
+        |face, start, len| {
             for c in 0..2 {
-                operator_run::<T, RESIDUAL>(layout, c, (start, len), (mass, w, r), x, out);
+                let at = (face, start, len);
+                operator_run::<T, RESIDUAL>(layout, c, at, (mass, w, r), x, out);
             }
         },
     );
@@ -181,7 +228,7 @@ pub(super) fn operator<T: Real, const RESIDUAL: bool>(
 #[inline(always)]
 pub(super) fn residuals<T: Real>(
     layout: &Layout,
-    (mass, w, b): (&[T], &Stencil<T>, &[T]),
+    (mass, w, b): (LevelField<T>, &Stencil<T>, &[T]),
     starts: [Option<&[T]>; 2],
     outs: [&mut [T]; 2],
 ) {
@@ -195,26 +242,29 @@ pub(super) fn residuals<T: Real>(
         }
     }
     in_blocks(
+        layout,
         range,
+        mass.per_face,
         #[inline(always)]
-        |start, len| {
+        |face, start, len| {
             for (x, out) in &mut pairs {
                 let Some(x) = x else { continue };
                 for c in 0..2 {
-                    operator_run::<T, true>(layout, c, (start, len), (mass, w, b), x, out);
+                    let at = (face, start, len);
+                    operator_run::<T, true>(layout, c, at, (mass, w, b), x, out);
                 }
             }
         },
     );
 }
 
-/// [`operator`] at the `len` positions from `start` of colour `c`.
+/// [`operator`] at the `len` positions from `start` of colour `c`, of face `face`.
 #[inline(always)]
 fn operator_run<T: Real, const RESIDUAL: bool>(
     layout: &Layout,
     c: usize,
-    (start, len): (usize, usize),
-    (mass, w, r): (&[T], &Stencil<T>, &[T]),
+    (face, start, len): (usize, usize, usize),
+    (mass, w, r): (LevelField<T>, &Stencil<T>, &[T]),
     x: &[T],
     out: &mut [T],
 ) {
@@ -226,7 +276,7 @@ fn operator_run<T: Real, const RESIDUAL: bool>(
     );
     let base = c * layout.half + start;
     let (m, xs, r) = (
-        &mass[base..][..len],
+        mass.at(layout, face, base, len),
         &own[start..][..len],
         &r[base..][..len],
     );
@@ -249,34 +299,43 @@ fn operator_run<T: Real, const RESIDUAL: bool>(
 /// A level's numbers scaled by `scale` and rounded to `f32` for the V-cycle (`mass32`,
 /// `w32`), and its inverse diagonal `1/(scale·d)`, `d` the mass term plus the four side
 /// weights summed in `f64` (LEFT to TOP) and rounded once; zero outside the cells. One
-/// pass over the level's numbers, both colours a block at a time ([`operator`]).
+/// pass over the level's numbers, both colours a block at a time ([`operator`]); a
+/// mass term held `per_face` is rounded on face 0 alone, and read so.
 #[inline(always)]
 pub(super) fn rounded_level(
     layout: &Layout,
     scale: f64,
-    (mass, w): (&[f64], &Stencil<f64>),
+    (mass, w): (LevelField<f64>, &Stencil<f64>),
     (mass32, w32): (&mut [f32], &mut Stencil<f32>),
     inv_diag: &mut [f32],
 ) {
     let range = both_sweeps(layout);
     let half = layout.half;
-    let (numbers, mut numbers32) = ((mass, w), (mass32, w32));
     for c in 0..2 {
         let start = c * half;
         for part in [start..start + range.start, start + range.end..start + half] {
-            round_numbers(scale, part.clone(), numbers, &mut numbers32);
+            round_run(scale, part.clone(), mass.values, mass32);
+            round_run(scale, part.clone(), &w[RIGHT_W], &mut w32[RIGHT_W]);
+            round_run(scale, part.clone(), &w[TOP_W], &mut w32[TOP_W]);
             inv_diag[part].fill(0.0);
         }
     }
     in_blocks(
+        layout,
         range,
+        mass.per_face,
         #[inline(always)]
-        |start, len| {
+        |face, start, len| {
             for c in 0..2 {
                 let own = c * half + start..c * half + start + len;
-                round_numbers(scale, own.clone(), numbers, &mut numbers32);
+                if !mass.per_face || face == 0 {
+                    round_run(scale, own.clone(), mass.values, mass32);
+                }
+                round_run(scale, own.clone(), &w[RIGHT_W], &mut w32[RIGHT_W]);
+                round_run(scale, own.clone(), &w[TOP_W], &mut w32[TOP_W]);
                 let [w0, w1, w2, w3] = side_weights(layout, c, (start, len), w);
-                let (m, inv_diag) = (&mass[own.clone()], &mut inv_diag[own]);
+                let m = mass.at(layout, face, own.start, len);
+                let inv_diag = &mut inv_diag[own];
                 for i in 0..len {
                     let d = m[i] + w0[i] + w1[i] + w2[i] + w3[i];
                     // Zero outside the cells, by a select, so the loop vectorises (a
@@ -288,19 +347,6 @@ pub(super) fn rounded_level(
             }
         },
     );
-}
-
-/// [`round_run`] of the mass term and both weight fields over `range`.
-#[inline(always)]
-fn round_numbers(
-    scale: f64,
-    range: std::ops::Range<usize>,
-    (mass, w): (&[f64], &Stencil<f64>),
-    (mass32, w32): &mut (&mut [f32], &mut Stencil<f32>),
-) {
-    round_run(scale, range.clone(), mass, mass32);
-    round_run(scale, range.clone(), &w[RIGHT_W], &mut w32[RIGHT_W]);
-    round_run(scale, range, &w[TOP_W], &mut w32[TOP_W]);
 }
 
 /// `out[range] = scale·values[range]` rounded to `f32`.
@@ -337,12 +383,42 @@ pub(super) fn restrict<T: Real>(
     out: &mut [T],
     row: &mut Vec<T>,
 ) {
+    restrict_from(fine, (fine_values, |face| face), coarse, out, row);
+}
+
+/// [`restrict`] of a field that may be held per face ([`LevelField`]): every coarse
+/// face from fine face 0's values where it is.
+#[inline(always)]
+pub(super) fn restrict_field<T: Real>(
+    fine: &Layout,
+    fine_values: LevelField<T>,
+    coarse: &Layout,
+    out: &mut [T],
+    row: &mut Vec<T>,
+) {
+    let values = fine_values.values;
+    if fine_values.per_face {
+        restrict_from(fine, (values, |_| 0), coarse, out, row);
+    } else {
+        restrict_from(fine, (values, |face| face), coarse, out, row);
+    }
+}
+
+/// [`restrict`], coarse face `face` from fine face `from(face)`'s values.
+#[inline(always)]
+fn restrict_from<T: Real>(
+    fine: &Layout,
+    (fine_values, from): (&[T], impl Fn(usize) -> usize),
+    coarse: &Layout,
+    out: &mut [T],
+    row: &mut Vec<T>,
+) {
     let m = coarse.m;
     row.resize(m, T::ZERO);
     for face in 0..6 {
         for y in 0..m {
-            let [a0, b0] = fine.children_of_row(face, y, 0);
-            let [a1, b1] = fine.children_of_row(face, y, 1);
+            let [a0, b0] = fine.children_of_row(from(face), y, 0);
+            let [a1, b1] = fine.children_of_row(from(face), y, 1);
             let (a0, b0) = (&fine_values[a0..][..m], &fine_values[b0..][..m]);
             let (a1, b1) = (&fine_values[a1..][..m], &fine_values[b1..][..m]);
             let row = &mut row[..m];

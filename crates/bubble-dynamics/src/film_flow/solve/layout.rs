@@ -137,6 +137,20 @@ impl Layout {
         (f & 1) * self.half + (f >> 1)
     }
 
+    /// The first position of face `face` in each colour's array (`face` 6: the end):
+    /// where a face's padded cells have an even count, the same in both colours, and
+    /// every face's cells lie at face 0's positions plus this
+    /// ([`Layout::faces_alike`]).
+    pub(super) fn face_start(&self, face: usize) -> usize {
+        face * self.face_len / 2
+    }
+
+    /// Whether every face's cells lie in both colours' arrays at face 0's positions plus
+    /// [`Layout::face_start`]: a face's padded cells have an even count (`m` even).
+    pub(super) fn faces_alike(&self) -> bool {
+        self.face_len % 2 == 0
+    }
+
     /// Padded index of face `face`'s padded row `row`, column `col` (row and column 0 are
     /// the halo before the face's first row and column).
     pub(super) fn padded_at(&self, face: usize, row: usize, col: usize) -> usize {
