@@ -137,24 +137,25 @@ fn subtract_and_square_lanes_avx2(step: f64, q: &[f64], r: &mut [f64]) -> [f64; 
     lanes
 }
 
-/// Four running sums of `r[i]·(back·z32[i])` (`z32` widened to `f64`) as [`dot_lanes`]
-/// sums, over the first `4⌊len/4⌋` elements: the solve's `r·z` read from the `f32`
-/// preconditioner's answer, never stored in `f64`; the same bits with AVX2 as without.
+/// Four running sums of `a[i]·b[i]`, both widened from `f32` to `f64` (each product
+/// exact), as [`dot_lanes`] sums, over the first `4⌊len/4⌋` elements: the solve's `r·z`
+/// read from the `f32` preconditioner's right-hand side and answer, both still in cache;
+/// the same bits with AVX2 as without.
 ///
 /// # Panics
 /// If the slices differ in length.
 #[inline(always)]
-pub(crate) fn widened_dot_lanes(back: f64, z32: &[f32], r: &[f64]) -> [f64; 4] {
-    assert_eq!(z32.len(), r.len(), "slices of different lengths");
+pub(crate) fn widened_dot_lanes(a: &[f32], b: &[f32]) -> [f64; 4] {
+    assert_eq!(a.len(), b.len(), "slices of different lengths");
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && !portable_only() {
         // SAFETY: the processor supports AVX2, checked just above.
-        return unsafe { widened_dot_lanes_avx2(back, z32, r) };
+        return unsafe { widened_dot_lanes_avx2(a, b) };
     }
     let mut lanes = [0.0; 4];
-    for (ws, rs) in z32.chunks_exact(4).zip(r.chunks_exact(4)) {
+    for (x, y) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
         for k in 0..4 {
-            lanes[k] += rs[k] * (back * f64::from(ws[k]));
+            lanes[k] += f64::from(x[k]) * f64::from(y[k]);
         }
     }
     lanes
@@ -163,17 +164,18 @@ pub(crate) fn widened_dot_lanes(back: f64, z32: &[f32], r: &[f64]) -> [f64; 4] {
 /// [`widened_dot_lanes`] in AVX2 registers.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn widened_dot_lanes_avx2(back: f64, z32: &[f32], r: &[f64]) -> [f64; 4] {
+fn widened_dot_lanes_avx2(a: &[f32], b: &[f32]) -> [f64; 4] {
     use std::arch::x86_64::{
-        _mm_loadu_ps, _mm256_add_pd, _mm256_cvtps_pd, _mm256_loadu_pd, _mm256_mul_pd,
-        _mm256_set1_pd, _mm256_setzero_pd, _mm256_storeu_pd,
+        _mm_loadu_ps, _mm256_add_pd, _mm256_cvtps_pd, _mm256_mul_pd, _mm256_setzero_pd,
+        _mm256_storeu_pd,
     };
-    let (back, mut sum) = (_mm256_set1_pd(back), _mm256_setzero_pd());
-    for (ws, rs) in z32.chunks_exact(4).zip(r.chunks_exact(4)) {
+    let mut sum = _mm256_setzero_pd();
+    for (x, y) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
         // SAFETY: each chunk holds four numbers, the unaligned loads' width.
         unsafe {
-            let zi = _mm256_mul_pd(back, _mm256_cvtps_pd(_mm_loadu_ps(ws.as_ptr())));
-            sum = _mm256_add_pd(sum, _mm256_mul_pd(_mm256_loadu_pd(rs.as_ptr()), zi));
+            let x = _mm256_cvtps_pd(_mm_loadu_ps(x.as_ptr()));
+            let y = _mm256_cvtps_pd(_mm_loadu_ps(y.as_ptr()));
+            sum = _mm256_add_pd(sum, _mm256_mul_pd(x, y));
         }
     }
     let mut lanes = [0.0; 4];

@@ -559,7 +559,11 @@ impl Hierarchy {
         rounded(to, r, &mut r32);
         let mut z32 = std::mem::take(&mut work.correction[0]);
         self.v_cycle(work, 0, &r32, &mut z32);
-        let rz = widened_dot(back, &z32, r);
+        // `r·z` from the V-cycle's own numbers, still in cache where `r` is not: `r'`
+        // is `to·r` rounded to `f32`, so `(r'·z')·back/to` is `r·z` but for that
+        // rounding (about 1e-7 of each term, below the preconditioner's own error; `r`
+        // itself, the tolerance's, stays exact in `f64`). `back/to` is a power of two.
+        let rz = widened_dot(&r32, &z32) * (back / to);
         work.residual[0] = r32;
         work.correction[0] = z32;
         (rz, back)

@@ -589,16 +589,15 @@ pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
 }
 
-/// `r·(back·z32)`, `z32` widened to `f64`, summed as [`dot`] sums
-/// ([`widened_dot_lanes`]): the conjugate gradients' `r·z` without `z` stored in `f64`
-/// ([`update_direction`] forms `back·z32` again as it reads it: the same bits).
+/// `a·b`, `f32` fields widened to `f64` (each product exact), summed as [`dot`] sums
+/// ([`widened_dot_lanes`]).
 #[inline(always)]
-pub(super) fn widened_dot(back: f64, z32: &[f32], r: &[f64]) -> f64 {
-    let main = r.len() - r.len() % LANES;
-    let lanes = widened_dot_lanes(back, &z32[..main], &r[..main]);
+pub(super) fn widened_dot(a: &[f32], b: &[f32]) -> f64 {
+    let main = a.len() - a.len() % LANES;
+    let lanes = widened_dot_lanes(&a[..main], &b[..main]);
     let mut tail = 0.0;
-    for (ri, zi) in r[main..].iter().zip(&z32[main..r.len()]) {
-        tail += ri * (back * f64::from(*zi));
+    for (x, y) in a[main..].iter().zip(&b[main..a.len()]) {
+        tail += f64::from(*x) * f64::from(*y);
     }
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
 }
