@@ -124,7 +124,9 @@ pub struct Hierarchy {
 /// was, up to rounding), and its rounding, about 1e-7 of each value, is far below its
 /// own error as an inverse. `x` and the residual the tolerance is judged on are updated
 /// in `f64` from the same `f64` direction and its `f64` product with `M`, so the
-/// answer's accuracy does not depend on the preconditioner's. `f32`'s narrower range is
+/// answer's accuracy does not depend on the preconditioner's; `r·z`, which only weighs
+/// the directions, is summed in `f64` from the V-cycle's `f32` right-hand side and
+/// answer (`Hierarchy::precondition`). `f32`'s narrower range is
 /// kept away from: the system enters the V-cycle scaled by a power of two that brings
 /// the first cell's diagonal entry to `[1, 2)`, and each right-hand side by one that
 /// brings its norm there (a power of two changes the exponent, not the bits of the rest,
