@@ -2,7 +2,9 @@
 //! operator, the halo refresh, the restriction and the coarse correction, and the
 //! conjugate gradients' dot products and updates. Each is a loop over contiguous slices
 //! cut to one length first (so it vectorises and checks no bounds inside), written
-//! once for `f32` and `f64` ([`Real`]) as IEEE operations in a fixed order.
+//! once for `f32` and `f64` ([`Real`]) as IEEE operations in a fixed order. The passes
+//! that read both colours' weights (the operator, the V-cycle's rounding) take both
+//! colours a block at a time ([`BLOCK`]).
 
 use super::Real;
 use super::layout::{Layout, RIGHT_W, TOP_W};
@@ -193,7 +195,7 @@ pub(super) fn relax_from_zero<T: Real>(layout: &Layout, inv_diag: &[T], r: &[T],
 /// surfactant). `x`'s halo must be fresh; the results outside the cells are zero (so a
 /// field made from them adds nothing outside the faces to a dot product). Both colours
 /// a block at a time ([`BLOCK`]): each weight entry is read once, by its cell and by the
-/// neighbour across the edge, while it is in L1.
+/// neighbour across the edge, while it is in L2.
 #[inline(always)]
 pub(super) fn operator<T: Real, const RESIDUAL: bool>(
     layout: &Layout,
