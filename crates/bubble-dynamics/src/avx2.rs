@@ -137,50 +137,45 @@ fn subtract_and_square_lanes_avx2(step: f64, q: &[f64], r: &mut [f64]) -> [f64; 
     lanes
 }
 
-/// `z[i] = back·z32[i]` (widened to `f64`) over the first `4⌊len/4⌋` elements, and four
-/// running sums of `r[i]·z[i]` as [`dot_lanes`] sums: the conversion and the dot
-/// product that reads it in one pass, the same bits with AVX2 as without.
+/// Four running sums of `a[i]·b[i]`, both widened from `f32` to `f64` (each product
+/// exact), as [`dot_lanes`] sums, over the first `4⌊len/4⌋` elements: the solve's `r·z`
+/// read from the `f32` preconditioner's right-hand side and answer, both still in cache;
+/// the same bits with AVX2 as without.
 ///
 /// # Panics
 /// If the slices differ in length.
 #[inline(always)]
-pub(crate) fn widen_and_dot_lanes(back: f64, z32: &[f32], r: &[f64], z: &mut [f64]) -> [f64; 4] {
-    assert!(
-        z32.len() == r.len() && r.len() == z.len(),
-        "slices of different lengths"
-    );
+pub(crate) fn widened_dot_lanes(a: &[f32], b: &[f32]) -> [f64; 4] {
+    assert_eq!(a.len(), b.len(), "slices of different lengths");
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && !portable_only() {
         // SAFETY: the processor supports AVX2, checked just above.
-        return unsafe { widen_and_dot_lanes_avx2(back, z32, r, z) };
+        return unsafe { widened_dot_lanes_avx2(a, b) };
     }
     let mut lanes = [0.0; 4];
-    let chunks = z.chunks_exact_mut(4).zip(z32.chunks_exact(4));
-    for ((zs, ws), rs) in chunks.zip(r.chunks_exact(4)) {
+    for (x, y) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
         for k in 0..4 {
-            zs[k] = back * f64::from(ws[k]);
-            lanes[k] += rs[k] * zs[k];
+            lanes[k] += f64::from(x[k]) * f64::from(y[k]);
         }
     }
     lanes
 }
 
-/// [`widen_and_dot_lanes`] in AVX2 registers.
+/// [`widened_dot_lanes`] in AVX2 registers.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn widen_and_dot_lanes_avx2(back: f64, z32: &[f32], r: &[f64], z: &mut [f64]) -> [f64; 4] {
+fn widened_dot_lanes_avx2(a: &[f32], b: &[f32]) -> [f64; 4] {
     use std::arch::x86_64::{
-        _mm_loadu_ps, _mm256_add_pd, _mm256_cvtps_pd, _mm256_loadu_pd, _mm256_mul_pd,
-        _mm256_set1_pd, _mm256_setzero_pd, _mm256_storeu_pd,
+        _mm_loadu_ps, _mm256_add_pd, _mm256_cvtps_pd, _mm256_mul_pd, _mm256_setzero_pd,
+        _mm256_storeu_pd,
     };
-    let (back, mut sum) = (_mm256_set1_pd(back), _mm256_setzero_pd());
-    let chunks = z.chunks_exact_mut(4).zip(z32.chunks_exact(4));
-    for ((zs, ws), rs) in chunks.zip(r.chunks_exact(4)) {
-        // SAFETY: each chunk holds four numbers, the unaligned loads' and store's width.
+    let mut sum = _mm256_setzero_pd();
+    for (x, y) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
+        // SAFETY: each chunk holds four numbers, the unaligned loads' width.
         unsafe {
-            let zi = _mm256_mul_pd(back, _mm256_cvtps_pd(_mm_loadu_ps(ws.as_ptr())));
-            _mm256_storeu_pd(zs.as_mut_ptr(), zi);
-            sum = _mm256_add_pd(sum, _mm256_mul_pd(_mm256_loadu_pd(rs.as_ptr()), zi));
+            let x = _mm256_cvtps_pd(_mm_loadu_ps(x.as_ptr()));
+            let y = _mm256_cvtps_pd(_mm_loadu_ps(y.as_ptr()));
+            sum = _mm256_add_pd(sum, _mm256_mul_pd(x, y));
         }
     }
     let mut lanes = [0.0; 4];

@@ -8,8 +8,23 @@
 //!
 //! Every level is held in a padded, colour-split layout (`layout`): each face ringed by
 //! halo copies of its neighbours' cells, and the cells split by parity into two arrays,
-//! so that every loop is one pass over contiguous slices. The smoother is red–black
-//! Gauss–Seidel in that layout: each half-sweep updates one colour from the other's
+//! so that every loop is one pass over contiguous slices. Its edge weights are held once
+//! an edge, each cell's RIGHT and TOP ones (a cell reads its LEFT and BOTTOM ones from
+//! its neighbours' entries, the halo's holding the seams'), and the passes that are not
+//! a half-sweep take both colours a block at a time, so that an entry is streamed in
+//! once for both of its cells. Where the system's faces are alike to the bit (the
+//! Marangoni step's mass term is the cells' areas, the same on every face), the finest
+//! level's mass term is held for face 0 alone and read by every face (`LevelField`).
+//!
+//! The solve is bound by memory traffic (at n = 64 a field of the finest level is
+//! 220 kB in `f64`, the L2 1 MB), so each pass is counted: an iteration of the conjugate
+//! gradients streams the weights once (the operator's product `q`), `x`, `r` and `p`
+//! once each, and writes `q` and the V-cycle's right-hand side. The preconditioned
+//! residual `z` is never held in `f64` (`r·z` is summed from the V-cycle's own numbers,
+//! `p = z + β·p` formed from them as it is read), and both starts' residuals come from
+//! one pass over the system.
+//!
+//! The smoother is red–black Gauss–Seidel in that layout: each half-sweep updates one colour from the other's
 //! values. Where a seam joins two cells of one colour (the faces' chequerboards do not
 //! all agree across the cube's edges), the half-sweep reads its neighbour's value from
 //! before it (a Jacobi step inside the colour): each half-sweep is still a symmetric
@@ -31,8 +46,9 @@ use super::sides::{BOTTOM, CellSides, LEFT, RIGHT, TOP};
 use crate::avx2::with_avx2;
 use dense::{dense_cholesky, dense_solve};
 use kernels::{
-    Stencil, correct, dot, gather_row, operator, refresh, refresh_all, relax, relax_from_zero,
-    restrict, scatter_row, update_and_norm2, widen_and_dot,
+    LevelField, NOT_A_CELL, Stencil, correct, dot, gather_row, operator, refresh, refresh_all,
+    relax, relax_from_zero, residuals, restrict, restrict_field, rounded_level, scatter_row,
+    update_and_norm2, update_direction, widened_dot,
 };
 use layout::Layout;
 
@@ -41,7 +57,7 @@ use layout::Layout;
 /// generic over it, each an IEEE operation in a fixed order in either.
 trait Real:
     Copy
-    + PartialEq
+    + PartialOrd
     + std::ops::Add<Output = Self>
     + std::ops::Sub<Output = Self>
     + std::ops::Mul<Output = Self>
@@ -96,10 +112,11 @@ const COARSEST_FACE: usize = 2;
 pub struct Hierarchy {
     /// Each level's layout, finest first.
     levels: Vec<Layout>,
-    /// The rim cells' seam edges, in the order the finest level's weights are filled
-    /// in (the rest of a face row's edges are a slice): read from a table by cell, each
-    /// was a cache miss.
-    seam_edges: Vec<u32>,
+    /// Per weight field ([`RIGHT_W`](layout::RIGHT_W), [`TOP_W`](layout::TOP_W)), the finest level's entries that hold a
+    /// seam edge's weight, as `(position, edge)` in increasing position: the rim cells'
+    /// RIGHT or TOP entries and the halo's (the rest of a face row's weights are a slice
+    /// of the grid's edges).
+    seam_weights: [Vec<[u32; 2]>; 2],
 }
 
 /// The numbers of one system: per level, the mass term and the edge weights.
@@ -116,7 +133,9 @@ pub struct Hierarchy {
 /// was, up to rounding), and its rounding, about 1e-7 of each value, is far below its
 /// own error as an inverse. `x` and the residual the tolerance is judged on are updated
 /// in `f64` from the same `f64` direction and its `f64` product with `M`, so the
-/// answer's accuracy does not depend on the preconditioner's. `f32`'s narrower range is
+/// answer's accuracy does not depend on the preconditioner's; `r·z`, which only weighs
+/// the directions, is summed in `f64` from the V-cycle's `f32` right-hand side and
+/// answer (`Hierarchy::precondition`). `f32`'s narrower range is
 /// kept away from: the system enters the V-cycle scaled by a power of two that brings
 /// the first cell's diagonal entry to `[1, 2)`, and each right-hand side by one that
 /// brings its norm there (a power of two changes the exponent, not the bits of the rest,
@@ -129,10 +148,15 @@ pub struct Hierarchy {
 /// the faces stay zero where the conjugate gradients' dot products would see them.
 #[derive(Clone, Debug, Default)]
 pub struct Work {
-    /// Per level, the mass term and the edge weights in `f64`: the finest level's the
-    /// conjugate gradients' operator, the others what the V-cycle's are rounded from.
+    /// Per level, the mass term ([`NOT_A_CELL`] outside the cells) and the edge weights
+    /// ([`Stencil`]) in `f64`: the finest level's the conjugate gradients' operator, the
+    /// others what the V-cycle's are rounded from.
     mass: Vec<Vec<f64>>,
     stencil: Vec<Stencil<f64>>,
+    /// Whether the finest level's mass term (in `f64` and `f32`) is held per face
+    /// ([`LevelField`]): the system's faces are alike to the bit, as the grid's cell
+    /// areas are.
+    mass_per_face: bool,
     /// The coarsest level's Cholesky factor, of the system as scaled for the V-cycle
     /// ([`Work::scale`]), in `f64` (the level is solved in `f64`: its right-hand side
     /// and answer converted, [`Work::coarse_rhs`] and [`Work::coarse_x`]).
@@ -142,7 +166,7 @@ pub struct Work {
     /// The power of two the V-cycle's system is scaled by (1 where there is one level).
     scale: f64,
     /// Per level but the coarsest, in `f32` and scaled by [`Work::scale`]: the mass
-    /// term, the inverse diagonal (zero at the halo) and the edge weights.
+    /// term, the inverse diagonal (zero outside the cells) and the edge weights.
     mass32: Vec<Vec<f32>>,
     inv_diag: Vec<Vec<f32>>,
     stencil32: Vec<Stencil<f32>>,
@@ -156,14 +180,27 @@ pub struct Work {
     row: Vec<f32>,
     /// One face row of the finest level's numbers.
     row64: Vec<f64>,
+    /// The conjugate gradients' residual, direction and the operator's product with it
+    /// (at the start, the guess's residual).
     r: Vec<f64>,
-    z: Vec<f64>,
     p: Vec<f64>,
     q: Vec<f64>,
+    /// The preconditioned residual where the finest level is solved densely (in `f64`).
+    z: Vec<f64>,
     /// `b`, `x` and the guess in the finest level's layout.
     b: Vec<f64>,
     x: Vec<f64>,
     guess: Vec<f64>,
+}
+
+impl Work {
+    /// Level `k`'s mass term in `f64`, as the kernels read it ([`LevelField`]).
+    fn mass_term(&self, k: usize) -> LevelField<'_, f64> {
+        LevelField {
+            values: &self.mass[k],
+            per_face: k == 0 && self.mass_per_face,
+        }
+    }
 }
 
 /// When a solve stops.
@@ -198,9 +235,10 @@ impl Hierarchy {
             levels.push(coarse);
             n /= 2;
         }
+        let seam_weights = seam_weights(&levels[0], &sides);
         Self {
             levels,
-            seam_edges: seam_edges(&sides),
+            seam_weights,
         }
     }
 
@@ -288,7 +326,7 @@ impl Hierarchy {
                 }
             },
         );
-        let guess = guess.map(|_| gs.as_mut_slice());
+        let guess = guess.map(|_| &mut gs);
         let report = self.solve_split(work, &bs, &mut xs, guess, limits);
         with_avx2(
             #[inline(always)]
@@ -299,13 +337,14 @@ impl Hierarchy {
     }
 
     /// The conjugate gradients in the finest level's split layout, compiled for AVX2
-    /// where the processor has it ([`with_avx2`]).
+    /// where the processor has it ([`with_avx2`]). Where the guess is taken, it and `x`
+    /// trade places (a swap, not a copy of the field).
     fn solve_split(
         &self,
         work: &mut Work,
         b: &[f64],
-        x: &mut [f64],
-        guess: Option<&mut [f64]>,
+        x: &mut Vec<f64>,
+        guess: Option<&mut Vec<f64>>,
         limits: SolveLimits,
     ) -> SolveReport {
         with_avx2(
@@ -314,25 +353,30 @@ impl Hierarchy {
                 let fine = &self.levels[0];
                 let len = fine.len();
                 let mut r = std::mem::take(&mut work.r);
-                let mut z = std::mem::take(&mut work.z);
                 let mut p = std::mem::take(&mut work.p);
                 let mut q = std::mem::take(&mut work.q);
-                for v in [&mut r, &mut z, &mut p, &mut q] {
+                for v in [&mut r, &mut p, &mut q] {
                     v.resize(len, 0.0);
                 }
-                let (mass, stencil) = (&work.mass[0], &work.stencil[0]);
+                let stencil = &work.stencil[0];
                 refresh_all(fine, x);
-                operator::<f64, true>(fine, mass, stencil, b, x, &mut r);
+                let mut guess = guess;
+                if let Some(g) = guess.as_mut() {
+                    refresh_all(fine, g);
+                }
+                // Both starts' residuals in one pass over the system: `x`'s into `r`, the
+                // guess's into `q`.
+                let starts = [Some(&x[..]), guess.as_deref().map(|g| &g[..])];
+                let mass = work.mass_term(0);
+                residuals(fine, (mass, stencil, b), starts, [&mut r, &mut q]);
                 // Relative to the start's residual: the step's change, not the whole field.
                 let mut start_norm = dot(&r, &r).sqrt();
                 let b_norm = if start_norm > 0.0 { start_norm } else { 1.0 };
                 if let Some(guess) = guess.filter(|_| start_norm > 0.0) {
-                    refresh_all(fine, guess);
-                    operator::<f64, true>(fine, mass, stencil, b, guess, &mut z);
-                    let guess_norm = dot(&z, &z).sqrt();
+                    let guess_norm = dot(&q, &q).sqrt();
                     if guess_norm < start_norm {
-                        x.copy_from_slice(guess);
-                        r.copy_from_slice(&z);
+                        std::mem::swap(x, guess);
+                        std::mem::swap(&mut r, &mut q);
                         start_norm = guess_norm;
                     }
                 }
@@ -342,10 +386,10 @@ impl Hierarchy {
                     start_residual: b_norm,
                 };
                 if report.relative_residual > limits.tolerance {
-                    let mut rz = self.precondition(work, &r, start_norm, &mut z);
-                    p.copy_from_slice(&z);
+                    let (mut rz, back) = self.precondition(work, &r, start_norm);
+                    self.next_direction(work, back, None, &mut p);
                     while report.iterations < limits.max_iterations {
-                        let (mass, stencil) = (&work.mass[0], &work.stencil[0]);
+                        let (mass, stencil) = (work.mass_term(0), &work.stencil[0]);
                         refresh_all(fine, &mut p);
                         operator::<f64, false>(fine, mass, stencil, &r, &p, &mut q);
                         let pq = dot(&p, &q);
@@ -356,18 +400,17 @@ impl Hierarchy {
                         let rr = update_and_norm2(step, &p, &q, x, &mut r);
                         report.iterations += 1;
                         report.relative_residual = rr.sqrt() / b_norm;
-                        if report.relative_residual <= limits.tolerance {
+                        let done = report.relative_residual <= limits.tolerance;
+                        if done || report.iterations == limits.max_iterations {
                             break;
                         }
-                        let rz_next = self.precondition(work, &r, rr.sqrt(), &mut z);
+                        let (rz_next, back) = self.precondition(work, &r, rr.sqrt());
                         let beta = rz_next / rz;
                         rz = rz_next;
-                        for (pi, zi) in p.iter_mut().zip(&z) {
-                            *pi = *zi + beta * *pi;
-                        }
+                        self.next_direction(work, back, Some(beta), &mut p);
                     }
                 }
-                (work.r, work.z, work.p, work.q) = (r, z, p, q);
+                (work.r, work.p, work.q) = (r, p, q);
                 report
             },
         )
@@ -391,9 +434,9 @@ impl Hierarchy {
         work.residual.resize(count, Vec::new());
         work.correction.resize(count, Vec::new());
         for (k, level) in self.levels.iter().enumerate() {
-            work.mass[k].resize(level.len(), 0.0);
+            sized(&mut work.mass[k], level.len(), NOT_A_CELL);
             for w in &mut work.stencil[k] {
-                w.resize(level.len(), 0.0);
+                sized(w, level.len(), 0.0);
             }
             work.residual[k].resize(level.len(), 0.0);
             work.correction[k].resize(level.len(), 0.0);
@@ -401,8 +444,13 @@ impl Hierarchy {
         self.fine_numbers(work, alpha, weight);
         for k in 1..count {
             let (fine, coarse) = (&self.levels[k - 1], &self.levels[k]);
+            let per_face = k == 1 && work.mass_per_face;
             let (done, rest) = work.mass.split_at_mut(k);
-            restrict(fine, &done[k - 1], coarse, &mut rest[0], &mut work.row64);
+            let fine_mass = LevelField {
+                values: &done[k - 1],
+                per_face,
+            };
+            restrict_field(fine, fine_mass, coarse, &mut rest[0], &mut work.row64);
             let (done, rest) = work.stencil.split_at_mut(k);
             kernels::restrict_weights(fine, &done[k - 1], coarse, &mut rest[0], &mut work.row64);
         }
@@ -410,9 +458,11 @@ impl Hierarchy {
         work.scale = if count == 1 {
             1.0
         } else {
-            let first = self.levels[0].position[0] as usize;
-            let [w0, w1, w2, w3] = &work.stencil[0];
-            let diagonal = work.mass[0][first] + w0[first] + w1[first] + w2[first] + w3[first];
+            let fine = &self.levels[0];
+            let w = &work.stencil[0];
+            let [w0, w1, w2, w3] = fine.side_weights(0).map(|(field, p)| w[field][p]);
+            let first = work.mass[0][fine.position[0] as usize];
+            let diagonal = first + w0 + w1 + w2 + w3;
             power_of_two_below(diagonal).recip()
         };
         self.round_for_the_v_cycle(work);
@@ -427,28 +477,39 @@ impl Hierarchy {
         );
     }
 
-    /// The finest level's mass term and weights from the grid's cells and edges, a face
-    /// row at a time: a row of weights is a slice ([`inside_a_face`]) but for the seam
-    /// edges at its ends ([`Hierarchy::seam_edges`]).
+    /// The finest level's mass term (face 0's alone where the system's faces are
+    /// alike: [`Work::mass_per_face`]) and weights from the grid's cells and edges, a face
+    /// row at a time: a row's RIGHT weights but the last and its TOP weights (but the top
+    /// row's) are a slice of the grid's edges ([`inside_a_face`]); then the entries that
+    /// hold seam edges ([`Hierarchy::seam_weights`]).
     #[inline(always)]
     fn fine_numbers(&self, work: &mut Work, alpha: &[f64], weight: &[f64]) {
         let fine = &self.levels[0];
         let n = fine.m;
         let mut row = std::mem::take(&mut work.row64);
         row.resize(n, 0.0);
-        let mut seams = self.seam_edges.iter();
+        let [right, top] = &mut work.stencil[0];
+        work.mass_per_face = self.levels.len() > 1 && fine.faces_alike() && faces_alike(alpha);
+        let mass_faces = if work.mass_per_face { 1 } else { 6 };
         for face in 0..6 {
             for y in 0..n {
-                let alpha_row = &alpha[(face * n + y) * n..][..n];
-                scatter_row(fine, face, y, alpha_row, &mut work.mass[0]);
-                for k in 0..4 {
-                    let (xs, first) = inside_a_face(n, face, y, k);
-                    row[xs.clone()].copy_from_slice(&weight[first..][..xs.len()]);
-                    for x in (0..xs.start).chain(xs.end..n) {
-                        row[x] = weight[*seams.next().expect("a seam edge") as usize];
-                    }
-                    scatter_row(fine, face, y, &row, &mut work.stencil[0][k]);
+                if face < mass_faces {
+                    let alpha_row = &alpha[(face * n + y) * n..][..n];
+                    scatter_row(fine, face, y, alpha_row, &mut work.mass[0]);
                 }
+                // The last cell's RIGHT entry is a seam's, written below.
+                let (xs, first) = inside_a_face(n, face, y, RIGHT);
+                row[xs.clone()].copy_from_slice(&weight[first..][..xs.len()]);
+                scatter_row(fine, face, y, &row, right);
+                let (xs, first) = inside_a_face(n, face, y, TOP);
+                if !xs.is_empty() {
+                    scatter_row(fine, face, y, &weight[first..][..n], top);
+                }
+            }
+        }
+        for (field, seams) in [right, top].into_iter().zip(&self.seam_weights) {
+            for &[p, e] in seams {
+                field[p as usize] = weight[e as usize];
             }
         }
         work.row64 = row;
@@ -456,51 +517,50 @@ impl Hierarchy {
 
     /// The smoothed levels' numbers scaled by [`Work::scale`] and rounded to `f32`, the
     /// inverse diagonal summed in `f64` from the unrounded numbers and rounded once (zero
-    /// where there is no diagonal: the halo).
+    /// outside the cells: [`rounded_level`]).
     #[inline(always)]
     fn round_for_the_v_cycle(&self, work: &mut Work) {
         let (scale, smoothed) = (work.scale, self.levels.len() - 1);
         work.mass32.resize(smoothed, Vec::new());
         work.inv_diag.resize(smoothed, Vec::new());
         work.stencil32.resize(smoothed, Stencil::default());
-        for k in 0..smoothed {
-            let (mass, stencil) = (&work.mass[k], &work.stencil[k]);
-            let n = mass.len();
-            let mass = &mass[..n];
-            let [w0, w1, w2, w3] = stencil;
-            let (w0, w1, w2, w3) = (&w0[..n], &w1[..n], &w2[..n], &w3[..n]);
-            let [v0, v1, v2, v3] = &mut work.stencil32[k];
-            for v in [&mut *v0, &mut *v1, &mut *v2, &mut *v3] {
-                v.resize(n, 0.0);
+        for (k, level) in self.levels[..smoothed].iter().enumerate() {
+            let n = level.len();
+            work.mass32[k].resize(n, 0.0);
+            work.inv_diag[k].resize(n, 0.0);
+            for w in &mut work.stencil32[k] {
+                w.resize(n, 0.0);
             }
-            let (v0, v1, v2, v3) = (&mut v0[..n], &mut v1[..n], &mut v2[..n], &mut v3[..n]);
-            let mass32 = &mut work.mass32[k];
-            mass32.resize(n, 0.0);
-            let inv_diag = &mut work.inv_diag[k];
-            inv_diag.resize(n, 0.0);
-            let (mass32, inv_diag) = (&mut mass32[..n], &mut inv_diag[..n]);
-            // One pass over the level's numbers (they are read once, not once an array).
-            for i in 0..n {
-                let d = mass[i] + w0[i] + w1[i] + w2[i] + w3[i];
-                (v0[i], v1[i]) = ((scale * w0[i]) as f32, (scale * w1[i]) as f32);
-                (v2[i], v3[i]) = ((scale * w2[i]) as f32, (scale * w3[i]) as f32);
-                mass32[i] = (scale * mass[i]) as f32;
-                // The halo's zero diagonal stays a zero inverse (a select, so the loop
-                // vectorises: the division by zero's infinity is dropped, not trapped).
-                let inv = (1.0 / (scale * d)) as f32;
-                inv_diag[i] = if d > 0.0 { inv } else { 0.0 };
-            }
+            let mass = LevelField {
+                values: &work.mass[k],
+                per_face: k == 0 && work.mass_per_face,
+            };
+            rounded_level(
+                level,
+                scale,
+                (mass, &work.stencil[k]),
+                (&mut work.mass32[k], &mut work.stencil32[k]),
+                &mut work.inv_diag[k],
+            );
         }
     }
 
     /// `z` = the preconditioner applied to the conjugate gradients' residual `r`, whose
     /// norm is `norm`: one V-cycle in `f32` (see [`Work`]), or the dense solve where the
-    /// finest level is the coarsest; returns `r·z`.
+    /// finest level is the coarsest. Returns `r·z` and the factor `back` that `z` is
+    /// held scaled by: `z = back·z'`, `z'` the V-cycle's answer (in
+    /// [`Work::correction`]) or the dense solve's (in [`Work::z`], `back` 1). `z` is not
+    /// stored in `f64`: [`Hierarchy::next_direction`] forms it again as it reads it.
     #[inline(always)]
-    fn precondition(&self, work: &mut Work, r: &[f64], norm: f64, z: &mut [f64]) -> f64 {
+    fn precondition(&self, work: &mut Work, r: &[f64], norm: f64) -> (f64, f64) {
         if self.levels.len() == 1 {
-            self.coarsest(work, r, z);
-            return dot(r, z);
+            let mut z = std::mem::take(&mut work.z);
+            z.resize(r.len(), 0.0);
+            self.coarsest(work, r, &mut z);
+            // `r·(1·z)`, as `widened_dot` would form it: the same bits.
+            let rz = dot(r, &z);
+            work.z = z;
+            return (rz, 1.0);
         }
         // `M' = scale·M` is the system the V-cycle holds and `r' = to·r` its right-hand
         // side, so `M⁻¹ r = (scale / to)·M'⁻¹ r'`; each factor a power of two, exact.
@@ -510,10 +570,26 @@ impl Hierarchy {
         rounded(to, r, &mut r32);
         let mut z32 = std::mem::take(&mut work.correction[0]);
         self.v_cycle(work, 0, &r32, &mut z32);
-        let rz = widen_and_dot(back, &z32, r, z);
+        // `r·z` from the V-cycle's own numbers, still in cache where `r` is not: `r'`
+        // is `to·r` rounded to `f32`, so `(r'·z')·back/to` is `r·z` but for that
+        // rounding (about 1e-7 of each term, below the preconditioner's own error; `r`
+        // itself, the tolerance's, stays exact in `f64`). `back/to` is a power of two.
+        let rz = widened_dot(&r32, &z32) * (back / to);
         work.residual[0] = r32;
         work.correction[0] = z32;
-        rz
+        (rz, back)
+    }
+
+    /// The next search direction from the last preconditioned residual `z` (held as
+    /// [`Hierarchy::precondition`] left it, scaled by `back`): `p = z + β·p`, or `p = z`
+    /// for the first (`beta` `None`).
+    #[inline(always)]
+    fn next_direction(&self, work: &Work, back: f64, beta: Option<f64>, p: &mut [f64]) {
+        if self.levels.len() == 1 {
+            update_direction(back, &work.z, beta, p);
+        } else {
+            update_direction(back, &work.correction[0], beta, p);
+        }
     }
 
     /// One symmetric V-cycle on level `k` for residual `r`, result in `z`, in `f32`: three
@@ -544,7 +620,11 @@ impl Hierarchy {
                 // Kept at the finest level's length and sliced: resized to each level's in
                 // turn, it would be zeroed again every V-cycle.
                 d.resize(d.len().max(level.len()), 0.0);
-                operator::<f32, true>(level, &work.mass32[k], w, r, z, &mut d);
+                let mass = LevelField {
+                    values: &work.mass32[k],
+                    per_face: k == 0 && work.mass_per_face,
+                };
+                operator::<f32, true>(level, mass, w, r, z, &mut d);
                 let mut rc = std::mem::take(&mut work.residual[k + 1]);
                 restrict(level, &d, coarse, &mut rc, &mut work.row);
                 work.operator = d;
@@ -600,22 +680,42 @@ fn inside_a_face(n: usize, face: usize, y: usize, k: usize) -> (std::ops::Range<
     }
 }
 
-/// The seam edges of the cells on the faces' rims, in the order
-/// `Hierarchy::fine_numbers` visits them (face, row, side, cell).
-fn seam_edges(sides: &CellSides) -> Vec<u32> {
+/// [`Hierarchy::seam_weights`] of the finest level `fine`: each rim cell's sides on a
+/// seam, at the entries [`Layout::side_weights`] names.
+fn seam_weights(fine: &Layout, sides: &CellSides) -> [Vec<[u32; 2]>; 2] {
     let n = sides.n();
-    let mut seams = Vec::new();
-    for face in 0..6 {
-        for y in 0..n {
-            for k in 0..4 {
-                let (xs, _) = inside_a_face(n, face, y, k);
-                for x in (0..xs.start).chain(xs.end..n) {
-                    seams.push(sides.edge[(face * n + y) * n + x][k]);
-                }
+    let mut seams = [Vec::new(), Vec::new()];
+    for (c, edges) in sides.edge.iter().enumerate() {
+        let (x, y, face) = (c % n, (c / n) % n, c / (n * n));
+        for (k, (field, p)) in fine.side_weights(c).into_iter().enumerate() {
+            if !inside_a_face(n, face, y, k).0.contains(&x) {
+                seams[field].push([p as u32, edges[k]]);
             }
         }
     }
+    for s in &mut seams {
+        s.sort_unstable();
+    }
     seams
+}
+
+/// Whether every face's values (a sixth of `values` each) are face 0's, to the bit
+/// (without a branch a value, so that the comparison vectorises).
+fn faces_alike(values: &[f64]) -> bool {
+    let (first, rest) = values.split_at(values.len() / 6);
+    rest.chunks_exact(first.len()).all(|face| {
+        let differ = face.iter().zip(first);
+        differ.fold(0, |any, (a, b)| any | (a.to_bits() ^ b.to_bits())) == 0
+    })
+}
+
+/// `v` at `len` entries, set to `fill` throughout where its length changes (a field of
+/// another level's size holds nothing this one can keep).
+fn sized<T: Copy>(v: &mut Vec<T>, len: usize, fill: T) {
+    if v.len() != len {
+        v.clear();
+        v.resize(len, fill);
+    }
 }
 
 /// `out` = the grid-numbered `values` in `layout`'s split arrays (the halo untouched).
@@ -664,6 +764,7 @@ fn power_of_two_below(x: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use super::layout::{RIGHT_W, TOP_W};
     use super::*;
     use crate::film_flow::grid::parent_cell;
 
@@ -801,7 +902,8 @@ mod tests {
     }
 
     /// A guess near the answer saves iterations and meets the same residual target as
-    /// the plain solve from `x`; a guess worse than `x` is not taken.
+    /// the plain solve from `x`, whether it is already within it or still iterates from
+    /// there (from the guess's residual); a guess worse than `x` is not taken.
     #[test]
     fn a_good_guess_saves_iterations_and_a_bad_one_is_ignored() {
         let n = 16;
@@ -828,81 +930,202 @@ mod tests {
             let report = h.solve_with_guess(work, &alpha, &weight, &b, &mut x, guess, limits);
             (report, x)
         };
+        let rough: Vec<f64> = answer.iter().map(|a| a + 1e-3 * (a - 1.0)).collect();
+        let worst = |x: &[f64]| {
+            x.iter()
+                .zip(&answer)
+                .map(|(p, q)| (p - q).abs())
+                .fold(0.0, f64::max)
+        };
         let (plain, _) = solve(None, &mut work);
-        let (guessed, x) = solve(Some(&near), &mut work);
         let (ignored, _) = solve(Some(&far), &mut work);
-        assert!(
-            guessed.iterations < plain.iterations,
-            "{guessed:?} vs {plain:?}"
-        );
-        assert!(guessed.relative_residual <= 1e-6, "{guessed:?}");
         assert_eq!(ignored, plain);
-        let worst = x
-            .iter()
-            .zip(&answer)
-            .map(|(p, q)| (p - q).abs())
-            .fold(0.0, f64::max);
-        assert!(worst < 1e-8, "error {worst}");
+        for (guess, iterating) in [(&near, false), (&rough, true)] {
+            let (guessed, x) = solve(Some(guess), &mut work);
+            assert!(
+                guessed.iterations < plain.iterations,
+                "{guessed:?} vs {plain:?}"
+            );
+            assert_eq!(guessed.iterations > 0, iterating, "{guessed:?}");
+            assert!(guessed.relative_residual <= 1e-6, "{guessed:?}");
+            assert!(worst(&x) < 1e-8, "error {}", worst(&x));
+        }
     }
 
-    /// Every level's numbers as the grid's cells and edges give them: the finest
-    /// level's mass term and side weights at each cell's position (zero elsewhere), and
-    /// each coarser level's mass the sum of its four children's, its side weights the
-    /// same number seen from both cells of an edge (the matrix symmetric to the bit),
-    /// half the two fine weights along the side.
+    /// Level `k`'s mass term at cell `c`, read as the kernels read it ([`LevelField`]).
+    fn mass_at(h: &Hierarchy, work: &Work, k: usize, c: usize) -> f64 {
+        let level = &h.levels[k];
+        let field = if k == 0 {
+            work.mass_term(0)
+        } else {
+            LevelField {
+                values: &work.mass[k],
+                per_face: false,
+            }
+        };
+        let p = level.position[c] as usize;
+        let face = c / (level.m * level.m);
+        let shift = if field.per_face {
+            level.face_start(face)
+        } else {
+            0
+        };
+        field.values[p - shift]
+    }
+
+    /// A mass term whose faces differ (`1 + c mod 7`), and one whose faces are alike
+    /// (`1 + (c mod n²) mod 7`), on `n` cells a face.
+    fn mass_terms(n: usize) -> [(Vec<f64>, bool); 2] {
+        let cells = 6 * n * n;
+        let differ = (0..cells).map(|c| 1.0 + (c % 7) as f64).collect();
+        let alike = (0..cells).map(|c| 1.0 + (c % (n * n) % 7) as f64).collect();
+        [(differ, false), (alike, true)]
+    }
+
+    /// Every level's numbers as the grid's cells and edges give them, each side's weight
+    /// read where [`Layout::side_weights`] names and the mass term as the kernels read
+    /// it (held per face where the faces are alike and there is more than one level): the
+    /// finest level's mass term and side weights at each cell's position, and each
+    /// coarser level's mass the sum of its four children's, its side weights half the
+    /// two fine weights along the side, and the same number seen from both cells of an
+    /// edge (the matrix symmetric to the bit); outside the cells, the mass term
+    /// [`NOT_A_CELL`] and every weight entry no cell reads zero.
     #[test]
     fn each_level_holds_the_grids_numbers_at_its_cells() {
         for n in [3, 6, 16] {
             let grid = CubeSphere::new(n);
             let h = Hierarchy::new(&grid);
-            let alpha: Vec<f64> = (0..grid.cells()).map(|c| 1.0 + (c % 7) as f64).collect();
             let weight: Vec<f64> = (0..grid.edges().len())
                 .map(|e| 10.0 + (e % 13) as f64)
                 .collect();
             let mut work = Work::default();
-            h.prepare(&mut work, &alpha, &weight);
-            let fine = &h.levels[0];
-            let sides = CellSides::new(&grid);
-            let mut expected_mass = vec![0.0; fine.len()];
-            let mut expected_w: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; fine.len()]);
-            for (c, &p) in fine.position.iter().enumerate() {
-                expected_mass[p as usize] = alpha[c];
-                for k in 0..4 {
-                    expected_w[k][p as usize] = weight[sides.edge[c][k] as usize];
+            for (alpha, alike) in mass_terms(n) {
+                h.prepare(&mut work, &alpha, &weight);
+                assert_eq!(work.mass_per_face, alike && n > 3, "n {n}");
+                holds_the_grids_numbers(&h, &work, &alpha, &weight);
+            }
+        }
+    }
+
+    /// [`each_level_holds_the_grids_numbers_at_its_cells`] for one system.
+    fn holds_the_grids_numbers(h: &Hierarchy, work: &Work, alpha: &[f64], weight: &[f64]) {
+        let fine = &h.levels[0];
+        let n = fine.m;
+        let sides = CellSides::new(&CubeSphere::new(n));
+        for c in 0..fine.position.len() {
+            assert_eq!(mass_at(h, work, 0, c), alpha[c], "n {n} cell {c}");
+            for (k, (field, q)) in fine.side_weights(c).into_iter().enumerate() {
+                let expected = weight[sides.edge[c][k] as usize];
+                assert_eq!(work.stencil[0][field][q], expected, "n {n} {c} side {k}");
+            }
+        }
+        for (k, level) in h.levels.iter().enumerate() {
+            outside_the_cells_nothing_is_read(level, &work.mass[k], &work.stencil[k]);
+        }
+        for k in 1..h.levels.len() {
+            let (fine, coarse) = (&h.levels[k - 1], &h.levels[k]);
+            let side = |level: &Layout, w: &Stencil<f64>, c: usize, s: usize| {
+                let (field, q) = level.side_weights(c)[s];
+                w[field][q]
+            };
+            let mut children = vec![0.0; coarse.position.len()];
+            let mut child_side = vec![[0.0; 4]; coarse.position.len()];
+            let m = fine.m;
+            for c in 0..fine.position.len() {
+                let parent = parent_cell(m, c);
+                children[parent] += mass_at(h, work, k - 1, c);
+                let (x, y) = (c % m, (c / m) % m);
+                let on = [x % 2 == 0, x % 2 == 1, y % 2 == 0, y % 2 == 1];
+                for s in 0..4 {
+                    if on[s] {
+                        child_side[parent][s] += 0.5 * side(fine, &work.stencil[k - 1], c, s);
+                    }
                 }
             }
-            assert_eq!(work.mass[0], expected_mass, "n {n}");
-            assert_eq!(work.stencil[0], expected_w, "n {n}");
-            for k in 1..h.levels.len() {
-                let (fine, coarse) = (&h.levels[k - 1], &h.levels[k]);
-                let (mass, w) = (&work.mass[k], &work.stencil[k]);
-                let mut children = vec![0.0; coarse.position.len()];
-                let mut child_side = vec![[0.0; 4]; coarse.position.len()];
-                let m = fine.m;
-                for (c, &p) in fine.position.iter().enumerate() {
-                    let parent = parent_cell(m, c);
-                    children[parent] += work.mass[k - 1][p as usize];
-                    let (x, y) = (c % m, (c / m) % m);
-                    let on = [x % 2 == 0, x % 2 == 1, y % 2 == 0, y % 2 == 1];
-                    for side in 0..4 {
-                        if on[side] {
-                            child_side[parent][side] += 0.5 * work.stencil[k - 1][side][p as usize];
-                        }
-                    }
+            let w = &work.stencil[k];
+            for c in 0..coarse.position.len() {
+                let rel = (mass_at(h, work, k, c) - children[c]).abs() / children[c];
+                assert!(rel < 1e-15, "n {n} level {k} cell {c}: {rel:e}");
+                for (s, expected) in child_side[c].into_iter().enumerate() {
+                    let got = side(coarse, w, c, s);
+                    let rel = (got - expected).abs() / expected;
+                    assert!(rel < 1e-15, "n {n} level {k} cell {c} side {s}: {rel:e}");
+                    let j = coarse.neighbour[c][s] as usize;
+                    let back = (0..4).find(|&b| coarse.neighbour[j][b] as usize == c);
+                    let back = back.expect("the neighbour's side back");
+                    let there = side(coarse, w, j, back);
+                    assert_eq!(got.to_bits(), there.to_bits(), "n {n} {c}-{j}");
                 }
-                for (c, &p) in coarse.position.iter().enumerate() {
-                    let p = p as usize;
-                    let rel = (mass[p] - children[c]).abs() / children[c];
-                    assert!(rel < 1e-15, "n {n} level {k} cell {c}: {rel:e}");
-                    for side in 0..4 {
-                        let rel = (w[side][p] - child_side[c][side]).abs() / child_side[c][side];
-                        assert!(rel < 1e-15, "n {n} level {k} cell {c} side {side}: {rel:e}");
-                        let j = coarse.neighbour[c][side] as usize;
-                        let back = (0..4).find(|&s| coarse.neighbour[j][s] as usize == c);
-                        let back = back.expect("the neighbour's side back");
-                        let q = coarse.position[j] as usize;
-                        assert_eq!(w[side][p].to_bits(), w[back][q].to_bits(), "n {n} {c}-{j}");
-                    }
+            }
+        }
+    }
+
+    /// The grid's cell areas, the Marangoni step's mass term, are alike on every face to
+    /// the bit, so that its systems' mass terms are held per face.
+    #[test]
+    fn every_faces_areas_are_face_zeros() {
+        for n in [2, 5, 16, 64] {
+            assert!(faces_alike(CubeSphere::new(n).areas_sr()), "n {n}");
+        }
+        let mut areas = CubeSphere::new(16).areas_sr().to_vec();
+        areas[5 * 256 + 17] *= 1.0 + f64::EPSILON;
+        assert!(!faces_alike(&areas));
+    }
+
+    /// The operator applies the grid's system at every cell, through the halo, the
+    /// weights held once an edge and the mass term held whole or per face, and gives zero
+    /// at every other position (there the weight entries hold seam weights, the values
+    /// halo copies).
+    #[test]
+    fn the_operator_applies_the_grids_system_and_gives_zero_outside_the_cells() {
+        for (n, (alpha, _)) in [1, 3, 6, 16]
+            .into_iter()
+            .flat_map(|n| mass_terms(n).map(|m| (n, m)))
+        {
+            let grid = CubeSphere::new(n);
+            let h = Hierarchy::new(&grid);
+            let cells = grid.cells();
+            let weight: Vec<f64> = (0..grid.edges().len())
+                .map(|e| 10.0 + (e % 13) as f64)
+                .collect();
+            let x: Vec<f64> = (0..cells).map(|c| ((c * 37) % 11) as f64 - 5.0).collect();
+            let mut work = Work::default();
+            h.prepare(&mut work, &alpha, &weight);
+            let fine = &h.levels[0];
+            let mut xs = Vec::new();
+            to_split(fine, &x, &mut xs);
+            refresh_all(fine, &mut xs);
+            let none = vec![0.0; fine.len()];
+            let mut out = vec![f64::NAN; fine.len()];
+            let (mass, w) = (work.mass_term(0), &work.stencil[0]);
+            operator::<f64, false>(fine, mass, w, &none, &xs, &mut out);
+            let expected = grid_apply(&grid, &alpha, &weight, &x);
+            for (c, &p) in fine.position.iter().enumerate() {
+                let err = (out[p as usize] - expected[c]).abs();
+                assert!(err <= 1e-12 * expected[c].abs().max(1.0), "n {n} cell {c}");
+            }
+            for (p, v) in out.iter().enumerate() {
+                assert!(fine.is_cell(p) || *v == 0.0, "n {n} position {p}: {v}");
+            }
+        }
+    }
+
+    /// A level's mass term is [`NOT_A_CELL`] at every position outside its cells, and
+    /// its weight fields zero at every entry that no cell's side reads.
+    fn outside_the_cells_nothing_is_read(level: &Layout, mass: &[f64], w: &Stencil<f64>) {
+        let mut read = [vec![false; level.len()], vec![false; level.len()]];
+        for c in 0..level.position.len() {
+            for (field, q) in level.side_weights(c) {
+                read[field][q] = true;
+            }
+        }
+        for p in 0..level.len() {
+            if !level.is_cell(p) {
+                assert_eq!(mass[p], NOT_A_CELL, "m {} position {p}", level.m);
+            }
+            for field in [RIGHT_W, TOP_W] {
+                if !read[field][p] {
+                    assert_eq!(w[field][p], 0.0, "m {} field {field} at {p}", level.m);
                 }
             }
         }

@@ -24,12 +24,12 @@ pub(super) fn dense_cholesky(
     m.clear();
     m.resize(n * n, 0.0);
     // The matrix is symmetric: column-major is the same as row-major. Each cell's row
-    // from its own side weights (an edge's weight is the same seen from either cell).
+    // from its side weights (an edge's weight is the same seen from either cell).
     for (i, (&p, sides)) in layout.position.iter().zip(&layout.neighbour).enumerate() {
-        let p = p as usize;
-        m[i * n + i] = scale * mass[p];
-        for (k, &j) in sides.iter().enumerate() {
-            let wk = scale * w[k][p];
+        m[i * n + i] = scale * mass[p as usize];
+        let at = layout.side_weights(i);
+        for (&j, (field, q)) in sides.iter().zip(at) {
+            let wk = scale * w[field][q];
             m[i * n + i] += wk;
             m[i * n + j as usize] -= wk;
         }

@@ -2,15 +2,30 @@
 //! operator, the halo refresh, the restriction and the coarse correction, and the
 //! conjugate gradients' dot products and updates. Each is a loop over contiguous slices
 //! cut to one length first (so it vectorises and checks no bounds inside), written
-//! once for `f32` and `f64` ([`Real`]) as IEEE operations in a fixed order.
+//! once for `f32` and `f64` ([`Real`]) as IEEE operations in a fixed order. The passes
+//! that read both colours' weights (the operator, the V-cycle's rounding) take both
+//! colours a block at a time ([`BLOCK`]).
 
 use super::Real;
-use super::layout::Layout;
-use crate::avx2::{dot_lanes, subtract_and_square_lanes, widen_and_dot_lanes};
+use super::layout::{Layout, RIGHT_W, TOP_W};
+use crate::avx2::{dot_lanes, subtract_and_square_lanes, widened_dot_lanes};
 
-/// Per side, a level's edge weights as a field: each cell's weight of the edge on that
-/// side (zero at the halo cells).
-pub(super) type Stencil<T> = [Vec<T>; 4];
+/// A level's edge weights once an edge: per cell its RIGHT side's weight
+/// ([`RIGHT_W`]) and its TOP side's ([`TOP_W`]), the left halo column and the bottom
+/// halo row holding the rim cells' LEFT and BOTTOM seam weights
+/// ([`Layout::side_weights`]); zero wherever no cell reads them.
+pub(super) type Stencil<T> = [Vec<T>; 2];
+
+/// The mass term's value at the positions that hold no cell: negative, where a cell's
+/// is not (a mass term), so the operator can tell them apart and give them zero (their
+/// weight entries hold seam weights, and their values a halo copy).
+pub(super) const NOT_A_CELL: f64 = -1.0;
+
+/// Positions a blocked pass takes of each colour in turn: a block's slices of both
+/// colours (about 200 kB in `f64`) stay in L2 while the other colour reads them as
+/// neighbours. Over `film_profile 64 0 9.81`'s 40 steps, 256 took 21 M instructions
+/// more than 2048 (each block's slices set up anew), 4096 1.4 M fewer, the same misses.
+const BLOCK: usize = 2048;
 
 /// Slice `values[start + offset..][..len]`.
 #[inline(always)]
@@ -18,33 +33,103 @@ fn shifted<T>(values: &[T], start: usize, offset: isize, len: usize) -> &[T] {
     &values[(start as isize + offset) as usize..][..len]
 }
 
-/// The four neighbour slices and the four weight slices of the cells at `range` of
-/// colour `c` (`own` is the colour's array, `other` the other's).
+/// The four neighbour slices (LEFT, RIGHT, BOTTOM, TOP) of the `len` cells from
+/// `start` of colour `c`, in `other`, the other colour's array of the field.
 #[inline(always)]
-fn around<'a, T>(
+fn neighbours<'a, T>(
     layout: &Layout,
     c: usize,
+    (start, len): (usize, usize),
     other: &'a [T],
-    w: &'a Stencil<T>,
-) -> ([&'a [T]; 4], [&'a [T]; 4]) {
-    let range = layout.sweep[c].clone();
-    let (start, len) = (range.start, range.len());
+) -> [&'a [T]; 4] {
     let o = layout.neighbour_offsets(c);
-    let base = c * layout.half + start;
-    (
-        [
-            shifted(other, start, o[0], len),
-            shifted(other, start, o[1], len),
-            shifted(other, start, o[2], len),
-            shifted(other, start, o[3], len),
-        ],
-        [
-            &w[0][base..][..len],
-            &w[1][base..][..len],
-            &w[2][base..][..len],
-            &w[3][base..][..len],
-        ],
-    )
+    [0, 1, 2, 3].map(|k| shifted(other, start, o[k], len))
+}
+
+/// The four side-weight slices (LEFT, RIGHT, BOTTOM, TOP) of the `len` cells from
+/// `start` of colour `c`: a cell's LEFT and BOTTOM weights are its neighbours' RIGHT and
+/// TOP entries, at the same offsets as their values.
+#[inline(always)]
+fn side_weights<'a, T>(
+    layout: &Layout,
+    c: usize,
+    (start, len): (usize, usize),
+    w: &'a Stencil<T>,
+) -> [&'a [T]; 4] {
+    let o = layout.neighbour_offsets(c);
+    let own = c * layout.half + start;
+    let far = (1 - c) * layout.half + start;
+    let (right, top) = (&w[RIGHT_W][..], &w[TOP_W][..]);
+    [
+        shifted(right, far, o[0], len),
+        &right[own..][..len],
+        shifted(top, far, o[2], len),
+        &top[own..][..len],
+    ]
+}
+
+/// The positions both colours' cells lie within: the union of their sweeps (they differ
+/// by at most one position at each end, a halo cell).
+#[inline(always)]
+fn both_sweeps(layout: &Layout) -> std::ops::Range<usize> {
+    let [a, b] = &layout.sweep;
+    a.start.min(b.start)..a.end.max(b.end)
+}
+
+/// Runs `pass(face, start, len)` over `range` in blocks of at most [`BLOCK`] positions;
+/// `per_face`, each within one face's positions ([`Layout::face_start`]), so that a
+/// field held per face can be read from face 0's ([`LevelField`]), else `face` 0 (a
+/// block's unvectorised remainder costs as much as a few hundred cells: six blocks a
+/// face on a coarse level cost the V-cycle 5 % more instructions). `pass` is marked
+/// `#[inline(always)]`, so that it is built into the caller's AVX2 code.
+#[inline(always)]
+fn in_blocks(
+    layout: &Layout,
+    range: std::ops::Range<usize>,
+    per_face: bool,
+    mut pass: impl FnMut(usize, usize, usize),
+) {
+    let faces = if per_face { 6 } else { 1 };
+    for face in 0..faces {
+        let (start, end) = if per_face {
+            (layout.face_start(face), layout.face_start(face + 1))
+        } else {
+            (range.start, range.end)
+        };
+        let end = end.min(range.end);
+        let mut start = start.max(range.start);
+        while start < end {
+            let len = BLOCK.min(end - start);
+            pass(face, start, len);
+            start += len;
+        }
+    }
+}
+
+/// A field of a level as the kernels read it: whole, or `per_face`, face 0's positions
+/// alone, read by every face at its own positions less [`Layout::face_start`]. The
+/// finest level's mass term is held so where the system's faces are alike (every face
+/// holds face 0's cell areas): a pass then streams 1/6 of the field.
+#[derive(Clone, Copy)]
+pub(super) struct LevelField<'a, T> {
+    /// The field ([`NOT_A_CELL`] outside the cells, for a mass term).
+    pub(super) values: &'a [T],
+    /// Whether every face reads face 0's positions.
+    pub(super) per_face: bool,
+}
+
+impl<'a, T> LevelField<'a, T> {
+    /// The field at the `len` positions from split position `base`, all of face
+    /// `face`.
+    #[inline(always)]
+    fn at(&self, layout: &Layout, face: usize, base: usize, len: usize) -> &'a [T] {
+        let shift = if self.per_face {
+            layout.face_start(face)
+        } else {
+            0
+        };
+        &self.values[base - shift..][..len]
+    }
 }
 
 /// Splits a field into colour `c`'s array (mutable) and the other's.
@@ -69,7 +154,10 @@ pub(super) fn relax<T: Real>(
     let range = layout.sweep[c].clone();
     let (start, len) = (range.start, range.len());
     let (own, other) = colours(z, layout, c);
-    let (near, w) = around(layout, c, other, w);
+    let (near, w) = (
+        neighbours(layout, c, (start, len), other),
+        side_weights(layout, c, (start, len), w),
+    );
     let base = c * layout.half + start;
     let (inv_diag, r, out) = (&inv_diag[base..][..len], &r[base..][..len], &mut own[range]);
     let [n0, n1, n2, n3] = near;
@@ -104,40 +192,170 @@ pub(super) fn relax_from_zero<T: Real>(layout: &Layout, inv_diag: &[T], r: &[T],
 /// `out = (diag(mass) + L_w) x` (`RESIDUAL` false) or `r − (diag(mass) + L_w) x`
 /// (true), as `mᵢxᵢ + Σ wᵢⱼ (xᵢ − xⱼ)`: the differences keep the result accurate where
 /// the weights dwarf the mass term and `x` is nearly uniform (a stiff step's
-/// surfactant). `x`'s halo must be fresh; the halo cells' results are zero (so a
-/// field made from them adds nothing outside the faces to a dot product).
+/// surfactant). `x`'s halo must be fresh; the results outside the cells are zero (so a
+/// field made from them adds nothing outside the faces to a dot product). Both colours
+/// a block at a time ([`BLOCK`]): each weight entry is read once, by its cell and by the
+/// neighbour across the edge, while it is in L2.
 #[inline(always)]
 pub(super) fn operator<T: Real, const RESIDUAL: bool>(
     layout: &Layout,
-    mass: &[T],
+    mass: LevelField<T>,
     w: &Stencil<T>,
     r: &[T],
     x: &[T],
     out: &mut [T],
 ) {
-    for c in 0..2 {
-        let range = layout.sweep[c].clone();
-        let (start, len) = (range.start, range.len());
-        let (own, other) = x[..layout.len()].split_at(layout.half);
-        let (own, other) = if c == 0 { (own, other) } else { (other, own) };
-        let (near, w) = around(layout, c, other, w);
-        let base = c * layout.half + start;
-        let (m, xs, r) = (&mass[base..][..len], &own[range], &r[base..][..len]);
-        let colour = &mut out[c * layout.half..][..layout.half];
-        colour[..start].fill(T::ZERO);
-        colour[start + len..].fill(T::ZERO);
-        let out = &mut colour[start..][..len];
-        let [n0, n1, n2, n3] = near;
-        let [w0, w1, w2, w3] = w;
-        for i in 0..len {
-            let xi = xs[i];
-            let mut sum = m[i] * xi;
-            sum += w0[i] * (xi - n0[i]);
-            sum += w1[i] * (xi - n1[i]);
-            sum += w2[i] * (xi - n2[i]);
-            sum += w3[i] * (xi - n3[i]);
-            out[i] = if RESIDUAL { r[i] - sum } else { sum };
+    let range = both_sweeps(layout);
+    let half = layout.half;
+    for colour in out[..layout.len()].chunks_exact_mut(half) {
+        colour[..range.start].fill(T::ZERO);
+        colour[range.end..].fill(T::ZERO);
+    }
+    in_blocks(
+        layout,
+        range,
+        mass.per_face,
+        #[inline(always)]
+        |face, start, len| {
+            for c in 0..2 {
+                let at = (face, start, len);
+                operator_run::<T, RESIDUAL>(layout, c, at, (mass, w, r), x, out);
+            }
+        },
+    );
+}
+
+/// `out = b − (diag(mass) + L_w) x` for each start `x` given ([`operator`]'s residual),
+/// in one pass over the system: each block's numbers are read once for every start.
+#[inline(always)]
+pub(super) fn residuals<T: Real>(
+    layout: &Layout,
+    (mass, w, b): (LevelField<T>, &Stencil<T>, &[T]),
+    starts: [Option<&[T]>; 2],
+    outs: [&mut [T]; 2],
+) {
+    let range = both_sweeps(layout);
+    let half = layout.half;
+    let mut pairs: Vec<_> = starts.into_iter().zip(outs).collect();
+    for (_, out) in &mut pairs {
+        for colour in out[..layout.len()].chunks_exact_mut(half) {
+            colour[..range.start].fill(T::ZERO);
+            colour[range.end..].fill(T::ZERO);
         }
+    }
+    in_blocks(
+        layout,
+        range,
+        mass.per_face,
+        #[inline(always)]
+        |face, start, len| {
+            for (x, out) in &mut pairs {
+                let Some(x) = x else { continue };
+                for c in 0..2 {
+                    let at = (face, start, len);
+                    operator_run::<T, true>(layout, c, at, (mass, w, b), x, out);
+                }
+            }
+        },
+    );
+}
+
+/// [`operator`] at the `len` positions from `start` of colour `c`, of face `face`.
+#[inline(always)]
+fn operator_run<T: Real, const RESIDUAL: bool>(
+    layout: &Layout,
+    c: usize,
+    (face, start, len): (usize, usize, usize),
+    (mass, w, r): (LevelField<T>, &Stencil<T>, &[T]),
+    x: &[T],
+    out: &mut [T],
+) {
+    let (own, other) = x[..layout.len()].split_at(layout.half);
+    let (own, other) = if c == 0 { (own, other) } else { (other, own) };
+    let (near, w) = (
+        neighbours(layout, c, (start, len), other),
+        side_weights(layout, c, (start, len), w),
+    );
+    let base = c * layout.half + start;
+    let (m, xs, r) = (
+        mass.at(layout, face, base, len),
+        &own[start..][..len],
+        &r[base..][..len],
+    );
+    let out = &mut out[base..][..len];
+    let [n0, n1, n2, n3] = near;
+    let [w0, w1, w2, w3] = w;
+    for i in 0..len {
+        let xi = xs[i];
+        let mut sum = m[i] * xi;
+        sum += w0[i] * (xi - n0[i]);
+        sum += w1[i] * (xi - n1[i]);
+        sum += w2[i] * (xi - n2[i]);
+        sum += w3[i] * (xi - n3[i]);
+        let value = if RESIDUAL { r[i] - sum } else { sum };
+        // A select, so the loop vectorises: a halo cell's weights are seam weights.
+        out[i] = if m[i] >= T::ZERO { value } else { T::ZERO };
+    }
+}
+
+/// A level's numbers scaled by `scale` and rounded to `f32` for the V-cycle (`mass32`,
+/// `w32`), and its inverse diagonal `1/(scale·d)`, `d` the mass term plus the four side
+/// weights summed in `f64` (LEFT to TOP) and rounded once; zero outside the cells. One
+/// pass over the level's numbers, both colours a block at a time ([`operator`]); a
+/// mass term held `per_face` is rounded on face 0 alone, and read so.
+#[inline(always)]
+pub(super) fn rounded_level(
+    layout: &Layout,
+    scale: f64,
+    (mass, w): (LevelField<f64>, &Stencil<f64>),
+    (mass32, w32): (&mut [f32], &mut Stencil<f32>),
+    inv_diag: &mut [f32],
+) {
+    let range = both_sweeps(layout);
+    let half = layout.half;
+    for c in 0..2 {
+        let start = c * half;
+        for part in [start..start + range.start, start + range.end..start + half] {
+            round_run(scale, part.clone(), mass.values, mass32);
+            round_run(scale, part.clone(), &w[RIGHT_W], &mut w32[RIGHT_W]);
+            round_run(scale, part.clone(), &w[TOP_W], &mut w32[TOP_W]);
+            inv_diag[part].fill(0.0);
+        }
+    }
+    in_blocks(
+        layout,
+        range,
+        mass.per_face,
+        #[inline(always)]
+        |face, start, len| {
+            for c in 0..2 {
+                let own = c * half + start..c * half + start + len;
+                if !mass.per_face || face == 0 {
+                    round_run(scale, own.clone(), mass.values, mass32);
+                }
+                round_run(scale, own.clone(), &w[RIGHT_W], &mut w32[RIGHT_W]);
+                round_run(scale, own.clone(), &w[TOP_W], &mut w32[TOP_W]);
+                let [w0, w1, w2, w3] = side_weights(layout, c, (start, len), w);
+                let m = mass.at(layout, face, own.start, len);
+                let inv_diag = &mut inv_diag[own];
+                for i in 0..len {
+                    let d = m[i] + w0[i] + w1[i] + w2[i] + w3[i];
+                    // Zero outside the cells, by a select, so the loop vectorises (a
+                    // halo cell's sum of seam weights, or a division by zero's
+                    // infinity, is dropped, not trapped).
+                    let inv = (1.0 / (scale * d)) as f32;
+                    inv_diag[i] = if m[i] >= 0.0 && d > 0.0 { inv } else { 0.0 };
+                }
+            }
+        },
+    );
+}
+
+/// `out[range] = scale·values[range]` rounded to `f32`.
+#[inline(always)]
+fn round_run(scale: f64, range: std::ops::Range<usize>, values: &[f64], out: &mut [f32]) {
+    for (o, v) in out[range.clone()].iter_mut().zip(&values[range]) {
+        *o = (scale * v) as f32;
     }
 }
 
@@ -167,12 +385,42 @@ pub(super) fn restrict<T: Real>(
     out: &mut [T],
     row: &mut Vec<T>,
 ) {
+    restrict_from(fine, (fine_values, |face| face), coarse, out, row);
+}
+
+/// [`restrict`] of a field that may be held per face ([`LevelField`]): every coarse
+/// face from fine face 0's values where it is.
+#[inline(always)]
+pub(super) fn restrict_field<T: Real>(
+    fine: &Layout,
+    fine_values: LevelField<T>,
+    coarse: &Layout,
+    out: &mut [T],
+    row: &mut Vec<T>,
+) {
+    let values = fine_values.values;
+    if fine_values.per_face {
+        restrict_from(fine, (values, |_| 0), coarse, out, row);
+    } else {
+        restrict_from(fine, (values, |face| face), coarse, out, row);
+    }
+}
+
+/// [`restrict`], coarse face `face` from fine face `from(face)`'s values.
+#[inline(always)]
+fn restrict_from<T: Real>(
+    fine: &Layout,
+    (fine_values, from): (&[T], impl Fn(usize) -> usize),
+    coarse: &Layout,
+    out: &mut [T],
+    row: &mut Vec<T>,
+) {
     let m = coarse.m;
     row.resize(m, T::ZERO);
     for face in 0..6 {
         for y in 0..m {
-            let [a0, b0] = fine.children_of_row(face, y, 0);
-            let [a1, b1] = fine.children_of_row(face, y, 1);
+            let [a0, b0] = fine.children_of_row(from(face), y, 0);
+            let [a1, b1] = fine.children_of_row(from(face), y, 1);
             let (a0, b0) = (&fine_values[a0..][..m], &fine_values[b0..][..m]);
             let (a1, b1) = (&fine_values[a1..][..m], &fine_values[b1..][..m]);
             let row = &mut row[..m];
@@ -184,9 +432,13 @@ pub(super) fn restrict<T: Real>(
     }
 }
 
-/// The coarse level's edge weights per side: half the sum of the two fine edges' along
-/// each coarse side (see the module's documentation). An edge's two cells sum the same
-/// two numbers, so the coarse matrix stays symmetric to the bit.
+/// The coarse level's edge weights: half the sum of the two fine edges' along each
+/// coarse edge (see the module's documentation), the fine bottom one first for an
+/// x-edge, the fine left one first for a y-edge. The halo's seam weights restrict alike:
+/// a coarse rim cell's halo neighbour's entry is its two fine rim children's halo
+/// neighbours'. A seam edge held on both of its faces sums the same two numbers on
+/// each (in either order, the same bits), so the coarse matrix stays symmetric to the
+/// bit.
 #[inline(always)]
 pub(super) fn restrict_weights(
     fine: &Layout,
@@ -196,49 +448,75 @@ pub(super) fn restrict_weights(
     row: &mut Vec<f64>,
 ) {
     let m = coarse.m;
-    row.resize(m, 0.0);
-    // Per side: which fine row (0 bottom, 1 top) and which child of the pair (0 left,
-    // 1 right) give its two fine edges.
-    const FROM: [[(usize, usize); 2]; 4] = [
-        [(0, 0), (1, 0)], // LEFT: the left children of both rows
-        [(0, 1), (1, 1)], // RIGHT: the right children of both rows
-        [(0, 0), (0, 1)], // BOTTOM: the bottom row's pair
-        [(1, 0), (1, 1)], // TOP: the top row's pair
-    ];
+    row.resize(m + 1, 0.0);
+    // A run of one colour's entries of the fine level from padded `(row, col)`: every
+    // other padded cell along the row.
+    let run = |k: usize, face: usize, (r, col): (usize, usize), len: usize| {
+        &fine_w[k][fine.index(fine.padded_at(face, r, col))..][..len]
+    };
     for face in 0..6 {
+        // RIGHT entries of coarse padded row `y + 1`, columns 0 (the halo) to `m`: the
+        // fine ones of padded rows `2y + 1` and `2y + 2`, columns 0, 2, …, 2m.
         for y in 0..m {
-            let rows = [0, 1].map(|j| fine.children_of_row(face, y, j));
-            for (k, [(ja, ia), (jb, ib)]) in FROM.into_iter().enumerate() {
-                let a = &fine_w[k][rows[ja][ia]..][..m];
-                let b = &fine_w[k][rows[jb][ib]..][..m];
-                let row = &mut row[..m];
-                for x in 0..m {
-                    row[x] = 0.5 * a[x] + 0.5 * b[x];
-                }
-                scatter_row(coarse, face, y, row, &mut out[k]);
-            }
+            let a = run(RIGHT_W, face, (2 * y + 1, 0), m + 1);
+            let b = run(RIGHT_W, face, (2 * y + 2, 0), m + 1);
+            half_sums(a, b, &mut row[..m + 1]);
+            let first = coarse.padded_at(face, y + 1, 0);
+            scatter_run(coarse, first, &row[..m + 1], &mut out[RIGHT_W]);
+        }
+        // TOP entries of coarse padded row `y`, 0 (the halo) to `m`, columns 1 to `m`:
+        // the fine ones of padded row `2y`, columns 1, 3, … and 2, 4, ….
+        for y in 0..m + 1 {
+            let a = run(TOP_W, face, (2 * y, 1), m);
+            let b = run(TOP_W, face, (2 * y, 2), m);
+            half_sums(a, b, &mut row[..m]);
+            let first = coarse.padded_at(face, y, 1);
+            scatter_run(coarse, first, &row[..m], &mut out[TOP_W]);
         }
     }
 }
 
-/// A coarse row's cells of colour `even`'s (cells 0, 2, …) and of colour `odd`'s (cells
-/// 1, 3, …) as two slices of `field` ([`Layout::row_start`]).
+/// `out[x] = a[x]/2 + b[x]/2`.
 #[inline(always)]
-fn row_halves<'a, T>(
+fn half_sums(a: &[f64], b: &[f64], out: &mut [f64]) {
+    for ((o, a), b) in out.iter_mut().zip(a).zip(b) {
+        *o = 0.5 * a + 0.5 * b;
+    }
+}
+
+/// A run of `len` consecutive padded cells from padded index `first`: its cells of the
+/// first one's colour (the 1st, 3rd, …) and of the other colour (the 2nd, 4th, …) as
+/// two slices of `field`, each consecutive in its colour's array.
+#[inline(always)]
+fn run_halves<'a, T>(
     layout: &Layout,
-    face: usize,
-    y: usize,
+    first: usize,
+    len: usize,
     field: &'a mut [T],
 ) -> (&'a mut [T], &'a mut [T]) {
-    let (m, half) = (layout.m, layout.half);
-    let [even, odd] = layout.row_start(face, y);
+    let half = layout.half;
+    let (even, odd) = (layout.index(first), layout.index(first + 1));
     let (lo, hi) = field[..2 * half].split_at_mut(half);
     let (e, o) = if even < half {
         (&mut lo[even..], &mut hi[odd - half..])
     } else {
         (&mut hi[even - half..], &mut lo[odd..])
     };
-    (&mut e[..m.div_ceil(2)], &mut o[..m / 2])
+    (&mut e[..len.div_ceil(2)], &mut o[..len / 2])
+}
+
+/// Writes `values[j]` to padded index `first + j`, for each `j`.
+#[inline(always)]
+fn scatter_run<T: Real>(layout: &Layout, first: usize, values: &[T], out: &mut [T]) {
+    let len = values.len();
+    let (even, odd) = run_halves(layout, first, len, out);
+    let pairs = values.chunks_exact(2);
+    for ((e, o), pair) in even.iter_mut().zip(odd.iter_mut()).zip(pairs) {
+        (*e, *o) = (pair[0], pair[1]);
+    }
+    if len % 2 == 1 {
+        even[len / 2] = values[len - 1];
+    }
 }
 
 /// Writes a row's values `values[x]`, `x` along the row, to their positions.
@@ -251,15 +529,7 @@ pub(super) fn scatter_row<T: Real>(
     out: &mut [T],
 ) {
     let m = layout.m;
-    let values = &values[..m];
-    let (even, odd) = row_halves(layout, face, y, out);
-    let pairs = values.chunks_exact(2);
-    for ((e, o), pair) in even.iter_mut().zip(odd.iter_mut()).zip(pairs) {
-        (*e, *o) = (pair[0], pair[1]);
-    }
-    if m % 2 == 1 {
-        even[m / 2] = values[m - 1];
-    }
+    scatter_run(layout, layout.padded_at(face, y + 1, 1), &values[..m], out);
 }
 
 /// Reads a row's values, in order along the row, from their positions into `row`.
@@ -272,7 +542,7 @@ pub(super) fn gather_row<T: Real>(
     row: &mut [T],
 ) {
     let m = layout.m;
-    let (even, odd) = row_halves(layout, face, y, field);
+    let (even, odd) = run_halves(layout, layout.padded_at(face, y + 1, 1), m, field);
     let pairs = row[..m].chunks_exact_mut(2);
     for ((pair, e), o) in pairs.zip(even.iter()).zip(odd.iter()) {
         (pair[0], pair[1]) = (*e, *o);
@@ -321,18 +591,36 @@ pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
 }
 
-/// `z = back·z32` (widened to `f64`) and returns `r·z`, summed as [`dot`] sums, in one
-/// pass.
+/// `a·b`, `f32` fields widened to `f64` (each product exact), summed as [`dot`] sums
+/// ([`widened_dot_lanes`]).
 #[inline(always)]
-pub(super) fn widen_and_dot(back: f64, z32: &[f32], r: &[f64], z: &mut [f64]) -> f64 {
-    let main = r.len() - r.len() % LANES;
-    let lanes = widen_and_dot_lanes(back, &z32[..main], &r[..main], &mut z[..main]);
+pub(super) fn widened_dot(a: &[f32], b: &[f32]) -> f64 {
+    let main = a.len() - a.len() % LANES;
+    let lanes = widened_dot_lanes(&a[..main], &b[..main]);
     let mut tail = 0.0;
-    for ((zi, wi), ri) in z[main..].iter_mut().zip(&z32[main..]).zip(&r[main..]) {
-        *zi = back * f64::from(*wi);
-        tail += ri * *zi;
+    for (x, y) in a[main..].iter().zip(&b[main..a.len()]) {
+        tail += f64::from(*x) * f64::from(*y);
     }
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
+}
+
+/// The conjugate gradients' next direction `p = back·z + β·p`, `z` widened to `f64`, or
+/// `p = back·z` for the first (`beta` `None`).
+#[inline(always)]
+pub(super) fn update_direction<T: Real>(back: f64, z: &[T], beta: Option<f64>, p: &mut [f64]) {
+    let z = &z[..p.len()];
+    match beta {
+        Some(beta) => {
+            for (pi, zi) in p.iter_mut().zip(z) {
+                *pi = back * zi.widen() + beta * *pi;
+            }
+        }
+        None => {
+            for (pi, zi) in p.iter_mut().zip(z) {
+                *pi = back * zi.widen();
+            }
+        }
+    }
 }
 
 /// `x += step·p`, `r −= step·q`, and returns `r·r`, summed as [`dot`] sums: each lane's

@@ -13,6 +13,13 @@ use std::ops::Range;
 
 use super::super::sides::{BOTTOM, CellSides, LEFT, RIGHT, TOP};
 
+/// Of a level's two weight fields, the one holding each cell's RIGHT side's weight (and,
+/// at the left halo column, the rim cells' LEFT seam weights).
+pub(super) const RIGHT_W: usize = 0;
+/// The one holding each cell's TOP side's weight (and, at the bottom halo row, the rim
+/// cells' BOTTOM seam weights).
+pub(super) const TOP_W: usize = 1;
+
 /// A level's padded, colour-split layout.
 ///
 /// # Guarantees
@@ -130,6 +137,46 @@ impl Layout {
         (f & 1) * self.half + (f >> 1)
     }
 
+    /// The first position of face `face` in each colour's array (`face` 6: the end):
+    /// where a face's padded cells have an even count, the same in both colours, and
+    /// every face's cells lie at face 0's positions plus this
+    /// ([`Layout::faces_alike`]).
+    pub(super) fn face_start(&self, face: usize) -> usize {
+        face * self.face_len / 2
+    }
+
+    /// Whether every face's cells lie in both colours' arrays at face 0's positions plus
+    /// [`Layout::face_start`]: a face's padded cells have an even count (`m` even).
+    pub(super) fn faces_alike(&self) -> bool {
+        self.face_len % 2 == 0
+    }
+
+    /// Padded index of face `face`'s padded row `row`, column `col` (row and column 0 are
+    /// the halo before the face's first row and column).
+    pub(super) fn padded_at(&self, face: usize, row: usize, col: usize) -> usize {
+        face * self.face_len + row * self.stride + col
+    }
+
+    /// Of cell `c` (grid numbering), per side [`LEFT`]…[`TOP`], the weight field
+    /// ([`RIGHT_W`] or [`TOP_W`]) and the position in it that hold that side's weight: the
+    /// cell's own entry for RIGHT and TOP, its left or lower neighbour's in the padded
+    /// level (a halo cell on the rim) for LEFT and BOTTOM.
+    pub(super) fn side_weights(&self, c: usize) -> [(usize, usize); 4] {
+        let f = self.padded(c);
+        [
+            (RIGHT_W, self.index(f - 1)),
+            (RIGHT_W, self.index(f)),
+            (TOP_W, self.index(f - self.stride)),
+            (TOP_W, self.index(f)),
+        ]
+    }
+
+    /// Whether position `p` of the split arrays holds a cell (not a halo or padding cell).
+    #[cfg(test)]
+    pub(super) fn is_cell(&self, p: usize) -> bool {
+        self.position.contains(&(p as u32))
+    }
+
     /// Length of a field on the level: both colours' arrays.
     pub(super) fn len(&self) -> usize {
         2 * self.half
@@ -176,13 +223,6 @@ impl Layout {
         let f = face * self.face_len + (2 * y + j + 1) * self.stride + 1;
         [self.index(f), self.index(f + 1)]
     }
-
-    /// The positions of coarse face `face`, row `y` (0-based), cells 0 and 1: each
-    /// colour's later cells of the row follow every other cell at consecutive positions.
-    pub(super) fn row_start(&self, face: usize, y: usize) -> [usize; 2] {
-        let f = face * self.face_len + (y + 1) * self.stride + 1;
-        [self.index(f), self.index(f + 1)]
-    }
 }
 
 #[cfg(test)]
@@ -192,7 +232,9 @@ mod tests {
 
     /// Every cell reads, at its four neighbour offsets in the other colour's array, the
     /// grid's neighbour on that side: the cell itself inside a face, or a halo cell
-    /// whose refresh copies that neighbour; on every level of the hierarchy's sizes.
+    /// whose refresh copies that neighbour; and its LEFT and BOTTOM weights at the same
+    /// positions of the weight fields, where inside a face the neighbour keeps that
+    /// edge's weight as its own RIGHT or TOP one; on every level of the hierarchy's sizes.
     #[test]
     fn each_cell_reads_its_grid_neighbours_through_the_offsets_and_the_halo() {
         for n in [1, 2, 3, 6, 16] {
@@ -209,12 +251,29 @@ mod tests {
                     let at = p % level.half;
                     assert!(level.sweep[colour].contains(&at), "n {n} cell {c}");
                     let offsets = level.neighbour_offsets(colour);
+                    let weights = level.side_weights(c);
                     for (k, offset) in offsets.into_iter().enumerate() {
                         let read = (1 - colour) * level.half + (at as isize + offset) as usize;
                         let read = read as u32;
                         let value_of = copies.get(&read).copied().unwrap_or(read);
-                        let expected = level.position[level.neighbour[c][k] as usize];
+                        let j = level.neighbour[c][k] as usize;
+                        let expected = level.position[j];
                         assert_eq!(value_of, expected, "m {} cell {c} side {k}", level.m);
+                        // The side's weight: the cell's own entry, or the entry at the
+                        // position its neighbour's value is read from, which is the
+                        // neighbour's own entry for the same edge inside a face, a
+                        // halo cell's across a seam.
+                        let field = [RIGHT_W, RIGHT_W, TOP_W, TOP_W][k];
+                        let own = [read as usize, p, read as usize, p][k];
+                        assert_eq!(weights[k], (field, own), "m {} cell {c} side {k}", level.m);
+                        if k == LEFT || k == BOTTOM {
+                            let back = [RIGHT, LEFT, TOP, BOTTOM][k];
+                            let inside = read == expected;
+                            assert_eq!(inside, !copies.contains_key(&read), "cell {c} side {k}");
+                            if inside {
+                                assert_eq!(level.side_weights(j)[back], weights[k], "cell {c}");
+                            }
+                        }
                     }
                 }
                 if level.m % 2 == 1 || level.m <= 1 {
