@@ -502,20 +502,34 @@ impl FaceRows {
         scale: &[f64],
         finish: impl Fn(f64, f64) -> f64,
     ) {
+        let (n, start) = (self.n, self.vertex_at(0, 0, j));
+        let row = &mut out[f * self.vertices_per_face() + start..][..n];
+        let u = &u[f * self.edges_per_face()..];
+        self.face_circulation_row(u, j, row, &scale[start..start + n], finish);
+    }
+
+    /// [`Self::circulation_row`] of one face's local edges `u` into `row` (`n` long, its
+    /// first junk), with `scale` the row's entries (from vertex `(0, j)`).
+    #[inline(always)]
+    pub(crate) fn face_circulation_row(
+        &self,
+        u: &[f64],
+        j: usize,
+        row: &mut [f64],
+        scale: &[f64],
+        finish: impl Fn(f64, f64) -> f64,
+    ) {
         let (n, d) = (self.n, &self.dual_length);
-        // The rows of face 0's constants ([`FaceRows`]), and of face `f`'s velocities.
+        // The rows of face 0's constants ([`FaceRows`]), and of the face's velocities.
         let below = self.x_edge(0, 0, j - 1)..self.x_edge(0, n, j - 1);
         let left = self.y_edge(0, 0, j) - 1..self.y_edge(0, n - 1, j);
         let right = self.y_edge(0, 0, j)..self.y_edge(0, n, j);
         let above = self.x_edge(0, 0, j)..self.x_edge(0, n, j);
-        let u = &u[f * self.edges_per_face()..];
         let (ub, db) = (&u[below.clone()], &d[below]);
         let (ul, dl) = (&u[left.clone()], &d[left]);
         let (ur, dr) = (&u[right.clone()], &d[right]);
         let (ua, da) = (&u[above.clone()], &d[above]);
-        let start = self.vertex_at(0, 0, j);
-        let row = &mut out[f * self.vertices_per_face() + start..][..n];
-        let scale = &scale[start..start + n];
+        let (row, scale) = (&mut row[..n], &scale[..n]);
         for i in 0..n {
             let z = 0.0 - ub[i] * db[i] + ul[i] * dl[i] - ur[i] * dr[i] + ua[i] * da[i];
             row[i] = finish(z, scale[i]);

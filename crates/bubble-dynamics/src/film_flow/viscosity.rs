@@ -23,11 +23,29 @@ const EULER_RATE_LIMIT: f64 = 1.5;
 pub(super) struct ViscousScratch {
     /// The stage before the one under way, in the face rows ([`FaceRows`]), m/s.
     pub(super) stage: Vec<f64>,
-    /// Per local vertex: the vorticity on the unit sphere (m/s per rad).
+    /// Per local vertex: the vorticity on the unit sphere (m/s per rad), of the vertices
+    /// on the faces' borders only (every copy); the inner ones are taken row by row into
+    /// [`Self::window`].
     vorticity: Vec<f64>,
     /// Per cell, in the padded layout (`FaceRows::padded_cell`): the divergence on the
-    /// unit sphere (m/s per rad), the halo holding the cells across the faces' borders.
+    /// unit sphere (m/s per rad) of the cells on the faces' borders, and in the halo of
+    /// the cells across them; the inner ones are taken row by row into [`Self::window`].
     divergence: Vec<f64>,
+    /// The rows of vertices and cells a face's edge rows read ([`Window`]).
+    window: Window,
+}
+
+/// The vorticity and divergence rows that one face's edge rows under way read: each
+/// taken just before the first edge row that reads it, from edges that have not moved yet,
+/// so that a stage reads each edge once, where whole-grid passes of vorticity,
+/// divergence and update read the velocities three times and wrote and read 0.4 MB of
+/// fields besides (at n = 64, beyond the core's 1 MB L2 with the velocities).
+#[derive(Clone, Debug, Default)]
+struct Window {
+    /// Vertex rows `j` at `j mod 2`, `n + 1` each.
+    vertex: [Vec<f64>; 2],
+    /// Padded cell rows `p` at `p mod 2`, `n + 2` each (the halo at both ends).
+    cell: [Vec<f64>; 2],
 }
 
 impl FilmFlow {
@@ -89,8 +107,7 @@ impl FilmFlow {
         last: bool,
     ) {
         let rows = &self.rows;
-        vorticity_and_divergence(&self.grid, rows, u, v);
-        let (vorticity, divergence) = (&v.vorticity, &v.divergence);
+        border_fields(&self.grid, rows, u, v);
         // Vorticity and divergence per R (of the unit sphere's), and each difference of
         // them per R again: every term of the stress carries 1/R², taken once here.
         let r = self.params.radius_m;
@@ -105,20 +122,32 @@ impl FilmFlow {
             rows.vertices_per_face(),
             rows.padded_cells_per_face(),
         );
-        // Every face reads face 0's metric ([`FaceRows`] says why).
-        let metric = (&rows.inverse_length[..], &rows.inverse_dual_length[..]);
-        let faces = u.chunks_exact_mut(epf).zip(v.stage.chunks_exact_mut(epf));
-        let fields = vorticity
+        // Face 0's cells' inverse areas, which every face reads ([`FaceRows`] says why).
+        let ia = &self.grid.inverse_areas_per_sr()[..n * n];
+        let ViscousScratch {
+            stage,
+            vorticity,
+            divergence,
+            window,
+        } = v;
+        window.prepare(n);
+        let faces = u.chunks_exact_mut(epf).zip(stage.chunks_exact_mut(epf));
+        let borders = vorticity
             .chunks_exact(vpf)
             .zip(divergence.chunks_exact(cpf));
         // Each case its own loops: a test of the case per edge cost the reads and writes
         // it was to spare.
-        for ((u, stage), fields) in faces.zip(fields) {
+        for ((u, stage), borders) in faces.zip(borders) {
+            let face = Face {
+                rows,
+                inverse_areas: ia,
+                borders,
+            };
             match (nu_prev != 0.0, !last) {
-                (false, false) => blend.face::<false, false>(n, u, stage, metric, fields),
-                (false, true) => blend.face::<false, true>(n, u, stage, metric, fields),
-                (true, false) => blend.face::<true, false>(n, u, stage, metric, fields),
-                (true, true) => blend.face::<true, true>(n, u, stage, metric, fields),
+                (false, false) => blend.face::<false, false>(face, u, stage, window),
+                (false, true) => blend.face::<false, true>(face, u, stage, window),
+                (true, false) => blend.face::<true, false>(face, u, stage, window),
+                (true, true) => blend.face::<true, true>(face, u, stage, window),
             }
         }
     }
@@ -160,44 +189,51 @@ impl Blend {
         }
     }
 
-    /// One face's edges (`u` and `y_prev` its local edges, the metric
-    /// `[1/length, 1/dual length]` face 0's, `fields` its vertices' vorticities and its
-    /// padded cells' divergences), row by row. Every row of edges whole, the faces'
-    /// borders' too: their cells across the border are in the divergence's halo. The rows
-    /// come from chunk iterators over the face, where slicing each from the whole arrays
-    /// cost bounds checks and reloads of every base each row.
+    /// One face's edges (`u` and `y_prev` its local edges), row by row: Y-edge row `y`
+    /// reads vertex row `y` and padded cell rows `y` and `y + 1`, X-edge row `y` vertex
+    /// rows `y` (heads) and `y + 1` (tails) and padded cell row `y + 1`. Vertex row
+    /// `y + 1` and padded cell row `y + 1` are taken into `window` before those edge rows
+    /// move, from edges that have not moved yet: vertex row `j` reads X-edge rows `j − 1`
+    /// and `j` and Y-edge row `j`, padded cell row `p` X-edge row `p − 1` and Y-edge rows
+    /// `p − 1` and `p`. Every row of edges whole, the faces' borders' too: their cells across
+    /// the border are in the divergence's halo. Every face reads face 0's metric
+    /// `[1/length, 1/dual length]` ([`FaceRows`] says why).
     #[inline(always)]
     fn face<const BLEND: bool, const KEEP: bool>(
         self,
-        n: usize,
+        face: Face,
         u: &mut [f64],
         y_prev: &mut [f64],
-        (il, id): (&[f64], &[f64]),
-        (vorticity, divergence): (&[f64], &[f64]),
+        window: &mut Window,
     ) {
-        let (u_x, u_y) = u.split_at_mut(n * (n + 1));
-        let (y_x, y_y) = y_prev.split_at_mut(n * (n + 1));
-        let ((il_x, il_y), (id_x, id_y)) = (il.split_at(n * (n + 1)), id.split_at(n * (n + 1)));
-        // X-edge (i, y): tail the vertex (i, y + 1), head (i, y); from cell (i − 1, y)
-        // into (i, y) (padded row y + 1).
-        let (w, p) = (n + 1, n + 2);
-        let edges = u_x.chunks_exact_mut(w).zip(y_x.chunks_exact_mut(w));
-        let metric = il_x.chunks_exact(w).zip(id_x.chunks_exact(w));
-        let ends = vorticity
-            .chunks_exact(w)
-            .zip(vorticity[w..].chunks_exact(w));
-        let cells = divergence[p..].chunks_exact(p);
-        for (((u, y_prev), (il, id)), ((head, tail), d)) in edges.zip(metric).zip(ends.zip(cells)) {
-            self.row::<BLEND, KEEP>(u, y_prev, [head, tail], [&d[1..], d], [il, id]);
-        }
-        // Y-edge (x, j): tail the vertex (x, j), head (x + 1, j); from cell (x, j − 1)
-        // (padded row j) into (x, j).
-        let edges = u_y.chunks_exact_mut(n).zip(y_y.chunks_exact_mut(n));
-        let metric = il_y.chunks_exact(n).zip(id_y.chunks_exact(n));
-        let ends = vorticity.chunks_exact(w);
-        let cells = divergence[1..].chunks(p).zip(divergence[p + 1..].chunks(p));
-        for (((u, y_prev), (il, id)), (z, (from, into))) in edges.zip(metric).zip(ends.zip(cells)) {
-            self.row::<BLEND, KEEP>(u, y_prev, [&z[1..], z], [into, from], [il, id]);
+        let rows = face.rows;
+        let (n, w, xs) = (rows.n, rows.n + 1, rows.n * (rows.n + 1));
+        let (il, id) = (&rows.inverse_length[..], &rows.inverse_dual_length[..]);
+        window.take_vertex_row(face, u, 0);
+        window.take_cell_row(face, u, 0);
+        for y in 0..=n {
+            if y < n {
+                window.take_vertex_row(face, u, y + 1);
+            }
+            window.take_cell_row(face, u, y + 1);
+            let (u_x, u_y) = u.split_at_mut(xs);
+            let (p_x, p_y) = y_prev.split_at_mut(xs);
+            let z = &window.vertex[y % 2];
+            let (from, into) = (&window.cell[y % 2], &window.cell[(y + 1) % 2]);
+            // Y-edge (x, y): tail the vertex (x, y), head (x + 1, y); from cell (x, y − 1)
+            // (padded row y) into (x, y).
+            let metric = [&il[xs + y * n..][..n], &id[xs + y * n..][..n]];
+            let (u, p) = (&mut u_y[y * n..][..n], &mut p_y[y * n..][..n]);
+            self.row::<BLEND, KEEP>(u, p, [&z[1..], z], [&into[1..], &from[1..]], metric);
+            if y == n {
+                break;
+            }
+            // X-edge (i, y): tail the vertex (i, y + 1), head (i, y); from cell (i − 1, y)
+            // into (i, y) (padded row y + 1).
+            let tail = &window.vertex[(y + 1) % 2];
+            let metric = [&il[y * w..][..w], &id[y * w..][..w]];
+            let (u, p) = (&mut u_x[y * w..][..w], &mut p_x[y * w..][..w]);
+            self.row::<BLEND, KEEP>(u, p, [z, tail], [&into[1..], into], metric);
         }
     }
 
@@ -226,54 +262,126 @@ impl Blend {
     }
 }
 
-/// The vorticity at each local vertex into `v.vorticity` and the divergence of each cell
-/// into `v.divergence` (its halo too), of the edge velocities `u` (in the rows), on the unit sphere
-/// (m/s per rad). A cell's divergence sums its edges' `±u l` in the local order
+/// What one face's stage reads besides its edges.
+#[derive(Clone, Copy)]
+struct Face<'a> {
+    rows: &'a FaceRows,
+    /// Face 0's cells' inverse areas, per sr, which every face reads.
+    inverse_areas: &'a [f64],
+    /// The face's vertices' vorticities and padded cells' divergences on its borders and
+    /// halo ([`ViscousScratch::vorticity`], [`ViscousScratch::divergence`]).
+    borders: (&'a [f64], &'a [f64]),
+}
+
+impl Window {
+    /// Gives every row its length for `n` cells a face.
+    fn prepare(&mut self, n: usize) {
+        self.vertex.iter_mut().for_each(|r| r.resize(n + 1, 0.0));
+        self.cell.iter_mut().for_each(|r| r.resize(n + 2, 0.0));
+    }
+
+    /// Vertex row `j` of the face (local edges `u`) into `vertex[j mod 2]`: an inner
+    /// row's circulation, its ends (on the face's borders) and the border rows `0` and
+    /// `n` from the face's border vorticities.
+    #[inline(always)]
+    fn take_vertex_row(&mut self, face: Face, u: &[f64], j: usize) {
+        let (rows, border) = (face.rows, face.borders.0);
+        let (n, w) = (rows.n, rows.n + 1);
+        let out = &mut self.vertex[j % 2];
+        let border = &border[j * w..][..w];
+        if j == 0 || j == n {
+            out.copy_from_slice(border);
+            return;
+        }
+        let scale = &rows.vertex_inverse_area[j * w..][..n];
+        rows.face_circulation_row(u, j, &mut out[..n], scale, |z, ia| z * ia);
+        (out[0], out[n]) = (border[0], border[n]);
+    }
+
+    /// Padded cell row `p` of the face (local edges `u`) into `cell[p mod 2]`: cell row
+    /// `p − 1`'s divergences, the halo at its ends and the halo rows `0` and `n + 1` from
+    /// the face's border divergences.
+    #[inline(always)]
+    fn take_cell_row(&mut self, face: Face, u: &[f64], p: usize) {
+        let (rows, border) = (face.rows, face.borders.1);
+        let (n, pw) = (rows.n, rows.n + 2);
+        let out = &mut self.cell[p % 2];
+        let border = &border[p * pw..][..pw];
+        if p == 0 || p == n + 1 {
+            out.copy_from_slice(border);
+            return;
+        }
+        divergence_cells(rows, u, face.inverse_areas, p - 1, 0, &mut out[1..=n]);
+        (out[0], out[n + 1]) = (border[0], border[n + 1]);
+    }
+}
+
+/// The vorticity at the vertices on the faces' borders into `v.vorticity` (each copy),
+/// and the divergence of the cells on the faces' borders into `v.divergence`, its halo
+/// too, of the edge velocities `u` (in the rows), on the unit sphere (m/s per rad): what
+/// a face's rows read of the other faces' edges, taken before any face's edges move. A
+/// cell's divergence sums its edges' `±u l` in the local order
 /// ([`SIDES`](super::face_rows::SIDES)), `+` where the local normal points out of it (its
 /// right and top sides): the faces' border cells whose edges the grid numbers otherwise
 /// too ([`FaceRows::irregular_cells`]), which taken apart in the grid's order cost a tenth
 /// of the viscous step, for sums that differ only in rounding.
 #[inline(always)]
-fn vorticity_and_divergence(grid: &CubeSphere, rows: &FaceRows, u: &[f64], v: &mut ViscousScratch) {
-    rows.circulation(u, &mut v.vorticity, &rows.vertex_inverse_area, |z, ia| {
-        z * ia
-    });
+fn border_fields(grid: &CubeSphere, rows: &FaceRows, u: &[f64], v: &mut ViscousScratch) {
+    let vorticity = &mut v.vorticity;
+    vorticity.resize(rows.vertices(), 0.0);
+    rows.seam_circulation(u, vorticity, &rows.vertex_inverse_area, |z, ia| z * ia);
     let n = rows.n;
     let divergence = &mut v.divergence;
     divergence.resize(6 * rows.padded_cells_per_face(), 0.0);
-    // Face 0's lengths and cells' inverse areas, which every face reads ([`FaceRows`]
-    // says why; `face_rows::tests::every_faces_constants_are_face_0s` checks the areas
-    // too).
-    let (l, ia) = (&rows.length[..], &grid.inverse_areas_per_sr()[..n * n]);
-    let (epf, cpf) = (rows.edges_per_face(), rows.padded_cells_per_face());
+    // Face 0's cells' inverse areas, which every face reads ([`FaceRows`] says why;
+    // `face_rows::tests::every_faces_constants_are_face_0s` checks them).
+    let ia = &grid.inverse_areas_per_sr()[..n * n];
+    let (epf, cpf, pw) = (rows.edges_per_face(), rows.padded_cells_per_face(), n + 2);
     let faces = u.chunks_exact(epf).zip(divergence.chunks_exact_mut(cpf));
     for (u, out) in faces {
-        divergence_face(n, u, l, ia, out);
+        for y in [0, n - 1] {
+            divergence_cells(rows, u, ia, y, 0, &mut out[(y + 1) * pw + 1..][..n]);
+        }
+        for x in [0, n - 1] {
+            divergence_column(rows, u, ia, x, out);
+        }
     }
     for &[slot, across] in &rows.cell_halo {
         divergence[slot as usize] = divergence[across as usize];
     }
 }
 
-/// One face's divergences into its padded cells `out` (the halo left as it is), from
-/// its local edges' velocities `u`, and face 0's lengths `l` and cells' inverse areas
-/// `ia`, row by row from chunk iterators over the face (slicing each row from the whole
-/// arrays cost bounds checks and reloads of every base each row).
+/// The divergences of cells `(x.., y)` of a face (its local edges `u`) into `out`, as
+/// many as it holds, with face 0's lengths and cells' inverse areas `ia`.
 #[inline(always)]
-fn divergence_face(n: usize, u: &[f64], l: &[f64], ia: &[f64], out: &mut [f64]) {
-    let ((ux, uy), (lx, ly)) = (u.split_at(n * (n + 1)), l.split_at(n * (n + 1)));
-    let x_sides = ux.chunks_exact(n + 1).zip(lx.chunks_exact(n + 1));
-    let bottoms = uy.chunks_exact(n).zip(ly.chunks_exact(n));
-    let tops = uy[n..].chunks_exact(n).zip(ly[n..].chunks_exact(n));
-    let cells = ia.chunks_exact(n).zip(out[n + 3..].chunks_mut(n + 2));
-    for (((x, b), t), (ia, out)) in x_sides.zip(bottoms).zip(tops).zip(cells) {
-        divergence_row(
-            &mut out[..n],
-            [b.0, x.0, &x.0[1..], t.0],
-            [b.1, x.1, &x.1[1..], t.1],
-            ia,
-        );
+fn divergence_cells(rows: &FaceRows, u: &[f64], ia: &[f64], y: usize, x: usize, out: &mut [f64]) {
+    let n = rows.n;
+    let at = (n, x, y);
+    divergence_row(out, sides(u, at), sides(&rows.length, at), &ia[y * n + x..]);
+}
+
+/// The divergences of cells `(x, 1..n − 1)` of a face (its local edges `u`) into its
+/// padded cells `out`, as [`divergence_row`] takes each (the same sum in the same order),
+/// with face 0's lengths and cells' inverse areas `ia`: a column of the face's border
+/// cells, where a call of [`divergence_cells`] a cell cost several times the sum.
+#[inline(always)]
+fn divergence_column(rows: &FaceRows, u: &[f64], ia: &[f64], x: usize, out: &mut [f64]) {
+    let n = rows.n;
+    let ((ux, uy), (lx, ly)) = (u.split_at(n * (n + 1)), rows.length.split_at(n * (n + 1)));
+    for y in 1..n.saturating_sub(1) {
+        let (b, l, t) = (y * n + x, y * (n + 1) + x, (y + 1) * n + x);
+        let d = 0.0 - uy[b] * ly[b] - ux[l] * lx[l] + ux[l + 1] * lx[l + 1] + uy[t] * ly[t];
+        out[(y + 1) * (n + 2) + 1 + x] = d * ia[b];
     }
+}
+
+/// From cell `(x, y)` of a face of `n` cells a side on, its sides' entries of `a` (per
+/// local edge of the face), in [`SIDES`](super::face_rows::SIDES) order.
+#[inline(always)]
+fn sides(a: &[f64], (n, x, y): (usize, usize, usize)) -> [&[f64]; 4] {
+    let (ax, ay) = a.split_at(n * (n + 1));
+    let left = &ax[y * (n + 1) + x..];
+    [&ay[y * n + x..], left, &left[1..], &ay[(y + 1) * n + x..]]
 }
 
 /// A row of cells' divergences into `out`, from their sides' velocities and lengths (in
