@@ -315,11 +315,14 @@ pub(crate) struct AdvectionScratch {
 /// What a stage reads and writes besides the velocities.
 #[derive(Clone, Debug, Default)]
 struct StageWork {
-    /// Per local vertex: the vorticity of the velocities the stage under way starts
-    /// from, 1/s.
+    /// Per local vertex on the faces' borders (every copy; the inner ones are not
+    /// kept): the vorticity of the velocities the stage under way starts from, 1/s.
     vorticity: Vec<f64>,
-    /// Per local vertex: the vorticity of those it ends with.
-    next_vorticity: Vec<f64>,
+    /// Vertex rows `j` and `j + 1` of the face under way (at `j mod 2`, `n + 1` each):
+    /// the vorticity of the velocities the stage starts from, each inner row taken from
+    /// them as the stage reaches it ([`Stage::stage`]), where a whole-grid array of it
+    /// was written by one stage and read by the next (0.2 MB each way at n = 64).
+    vertex_rows: [Vec<f64>; 2],
     /// Per side of a cell (in [`SIDES`] order), per cell (slot `side·cells + cell`): the
     /// cell's term of that side's rate, m/s², in the rows' orientation, kept for the
     /// cells' sides on the faces' borders.
@@ -334,7 +337,10 @@ impl StageWork {
     /// Gives every buffer its length (each entry read is written first).
     fn prepare(&mut self, rows: &FaceRows) {
         let n = rows.n;
-        self.next_vorticity.resize(rows.vertices(), 0.0);
+        self.vorticity.resize(rows.vertices(), 0.0);
+        for r in &mut self.vertex_rows {
+            r.resize(n + 1, 0.0);
+        }
         self.border_rate.resize(4 * 6 * n * n, 0.0);
         for r in self.row_rate.iter_mut().flatten() {
             r.resize(n + 1, 0.0);
@@ -369,7 +375,7 @@ pub(crate) fn advect_momentum(
         #[inline(always)]
         || {
             let (w, scale) = (&mut s.work, &s.vorticity_scale);
-            rows.circulation(u, &mut w.vorticity, scale, |z, ia| z * ia);
+            rows.seam_circulation(u, &mut w.vorticity, scale, |z, ia| z * ia);
             for k in 1..=substeps {
                 ssp_rk3(rows, geo, scale, h, u, &mut s.stages, w, k < substeps);
             }
@@ -420,8 +426,9 @@ fn substeps(
 }
 
 /// One Shu–Osher third-order step of `u`: `u₁ = u + hL(u)`, `u₂ = ¾u + ¼(u₁ + hL(u₁))`,
-/// `u ← ⅓u + ⅔(u₂ + hL(u₂))`, from `u`'s vorticity in `w.vorticity`; it leaves the new
-/// `u`'s there where `next` (for the next sub-step). `u₁` and `u₂` go to `stages`.
+/// `u ← ⅓u + ⅔(u₂ + hL(u₂))`, from `u`'s vorticity on the faces' borders in
+/// `w.vorticity`; it leaves the new `u`'s there where `next` (for the next sub-step).
+/// `u₁` and `u₂` go to `stages`.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)] // the stages' parts, borrowed apart
 fn ssp_rk3(
@@ -460,15 +467,16 @@ struct Stage<'a> {
 impl Stage<'_> {
     /// One stage, in one pass over each face's rows: `dst ← step(src, u0, rate)` on every
     /// local edge, the rate the rotation term `−ζ (k×u)·n` of `src` (with its vorticity
-    /// in `w.vorticity`) summed over the edge's two cells (the lower-numbered cell's term
-    /// first), `u0` the edge's entry of `u0`, or of `dst` before it is written where
-    /// `None`; where `next`, the vorticity of `dst` then replaces it.
+    /// on the faces' borders in `w.vorticity`) summed over the edge's two cells (the
+    /// lower-numbered cell's term first), `u0` the edge's entry of `u0`, or of `dst`
+    /// before it is written where `None`; where `next`, the vorticity of `dst` on the
+    /// faces' borders then replaces it.
     ///
-    /// Row `y` of a face takes its cells' terms, then moves its X-edges (both their cells are in the row) and its Y-edges
-    /// below it (the row before holds their other cells), then takes the vorticity of its
-    /// vertex row `y`, whose edges have all moved by then. The edges on the faces'
-    /// borders move last, from their two faces' cells' terms, kept for that in
-    /// `w.border_rate`.
+    /// Row `y` of a face takes the vorticity of its vertex row `y + 1` from `src` (row
+    /// `y`'s it took the row before), then its cells' terms, then moves its X-edges (both
+    /// their cells are in the row) and its Y-edges below it (the row before holds their
+    /// other cells). The edges on the faces' borders move last, from their two faces'
+    /// cells' terms, kept for that in `w.border_rate`.
     #[inline(always)]
     fn stage(
         self,
@@ -482,15 +490,18 @@ impl Stage<'_> {
         let (rows, n) = (self.rows, self.rows.n);
         let (vorticity, border) = (&w.vorticity, &mut w.border_rate);
         let [even, odd] = &mut w.row_rate;
+        let [z_even, z_odd] = &mut w.vertex_rows;
         for f in 0..6 {
+            self.vertex_row(src, vorticity, f, 0, z_even);
             for y in 0..n {
                 let c = f * n * n + y * n;
-                let (rate, before) = if y % 2 == 0 {
-                    (&mut *even, &*odd)
+                let (rate, before, z, z_next) = if y % 2 == 0 {
+                    (&mut *even, &*odd, &*z_even, &mut *z_odd)
                 } else {
-                    (&mut *odd, &*even)
+                    (&mut *odd, &*even, &*z_odd, &mut *z_even)
                 };
-                self.cell_row(src, vorticity, f, y, rate);
+                self.vertex_row(src, vorticity, f, y + 1, z_next);
+                self.cell_row(src, [z, z_next], f, y, rate);
                 keep_border_rates(border, rate, c, n, y);
                 let [_, left, right, _] = &*rate;
                 // The X-edges inside the face: cell (i − 1, y)'s right side and (i, y)'s left.
@@ -508,33 +519,46 @@ impl Stage<'_> {
                 let (top, bottom) = (&before[Side::Top as usize], &rate[Side::Bottom as usize]);
                 let u0y = u0.map(|u0| &u0[k.clone()]);
                 move_edges(&mut dst[k.clone()], &src[k], u0y, top, bottom, &step);
-                if next {
-                    let z = &mut w.next_vorticity;
-                    rows.circulation_row(dst, f, y, z, self.scale, |z, ia| z * ia);
-                }
             }
         }
         self.move_seam_edges(src, dst, u0, &w.border_rate, &step);
         if next {
-            rows.seam_circulation(dst, &mut w.next_vorticity, self.scale, |z, ia| z * ia);
-            std::mem::swap(&mut w.vorticity, &mut w.next_vorticity);
+            rows.seam_circulation(dst, &mut w.vorticity, self.scale, |z, ia| z * ia);
         }
     }
 
-    /// Row `y` of face `f`'s cells' terms of their sides' rates into `rate` (per side, per
-    /// cell of the row), from the edge velocities `u` and the vertices' `vorticity`.
+    /// The vorticity of face `f`'s vertex row `j` of the edge velocities `u` into `out`:
+    /// an inner row's taken from `u`, its ends (on the face's borders) and the border
+    /// rows `0` and `n` from `border` (per local vertex, kept on the faces' borders).
     #[inline(always)]
-    fn cell_row(self, u: &[f64], vorticity: &[f64], f: usize, y: usize, rate: &mut [Vec<f64>; 4]) {
+    fn vertex_row(self, u: &[f64], border: &[f64], f: usize, j: usize, out: &mut [f64]) {
+        let (rows, n, w) = (self.rows, self.rows.n, self.rows.n + 1);
+        let border = &border[rows.vertex_at(f, 0, j)..][..w];
+        let out = &mut out[..w];
+        if j == 0 || j == n {
+            out.copy_from_slice(border);
+            return;
+        }
+        let u = &u[f * rows.edges_per_face()..][..rows.edges_per_face()];
+        let scale = &self.scale[j * w..][..n];
+        rows.face_circulation_row(u, j, &mut out[..n], scale, |z, ia| z * ia);
+        (out[0], out[n]) = (border[0], border[n]);
+    }
+
+    /// Row `y` of face `f`'s cells' terms of their sides' rates into `rate` (per side, per
+    /// cell of the row), from the edge velocities `u` and the vorticity `z` of the row's
+    /// bottom and top vertices.
+    #[inline(always)]
+    fn cell_row(self, u: &[f64], z: [&[f64]; 2], f: usize, y: usize, rate: &mut [Vec<f64>; 4]) {
         let (rows, n) = (self.rows, self.rows.n);
         let (uy, ux) = (rows.y_edge(f, 0, y), rows.x_edge(f, 0, y));
-        let (vb, vt) = (rows.vertex_at(f, 0, y), rows.vertex_at(f, 0, y + 1));
         let len = n.div_ceil(4) * QUAD_WEIGHTS;
         // Every face's weights are face 0's ([`AdvectionGeometry::coriolis`]).
         let w = &self.geo.coriolis[y * len..][..len];
         let [ob, ol, or, ot] = rate;
         coriolis_row(
             w,
-            [&vorticity[vb..vb + n + 1], &vorticity[vt..vt + n + 1]],
+            [&z[0][..n + 1], &z[1][..n + 1]],
             [&u[uy..uy + n], &u[ux..ux + n + 1], &u[uy + n..uy + 2 * n]],
             [&mut ob[..n], &mut ol[..n], &mut or[..n], &mut ot[..n]],
         );

@@ -465,12 +465,10 @@ impl FaceRows {
     /// The circulation `Σ ±u d` about every local vertex of the local edge velocities
     /// `u`, each then finished by `finish(circulation, scale)` with the vertex's entry of
     /// `scale` (per local vertex of face 0, which every face reads, as it does
-    /// [`Self::dual_length`]), into `out`.
-    ///
-    /// About an inner vertex `(i, j)` the grid's edge order is X-edge `(i, j − 1)`,
-    /// Y-edges `(i − 1, j)` and `(i, j)`, X-edge `(i, j)`: the first and third run into
-    /// the vertex's tail end (`−u d`), the others into its head (`+u d`).
-    #[inline(always)]
+    /// [`Self::dual_length`]), into `out`: the inner rows' as the passes take them
+    /// ([`Self::face_circulation_row`], each row as a pass reaches it), then the borders'
+    /// ([`Self::seam_circulation`]). The tests' whole-grid reference.
+    #[cfg(test)]
     pub(crate) fn circulation(
         &self,
         u: &[f64],
@@ -479,37 +477,30 @@ impl FaceRows {
         finish: impl Fn(f64, f64) -> f64,
     ) {
         out.resize(self.vertices(), 0.0);
+        let (n, epf, vpf) = (self.n, self.edges_per_face(), self.vertices_per_face());
         for f in 0..6 {
-            for j in 1..self.n {
-                self.circulation_row(u, f, j, out, scale, &finish);
+            for j in 1..n {
+                let start = self.vertex_at(0, 0, j);
+                let row = &mut out[f * vpf + start..][..n];
+                let u = &u[f * epf..][..epf];
+                self.face_circulation_row(u, j, row, &scale[start..start + n], &finish);
             }
         }
         self.seam_circulation(u, out, scale, finish);
     }
 
-    /// [`Self::circulation`] of row `j` (`1 ≤ j < n`) of face `f`'s inner vertices: it
-    /// reads X-edges `(0..n, j − 1)` and `(0..n, j)` and Y-edges `(−1..n, j)`. The row
-    /// starts at vertex `(0, j)`, on the border: `n` vertices vectorise without a scalar
-    /// tail where the `n − 1` inner ones left three. That one's value, from the Y-edge
-    /// before the row's first, is junk until [`Self::seam_circulation`] overwrites it.
-    #[inline(always)]
-    pub(crate) fn circulation_row(
-        &self,
-        u: &[f64],
-        f: usize,
-        j: usize,
-        out: &mut [f64],
-        scale: &[f64],
-        finish: impl Fn(f64, f64) -> f64,
-    ) {
-        let (n, start) = (self.n, self.vertex_at(0, 0, j));
-        let row = &mut out[f * self.vertices_per_face() + start..][..n];
-        let u = &u[f * self.edges_per_face()..];
-        self.face_circulation_row(u, j, row, &scale[start..start + n], finish);
-    }
-
-    /// [`Self::circulation_row`] of one face's local edges `u` into `row` (`n` long, its
-    /// first junk), with `scale` the row's entries (from vertex `(0, j)`).
+    /// The circulation `Σ ±u d` about row `j` (`1 ≤ j < n`) of one face's inner vertices,
+    /// from its local edges `u`, each finished by `finish(circulation, scale)` with the
+    /// vertex's entry of `scale` (the row's, from vertex `(0, j)`, per local vertex of
+    /// face 0, which every face reads, as it does [`Self::dual_length`]), into `row` (`n`
+    /// long). It reads X-edges `(0..n, j − 1)` and `(0..n, j)` and Y-edges
+    /// `(−1..n, j)`. About an inner vertex `(i, j)` the grid's edge order is X-edge
+    /// `(i, j − 1)`, Y-edges `(i − 1, j)` and `(i, j)`, X-edge `(i, j)`: the first and
+    /// third run into the vertex's tail end (`−u d`), the others into its head (`+u d`).
+    /// The row starts at vertex `(0, j)`, on the border: `n` vertices vectorise without a
+    /// scalar tail where the `n − 1` inner ones left three. That one's value, from the
+    /// Y-edge before the row's first, is junk: the caller takes the border's from
+    /// [`Self::seam_circulation`].
     #[inline(always)]
     pub(crate) fn face_circulation_row(
         &self,
@@ -536,8 +527,10 @@ impl FaceRows {
         }
     }
 
-    /// [`Self::circulation`] of the vertices on the faces' borders, into each copy: one
-    /// value, finished with the scale of its first copy's place in face 0.
+    /// The circulation of the vertices on the faces' borders, finished as
+    /// [`Self::face_circulation_row`] finishes an inner row's, into each copy (of `out`,
+    /// per local vertex): one value, finished with the scale of its first copy's place in
+    /// face 0.
     #[inline(always)]
     pub(crate) fn seam_circulation(
         &self,
