@@ -195,7 +195,7 @@ impl AdvectionGeometry {
             .seam_edges
             .iter()
             .map(|e| {
-                let slot = |(c, side, _): (u32, Side, u32)| (side as usize * cells) as u32 + c;
+                let slot = |(c, side, _): (u32, Side, u32)| border_slot(rows.n, c as usize, side);
                 SeamTerms {
                     slots: e.cells.map(slot),
                     edges: e.cells.map(|(_, _, k)| k),
@@ -323,9 +323,10 @@ struct StageWork {
     /// them as the stage reaches it ([`Stage::stage`]), where a whole-grid array of it
     /// was written by one stage and read by the next (0.2 MB each way at n = 64).
     vertex_rows: [Vec<f64>; 2],
-    /// Per side of a cell (in [`SIDES`] order), per cell (slot `side·cells + cell`): the
-    /// cell's term of that side's rate, m/s², in the rows' orientation, kept for the
-    /// cells' sides on the faces' borders.
+    /// Per face, per side of it (in [`SIDES`] order), per cell along it ([`border_slot`]):
+    /// the term of the border cell there of that side's rate, m/s², in the rows'
+    /// orientation (12 KB at n = 64, where a slot for every cell's every side spread
+    /// a row's two border terms over two lines of 0.8 MB).
     border_rate: Vec<f64>,
     /// The same for the row of cells under way and the one before (even and odd rows),
     /// and one slot more: the left side of the cell past the row's end, read (unset) for
@@ -341,7 +342,7 @@ impl StageWork {
         for r in &mut self.vertex_rows {
             r.resize(n + 1, 0.0);
         }
-        self.border_rate.resize(4 * 6 * n * n, 0.0);
+        self.border_rate.resize(6 * 4 * n, 0.0);
         for r in self.row_rate.iter_mut().flatten() {
             r.resize(n + 1, 0.0);
         }
@@ -494,7 +495,6 @@ impl Stage<'_> {
         for f in 0..6 {
             self.vertex_row(src, vorticity, f, 0, z_even);
             for y in 0..n {
-                let c = f * n * n + y * n;
                 let (rate, before, z, z_next) = if y % 2 == 0 {
                     (&mut *even, &*odd, &*z_even, &mut *z_odd)
                 } else {
@@ -502,7 +502,7 @@ impl Stage<'_> {
                 };
                 self.vertex_row(src, vorticity, f, y + 1, z_next);
                 self.cell_row(src, [z, z_next], f, y, rate);
-                keep_border_rates(border, rate, c, n, y);
+                keep_border_rates(&mut border[f * 4 * n..][..4 * n], rate, n, y);
                 let [_, left, right, _] = &*rate;
                 // The X-edges inside the face: cell (i − 1, y)'s right side and (i, y)'s left.
                 // Where the seam pass takes the starting velocities from `u0` (not from
@@ -586,22 +586,33 @@ impl Stage<'_> {
     }
 }
 
-/// Keeps the terms of row `y`'s cells (from cell `c`) on their face's borders: the left
-/// of its first cell, the right of its last, and the bottoms or tops of the first and
-/// last rows.
+/// Keeps the terms of row `y`'s cells on their face's borders into `border` (the face's
+/// part of [`StageWork::border_rate`]): the left of its first cell, the right of its
+/// last, and the bottoms or tops of the first and last rows.
 #[inline(always)]
-fn keep_border_rates(border: &mut [f64], rate: &[Vec<f64>; 4], c: usize, n: usize, y: usize) {
+fn keep_border_rates(border: &mut [f64], rate: &[Vec<f64>; 4], n: usize, y: usize) {
     let [bottom, left, right, top] = rate;
-    let cells = border.len() / 4;
-    let at = |side: Side| side as usize * cells + c;
-    border[at(Side::Left)] = left[0];
-    border[at(Side::Right) + n - 1] = right[n - 1];
+    let side = |side: Side| side as usize * n;
+    border[side(Side::Left) + y] = left[0];
+    border[side(Side::Right) + y] = right[n - 1];
     if y == 0 {
-        border[at(Side::Bottom)..][..n].copy_from_slice(&bottom[..n]);
+        border[side(Side::Bottom)..][..n].copy_from_slice(&bottom[..n]);
     }
     if y == n - 1 {
-        border[at(Side::Top)..][..n].copy_from_slice(&top[..n]);
+        border[side(Side::Top)..][..n].copy_from_slice(&top[..n]);
     }
+}
+
+/// The slot in [`StageWork::border_rate`] of side `side` of cell `c` (of a grid of `n`
+/// cells a face), on its face's border: per face, per side, along the side (`x` for the
+/// bottom and top, `y` for the left and right).
+fn border_slot(n: usize, c: usize, side: Side) -> u32 {
+    let (f, x, y) = (c / (n * n), c % n, (c / n) % n);
+    let along = match side {
+        Side::Bottom | Side::Top => x,
+        Side::Left | Side::Right => y,
+    };
+    ((f * 4 + side as usize) * n + along) as u32
 }
 
 /// `dst ← step(src, u0, (0 + ra) + rb)` edge by edge over `dst`, `u0` the edge's entry
