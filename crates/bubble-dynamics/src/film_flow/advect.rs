@@ -39,7 +39,7 @@ use glam::DVec3;
 use crate::avx2::{OTHERS, QUAD_WEIGHTS, coriolis_row, quad_starts, with_avx2};
 
 use super::compare::larger;
-use super::face_rows::{FaceRows, SIDES, Side};
+use super::face_rows::{FaceRows, SIDES, Side, face_order};
 use super::grid::CubeSphere;
 
 /// Largest fraction of the narrowest dual edge the fastest cell may cross in a sub-step.
@@ -445,15 +445,16 @@ fn ssp_rk3(
     let on = Stage { rows, geo, scale };
     // Stage 1 (what `stage` held is passed over). It ignores the starting velocities:
     // given `u`'s, the rows may move the border copies too (see `Stage::stage`).
+    // The stages' faces in alternate directions, the first in reverse ([`face_order`]).
     let step = |u, _, r| u + h * r;
-    on.stage(Some(u), stage, Some(u), w, true, step);
+    on.stage(Some(u), stage, Some(u), w, (true, true), step);
     // Stage 2, `u₁` into `u₂` where it is.
     let step = |u, u0, r| 0.75 * u0 + 0.25 * (u + h * r);
-    on.stage(None, stage, Some(u), w, true, step);
+    on.stage(None, stage, Some(u), w, (true, false), step);
     // Stage 3, onto `u`: each edge's starting velocity read before it is replaced.
     // ⅓ as a multiplication: a division took several times as long.
     let step = |u, u0, r| (1.0 / 3.0) * u0 + (2.0 / 3.0) * (u + h * r);
-    on.stage(Some(stage), u, None, w, next, step);
+    on.stage(Some(stage), u, None, w, (next, true), step);
 }
 
 /// What every stage reads of the grid.
@@ -473,7 +474,8 @@ impl Stage<'_> {
     /// on the faces' borders in `w.vorticity`) summed over the edge's two cells (the
     /// lower-numbered cell's term first), `u0` the edge's entry of `u0`, or of `dst`
     /// before it is written where `None`; where `next`, the vorticity of `dst` on the
-    /// faces' borders then replaces it.
+    /// faces' borders then replaces it. The faces in reverse order where `reverse`
+    /// ([`face_order`]).
     ///
     /// Row `y` of a face takes the vorticity of its vertex row `y + 1` from `src` (row
     /// `y`'s it took the row before), then its cells' terms, then moves its X-edges (both
@@ -492,14 +494,14 @@ impl Stage<'_> {
         dst: &mut [f64],
         u0: Option<&[f64]>,
         w: &mut StageWork,
-        next: bool,
+        (next, reverse): (bool, bool),
         step: impl Fn(f64, f64, f64) -> f64,
     ) {
         let (rows, n) = (self.rows, self.rows.n);
         let (vorticity, border) = (&w.vorticity, &mut w.border_rate);
         let [even, odd] = &mut w.row_rate;
         let [z_even, z_odd] = &mut w.vertex_rows;
-        for f in 0..6 {
+        for f in face_order(reverse) {
             self.vertex_row(src.unwrap_or(dst), vorticity, f, 0, z_even);
             for y in 0..n {
                 let (rate, before, z, z_next) = if y % 2 == 0 {

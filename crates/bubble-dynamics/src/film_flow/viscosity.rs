@@ -10,7 +10,7 @@
 
 use crate::avx2::with_avx2;
 
-use super::face_rows::FaceRows;
+use super::face_rows::{FaceRows, face_order};
 use super::flow::FilmFlow;
 use super::grid::CubeSphere;
 
@@ -70,16 +70,18 @@ impl FilmFlow {
         with_avx2(
             #[inline(always)]
             || {
-                let last = stages == 1;
-                self.viscous_stage(u, v, nu_m2_per_s, w1 * dt_s, (1.0, 0.0), last);
+                // The stages' faces in alternate directions, the first in reverse
+                // ([`face_order`]: the gravity's pass before ends at face 5).
+                let order = (stages == 1, true);
+                self.viscous_stage(u, v, nu_m2_per_s, w1 * dt_s, (1.0, 0.0), order);
                 for j in 2..=stages {
                     // Yⱼ = μⱼ Yⱼ₋₁ + νⱼ Yⱼ₋₂ + μⱼ w₁ dt M(Yⱼ₋₁), μⱼ = (2j − 1)/j,
                     // νⱼ = (1 − j)/j.
-                    let last = j == stages;
+                    let order = (j == stages, j % 2 == 1);
                     let j = f64::from(j);
                     let mu = (2.0 * j - 1.0) / j;
                     let weights = (mu, (1.0 - j) / j);
-                    self.viscous_stage(u, v, nu_m2_per_s, mu * w1 * dt_s, weights, last);
+                    self.viscous_stage(u, v, nu_m2_per_s, mu * w1 * dt_s, weights, order);
                 }
             },
         );
@@ -88,7 +90,8 @@ impl FilmFlow {
     /// One stage on the rows: `u ← mu·u + nu_prev·stage + dt_s·M(u)` with the stage
     /// before last in `v.stage` (read only where `nu_prev` is not 0), which then holds the
     /// `u` this stage started from, unless the stage is the `last` (which no stage reads:
-    /// 0.4 MB written and, with the portable blend's select, read a step at n = 64).
+    /// 0.4 MB written and, with the portable blend's select, read a step at n = 64). The
+    /// faces in reverse order where `reverse` ([`face_order`]).
     ///
     /// Every value is the grid-numbered pass's to rounding (the grid's constants are face
     /// 0's, [`FaceRows`]), in the rows' orientation (module `face_rows`): each edge's
@@ -104,7 +107,7 @@ impl FilmFlow {
         nu: f64,
         dt_s: f64,
         (mu, nu_prev): (f64, f64),
-        last: bool,
+        (last, reverse): (bool, bool),
     ) {
         let rows = &self.rows;
         border_fields(&self.grid, rows, u, v);
@@ -131,17 +134,14 @@ impl FilmFlow {
             window,
         } = v;
         window.prepare(n);
-        let faces = u.chunks_exact_mut(epf).zip(stage.chunks_exact_mut(epf));
-        let borders = vorticity
-            .chunks_exact(vpf)
-            .zip(divergence.chunks_exact(cpf));
         // Each case its own loops: a test of the case per edge cost the reads and writes
         // it was to spare.
-        for ((u, stage), borders) in faces.zip(borders) {
+        for f in face_order(reverse) {
+            let (u, stage) = (&mut u[f * epf..][..epf], &mut stage[f * epf..][..epf]);
             let face = Face {
                 rows,
                 inverse_areas: ia,
-                borders,
+                borders: (&vorticity[f * vpf..][..vpf], &divergence[f * cpf..][..cpf]),
             };
             match (nu_prev != 0.0, !last) {
                 (false, false) => blend.face::<false, false>(face, u, stage, window),
@@ -529,7 +529,7 @@ mod tests {
             // Plain forward-Euler sub-steps, not through the stage weights under test.
             s.stage.resize(u.len(), 0.0);
             for _ in 0..100 {
-                f.viscous_stage(u, &mut s, nu, dt / 100.0, (1.0, 0.0), true);
+                f.viscous_stage(u, &mut s, nu, dt / 100.0, (1.0, 0.0), (true, false));
             }
         };
         on_rows(&mut f, &mut euler_steps);
