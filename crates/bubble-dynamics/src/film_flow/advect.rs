@@ -953,4 +953,141 @@ mod tests {
             }
         }
     }
+
+    /// A rough field on a rotation at n = `n`, in the face rows (`seed` picks the roughness).
+    fn rough_rows(rows: &FaceRows, grid: &CubeSphere, seed: usize) -> Vec<f64> {
+        let field: Vec<f64> = grid
+            .edges()
+            .iter()
+            .enumerate()
+            .map(|(e, ed)| {
+                (DVec3::Z * 0.05).cross(ed.midpoint).dot(ed.normal)
+                    + ((e * seed) % 1000) as f64 * 1e-5
+            })
+            .collect();
+        let mut u = Vec::new();
+        rows.to_rows(&field, &mut u);
+        u
+    }
+
+    /// A stage's scratch, its border vorticity that of `src`, and the vorticity scale for
+    /// a radius of 1 cm.
+    fn stage_work(rows: &FaceRows, src: &[f64]) -> (StageWork, Vec<f64>) {
+        let scale: Vec<f64> = rows.vertex_area.iter().map(|a| 1.0 / (a * 0.01)).collect();
+        let mut w = StageWork::default();
+        w.prepare(rows);
+        rows.seam_circulation(src, &mut w.vorticity, &scale, |z, ia| z * ia);
+        (w, scale)
+    }
+
+    /// A stage that moves the edges where they are (its source its destination) gives
+    /// the bits of one that reads them apart, and so does one over the faces in reverse
+    /// order, the kept border vorticity too: no row reads an edge that a row before it
+    /// has moved. At n = 5 and 16.
+    #[test]
+    fn a_stage_in_place_or_in_reverse_is_the_stage_apart() {
+        for n in [5, 16] {
+            let grid = CubeSphere::new(n);
+            let rows = FaceRows::new(&grid);
+            let geo = AdvectionGeometry::new(&grid, &rows);
+            let (src, u0) = (
+                rough_rows(&rows, &grid, 7919),
+                rough_rows(&rows, &grid, 104_729),
+            );
+            let step = |u: f64, u0: f64, r: f64| 0.75 * u0 + 0.25 * (u + 0.01 * r);
+            let run = |in_place: bool, reverse: bool| {
+                let (mut w, scale) = stage_work(&rows, &src);
+                let on = Stage {
+                    rows: &rows,
+                    geo: &geo,
+                    scale: &scale,
+                };
+                let mut dst = if in_place {
+                    src.clone()
+                } else {
+                    vec![0.0; src.len()]
+                };
+                let from = (!in_place).then_some(&src[..]);
+                on.stage(from, &mut dst, Some(&u0), &mut w, (true, reverse), step);
+                (dst, w.vorticity)
+            };
+            let apart = run(false, false);
+            assert_ne!(apart.0, src, "n {n}: nothing moved");
+            for (in_place, reverse) in [(true, false), (false, true), (true, true)] {
+                let (dst, vorticity) = run(in_place, reverse);
+                let what = format!("n {n}, in place {in_place}, reverse {reverse}");
+                for (name, got, want) in
+                    [("edges", dst, &apart.0), ("vorticity", vorticity, &apart.1)]
+                {
+                    let differ = got
+                        .iter()
+                        .zip(want)
+                        .filter(|(a, b)| a.to_bits() != b.to_bits());
+                    assert_eq!(differ.count(), 0, "{what}: {name} differ");
+                }
+            }
+        }
+    }
+
+    /// The vertex rows a stage takes are the whole grid's circulation's rows, bit for bit,
+    /// the faces' border vertices' from the kept border vorticity: at n = 5 and 16.
+    #[test]
+    fn a_stages_vertex_rows_are_the_whole_grids() {
+        for n in [5, 16] {
+            let grid = CubeSphere::new(n);
+            let rows = FaceRows::new(&grid);
+            let geo = AdvectionGeometry::new(&grid, &rows);
+            let u = rough_rows(&rows, &grid, 7919);
+            let (w, scale) = stage_work(&rows, &u);
+            let mut want = Vec::new();
+            rows.circulation(&u, &mut want, &scale, |z, ia| z * ia);
+            let on = Stage {
+                rows: &rows,
+                geo: &geo,
+                scale: &scale,
+            };
+            let mut row = vec![0.0; n + 1];
+            for f in 0..6 {
+                for j in 0..=n {
+                    on.vertex_row(&u, &w.vorticity, f, j, &mut row);
+                    let want = &want[rows.vertex_at(f, 0, j)..][..n + 1];
+                    let same = row
+                        .iter()
+                        .zip(want)
+                        .all(|(a, b)| a.to_bits() == b.to_bits());
+                    assert!(same, "n {n}, face {f}, row {j}: {row:?} against {want:?}");
+                }
+            }
+        }
+    }
+
+    /// Each edge on the faces' borders reads, for each of its cells, the term that cell's
+    /// row kept for the edge's side ([`keep_border_rates`], [`border_slot`]): at n = 1, 5
+    /// and 16.
+    #[test]
+    fn each_seam_edge_reads_its_cells_kept_terms() {
+        for n in [1, 5, 16] {
+            let grid = CubeSphere::new(n);
+            let rows = FaceRows::new(&grid);
+            let geo = AdvectionGeometry::new(&grid, &rows);
+            // A term that names its cell and side.
+            let term = |c: usize, side: usize| (4 * c + side) as f64;
+            let mut border = vec![f64::NAN; 6 * 4 * n];
+            for f in 0..6 {
+                for y in 0..n {
+                    let c = (f * n + y) * n;
+                    let rate: [Vec<f64>; 4] =
+                        std::array::from_fn(|side| (0..n).map(|x| term(c + x, side)).collect());
+                    keep_border_rates(&mut border[f * 4 * n..][..4 * n], &rate, n, y);
+                }
+            }
+            for (e, terms) in rows.seam_edges.iter().zip(&geo.seams) {
+                for ((c, side, _), slot) in e.cells.into_iter().zip(terms.slots) {
+                    let got = border[slot as usize];
+                    let want = term(c as usize, side as usize);
+                    assert_eq!(got, want, "n {n}: cell {c}, side {side:?}");
+                }
+            }
+        }
+    }
 }

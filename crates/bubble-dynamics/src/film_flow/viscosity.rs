@@ -471,6 +471,127 @@ mod tests {
         per_edge.map(|(u, (l, d))| u * u * l * d).sum()
     }
 
+    /// A stage's edges against whole-grid passes of the same sums (the vorticity of every
+    /// vertex, the divergence of every cell with its halo, then every edge's update, from
+    /// the velocities the stage starts from), bit for bit: each case of stage (first,
+    /// blended, last), the faces in either order, a rough field at n = 5 and 16. The
+    /// window's rows must be taken before any edge they read moves.
+    #[test]
+    fn a_stage_is_the_whole_grid_passes() {
+        for n in [5, 16] {
+            let grid = Arc::new(CubeSphere::new(n));
+            let hierarchy = Arc::new(Hierarchy::new(&grid));
+            let p = FlowParams {
+                viscosity_pa_s: 0.5,
+                ..FlowParams::water_film(0.01)
+            };
+            let f = FilmFlow::new(grid.clone(), hierarchy, p, |_| 1e-6);
+            let rough = |seed: usize| -> Vec<f64> {
+                let values = (0..grid.edges().len()).map(|e| ((e * seed) % 1000) as f64 * 1e-6);
+                let mut out = Vec::new();
+                f.rows.to_rows(&values.collect::<Vec<_>>(), &mut out);
+                out
+            };
+            let (start, before_last) = (rough(7919), rough(104_729));
+            let nu = p.viscosity_pa_s / p.density_kg_per_m3;
+            for (weights, last) in [
+                ((1.0, 0.0), false),
+                ((1.5, -0.5), false),
+                ((1.5, -0.5), true),
+            ] {
+                let want = whole_grid_stage(&f, &start, &before_last, nu, 0.01, weights, last);
+                for reverse in [false, true] {
+                    let (mut u, mut v) = (start.clone(), ViscousScratch::default());
+                    v.stage = before_last.clone();
+                    f.viscous_stage(&mut u, &mut v, nu, 0.01, weights, (last, reverse));
+                    let got = (u, v.stage);
+                    let what =
+                        format!("n {n}, weights {weights:?}, last {last}, reverse {reverse}");
+                    for (name, got, want) in [("u", &got.0, &want.0), ("stage", &got.1, &want.1)] {
+                        let differ = got
+                            .iter()
+                            .zip(want)
+                            .filter(|(a, b)| a.to_bits() != b.to_bits());
+                        assert_eq!(differ.count(), 0, "{what}: {name} differs");
+                    }
+                }
+            }
+        }
+    }
+
+    /// [`FilmFlow::viscous_stage`] as whole-grid passes: `(u, stage)` after it, from `u`
+    /// and the stage before last `before_last`.
+    fn whole_grid_stage(
+        f: &FilmFlow,
+        u: &[f64],
+        before_last: &[f64],
+        nu: f64,
+        dt_s: f64,
+        (mu, nu_prev): (f64, f64),
+        last: bool,
+    ) -> (Vec<f64>, Vec<f64>) {
+        let (rows, n) = (&*f.rows, f.rows.n);
+        let mut z = Vec::new();
+        rows.circulation(u, &mut z, &rows.vertex_inverse_area, |z, ia| z * ia);
+        let (epf, w) = (rows.edges_per_face(), n + 1);
+        let ia = f.grid.inverse_areas_per_sr();
+        let mut div = vec![0.0; 6 * rows.padded_cells_per_face()];
+        for face in 0..6 {
+            let ue = |k: usize| u[face * epf + k];
+            for y in 0..n {
+                for x in 0..n {
+                    let [b, l, r, t] = [xs_y(n, x, y), y * w + x, y * w + x + 1, xs_y(n, x, y + 1)];
+                    let len = &rows.length;
+                    let d = 0.0 - ue(b) * len[b] - ue(l) * len[l] + ue(r) * len[r] + ue(t) * len[t];
+                    div[rows.padded_cell(face, x + 1, y + 1)] = d * ia[y * n + x];
+                }
+            }
+        }
+        for &[slot, across] in &rows.cell_halo {
+            div[slot as usize] = div[across as usize];
+        }
+        let r = f.params.radius_m;
+        let rate = dt_s * nu / (r * r);
+        let (mut out, mut stage) = (u.to_vec(), before_last.to_vec());
+        for face in 0..6 {
+            let vz = |i: usize, j: usize| z[rows.vertex_at(face, i, j)];
+            let d = |px: usize, py: usize| div[rows.padded_cell(face, px, py)];
+            // Per local edge of the face: [head, tail] vorticities, [into, from] divergences.
+            let mut fields = Vec::with_capacity(epf);
+            for y in 0..n {
+                for i in 0..=n {
+                    fields.push(([vz(i, y), vz(i, y + 1)], [d(i + 1, y + 1), d(i, y + 1)]));
+                }
+            }
+            for j in 0..=n {
+                for x in 0..n {
+                    fields.push(([vz(x + 1, j), vz(x, j)], [d(x + 1, j + 1), d(x + 1, j)]));
+                }
+            }
+            for (k, ([head, tail], [into, from])) in fields.into_iter().enumerate() {
+                let e = face * epf + k;
+                let curl_curl = (head - tail) * rows.inverse_length[k];
+                let grad_div = (into - from) * rows.inverse_dual_length[k];
+                let y = u[e];
+                let change = rate * (4.0 * grad_div - curl_curl + 2.0 * y);
+                out[e] = if nu_prev == 0.0 {
+                    y + change
+                } else {
+                    mu * y + nu_prev * before_last[e] + change
+                };
+                if !last {
+                    stage[e] = y;
+                }
+            }
+        }
+        (out, stage)
+    }
+
+    /// Face 0's local Y-edge `(x, j)` of a grid of `n` cells a face, within the face.
+    fn xs_y(n: usize, x: usize, j: usize) -> usize {
+        n * (n + 1) + j * n + x
+    }
+
     /// The stages keep each edge on the faces' borders the same in both its copies (its
     /// value, or its negation, bit for bit): they read the same shared constants
     /// ([`FaceRows`](super::super::face_rows::FaceRows)). A rough field, at n = 5 and 32.
