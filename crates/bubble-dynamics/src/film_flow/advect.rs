@@ -40,7 +40,7 @@ use crate::avx2::{OTHERS, QUAD_WEIGHTS, coriolis_row, quad_starts, with_avx2};
 
 use super::compare::larger;
 use super::face_rows::{FaceRows, SIDES, Side, face_order};
-use super::grid::CubeSphere;
+use super::grid::{CubeSphere, FaceLayout};
 
 /// Largest fraction of the narrowest dual edge the fastest cell may cross in a sub-step.
 /// SSP-RK3 damps (never amplifies) a rotation of `ω·sub_dt < √3`; the vorticity at the
@@ -109,6 +109,9 @@ struct SeamTerms {
     edges: [u32; 2],
     /// Per cell: the copy's orientation against the grid's (`±1`).
     signs: [f64; 2],
+    /// The grid's edge (both copies'), for the starting velocities in the grid's
+    /// numbering ([`Start::Grid`]).
+    grid_edge: u32,
 }
 
 /// An irregular cell's reconstruction weights, its sides in the grid's order.
@@ -200,6 +203,7 @@ impl AdvectionGeometry {
                     slots: e.cells.map(slot),
                     edges: e.cells.map(|(_, _, k)| k),
                     signs: e.cells.map(|(_, _, k)| rows.sign(k as usize)),
+                    grid_edge: rows.edge[e.cells[0].2 as usize],
                 }
             })
             .collect();
@@ -297,7 +301,8 @@ fn coriolis_stencil(
 pub(crate) struct AdvectionScratch {
     /// The first stage's edge velocities, then the second's (which moves them where they
     /// are, [`Stage::stage`]), in the face rows, m/s: the sub-step's starting velocities
-    /// stay where they are, and no copy of them is taken.
+    /// stay where they are, and no copy of them is taken. Untouched where the stages
+    /// read those from the grid's numbering ([`advect_momentum`]).
     stage: Vec<f64>,
     /// Per cell: its squared speed, m²/s².
     speed_squared: Vec<f64>,
@@ -350,20 +355,29 @@ impl StageWork {
 }
 
 /// Advances the edge velocities `u` (m/s, in the face rows) by `u·∇u` over `dt_s` on a
-/// sphere of `radius_m`.
+/// sphere of `radius_m`. Where `grid` is given, `u` is [`FaceRows::to_rows`] of it (the
+/// same values in the grid's numbering and orientation): a lone sub-step then moves `u`
+/// where it is in all three stages and reads its starting velocities from `grid`
+/// ([`Start::Grid`]), where otherwise it writes a stage buffer of the rows from cold
+/// (0.4 MB at n = 64); the same bits either way.
 pub(crate) fn advect_momentum(
     rows: &FaceRows,
     geo: &AdvectionGeometry,
     radius_m: f64,
     dt_s: f64,
     u: &mut [f64],
+    grid: Option<&[f64]>,
     s: &mut AdvectionScratch,
 ) {
     let Some(substeps) = substeps(rows, geo, radius_m, dt_s, u, s) else {
         return;
     };
     let h = dt_s / f64::from(substeps);
-    s.stage.resize(u.len(), 0.0);
+    // (A grid of one cell a face has no inner edges to run.)
+    let grid = grid.filter(|_| substeps == 1 && rows.n >= 2);
+    if grid.is_none() {
+        s.stage.resize(u.len(), 0.0);
+    }
     s.work.prepare(rows);
     if s.scale_radius_m != radius_m || s.vorticity_scale.len() != rows.vertex_area.len() {
         let scale = rows.vertex_area.iter().map(|a| 1.0 / (a * radius_m));
@@ -376,7 +390,8 @@ pub(crate) fn advect_momentum(
             let (w, scale) = (&mut s.work, &s.vorticity_scale);
             rows.seam_circulation(u, &mut w.vorticity, scale, |z, ia| z * ia);
             for k in 1..=substeps {
-                ssp_rk3(rows, geo, scale, h, u, &mut s.stage, w, k < substeps);
+                let buffers = (&mut *u, grid.ok_or(&mut s.stage));
+                ssp_rk3(rows, geo, scale, h, buffers, w, k < substeps);
             }
         },
     );
@@ -427,34 +442,98 @@ fn substeps(
 /// One Shu–Osher third-order step of `u`: `u₁ = u + hL(u)`, `u₂ = ¾u + ¼(u₁ + hL(u₁))`,
 /// `u ← ⅓u + ⅔(u₂ + hL(u₂))`, from `u`'s vorticity on the faces' borders in
 /// `w.vorticity`; it leaves the new `u`'s there where `next` (for the next sub-step).
-/// `u₁`, then `u₂`, goes to `stage`: the second stage moves its edges where they are (a
-/// stage reads no edge of its source once it has moved it), so that one buffer is written
-/// from cold a sub-step, not two (0.4 MB at n = 64).
+/// A stage reads no edge of its source once it has moved it, so it may move them where
+/// they are: with `Ok(grid)` (`u` in the grid's numbering) every stage does, the
+/// starting velocities read from `grid`; with `Err(stage)`, `u₁`, then `u₂`, goes to
+/// `stage` (the second stage moves its edges where they are), so that one buffer is
+/// written from cold a sub-step, not two (0.4 MB at n = 64).
 #[inline(always)]
-#[allow(clippy::too_many_arguments)] // the stages' parts, borrowed apart
 fn ssp_rk3(
     rows: &FaceRows,
     geo: &AdvectionGeometry,
     scale: &[f64],
     h: f64,
-    u: &mut [f64],
-    stage: &mut [f64],
+    (u, stage): (&mut [f64], Result<&[f64], &mut Vec<f64>>),
     w: &mut StageWork,
     next: bool,
 ) {
     let on = Stage { rows, geo, scale };
-    // Stage 1 (what `stage` held is passed over). It ignores the starting velocities:
-    // given `u`'s, the rows may move the border copies too (see `Stage::stage`).
     // The stages' faces in alternate directions, the first in reverse ([`face_order`]).
-    let step = |u, _, r| u + h * r;
-    on.stage(Some(u), stage, Some(u), w, (true, true), step);
-    // Stage 2, `u₁` into `u₂` where it is.
-    let step = |u, u0, r| 0.75 * u0 + 0.25 * (u + h * r);
-    on.stage(None, stage, Some(u), w, (true, false), step);
-    // Stage 3, onto `u`: each edge's starting velocity read before it is replaced.
-    // ⅓ as a multiplication: a division took several times as long.
-    let step = |u, u0, r| (1.0 / 3.0) * u0 + (2.0 / 3.0) * (u + h * r);
-    on.stage(Some(stage), u, None, w, (next, true), step);
+    let step1 = |u, _, r| u + h * r;
+    let step2 = |u, u0, r| 0.75 * u0 + 0.25 * (u + h * r);
+    // Stage 3: each edge's starting velocity read before it is replaced. ⅓ as a
+    // multiplication: a division took several times as long.
+    let step3 = |u, u0, r| (1.0 / 3.0) * u0 + (2.0 / 3.0) * (u + h * r);
+    match stage {
+        Ok(grid) => {
+            on.stage(None, u, Start::Dst, w, (true, true), step1);
+            on.stage(None, u, Start::Grid(grid), w, (true, false), step2);
+            on.stage(None, u, Start::Grid(grid), w, (next, true), step3);
+        }
+        Err(stage) => {
+            // Stage 1 (what `stage` held is passed over) ignores the starting velocities:
+            // given `u`'s, the rows may move the border copies too (see `Stage::stage`).
+            on.stage(Some(u), stage, Start::Rows(u), w, (true, true), step1);
+            // Stage 2, `u₁` into `u₂` where it is.
+            on.stage(None, stage, Start::Rows(u), w, (true, false), step2);
+            // Stage 3, onto `u`.
+            on.stage(Some(stage), u, Start::Dst, w, (next, true), step3);
+        }
+    }
+}
+
+/// Where a stage reads each edge's starting velocity (the sub-step's).
+#[derive(Clone, Copy)]
+enum Start<'a> {
+    /// The edge's entry of the destination, before it is written.
+    Dst,
+    /// The edge's entry of these, in the face rows.
+    Rows(&'a [f64]),
+    /// These, in the grid's numbering and orientation ([`FaceRows::to_rows`] takes the
+    /// rows from them): an inner edge's a run of the grid's ([`FaceLayout`]), a copy on a
+    /// face's border its grid edge's times its sign.
+    Grid(&'a [f64]),
+}
+
+impl<'a> Start<'a> {
+    /// The starting velocities of the run of local edges `k`, from `(1, y)` of face `f`'s
+    /// X-edge row `y` (`x` true) or from `(0, y)` of its Y-edge row `y` (`x` false);
+    /// `None` for [`Start::Dst`]. In the grid's numbering, an X-edge row's run on through
+    /// its right border copy reads the grid's next inner edge (junk, in bounds: the last
+    /// face's last X-edge row is followed by the Y-edges).
+    #[inline(always)]
+    fn run(
+        self,
+        rows: &FaceRows,
+        (f, y, x): (usize, usize, bool),
+        k: std::ops::Range<usize>,
+    ) -> Option<&'a [f64]> {
+        let n = rows.n;
+        match self {
+            Start::Dst => None,
+            Start::Rows(u0) => Some(&u0[k]),
+            Start::Grid(grid) => {
+                let layout = FaceLayout { n };
+                let at = if x {
+                    layout.x_edge_of_cell((f * n + y) * n + 1)
+                } else {
+                    layout.y_edge_of_cell((f * n + y) * n)
+                };
+                Some(&grid[at..at + k.len()])
+            }
+        }
+    }
+
+    /// Local edge `k`'s starting velocity, `dst` the destination, `(e, sign)` its grid
+    /// edge and its orientation against it.
+    #[inline(always)]
+    fn at(self, dst: &[f64], k: usize, (e, sign): (usize, f64)) -> f64 {
+        match self {
+            Start::Dst => dst[k],
+            Start::Rows(u0) => u0[k],
+            Start::Grid(grid) => grid[e] * sign,
+        }
+    }
 }
 
 /// What every stage reads of the grid.
@@ -472,8 +551,8 @@ impl Stage<'_> {
     /// stage moves the edges where they are), the rate the rotation term `−ζ (k×u)·n` of
     /// `src` (with its vorticity
     /// on the faces' borders in `w.vorticity`) summed over the edge's two cells (the
-    /// lower-numbered cell's term first), `u0` the edge's entry of `u0`, or of `dst`
-    /// before it is written where `None`; where `next`, the vorticity of `dst` on the
+    /// lower-numbered cell's term first), `u0` the edge's starting velocity ([`Start`]);
+    /// where `next`, the vorticity of `dst` on the
     /// faces' borders then replaces it. The faces in reverse order where `reverse`
     /// ([`face_order`]).
     ///
@@ -492,7 +571,7 @@ impl Stage<'_> {
         self,
         src: Option<&[f64]>,
         dst: &mut [f64],
-        u0: Option<&[f64]>,
+        u0: Start,
         w: &mut StageWork,
         (next, reverse): (bool, bool),
         step: impl Fn(f64, f64, f64) -> f64,
@@ -515,21 +594,23 @@ impl Stage<'_> {
                 keep_border_rates(&mut border[f * 4 * n..][..4 * n], rate, n, y);
                 let [_, left, right, _] = &*rate;
                 // The X-edges inside the face: cell (i − 1, y)'s right side and (i, y)'s left.
-                // Where the seam pass takes the starting velocities from `u0` and the
-                // source from `src` (neither from `dst`), the row runs on through the right
-                // border copy (junk until that pass moves it): n edges vectorise without the
-                // scalar tail of n − 1.
-                let run_on = u0.is_some() && src.is_some();
-                let k = rows.x_edge(f, 1, y)..rows.x_edge(f, n + usize::from(run_on), y);
-                let (u0x, srcx) = (u0.map(|u0| &u0[k.clone()]), src.map(|s| &s[k.clone()]));
-                move_edges(&mut dst[k], srcx, u0x, right, &left[1..], &step);
+                // The row runs on through the right border copy, n edges, which vectorise
+                // without the scalar tail of n − 1: that copy's entry of `dst` (which the
+                // seam pass may read, as the source or the start) is put back after.
+                let k = rows.x_edge(f, 1, y)..rows.x_edge(f, n + 1, y);
+                let border_copy = dst[k.end - 1];
+                let u0x = u0.run(rows, (f, y, true), k.clone());
+                let srcx = src.map(|s| &s[k.clone()]);
+                move_edges(&mut dst[k.clone()], srcx, u0x, right, &left[1..], &step);
+                dst[k.end - 1] = border_copy;
                 if y == 0 {
                     continue;
                 }
                 // The Y-edges below: cell (x, y − 1)'s top and (x, y)'s bottom.
                 let k = rows.y_edge(f, 0, y)..rows.y_edge(f, n, y);
                 let (top, bottom) = (&before[Side::Top as usize], &rate[Side::Bottom as usize]);
-                let (u0y, srcy) = (u0.map(|u0| &u0[k.clone()]), src.map(|s| &s[k.clone()]));
+                let u0y = u0.run(rows, (f, y, false), k.clone());
+                let srcy = src.map(|s| &s[k.clone()]);
                 move_edges(&mut dst[k], srcy, u0y, top, bottom, &step);
             }
         }
@@ -583,7 +664,7 @@ impl Stage<'_> {
         self,
         src: Option<&[f64]>,
         dst: &mut [f64],
-        u0: Option<&[f64]>,
+        u0: Start,
         border: &[f64],
         step: &impl Fn(f64, f64, f64) -> f64,
     ) {
@@ -591,7 +672,7 @@ impl Stage<'_> {
             let ([ia, ib], [sa, sb]) = (e.slots.map(|i| i as usize), e.signs);
             let r = (0.0 + sa * border[ia]) + sb * border[ib];
             for (k, sign) in [(e.edges[0] as usize, sa), (e.edges[1] as usize, sb)] {
-                let start = u0.map_or(dst[k], |u0| u0[k]);
+                let start = u0.at(dst, k, (e.grid_edge as usize, sign));
                 let from = src.map_or(dst[k], |s| s[k]);
                 dst[k] = step(from, start, sign * r);
             }
@@ -874,7 +955,7 @@ mod tests {
         let mut in_rows = Vec::new();
         rows.to_rows(&u, &mut in_rows);
         for _ in 0..240 {
-            advect_momentum(&rows, &geo, 0.01, 1.0 / 960.0, &mut in_rows, &mut s);
+            advect_momentum(&rows, &geo, 0.01, 1.0 / 960.0, &mut in_rows, None, &mut s);
         }
         rows.to_grid(&in_rows, &mut u);
         let change = energy(&u) / e0 - 1.0;
@@ -906,6 +987,7 @@ mod tests {
                     0.01,
                     1.0 / 60.0,
                     &mut u,
+                    None,
                     &mut AdvectionScratch::default(),
                 );
                 crate::avx2::set_portable_only(false);
@@ -982,8 +1064,9 @@ mod tests {
 
     /// A stage that moves the edges where they are (its source its destination) gives
     /// the bits of one that reads them apart, and so does one over the faces in reverse
-    /// order, the kept border vorticity too: no row reads an edge that a row before it
-    /// has moved. At n = 5 and 16.
+    /// order, or one that reads its starting velocities in the grid's numbering, the kept
+    /// border vorticity too: no row reads an edge that a row before it has moved, and a
+    /// row's run through its right border copy leaves it as it was. At n = 5 and 16.
     #[test]
     fn a_stage_in_place_or_in_reverse_is_the_stage_apart() {
         for n in [5, 16] {
@@ -994,8 +1077,10 @@ mod tests {
                 rough_rows(&rows, &grid, 7919),
                 rough_rows(&rows, &grid, 104_729),
             );
+            let mut u0_grid = vec![0.0; grid.edges().len()];
+            rows.to_grid(&u0, &mut u0_grid);
             let step = |u: f64, u0: f64, r: f64| 0.75 * u0 + 0.25 * (u + 0.01 * r);
-            let run = |in_place: bool, reverse: bool| {
+            let run = |in_place: bool, reverse: bool, from_grid: bool| {
                 let (mut w, scale) = stage_work(&rows, &src);
                 let on = Stage {
                     rows: &rows,
@@ -1008,14 +1093,23 @@ mod tests {
                     vec![0.0; src.len()]
                 };
                 let from = (!in_place).then_some(&src[..]);
-                on.stage(from, &mut dst, Some(&u0), &mut w, (true, reverse), step);
+                let start = if from_grid {
+                    Start::Grid(&u0_grid)
+                } else {
+                    Start::Rows(&u0)
+                };
+                on.stage(from, &mut dst, start, &mut w, (true, reverse), step);
                 (dst, w.vorticity)
             };
-            let apart = run(false, false);
+            let apart = run(false, false, false);
             assert_ne!(apart.0, src, "n {n}: nothing moved");
-            for (in_place, reverse) in [(true, false), (false, true), (true, true)] {
-                let (dst, vorticity) = run(in_place, reverse);
-                let what = format!("n {n}, in place {in_place}, reverse {reverse}");
+            let cases = [(true, false), (false, true), (true, true)];
+            let cases = cases.map(|(a, b)| (a, b, false)).into_iter();
+            for (in_place, reverse, from_grid) in cases.chain([(true, true, true)]) {
+                let (dst, vorticity) = run(in_place, reverse, from_grid);
+                let what = format!(
+                    "n {n}, in place {in_place}, reverse {reverse}, from the grid {from_grid}"
+                );
                 for (name, got, want) in
                     [("edges", dst, &apart.0), ("vorticity", vorticity, &apart.1)]
                 {
@@ -1087,6 +1181,37 @@ mod tests {
                     let want = term(c as usize, side as usize);
                     assert_eq!(got, want, "n {n}: cell {c}, side {side:?}");
                 }
+            }
+        }
+    }
+
+    /// The advection that reads its starting velocities in the grid's numbering (every
+    /// stage in place) gives the bits of the one through the stage buffer: one sub-step
+    /// and (on a small sphere) several, at n = 2, 5 and 16.
+    #[test]
+    fn the_advection_from_the_grids_numbering_is_the_advection_through_a_buffer() {
+        for n in [2, 5, 16] {
+            let grid = CubeSphere::new(n);
+            let rows = FaceRows::new(&grid);
+            let geo = AdvectionGeometry::new(&grid, &rows);
+            let start = rough_rows(&rows, &grid, 7919);
+            let mut start_grid = vec![0.0; grid.edges().len()];
+            rows.to_grid(&start, &mut start_grid);
+            for radius in [1.0, 1e-4] {
+                let run = |from_grid: bool| {
+                    let mut u = start.clone();
+                    let g = from_grid.then_some(&start_grid[..]);
+                    let s = &mut AdvectionScratch::default();
+                    advect_momentum(&rows, &geo, radius, 1.0 / 60.0, &mut u, g, s);
+                    u
+                };
+                let (through, from_grid) = (run(false), run(true));
+                assert_ne!(through, start, "n {n}, radius {radius}: nothing moved");
+                let differ = through
+                    .iter()
+                    .zip(&from_grid)
+                    .filter(|(a, b)| a.to_bits() != b.to_bits());
+                assert_eq!(differ.count(), 0, "n {n}, radius {radius}: edges differ");
             }
         }
     }

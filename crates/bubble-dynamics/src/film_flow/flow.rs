@@ -413,7 +413,16 @@ impl FilmFlow {
         // From the step's start (`step` swapped it aside: `u_m_per_s` is stale until the
         // rows are written back below).
         self.rows.to_rows(&s.u_start, u);
-        advect_momentum(&self.rows, &self.advection, r, dt_s, u, &mut s.advect);
+        let start = Some(&s.u_start[..]);
+        advect_momentum(
+            &self.rows,
+            &self.advection,
+            r,
+            dt_s,
+            u,
+            start,
+            &mut s.advect,
+        );
         let nu = self.params.viscosity_pa_s / self.params.density_kg_per_m3;
         let g = forcing.g_eff_m_per_s2;
         match self.params.gradient {
