@@ -21,7 +21,9 @@ const EULER_RATE_LIMIT: f64 = 1.5;
 /// Buffers of the viscous step, reused across steps.
 #[derive(Clone, Debug, Default)]
 pub(super) struct ViscousScratch {
-    /// The stage before the one under way, in the face rows ([`FaceRows`]), m/s.
+    /// The stage before the one under way, in the face rows ([`FaceRows`]), m/s. Between
+    /// steps, a buffer of the grid's (`FilmFlow::momentum_explicit` copies the rows back
+    /// into it and swaps it with the grid's velocities' buffer).
     pub(super) stage: Vec<f64>,
     /// Per local vertex: the vorticity on the unit sphere (m/s per rad), of the vertices
     /// on the faces' borders only (every copy); the inner ones are taken row by row into
