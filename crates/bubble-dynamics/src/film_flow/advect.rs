@@ -39,8 +39,8 @@ use glam::DVec3;
 use crate::avx2::{OTHERS, QUAD_WEIGHTS, coriolis_row, quad_starts, with_avx2};
 
 use super::compare::larger;
-use super::face_rows::{FaceRows, SIDES, Side};
-use super::grid::CubeSphere;
+use super::face_rows::{FaceRows, SIDES, Side, face_order};
+use super::grid::{CubeSphere, FaceLayout};
 
 /// Largest fraction of the narrowest dual edge the fastest cell may cross in a sub-step.
 /// SSP-RK3 damps (never amplifies) a rotation of `ω·sub_dt < √3`; the vorticity at the
@@ -109,6 +109,9 @@ struct SeamTerms {
     edges: [u32; 2],
     /// Per cell: the copy's orientation against the grid's (`±1`).
     signs: [f64; 2],
+    /// The grid's edge (both copies'), for the starting velocities in the grid's
+    /// numbering ([`Start::Grid`]).
+    grid_edge: u32,
 }
 
 /// An irregular cell's reconstruction weights, its sides in the grid's order.
@@ -195,11 +198,12 @@ impl AdvectionGeometry {
             .seam_edges
             .iter()
             .map(|e| {
-                let slot = |(c, side, _): (u32, Side, u32)| (side as usize * cells) as u32 + c;
+                let slot = |(c, side, _): (u32, Side, u32)| border_slot(rows.n, c as usize, side);
                 SeamTerms {
                     slots: e.cells.map(slot),
                     edges: e.cells.map(|(_, _, k)| k),
                     signs: e.cells.map(|(_, _, k)| rows.sign(k as usize)),
+                    grid_edge: rows.edge[e.cells[0].2 as usize],
                 }
             })
             .collect();
@@ -295,10 +299,11 @@ fn coriolis_stencil(
 /// Buffers of one advection step, reused across steps.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct AdvectionScratch {
-    /// The first and second stages' edge velocities, in the face rows, m/s (each stage
-    /// writes apart from what it reads: the sub-step's starting velocities stay where
-    /// they are, and no copy of them is taken).
-    stages: [Vec<f64>; 2],
+    /// The first stage's edge velocities, then the second's (which moves them where they
+    /// are, [`Stage::stage`]), in the face rows, m/s: the sub-step's starting velocities
+    /// stay where they are, and no copy of them is taken. Untouched where the stages
+    /// read those from the grid's numbering ([`advect_momentum`]).
+    stage: Vec<f64>,
     /// Per cell: its squared speed, m²/s².
     speed_squared: Vec<f64>,
     /// What a stage keeps besides the velocities.
@@ -315,14 +320,18 @@ pub(crate) struct AdvectionScratch {
 /// What a stage reads and writes besides the velocities.
 #[derive(Clone, Debug, Default)]
 struct StageWork {
-    /// Per local vertex: the vorticity of the velocities the stage under way starts
-    /// from, 1/s.
+    /// Per local vertex on the faces' borders (every copy; the inner ones are not
+    /// kept): the vorticity of the velocities the stage under way starts from, 1/s.
     vorticity: Vec<f64>,
-    /// Per local vertex: the vorticity of those it ends with.
-    next_vorticity: Vec<f64>,
-    /// Per side of a cell (in [`SIDES`] order), per cell (slot `side·cells + cell`): the
-    /// cell's term of that side's rate, m/s², in the rows' orientation, kept for the
-    /// cells' sides on the faces' borders.
+    /// Vertex rows `j` and `j + 1` of the face under way (at `j mod 2`, `n + 1` each):
+    /// the vorticity of the velocities the stage starts from, each inner row taken from
+    /// them as the stage reaches it ([`Stage::stage`]), where a whole-grid array of it
+    /// was written by one stage and read by the next (0.2 MB each way at n = 64).
+    vertex_rows: [Vec<f64>; 2],
+    /// Per face, per side of it (in [`SIDES`] order), per cell along it ([`border_slot`]):
+    /// the term of the border cell there of that side's rate, m/s², in the rows'
+    /// orientation (12 KB at n = 64, where a slot for every cell's every side spread
+    /// a row's two border terms over two lines of 0.8 MB).
     border_rate: Vec<f64>,
     /// The same for the row of cells under way and the one before (even and odd rows),
     /// and one slot more: the left side of the cell past the row's end, read (unset) for
@@ -334,8 +343,11 @@ impl StageWork {
     /// Gives every buffer its length (each entry read is written first).
     fn prepare(&mut self, rows: &FaceRows) {
         let n = rows.n;
-        self.next_vorticity.resize(rows.vertices(), 0.0);
-        self.border_rate.resize(4 * 6 * n * n, 0.0);
+        self.vorticity.resize(rows.vertices(), 0.0);
+        for r in &mut self.vertex_rows {
+            r.resize(n + 1, 0.0);
+        }
+        self.border_rate.resize(6 * 4 * n, 0.0);
         for r in self.row_rate.iter_mut().flatten() {
             r.resize(n + 1, 0.0);
         }
@@ -343,21 +355,28 @@ impl StageWork {
 }
 
 /// Advances the edge velocities `u` (m/s, in the face rows) by `u·∇u` over `dt_s` on a
-/// sphere of `radius_m`.
+/// sphere of `radius_m`. Where `grid` is given, `u` is [`FaceRows::to_rows`] of it (the
+/// same values in the grid's numbering and orientation): a lone sub-step then moves `u`
+/// where it is in all three stages and reads its starting velocities from `grid`
+/// ([`Start::Grid`]), where otherwise it writes a stage buffer of the rows from cold
+/// (0.4 MB at n = 64); the same bits either way.
 pub(crate) fn advect_momentum(
     rows: &FaceRows,
     geo: &AdvectionGeometry,
     radius_m: f64,
     dt_s: f64,
     u: &mut [f64],
+    grid: Option<&[f64]>,
     s: &mut AdvectionScratch,
 ) {
     let Some(substeps) = substeps(rows, geo, radius_m, dt_s, u, s) else {
         return;
     };
     let h = dt_s / f64::from(substeps);
-    for stage in &mut s.stages {
-        stage.resize(u.len(), 0.0);
+    // (A grid of one cell a face has no inner edges to run.)
+    let grid = grid.filter(|_| substeps == 1 && rows.n >= 2);
+    if grid.is_none() {
+        s.stage.resize(u.len(), 0.0);
     }
     s.work.prepare(rows);
     if s.scale_radius_m != radius_m || s.vorticity_scale.len() != rows.vertex_area.len() {
@@ -369,9 +388,10 @@ pub(crate) fn advect_momentum(
         #[inline(always)]
         || {
             let (w, scale) = (&mut s.work, &s.vorticity_scale);
-            rows.circulation(u, &mut w.vorticity, scale, |z, ia| z * ia);
+            rows.seam_circulation(u, &mut w.vorticity, scale, |z, ia| z * ia);
             for k in 1..=substeps {
-                ssp_rk3(rows, geo, scale, h, u, &mut s.stages, w, k < substeps);
+                let buffers = (&mut *u, grid.ok_or(&mut s.stage));
+                ssp_rk3(rows, geo, scale, h, buffers, w, k < substeps);
             }
         },
     );
@@ -420,32 +440,100 @@ fn substeps(
 }
 
 /// One Shu–Osher third-order step of `u`: `u₁ = u + hL(u)`, `u₂ = ¾u + ¼(u₁ + hL(u₁))`,
-/// `u ← ⅓u + ⅔(u₂ + hL(u₂))`, from `u`'s vorticity in `w.vorticity`; it leaves the new
-/// `u`'s there where `next` (for the next sub-step). `u₁` and `u₂` go to `stages`.
+/// `u ← ⅓u + ⅔(u₂ + hL(u₂))`, from `u`'s vorticity on the faces' borders in
+/// `w.vorticity`; it leaves the new `u`'s there where `next` (for the next sub-step).
+/// A stage reads no edge of its source once it has moved it, so it may move them where
+/// they are: with `Ok(grid)` (`u` in the grid's numbering) every stage does, the
+/// starting velocities read from `grid`; with `Err(stage)`, `u₁`, then `u₂`, goes to
+/// `stage` (the second stage moves its edges where they are), so that one buffer is
+/// written from cold a sub-step, not two (0.4 MB at n = 64).
 #[inline(always)]
-#[allow(clippy::too_many_arguments)] // the stages' parts, borrowed apart
 fn ssp_rk3(
     rows: &FaceRows,
     geo: &AdvectionGeometry,
     scale: &[f64],
     h: f64,
-    u: &mut [f64],
-    stages: &mut [Vec<f64>; 2],
+    (u, stage): (&mut [f64], Result<&[f64], &mut Vec<f64>>),
     w: &mut StageWork,
     next: bool,
 ) {
-    let [u1, u2] = stages;
     let on = Stage { rows, geo, scale };
-    // Stage 1 (what `u1` held is passed over). It ignores the starting velocities: given
-    // `u`'s, the rows may move the border copies too (see `Stage::stage`).
-    let step = |u, _, r| u + h * r;
-    on.stage(u, u1, Some(u), w, true, step);
-    let step = |u, u0, r| 0.75 * u0 + 0.25 * (u + h * r);
-    on.stage(u1, u2, Some(u), w, true, step);
-    // Stage 3, onto `u`: each edge's starting velocity read before it is replaced.
-    // ⅓ as a multiplication: a division took several times as long.
-    let step = |u, u0, r| (1.0 / 3.0) * u0 + (2.0 / 3.0) * (u + h * r);
-    on.stage(u2, u, None, w, next, step);
+    // The stages' faces in alternate directions, the first in reverse ([`face_order`]).
+    let step1 = |u, _, r| u + h * r;
+    let step2 = |u, u0, r| 0.75 * u0 + 0.25 * (u + h * r);
+    // Stage 3: each edge's starting velocity read before it is replaced. ⅓ as a
+    // multiplication: a division took several times as long.
+    let step3 = |u, u0, r| (1.0 / 3.0) * u0 + (2.0 / 3.0) * (u + h * r);
+    match stage {
+        Ok(grid) => {
+            on.stage(None, u, Start::Dst, w, (true, true), step1);
+            on.stage(None, u, Start::Grid(grid), w, (true, false), step2);
+            on.stage(None, u, Start::Grid(grid), w, (next, true), step3);
+        }
+        Err(stage) => {
+            // Stage 1 (what `stage` held is passed over) ignores the starting velocities:
+            // given `u`'s, the rows may move the border copies too (see `Stage::stage`).
+            on.stage(Some(u), stage, Start::Rows(u), w, (true, true), step1);
+            // Stage 2, `u₁` into `u₂` where it is.
+            on.stage(None, stage, Start::Rows(u), w, (true, false), step2);
+            // Stage 3, onto `u`.
+            on.stage(Some(stage), u, Start::Dst, w, (next, true), step3);
+        }
+    }
+}
+
+/// Where a stage reads each edge's starting velocity (the sub-step's).
+#[derive(Clone, Copy)]
+enum Start<'a> {
+    /// The edge's entry of the destination, before it is written.
+    Dst,
+    /// The edge's entry of these, in the face rows.
+    Rows(&'a [f64]),
+    /// These, in the grid's numbering and orientation ([`FaceRows::to_rows`] takes the
+    /// rows from them): an inner edge's a run of the grid's ([`FaceLayout`]), a copy on a
+    /// face's border its grid edge's times its sign.
+    Grid(&'a [f64]),
+}
+
+impl<'a> Start<'a> {
+    /// The starting velocities of the run of local edges `k`, from `(1, y)` of face `f`'s
+    /// X-edge row `y` (`x` true) or from `(0, y)` of its Y-edge row `y` (`x` false);
+    /// `None` for [`Start::Dst`]. In the grid's numbering, an X-edge row's run on through
+    /// its right border copy reads the grid's next inner edge (junk, in bounds: the last
+    /// face's last X-edge row is followed by the Y-edges).
+    #[inline(always)]
+    fn run(
+        self,
+        rows: &FaceRows,
+        (f, y, x): (usize, usize, bool),
+        k: std::ops::Range<usize>,
+    ) -> Option<&'a [f64]> {
+        let n = rows.n;
+        match self {
+            Start::Dst => None,
+            Start::Rows(u0) => Some(&u0[k]),
+            Start::Grid(grid) => {
+                let layout = FaceLayout { n };
+                let at = if x {
+                    layout.x_edge_of_cell((f * n + y) * n + 1)
+                } else {
+                    layout.y_edge_of_cell((f * n + y) * n)
+                };
+                Some(&grid[at..at + k.len()])
+            }
+        }
+    }
+
+    /// Local edge `k`'s starting velocity, `dst` the destination, `(e, sign)` its grid
+    /// edge and its orientation against it.
+    #[inline(always)]
+    fn at(self, dst: &[f64], k: usize, (e, sign): (usize, f64)) -> f64 {
+        match self {
+            Start::Dst => dst[k],
+            Start::Rows(u0) => u0[k],
+            Start::Grid(grid) => grid[e] * sign,
+        }
+    }
 }
 
 /// What every stage reads of the grid.
@@ -459,82 +547,111 @@ struct Stage<'a> {
 
 impl Stage<'_> {
     /// One stage, in one pass over each face's rows: `dst ← step(src, u0, rate)` on every
-    /// local edge, the rate the rotation term `−ζ (k×u)·n` of `src` (with its vorticity
-    /// in `w.vorticity`) summed over the edge's two cells (the lower-numbered cell's term
-    /// first), `u0` the edge's entry of `u0`, or of `dst` before it is written where
-    /// `None`; where `next`, the vorticity of `dst` then replaces it.
+    /// local edge (`src` the edge's entry of `dst` before it is written where `None`: the
+    /// stage moves the edges where they are), the rate the rotation term `−ζ (k×u)·n` of
+    /// `src` (with its vorticity
+    /// on the faces' borders in `w.vorticity`) summed over the edge's two cells (the
+    /// lower-numbered cell's term first), `u0` the edge's starting velocity ([`Start`]);
+    /// where `next`, the vorticity of `dst` on the
+    /// faces' borders then replaces it. The faces in reverse order where `reverse`
+    /// ([`face_order`]).
     ///
-    /// Row `y` of a face takes its cells' terms, then moves its X-edges (both their cells are in the row) and its Y-edges
-    /// below it (the row before holds their other cells), then takes the vorticity of its
-    /// vertex row `y`, whose edges have all moved by then. The edges on the faces'
-    /// borders move last, from their two faces' cells' terms, kept for that in
-    /// `w.border_rate`.
+    /// Row `y` of a face takes the vorticity of its vertex row `y + 1` from `src` (row
+    /// `y`'s it took the row before), then its cells' terms, then moves its X-edges (both
+    /// their cells are in the row) and its Y-edges below it (the row before holds their
+    /// other cells). The edges on the faces' borders move last, from their two faces'
+    /// cells' terms, kept for that in `w.border_rate`. No row reads an edge of `src` that
+    /// a row before it has moved: vertex row `y + 1` reads X-edge rows `y` and `y + 1` and
+    /// Y-edge row `y + 1`, cell row `y` X-edge row `y` and Y-edge rows `y` and `y + 1`, and
+    /// row `y` moves X-edge row `y` and Y-edge row `y` (a face reads no other face's
+    /// edges, and its border vertices' vorticity is kept from the stage before), so a
+    /// stage may move the edges where they are.
     #[inline(always)]
     fn stage(
         self,
-        src: &[f64],
+        src: Option<&[f64]>,
         dst: &mut [f64],
-        u0: Option<&[f64]>,
+        u0: Start,
         w: &mut StageWork,
-        next: bool,
+        (next, reverse): (bool, bool),
         step: impl Fn(f64, f64, f64) -> f64,
     ) {
         let (rows, n) = (self.rows, self.rows.n);
         let (vorticity, border) = (&w.vorticity, &mut w.border_rate);
         let [even, odd] = &mut w.row_rate;
-        for f in 0..6 {
+        let [z_even, z_odd] = &mut w.vertex_rows;
+        for f in face_order(reverse) {
+            self.vertex_row(src.unwrap_or(dst), vorticity, f, 0, z_even);
             for y in 0..n {
-                let c = f * n * n + y * n;
-                let (rate, before) = if y % 2 == 0 {
-                    (&mut *even, &*odd)
+                let (rate, before, z, z_next) = if y % 2 == 0 {
+                    (&mut *even, &*odd, &*z_even, &mut *z_odd)
                 } else {
-                    (&mut *odd, &*even)
+                    (&mut *odd, &*even, &*z_odd, &mut *z_even)
                 };
-                self.cell_row(src, vorticity, f, y, rate);
-                keep_border_rates(border, rate, c, n, y);
+                let from = src.unwrap_or(dst);
+                self.vertex_row(from, vorticity, f, y + 1, z_next);
+                self.cell_row(from, [z, z_next], f, y, rate);
+                keep_border_rates(&mut border[f * 4 * n..][..4 * n], rate, n, y);
                 let [_, left, right, _] = &*rate;
                 // The X-edges inside the face: cell (i − 1, y)'s right side and (i, y)'s left.
-                // Where the seam pass takes the starting velocities from `u0` (not from
-                // `dst`), the row runs on through the right border copy (junk until that
-                // pass moves it): n edges vectorise without the scalar tail of n − 1.
-                let k = rows.x_edge(f, 1, y)..rows.x_edge(f, n + usize::from(u0.is_some()), y);
-                let u0x = u0.map(|u0| &u0[k.clone()]);
-                move_edges(&mut dst[k.clone()], &src[k], u0x, right, &left[1..], &step);
+                // The row runs on through the right border copy, n edges, which vectorise
+                // without the scalar tail of n − 1: that copy's entry of `dst` (which the
+                // seam pass may read, as the source or the start) is put back after.
+                let k = rows.x_edge(f, 1, y)..rows.x_edge(f, n + 1, y);
+                let border_copy = dst[k.end - 1];
+                let u0x = u0.run(rows, (f, y, true), k.clone());
+                let srcx = src.map(|s| &s[k.clone()]);
+                move_edges(&mut dst[k.clone()], srcx, u0x, right, &left[1..], &step);
+                dst[k.end - 1] = border_copy;
                 if y == 0 {
                     continue;
                 }
                 // The Y-edges below: cell (x, y − 1)'s top and (x, y)'s bottom.
                 let k = rows.y_edge(f, 0, y)..rows.y_edge(f, n, y);
                 let (top, bottom) = (&before[Side::Top as usize], &rate[Side::Bottom as usize]);
-                let u0y = u0.map(|u0| &u0[k.clone()]);
-                move_edges(&mut dst[k.clone()], &src[k], u0y, top, bottom, &step);
-                if next {
-                    let z = &mut w.next_vorticity;
-                    rows.circulation_row(dst, f, y, z, self.scale, |z, ia| z * ia);
-                }
+                let u0y = u0.run(rows, (f, y, false), k.clone());
+                let srcy = src.map(|s| &s[k.clone()]);
+                move_edges(&mut dst[k], srcy, u0y, top, bottom, &step);
             }
         }
         self.move_seam_edges(src, dst, u0, &w.border_rate, &step);
         if next {
-            rows.seam_circulation(dst, &mut w.next_vorticity, self.scale, |z, ia| z * ia);
-            std::mem::swap(&mut w.vorticity, &mut w.next_vorticity);
+            rows.seam_circulation(dst, &mut w.vorticity, self.scale, |z, ia| z * ia);
         }
     }
 
-    /// Row `y` of face `f`'s cells' terms of their sides' rates into `rate` (per side, per
-    /// cell of the row), from the edge velocities `u` and the vertices' `vorticity`.
+    /// The vorticity of face `f`'s vertex row `j` of the edge velocities `u` into `out`:
+    /// an inner row's taken from `u`, its ends (on the face's borders) and the border
+    /// rows `0` and `n` from `border` (per local vertex, kept on the faces' borders).
     #[inline(always)]
-    fn cell_row(self, u: &[f64], vorticity: &[f64], f: usize, y: usize, rate: &mut [Vec<f64>; 4]) {
+    fn vertex_row(self, u: &[f64], border: &[f64], f: usize, j: usize, out: &mut [f64]) {
+        let (rows, n, w) = (self.rows, self.rows.n, self.rows.n + 1);
+        let border = &border[rows.vertex_at(f, 0, j)..][..w];
+        let out = &mut out[..w];
+        if j == 0 || j == n {
+            out.copy_from_slice(border);
+            return;
+        }
+        let u = &u[f * rows.edges_per_face()..][..rows.edges_per_face()];
+        let scale = &self.scale[j * w..][..n];
+        rows.face_circulation_row(u, j, &mut out[..n], scale, |z, ia| z * ia);
+        (out[0], out[n]) = (border[0], border[n]);
+    }
+
+    /// Row `y` of face `f`'s cells' terms of their sides' rates into `rate` (per side, per
+    /// cell of the row), from the edge velocities `u` and the vorticity `z` of the row's
+    /// bottom and top vertices.
+    #[inline(always)]
+    fn cell_row(self, u: &[f64], z: [&[f64]; 2], f: usize, y: usize, rate: &mut [Vec<f64>; 4]) {
         let (rows, n) = (self.rows, self.rows.n);
         let (uy, ux) = (rows.y_edge(f, 0, y), rows.x_edge(f, 0, y));
-        let (vb, vt) = (rows.vertex_at(f, 0, y), rows.vertex_at(f, 0, y + 1));
         let len = n.div_ceil(4) * QUAD_WEIGHTS;
         // Every face's weights are face 0's ([`AdvectionGeometry::coriolis`]).
         let w = &self.geo.coriolis[y * len..][..len];
         let [ob, ol, or, ot] = rate;
         coriolis_row(
             w,
-            [&vorticity[vb..vb + n + 1], &vorticity[vt..vt + n + 1]],
+            [&z[0][..n + 1], &z[1][..n + 1]],
             [&u[uy..uy + n], &u[ux..ux + n + 1], &u[uy + n..uy + 2 * n]],
             [&mut ob[..n], &mut ol[..n], &mut or[..n], &mut ot[..n]],
         );
@@ -545,9 +662,9 @@ impl Stage<'_> {
     #[inline(always)]
     fn move_seam_edges(
         self,
-        src: &[f64],
+        src: Option<&[f64]>,
         dst: &mut [f64],
-        u0: Option<&[f64]>,
+        u0: Start,
         border: &[f64],
         step: &impl Fn(f64, f64, f64) -> f64,
     ) {
@@ -555,52 +672,79 @@ impl Stage<'_> {
             let ([ia, ib], [sa, sb]) = (e.slots.map(|i| i as usize), e.signs);
             let r = (0.0 + sa * border[ia]) + sb * border[ib];
             for (k, sign) in [(e.edges[0] as usize, sa), (e.edges[1] as usize, sb)] {
-                let start = u0.map_or(dst[k], |u0| u0[k]);
-                dst[k] = step(src[k], start, sign * r);
+                let start = u0.at(dst, k, (e.grid_edge as usize, sign));
+                let from = src.map_or(dst[k], |s| s[k]);
+                dst[k] = step(from, start, sign * r);
             }
         }
     }
 }
 
-/// Keeps the terms of row `y`'s cells (from cell `c`) on their face's borders: the left
-/// of its first cell, the right of its last, and the bottoms or tops of the first and
-/// last rows.
+/// Keeps the terms of row `y`'s cells on their face's borders into `border` (the face's
+/// part of [`StageWork::border_rate`]): the left of its first cell, the right of its
+/// last, and the bottoms or tops of the first and last rows.
 #[inline(always)]
-fn keep_border_rates(border: &mut [f64], rate: &[Vec<f64>; 4], c: usize, n: usize, y: usize) {
+fn keep_border_rates(border: &mut [f64], rate: &[Vec<f64>; 4], n: usize, y: usize) {
     let [bottom, left, right, top] = rate;
-    let cells = border.len() / 4;
-    let at = |side: Side| side as usize * cells + c;
-    border[at(Side::Left)] = left[0];
-    border[at(Side::Right) + n - 1] = right[n - 1];
+    let side = |side: Side| side as usize * n;
+    border[side(Side::Left) + y] = left[0];
+    border[side(Side::Right) + y] = right[n - 1];
     if y == 0 {
-        border[at(Side::Bottom)..][..n].copy_from_slice(&bottom[..n]);
+        border[side(Side::Bottom)..][..n].copy_from_slice(&bottom[..n]);
     }
     if y == n - 1 {
-        border[at(Side::Top)..][..n].copy_from_slice(&top[..n]);
+        border[side(Side::Top)..][..n].copy_from_slice(&top[..n]);
     }
 }
 
-/// `dst ← step(src, u0, (0 + ra) + rb)` edge by edge over `dst`, `u0` the edge's entry
-/// of `u0`, or of `dst` before it is written where `None`.
+/// The slot in [`StageWork::border_rate`] of side `side` of cell `c` (of a grid of `n`
+/// cells a face), on its face's border: per face, per side, along the side (`x` for the
+/// bottom and top, `y` for the left and right).
+fn border_slot(n: usize, c: usize, side: Side) -> u32 {
+    let (f, x, y) = (c / (n * n), c % n, (c / n) % n);
+    let along = match side {
+        Side::Bottom | Side::Top => x,
+        Side::Left | Side::Right => y,
+    };
+    ((f * 4 + side as usize) * n + along) as u32
+}
+
+/// `dst ← step(src, u0, (0 + ra) + rb)` edge by edge over `dst`, `src` and `u0` the
+/// edge's entries of them, or of `dst` before it is written where `None`.
 #[inline(always)]
 fn move_edges(
     dst: &mut [f64],
-    src: &[f64],
+    src: Option<&[f64]>,
     u0: Option<&[f64]>,
     ra: &[f64],
     rb: &[f64],
     step: &impl Fn(f64, f64, f64) -> f64,
 ) {
     let len = dst.len();
-    let (src, ra, rb) = (&src[..len], &ra[..len], &rb[..len]);
-    if let Some(u0) = u0 {
-        let u0 = &u0[..len];
-        for i in 0..len {
-            dst[i] = step(src[i], u0[i], (0.0 + ra[i]) + rb[i]);
+    let (ra, rb) = (&ra[..len], &rb[..len]);
+    match (src, u0) {
+        (Some(src), Some(u0)) => {
+            let (src, u0) = (&src[..len], &u0[..len]);
+            for i in 0..len {
+                dst[i] = step(src[i], u0[i], (0.0 + ra[i]) + rb[i]);
+            }
         }
-    } else {
-        for i in 0..len {
-            dst[i] = step(src[i], dst[i], (0.0 + ra[i]) + rb[i]);
+        (Some(src), None) => {
+            let src = &src[..len];
+            for i in 0..len {
+                dst[i] = step(src[i], dst[i], (0.0 + ra[i]) + rb[i]);
+            }
+        }
+        (None, Some(u0)) => {
+            let u0 = &u0[..len];
+            for i in 0..len {
+                dst[i] = step(dst[i], u0[i], (0.0 + ra[i]) + rb[i]);
+            }
+        }
+        (None, None) => {
+            for i in 0..len {
+                dst[i] = step(dst[i], dst[i], (0.0 + ra[i]) + rb[i]);
+            }
         }
     }
 }
@@ -811,7 +955,7 @@ mod tests {
         let mut in_rows = Vec::new();
         rows.to_rows(&u, &mut in_rows);
         for _ in 0..240 {
-            advect_momentum(&rows, &geo, 0.01, 1.0 / 960.0, &mut in_rows, &mut s);
+            advect_momentum(&rows, &geo, 0.01, 1.0 / 960.0, &mut in_rows, None, &mut s);
         }
         rows.to_grid(&in_rows, &mut u);
         let change = energy(&u) / e0 - 1.0;
@@ -843,6 +987,7 @@ mod tests {
                     0.01,
                     1.0 / 60.0,
                     &mut u,
+                    None,
                     &mut AdvectionScratch::default(),
                 );
                 crate::avx2::set_portable_only(false);
@@ -887,6 +1032,186 @@ mod tests {
                     1 + k / face,
                     k % face
                 );
+            }
+        }
+    }
+
+    /// A rough field on a rotation at n = `n`, in the face rows (`seed` picks the roughness).
+    fn rough_rows(rows: &FaceRows, grid: &CubeSphere, seed: usize) -> Vec<f64> {
+        let field: Vec<f64> = grid
+            .edges()
+            .iter()
+            .enumerate()
+            .map(|(e, ed)| {
+                (DVec3::Z * 0.05).cross(ed.midpoint).dot(ed.normal)
+                    + ((e * seed) % 1000) as f64 * 1e-5
+            })
+            .collect();
+        let mut u = Vec::new();
+        rows.to_rows(&field, &mut u);
+        u
+    }
+
+    /// A stage's scratch, its border vorticity that of `src`, and the vorticity scale for
+    /// a radius of 1 cm.
+    fn stage_work(rows: &FaceRows, src: &[f64]) -> (StageWork, Vec<f64>) {
+        let scale: Vec<f64> = rows.vertex_area.iter().map(|a| 1.0 / (a * 0.01)).collect();
+        let mut w = StageWork::default();
+        w.prepare(rows);
+        rows.seam_circulation(src, &mut w.vorticity, &scale, |z, ia| z * ia);
+        (w, scale)
+    }
+
+    /// A stage that moves the edges where they are (its source its destination) gives
+    /// the bits of one that reads them apart, and so does one over the faces in reverse
+    /// order, or one that reads its starting velocities in the grid's numbering, the kept
+    /// border vorticity too: no row reads an edge that a row before it has moved, and a
+    /// row's run through its right border copy leaves it as it was. At n = 5 and 16.
+    #[test]
+    fn a_stage_in_place_or_in_reverse_is_the_stage_apart() {
+        for n in [5, 16] {
+            let grid = CubeSphere::new(n);
+            let rows = FaceRows::new(&grid);
+            let geo = AdvectionGeometry::new(&grid, &rows);
+            let (src, u0) = (
+                rough_rows(&rows, &grid, 7919),
+                rough_rows(&rows, &grid, 104_729),
+            );
+            let mut u0_grid = vec![0.0; grid.edges().len()];
+            rows.to_grid(&u0, &mut u0_grid);
+            let step = |u: f64, u0: f64, r: f64| 0.75 * u0 + 0.25 * (u + 0.01 * r);
+            let run = |in_place: bool, reverse: bool, from_grid: bool| {
+                let (mut w, scale) = stage_work(&rows, &src);
+                let on = Stage {
+                    rows: &rows,
+                    geo: &geo,
+                    scale: &scale,
+                };
+                let mut dst = if in_place {
+                    src.clone()
+                } else {
+                    vec![0.0; src.len()]
+                };
+                let from = (!in_place).then_some(&src[..]);
+                let start = if from_grid {
+                    Start::Grid(&u0_grid)
+                } else {
+                    Start::Rows(&u0)
+                };
+                on.stage(from, &mut dst, start, &mut w, (true, reverse), step);
+                (dst, w.vorticity)
+            };
+            let apart = run(false, false, false);
+            assert_ne!(apart.0, src, "n {n}: nothing moved");
+            let cases = [(true, false), (false, true), (true, true)];
+            let cases = cases.map(|(a, b)| (a, b, false)).into_iter();
+            for (in_place, reverse, from_grid) in cases.chain([(true, true, true)]) {
+                let (dst, vorticity) = run(in_place, reverse, from_grid);
+                let what = format!(
+                    "n {n}, in place {in_place}, reverse {reverse}, from the grid {from_grid}"
+                );
+                for (name, got, want) in
+                    [("edges", dst, &apart.0), ("vorticity", vorticity, &apart.1)]
+                {
+                    let differ = got
+                        .iter()
+                        .zip(want)
+                        .filter(|(a, b)| a.to_bits() != b.to_bits());
+                    assert_eq!(differ.count(), 0, "{what}: {name} differ");
+                }
+            }
+        }
+    }
+
+    /// The vertex rows a stage takes are the whole grid's circulation's rows, bit for bit,
+    /// the faces' border vertices' from the kept border vorticity: at n = 5 and 16.
+    #[test]
+    fn a_stages_vertex_rows_are_the_whole_grids() {
+        for n in [5, 16] {
+            let grid = CubeSphere::new(n);
+            let rows = FaceRows::new(&grid);
+            let geo = AdvectionGeometry::new(&grid, &rows);
+            let u = rough_rows(&rows, &grid, 7919);
+            let (w, scale) = stage_work(&rows, &u);
+            let mut want = Vec::new();
+            rows.circulation(&u, &mut want, &scale, |z, ia| z * ia);
+            let on = Stage {
+                rows: &rows,
+                geo: &geo,
+                scale: &scale,
+            };
+            let mut row = vec![0.0; n + 1];
+            for f in 0..6 {
+                for j in 0..=n {
+                    on.vertex_row(&u, &w.vorticity, f, j, &mut row);
+                    let want = &want[rows.vertex_at(f, 0, j)..][..n + 1];
+                    let same = row
+                        .iter()
+                        .zip(want)
+                        .all(|(a, b)| a.to_bits() == b.to_bits());
+                    assert!(same, "n {n}, face {f}, row {j}: {row:?} against {want:?}");
+                }
+            }
+        }
+    }
+
+    /// Each edge on the faces' borders reads, for each of its cells, the term that cell's
+    /// row kept for the edge's side ([`keep_border_rates`], [`border_slot`]): at n = 1, 5
+    /// and 16.
+    #[test]
+    fn each_seam_edge_reads_its_cells_kept_terms() {
+        for n in [1, 5, 16] {
+            let grid = CubeSphere::new(n);
+            let rows = FaceRows::new(&grid);
+            let geo = AdvectionGeometry::new(&grid, &rows);
+            // A term that names its cell and side.
+            let term = |c: usize, side: usize| (4 * c + side) as f64;
+            let mut border = vec![f64::NAN; 6 * 4 * n];
+            for f in 0..6 {
+                for y in 0..n {
+                    let c = (f * n + y) * n;
+                    let rate: [Vec<f64>; 4] =
+                        std::array::from_fn(|side| (0..n).map(|x| term(c + x, side)).collect());
+                    keep_border_rates(&mut border[f * 4 * n..][..4 * n], &rate, n, y);
+                }
+            }
+            for (e, terms) in rows.seam_edges.iter().zip(&geo.seams) {
+                for ((c, side, _), slot) in e.cells.into_iter().zip(terms.slots) {
+                    let got = border[slot as usize];
+                    let want = term(c as usize, side as usize);
+                    assert_eq!(got, want, "n {n}: cell {c}, side {side:?}");
+                }
+            }
+        }
+    }
+
+    /// The advection that reads its starting velocities in the grid's numbering (every
+    /// stage in place) gives the bits of the one through the stage buffer: one sub-step
+    /// and (on a small sphere) several, at n = 2, 5 and 16.
+    #[test]
+    fn the_advection_from_the_grids_numbering_is_the_advection_through_a_buffer() {
+        for n in [2, 5, 16] {
+            let grid = CubeSphere::new(n);
+            let rows = FaceRows::new(&grid);
+            let geo = AdvectionGeometry::new(&grid, &rows);
+            let start = rough_rows(&rows, &grid, 7919);
+            let mut start_grid = vec![0.0; grid.edges().len()];
+            rows.to_grid(&start, &mut start_grid);
+            for radius in [1.0, 1e-4] {
+                let run = |from_grid: bool| {
+                    let mut u = start.clone();
+                    let g = from_grid.then_some(&start_grid[..]);
+                    let s = &mut AdvectionScratch::default();
+                    advect_momentum(&rows, &geo, radius, 1.0 / 60.0, &mut u, g, s);
+                    u
+                };
+                let (through, from_grid) = (run(false), run(true));
+                assert_ne!(through, start, "n {n}, radius {radius}: nothing moved");
+                let differ = through
+                    .iter()
+                    .zip(&from_grid)
+                    .filter(|(a, b)| a.to_bits() != b.to_bits());
+                assert_eq!(differ.count(), 0, "n {n}, radius {radius}: edges differ");
             }
         }
     }

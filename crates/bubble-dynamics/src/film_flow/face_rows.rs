@@ -233,7 +233,7 @@ impl FaceRows {
     pub(crate) fn to_rows(&self, grid: &[f64], rows: &mut Vec<f64>) {
         // Every entry is written: the buffer needs its length, not a fill.
         rows.resize(self.edge.len(), 0.0);
-        self.for_each_inner_run(|local, at| {
+        self.for_each_inner_run(face_order(false), |local, at| {
             rows[local.clone()].copy_from_slice(&grid[at..at + local.len()]);
         });
         for &k in &self.border_edges {
@@ -243,9 +243,10 @@ impl FaceRows {
     }
 
     /// The rows' edge values back into the grid's numbering and orientation (a border
-    /// edge's two copies agree: its first is taken).
+    /// edge's two copies agree: its first is taken), the faces in reverse order
+    /// ([`face_order`]: the viscous step's last stage ends at face 5).
     pub(crate) fn to_grid(&self, rows: &[f64], grid: &mut [f64]) {
-        self.for_each_inner_run(|local, at| {
+        self.for_each_inner_run(face_order(true), |local, at| {
             grid[at..at + local.len()].copy_from_slice(&rows[local]);
         });
         for e in &self.seam_edges {
@@ -255,17 +256,21 @@ impl FaceRows {
     }
 
     /// `run(local, at)` for each run of inner local edges (a row of a face's X-edges, or
-    /// a row of its Y-edges) and the grid edge its first is: the grid numbers a face's
-    /// inner edges in the same rows, unflipped ([`FaceLayout`]). A row is
-    /// under 2 KiB up to n = 256, which `memcpy` copies with vector moves (`rep movsb`
-    /// above that).
+    /// a row of its Y-edges) and the grid edge its first is, face by face in the order
+    /// `faces`: the grid numbers a face's inner edges in the same rows, unflipped
+    /// ([`FaceLayout`]). A row is under 2 KiB up to n = 256, which `memcpy` copies with
+    /// vector moves (`rep movsb` above that).
     #[inline(always)]
-    fn for_each_inner_run(&self, mut run: impl FnMut(std::ops::Range<usize>, usize)) {
+    fn for_each_inner_run(
+        &self,
+        faces: impl Iterator<Item = usize>,
+        mut run: impl FnMut(std::ops::Range<usize>, usize),
+    ) {
         let (n, layout) = (self.n, FaceLayout { n: self.n });
         if n < 2 {
             return; // no inner edges
         }
-        for f in 0..6 {
+        for f in faces {
             for y in 0..n {
                 let k = self.x_edge(f, 1, y);
                 run(k..k + n - 1, layout.x_edge_of_cell(f * n * n + y * n + 1));
@@ -407,7 +412,7 @@ impl FaceRows {
             rows.edge.iter().all(|&e| e != u32::MAX),
             "a local edge unset"
         );
-        rows.for_each_inner_run(|local, at| {
+        rows.for_each_inner_run(face_order(false), |local, at| {
             for (k, e) in local.zip(at..) {
                 assert_eq!(
                     rows.edge[k] as usize, e,
@@ -465,12 +470,10 @@ impl FaceRows {
     /// The circulation `Σ ±u d` about every local vertex of the local edge velocities
     /// `u`, each then finished by `finish(circulation, scale)` with the vertex's entry of
     /// `scale` (per local vertex of face 0, which every face reads, as it does
-    /// [`Self::dual_length`]), into `out`.
-    ///
-    /// About an inner vertex `(i, j)` the grid's edge order is X-edge `(i, j − 1)`,
-    /// Y-edges `(i − 1, j)` and `(i, j)`, X-edge `(i, j)`: the first and third run into
-    /// the vertex's tail end (`−u d`), the others into its head (`+u d`).
-    #[inline(always)]
+    /// [`Self::dual_length`]), into `out`: the inner rows' as the passes take them
+    /// ([`Self::face_circulation_row`], each row as a pass reaches it), then the borders'
+    /// ([`Self::seam_circulation`]). The tests' whole-grid reference.
+    #[cfg(test)]
     pub(crate) fn circulation(
         &self,
         u: &[f64],
@@ -479,51 +482,60 @@ impl FaceRows {
         finish: impl Fn(f64, f64) -> f64,
     ) {
         out.resize(self.vertices(), 0.0);
+        let (n, epf, vpf) = (self.n, self.edges_per_face(), self.vertices_per_face());
         for f in 0..6 {
-            for j in 1..self.n {
-                self.circulation_row(u, f, j, out, scale, &finish);
+            for j in 1..n {
+                let start = self.vertex_at(0, 0, j);
+                let row = &mut out[f * vpf + start..][..n];
+                let u = &u[f * epf..][..epf];
+                self.face_circulation_row(u, j, row, &scale[start..start + n], &finish);
             }
         }
         self.seam_circulation(u, out, scale, finish);
     }
 
-    /// [`Self::circulation`] of row `j` (`1 ≤ j < n`) of face `f`'s inner vertices: it
-    /// reads X-edges `(0..n, j − 1)` and `(0..n, j)` and Y-edges `(−1..n, j)`. The row
-    /// starts at vertex `(0, j)`, on the border: `n` vertices vectorise without a scalar
-    /// tail where the `n − 1` inner ones left three. That one's value, from the Y-edge
-    /// before the row's first, is junk until [`Self::seam_circulation`] overwrites it.
+    /// The circulation `Σ ±u d` about row `j` (`1 ≤ j < n`) of one face's inner vertices,
+    /// from its local edges `u`, each finished by `finish(circulation, scale)` with the
+    /// vertex's entry of `scale` (the row's, from vertex `(0, j)`, per local vertex of
+    /// face 0, which every face reads, as it does [`Self::dual_length`]), into `row` (`n`
+    /// long). It reads X-edges `(0..n, j − 1)` and `(0..n, j)` and Y-edges
+    /// `(−1..n, j)`. About an inner vertex `(i, j)` the grid's edge order is X-edge
+    /// `(i, j − 1)`, Y-edges `(i − 1, j)` and `(i, j)`, X-edge `(i, j)`: the first and
+    /// third run into the vertex's tail end (`−u d`), the others into its head (`+u d`).
+    /// The row starts at vertex `(0, j)`, on the border: `n` vertices vectorise without a
+    /// scalar tail where the `n − 1` inner ones left three. That one's value, from the
+    /// Y-edge before the row's first, is junk: the caller takes the border's from
+    /// [`Self::seam_circulation`].
     #[inline(always)]
-    pub(crate) fn circulation_row(
+    pub(crate) fn face_circulation_row(
         &self,
         u: &[f64],
-        f: usize,
         j: usize,
-        out: &mut [f64],
+        row: &mut [f64],
         scale: &[f64],
         finish: impl Fn(f64, f64) -> f64,
     ) {
         let (n, d) = (self.n, &self.dual_length);
-        // The rows of face 0's constants ([`FaceRows`]), and of face `f`'s velocities.
+        // The rows of face 0's constants ([`FaceRows`]), and of the face's velocities.
         let below = self.x_edge(0, 0, j - 1)..self.x_edge(0, n, j - 1);
         let left = self.y_edge(0, 0, j) - 1..self.y_edge(0, n - 1, j);
         let right = self.y_edge(0, 0, j)..self.y_edge(0, n, j);
         let above = self.x_edge(0, 0, j)..self.x_edge(0, n, j);
-        let u = &u[f * self.edges_per_face()..];
         let (ub, db) = (&u[below.clone()], &d[below]);
         let (ul, dl) = (&u[left.clone()], &d[left]);
         let (ur, dr) = (&u[right.clone()], &d[right]);
         let (ua, da) = (&u[above.clone()], &d[above]);
-        let start = self.vertex_at(0, 0, j);
-        let row = &mut out[f * self.vertices_per_face() + start..][..n];
-        let scale = &scale[start..start + n];
+        let (row, scale) = (&mut row[..n], &scale[..n]);
         for i in 0..n {
             let z = 0.0 - ub[i] * db[i] + ul[i] * dl[i] - ur[i] * dr[i] + ua[i] * da[i];
             row[i] = finish(z, scale[i]);
         }
     }
 
-    /// [`Self::circulation`] of the vertices on the faces' borders, into each copy: one
-    /// value, finished with the scale of its first copy's place in face 0.
+    /// The circulation of the vertices on the faces' borders, finished as
+    /// [`Self::face_circulation_row`] finishes an inner row's, into each copy (of `out`,
+    /// per local vertex): one value, finished with the scale of its first copy's place in
+    /// face 0.
     #[inline(always)]
     pub(crate) fn seam_circulation(
         &self,
@@ -577,6 +589,15 @@ fn share_border_values(n: usize, values: &mut [f64]) {
             values[place] = value;
         }
     }
+}
+
+/// The six faces, in order or in reverse (`reverse`). The momentum's passes over the
+/// faces alternate directions, so that each starts on the faces the pass before ended on,
+/// whose rows are still in the core's caches (at n = 64 a face's edge rows are 66 KB, a
+/// pass's whole stream several times the 1 MB L2); each face's values are the same in
+/// either order.
+pub(crate) fn face_order(reverse: bool) -> impl Iterator<Item = usize> {
+    (0..6).map(move |f| if reverse { 5 - f } else { f })
 }
 
 /// Face `f`'s axes: its major axis, its `s` axis and its `t` axis ([`FACE_BASES`]), each

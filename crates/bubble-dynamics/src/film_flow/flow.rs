@@ -413,7 +413,16 @@ impl FilmFlow {
         // From the step's start (`step` swapped it aside: `u_m_per_s` is stale until the
         // rows are written back below).
         self.rows.to_rows(&s.u_start, u);
-        advect_momentum(&self.rows, &self.advection, r, dt_s, u, &mut s.advect);
+        let start = Some(&s.u_start[..]);
+        advect_momentum(
+            &self.rows,
+            &self.advection,
+            r,
+            dt_s,
+            u,
+            start,
+            &mut s.advect,
+        );
         let nu = self.params.viscosity_pa_s / self.params.density_kg_per_m3;
         let g = forcing.g_eff_m_per_s2;
         match self.params.gradient {
@@ -431,8 +440,16 @@ impl FilmFlow {
                 }
                 if nu > 0.0 {
                     self.viscous_step(u, &mut s.viscous, nu, dt_s);
+                    // Into the viscous stage buffer, whose lines its last stage read (L2 has
+                    // many still), which then holds the grid's velocities; the grid's old
+                    // buffer is the next step's stage buffer.
+                    let out = &mut s.viscous.stage;
+                    out.truncate(self.u_m_per_s.len());
+                    self.rows.to_grid(u, out);
+                    std::mem::swap(out, &mut self.u_m_per_s);
+                } else {
+                    self.rows.to_grid(u, &mut self.u_m_per_s);
                 }
-                self.rows.to_grid(u, &mut self.u_m_per_s);
             }
             FilmGradient::Normal => {
                 if nu > 0.0 {

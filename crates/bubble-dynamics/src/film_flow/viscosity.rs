@@ -10,7 +10,7 @@
 
 use crate::avx2::with_avx2;
 
-use super::face_rows::FaceRows;
+use super::face_rows::{FaceRows, face_order};
 use super::flow::FilmFlow;
 use super::grid::CubeSphere;
 
@@ -21,13 +21,33 @@ const EULER_RATE_LIMIT: f64 = 1.5;
 /// Buffers of the viscous step, reused across steps.
 #[derive(Clone, Debug, Default)]
 pub(super) struct ViscousScratch {
-    /// The stage before the one under way, in the face rows ([`FaceRows`]), m/s.
+    /// The stage before the one under way, in the face rows ([`FaceRows`]), m/s. Between
+    /// steps, a buffer of the grid's (`FilmFlow::momentum_explicit` copies the rows back
+    /// into it and swaps it with the grid's velocities' buffer).
     pub(super) stage: Vec<f64>,
-    /// Per local vertex: the vorticity on the unit sphere (m/s per rad).
+    /// Per local vertex: the vorticity on the unit sphere (m/s per rad), of the vertices
+    /// on the faces' borders only (every copy); the inner ones are taken row by row into
+    /// [`Self::window`].
     vorticity: Vec<f64>,
     /// Per cell, in the padded layout (`FaceRows::padded_cell`): the divergence on the
-    /// unit sphere (m/s per rad), the halo holding the cells across the faces' borders.
+    /// unit sphere (m/s per rad) of the cells on the faces' borders, and in the halo of
+    /// the cells across them; the inner ones are taken row by row into [`Self::window`].
     divergence: Vec<f64>,
+    /// The rows of vertices and cells a face's edge rows read ([`Window`]).
+    window: Window,
+}
+
+/// The vorticity and divergence rows that one face's edge rows under way read: each
+/// taken just before the first edge row that reads it, from edges that have not moved yet,
+/// so that a stage reads each edge once, where whole-grid passes of vorticity,
+/// divergence and update read the velocities three times and wrote and read 0.4 MB of
+/// fields besides (at n = 64, beyond the core's 1 MB L2 with the velocities).
+#[derive(Clone, Debug, Default)]
+struct Window {
+    /// Vertex rows `j` at `j mod 2`, `n + 1` each.
+    vertex: [Vec<f64>; 2],
+    /// Padded cell rows `p` at `p mod 2`, `n + 2` each (the halo at both ends).
+    cell: [Vec<f64>; 2],
 }
 
 impl FilmFlow {
@@ -46,25 +66,34 @@ impl FilmFlow {
         let stages = legendre_stages((dt_s * rate / EULER_RATE_LIMIT).ceil().max(1.0));
         let w1 = 2.0 / f64::from(stages * stages + stages);
         // Y₁ = Y₀ + w₁ dt M(Y₀), with Y₀ = u. The first stage reads no stage before last
-        // (it only writes Y₀ there), so `v.stage` needs its length, not a copy of u.
+        // (it only writes Y₀ there, where a stage follows), so `v.stage` needs its length,
+        // not a copy of u; a lone stage touches it not at all.
         v.stage.resize(u.len(), 0.0);
         with_avx2(
             #[inline(always)]
             || {
-                self.viscous_stage(u, v, nu_m2_per_s, w1 * dt_s, 1.0, 0.0);
+                // The stages' faces in alternate directions, the first in reverse
+                // ([`face_order`]: the gravity's pass before ends at face 5).
+                let order = (stages == 1, true);
+                self.viscous_stage(u, v, nu_m2_per_s, w1 * dt_s, (1.0, 0.0), order);
                 for j in 2..=stages {
                     // Yⱼ = μⱼ Yⱼ₋₁ + νⱼ Yⱼ₋₂ + μⱼ w₁ dt M(Yⱼ₋₁), μⱼ = (2j − 1)/j,
                     // νⱼ = (1 − j)/j.
+                    let order = (j == stages, j % 2 == 1);
                     let j = f64::from(j);
                     let mu = (2.0 * j - 1.0) / j;
-                    self.viscous_stage(u, v, nu_m2_per_s, mu * w1 * dt_s, mu, (1.0 - j) / j);
+                    let weights = (mu, (1.0 - j) / j);
+                    self.viscous_stage(u, v, nu_m2_per_s, mu * w1 * dt_s, weights, order);
                 }
             },
         );
     }
 
     /// One stage on the rows: `u ← mu·u + nu_prev·stage + dt_s·M(u)` with the stage
-    /// before last in `v.stage`, which then holds the `u` this stage started from.
+    /// before last in `v.stage` (read only where `nu_prev` is not 0), which then holds the
+    /// `u` this stage started from, unless the stage is the `last` (which no stage reads:
+    /// 0.4 MB written and, with the portable blend's select, read a step at n = 64). The
+    /// faces in reverse order where `reverse` ([`face_order`]).
     ///
     /// Every value is the grid-numbered pass's to rounding (the grid's constants are face
     /// 0's, [`FaceRows`]), in the rows' orientation (module `face_rows`): each edge's
@@ -79,12 +108,11 @@ impl FilmFlow {
         v: &mut ViscousScratch,
         nu: f64,
         dt_s: f64,
-        mu: f64,
-        nu_prev: f64,
+        (mu, nu_prev): (f64, f64),
+        (last, reverse): (bool, bool),
     ) {
         let rows = &self.rows;
-        vorticity_and_divergence(&self.grid, rows, u, v);
-        let (vorticity, divergence) = (&v.vorticity, &v.divergence);
+        border_fields(&self.grid, rows, u, v);
         // Vorticity and divergence per R (of the unit sphere's), and each difference of
         // them per R again: every term of the stress carries 1/R², taken once here.
         let r = self.params.radius_m;
@@ -99,14 +127,30 @@ impl FilmFlow {
             rows.vertices_per_face(),
             rows.padded_cells_per_face(),
         );
-        // Every face reads face 0's metric ([`FaceRows`] says why).
-        let metric = (&rows.inverse_length[..], &rows.inverse_dual_length[..]);
-        let faces = u.chunks_exact_mut(epf).zip(v.stage.chunks_exact_mut(epf));
-        let fields = vorticity
-            .chunks_exact(vpf)
-            .zip(divergence.chunks_exact(cpf));
-        for ((u, stage), fields) in faces.zip(fields) {
-            blend.face(n, u, stage, metric, fields);
+        // Face 0's cells' inverse areas, which every face reads ([`FaceRows`] says why).
+        let ia = &self.grid.inverse_areas_per_sr()[..n * n];
+        let ViscousScratch {
+            stage,
+            vorticity,
+            divergence,
+            window,
+        } = v;
+        window.prepare(n);
+        // Each case its own loops: a test of the case per edge cost the reads and writes
+        // it was to spare.
+        for f in face_order(reverse) {
+            let (u, stage) = (&mut u[f * epf..][..epf], &mut stage[f * epf..][..epf]);
+            let face = Face {
+                rows,
+                inverse_areas: ia,
+                borders: (&vorticity[f * vpf..][..vpf], &divergence[f * cpf..][..cpf]),
+            };
+            match (nu_prev != 0.0, !last) {
+                (false, false) => blend.face::<false, false>(face, u, stage, window),
+                (false, true) => blend.face::<false, true>(face, u, stage, window),
+                (true, false) => blend.face::<true, false>(face, u, stage, window),
+                (true, true) => blend.face::<true, true>(face, u, stage, window),
+            }
         }
     }
 }
@@ -124,58 +168,74 @@ struct Blend {
 }
 
 impl Blend {
-    /// One edge, its stage before last `y_prev` replaced by its `u` on entry. The first
-    /// stage (`nu_prev` 0) is a plain forward-Euler step: no blend.
+    /// One edge: the stage before last `y_prev` read where `BLEND` (else the stage, the
+    /// first, is a plain forward-Euler step), and replaced by the edge's `u` on entry where
+    /// `KEEP` (a stage follows).
     #[inline(always)]
-    fn step(self, u: &mut f64, y_prev: &mut f64, curl_curl: f64, grad_div: f64) {
+    fn step<const BLEND: bool, const KEEP: bool>(
+        self,
+        u: &mut f64,
+        y_prev: &mut f64,
+        curl_curl: f64,
+        grad_div: f64,
+    ) {
         let y = *u;
         let change = self.rate * (4.0 * grad_div - curl_curl + 2.0 * y);
-        *u = if self.nu_prev == 0.0 {
-            y + change
-        } else {
+        *u = if BLEND {
             self.mu * y + self.nu_prev * *y_prev + change
+        } else {
+            y + change
         };
-        *y_prev = y;
+        if KEEP {
+            *y_prev = y;
+        }
     }
 
-    /// One face's edges (`u` and `y_prev` its local edges, the metric
-    /// `[1/length, 1/dual length]` face 0's, `fields` its vertices' vorticities and its
-    /// padded cells' divergences), row by row. Every row of edges whole, the faces'
-    /// borders' too: their cells across the border are in the divergence's halo. The rows
-    /// come from chunk iterators over the face, where slicing each from the whole arrays
-    /// cost bounds checks and reloads of every base each row.
+    /// One face's edges (`u` and `y_prev` its local edges), row by row: Y-edge row `y`
+    /// reads vertex row `y` and padded cell rows `y` and `y + 1`, X-edge row `y` vertex
+    /// rows `y` (heads) and `y + 1` (tails) and padded cell row `y + 1`. Vertex row
+    /// `y + 1` and padded cell row `y + 1` are taken into `window` before those edge rows
+    /// move, from edges that have not moved yet: vertex row `j` reads X-edge rows `j − 1`
+    /// and `j` and Y-edge row `j`, padded cell row `p` X-edge row `p − 1` and Y-edge rows
+    /// `p − 1` and `p`. Every row of edges whole, the faces' borders' too: their cells across
+    /// the border are in the divergence's halo. Every face reads face 0's metric
+    /// `[1/length, 1/dual length]` ([`FaceRows`] says why).
     #[inline(always)]
-    fn face(
+    fn face<const BLEND: bool, const KEEP: bool>(
         self,
-        n: usize,
+        face: Face,
         u: &mut [f64],
         y_prev: &mut [f64],
-        (il, id): (&[f64], &[f64]),
-        (vorticity, divergence): (&[f64], &[f64]),
+        window: &mut Window,
     ) {
-        let (u_x, u_y) = u.split_at_mut(n * (n + 1));
-        let (y_x, y_y) = y_prev.split_at_mut(n * (n + 1));
-        let ((il_x, il_y), (id_x, id_y)) = (il.split_at(n * (n + 1)), id.split_at(n * (n + 1)));
-        // X-edge (i, y): tail the vertex (i, y + 1), head (i, y); from cell (i − 1, y)
-        // into (i, y) (padded row y + 1).
-        let (w, p) = (n + 1, n + 2);
-        let edges = u_x.chunks_exact_mut(w).zip(y_x.chunks_exact_mut(w));
-        let metric = il_x.chunks_exact(w).zip(id_x.chunks_exact(w));
-        let ends = vorticity
-            .chunks_exact(w)
-            .zip(vorticity[w..].chunks_exact(w));
-        let cells = divergence[p..].chunks_exact(p);
-        for (((u, y_prev), (il, id)), ((head, tail), d)) in edges.zip(metric).zip(ends.zip(cells)) {
-            self.row(u, y_prev, [head, tail], [&d[1..], d], [il, id]);
-        }
-        // Y-edge (x, j): tail the vertex (x, j), head (x + 1, j); from cell (x, j − 1)
-        // (padded row j) into (x, j).
-        let edges = u_y.chunks_exact_mut(n).zip(y_y.chunks_exact_mut(n));
-        let metric = il_y.chunks_exact(n).zip(id_y.chunks_exact(n));
-        let ends = vorticity.chunks_exact(w);
-        let cells = divergence[1..].chunks(p).zip(divergence[p + 1..].chunks(p));
-        for (((u, y_prev), (il, id)), (z, (from, into))) in edges.zip(metric).zip(ends.zip(cells)) {
-            self.row(u, y_prev, [&z[1..], z], [into, from], [il, id]);
+        let rows = face.rows;
+        let (n, w, xs) = (rows.n, rows.n + 1, rows.n * (rows.n + 1));
+        let (il, id) = (&rows.inverse_length[..], &rows.inverse_dual_length[..]);
+        window.take_vertex_row(face, u, 0);
+        window.take_cell_row(face, u, 0);
+        for y in 0..=n {
+            if y < n {
+                window.take_vertex_row(face, u, y + 1);
+            }
+            window.take_cell_row(face, u, y + 1);
+            let (u_x, u_y) = u.split_at_mut(xs);
+            let (p_x, p_y) = y_prev.split_at_mut(xs);
+            let z = &window.vertex[y % 2];
+            let (from, into) = (&window.cell[y % 2], &window.cell[(y + 1) % 2]);
+            // Y-edge (x, y): tail the vertex (x, y), head (x + 1, y); from cell (x, y − 1)
+            // (padded row y) into (x, y).
+            let metric = [&il[xs + y * n..][..n], &id[xs + y * n..][..n]];
+            let (u, p) = (&mut u_y[y * n..][..n], &mut p_y[y * n..][..n]);
+            self.row::<BLEND, KEEP>(u, p, [&z[1..], z], [&into[1..], &from[1..]], metric);
+            if y == n {
+                break;
+            }
+            // X-edge (i, y): tail the vertex (i, y + 1), head (i, y); from cell (i − 1, y)
+            // into (i, y) (padded row y + 1).
+            let tail = &window.vertex[(y + 1) % 2];
+            let metric = [&il[y * w..][..w], &id[y * w..][..w]];
+            let (u, p) = (&mut u_x[y * w..][..w], &mut p_x[y * w..][..w]);
+            self.row::<BLEND, KEEP>(u, p, [z, tail], [&into[1..], into], metric);
         }
     }
 
@@ -184,7 +244,7 @@ impl Blend {
     /// argument of its own: the compiler then knows the outputs overlap no input, where
     /// slices of the scratch's vectors cost it a run-time test of each pair every row.
     #[inline(always)]
-    fn row(
+    fn row<const BLEND: bool, const KEEP: bool>(
         self,
         u: &mut [f64],
         y_prev: &mut [f64],
@@ -199,59 +259,131 @@ impl Blend {
         for i in 0..len {
             let curl_curl = (head[i] - tail[i]) * il[i];
             let grad_div = (into[i] - from[i]) * id[i];
-            self.step(&mut u[i], &mut y_prev[i], curl_curl, grad_div);
+            self.step::<BLEND, KEEP>(&mut u[i], &mut y_prev[i], curl_curl, grad_div);
         }
     }
 }
 
-/// The vorticity at each local vertex into `v.vorticity` and the divergence of each cell
-/// into `v.divergence` (its halo too), of the edge velocities `u` (in the rows), on the unit sphere
-/// (m/s per rad). A cell's divergence sums its edges' `±u l` in the local order
+/// What one face's stage reads besides its edges.
+#[derive(Clone, Copy)]
+struct Face<'a> {
+    rows: &'a FaceRows,
+    /// Face 0's cells' inverse areas, per sr, which every face reads.
+    inverse_areas: &'a [f64],
+    /// The face's vertices' vorticities and padded cells' divergences on its borders and
+    /// halo ([`ViscousScratch::vorticity`], [`ViscousScratch::divergence`]).
+    borders: (&'a [f64], &'a [f64]),
+}
+
+impl Window {
+    /// Gives every row its length for `n` cells a face.
+    fn prepare(&mut self, n: usize) {
+        self.vertex.iter_mut().for_each(|r| r.resize(n + 1, 0.0));
+        self.cell.iter_mut().for_each(|r| r.resize(n + 2, 0.0));
+    }
+
+    /// Vertex row `j` of the face (local edges `u`) into `vertex[j mod 2]`: an inner
+    /// row's circulation, its ends (on the face's borders) and the border rows `0` and
+    /// `n` from the face's border vorticities.
+    #[inline(always)]
+    fn take_vertex_row(&mut self, face: Face, u: &[f64], j: usize) {
+        let (rows, border) = (face.rows, face.borders.0);
+        let (n, w) = (rows.n, rows.n + 1);
+        let out = &mut self.vertex[j % 2];
+        let border = &border[j * w..][..w];
+        if j == 0 || j == n {
+            out.copy_from_slice(border);
+            return;
+        }
+        let scale = &rows.vertex_inverse_area[j * w..][..n];
+        rows.face_circulation_row(u, j, &mut out[..n], scale, |z, ia| z * ia);
+        (out[0], out[n]) = (border[0], border[n]);
+    }
+
+    /// Padded cell row `p` of the face (local edges `u`) into `cell[p mod 2]`: cell row
+    /// `p − 1`'s divergences, the halo at its ends and the halo rows `0` and `n + 1` from
+    /// the face's border divergences.
+    #[inline(always)]
+    fn take_cell_row(&mut self, face: Face, u: &[f64], p: usize) {
+        let (rows, border) = (face.rows, face.borders.1);
+        let (n, pw) = (rows.n, rows.n + 2);
+        let out = &mut self.cell[p % 2];
+        let border = &border[p * pw..][..pw];
+        if p == 0 || p == n + 1 {
+            out.copy_from_slice(border);
+            return;
+        }
+        divergence_cells(rows, u, face.inverse_areas, p - 1, 0, &mut out[1..=n]);
+        (out[0], out[n + 1]) = (border[0], border[n + 1]);
+    }
+}
+
+/// The vorticity at the vertices on the faces' borders into `v.vorticity` (each copy),
+/// and the divergence of the cells on the faces' borders into `v.divergence`, its halo
+/// too, of the edge velocities `u` (in the rows), on the unit sphere (m/s per rad): what
+/// a face's rows read of the other faces' edges, taken before any face's edges move. A
+/// cell's divergence sums its edges' `±u l` in the local order
 /// ([`SIDES`](super::face_rows::SIDES)), `+` where the local normal points out of it (its
 /// right and top sides): the faces' border cells whose edges the grid numbers otherwise
 /// too ([`FaceRows::irregular_cells`]), which taken apart in the grid's order cost a tenth
 /// of the viscous step, for sums that differ only in rounding.
 #[inline(always)]
-fn vorticity_and_divergence(grid: &CubeSphere, rows: &FaceRows, u: &[f64], v: &mut ViscousScratch) {
-    rows.circulation(u, &mut v.vorticity, &rows.vertex_inverse_area, |z, ia| {
-        z * ia
-    });
+fn border_fields(grid: &CubeSphere, rows: &FaceRows, u: &[f64], v: &mut ViscousScratch) {
+    let vorticity = &mut v.vorticity;
+    vorticity.resize(rows.vertices(), 0.0);
+    rows.seam_circulation(u, vorticity, &rows.vertex_inverse_area, |z, ia| z * ia);
     let n = rows.n;
     let divergence = &mut v.divergence;
     divergence.resize(6 * rows.padded_cells_per_face(), 0.0);
-    // Face 0's lengths and cells' inverse areas, which every face reads ([`FaceRows`]
-    // says why; `face_rows::tests::every_faces_constants_are_face_0s` checks the areas
-    // too).
-    let (l, ia) = (&rows.length[..], &grid.inverse_areas_per_sr()[..n * n]);
-    let (epf, cpf) = (rows.edges_per_face(), rows.padded_cells_per_face());
+    // Face 0's cells' inverse areas, which every face reads ([`FaceRows`] says why;
+    // `face_rows::tests::every_faces_constants_are_face_0s` checks them).
+    let ia = &grid.inverse_areas_per_sr()[..n * n];
+    let (epf, cpf, pw) = (rows.edges_per_face(), rows.padded_cells_per_face(), n + 2);
     let faces = u.chunks_exact(epf).zip(divergence.chunks_exact_mut(cpf));
     for (u, out) in faces {
-        divergence_face(n, u, l, ia, out);
+        for y in [0, n - 1] {
+            divergence_cells(rows, u, ia, y, 0, &mut out[(y + 1) * pw + 1..][..n]);
+        }
+        for x in [0, n - 1] {
+            divergence_column(rows, u, ia, x, out);
+        }
     }
     for &[slot, across] in &rows.cell_halo {
         divergence[slot as usize] = divergence[across as usize];
     }
 }
 
-/// One face's divergences into its padded cells `out` (the halo left as it is), from
-/// its local edges' velocities `u`, and face 0's lengths `l` and cells' inverse areas
-/// `ia`, row by row from chunk iterators over the face (slicing each row from the whole
-/// arrays cost bounds checks and reloads of every base each row).
+/// The divergences of cells `(x.., y)` of a face (its local edges `u`) into `out`, as
+/// many as it holds, with face 0's lengths and cells' inverse areas `ia`.
 #[inline(always)]
-fn divergence_face(n: usize, u: &[f64], l: &[f64], ia: &[f64], out: &mut [f64]) {
-    let ((ux, uy), (lx, ly)) = (u.split_at(n * (n + 1)), l.split_at(n * (n + 1)));
-    let x_sides = ux.chunks_exact(n + 1).zip(lx.chunks_exact(n + 1));
-    let bottoms = uy.chunks_exact(n).zip(ly.chunks_exact(n));
-    let tops = uy[n..].chunks_exact(n).zip(ly[n..].chunks_exact(n));
-    let cells = ia.chunks_exact(n).zip(out[n + 3..].chunks_mut(n + 2));
-    for (((x, b), t), (ia, out)) in x_sides.zip(bottoms).zip(tops).zip(cells) {
-        divergence_row(
-            &mut out[..n],
-            [b.0, x.0, &x.0[1..], t.0],
-            [b.1, x.1, &x.1[1..], t.1],
-            ia,
-        );
+fn divergence_cells(rows: &FaceRows, u: &[f64], ia: &[f64], y: usize, x: usize, out: &mut [f64]) {
+    let n = rows.n;
+    let at = (n, x, y);
+    divergence_row(out, sides(u, at), sides(&rows.length, at), &ia[y * n + x..]);
+}
+
+/// The divergences of cells `(x, 1..n − 1)` of a face (its local edges `u`) into its
+/// padded cells `out`, as [`divergence_row`] takes each (the same sum in the same order),
+/// with face 0's lengths and cells' inverse areas `ia`: a column of the face's border
+/// cells, where a call of [`divergence_cells`] a cell cost several times the sum.
+#[inline(always)]
+fn divergence_column(rows: &FaceRows, u: &[f64], ia: &[f64], x: usize, out: &mut [f64]) {
+    let n = rows.n;
+    let ((ux, uy), (lx, ly)) = (u.split_at(n * (n + 1)), rows.length.split_at(n * (n + 1)));
+    for y in 1..n.saturating_sub(1) {
+        let (b, l, t) = (y * n + x, y * (n + 1) + x, (y + 1) * n + x);
+        let d = 0.0 - uy[b] * ly[b] - ux[l] * lx[l] + ux[l + 1] * lx[l + 1] + uy[t] * ly[t];
+        out[(y + 1) * (n + 2) + 1 + x] = d * ia[b];
     }
+}
+
+/// From cell `(x, y)` of a face of `n` cells a side on, its sides' entries of `a` (per
+/// local edge of the face), in [`SIDES`](super::face_rows::SIDES) order.
+#[inline(always)]
+fn sides(a: &[f64], (n, x, y): (usize, usize, usize)) -> [&[f64]; 4] {
+    let (ax, ay) = a.split_at(n * (n + 1));
+    let left = &ax[y * (n + 1) + x..];
+    [&ay[y * n + x..], left, &left[1..], &ay[(y + 1) * n + x..]]
 }
 
 /// A row of cells' divergences into `out`, from their sides' velocities and lengths (in
@@ -341,6 +473,127 @@ mod tests {
         per_edge.map(|(u, (l, d))| u * u * l * d).sum()
     }
 
+    /// A stage's edges against whole-grid passes of the same sums (the vorticity of every
+    /// vertex, the divergence of every cell with its halo, then every edge's update, from
+    /// the velocities the stage starts from), bit for bit: each case of stage (first,
+    /// blended, last), the faces in either order, a rough field at n = 5 and 16. The
+    /// window's rows must be taken before any edge they read moves.
+    #[test]
+    fn a_stage_is_the_whole_grid_passes() {
+        for n in [5, 16] {
+            let grid = Arc::new(CubeSphere::new(n));
+            let hierarchy = Arc::new(Hierarchy::new(&grid));
+            let p = FlowParams {
+                viscosity_pa_s: 0.5,
+                ..FlowParams::water_film(0.01)
+            };
+            let f = FilmFlow::new(grid.clone(), hierarchy, p, |_| 1e-6);
+            let rough = |seed: usize| -> Vec<f64> {
+                let values = (0..grid.edges().len()).map(|e| ((e * seed) % 1000) as f64 * 1e-6);
+                let mut out = Vec::new();
+                f.rows.to_rows(&values.collect::<Vec<_>>(), &mut out);
+                out
+            };
+            let (start, before_last) = (rough(7919), rough(104_729));
+            let nu = p.viscosity_pa_s / p.density_kg_per_m3;
+            for (weights, last) in [
+                ((1.0, 0.0), false),
+                ((1.5, -0.5), false),
+                ((1.5, -0.5), true),
+            ] {
+                let want = whole_grid_stage(&f, &start, &before_last, nu, 0.01, weights, last);
+                for reverse in [false, true] {
+                    let (mut u, mut v) = (start.clone(), ViscousScratch::default());
+                    v.stage = before_last.clone();
+                    f.viscous_stage(&mut u, &mut v, nu, 0.01, weights, (last, reverse));
+                    let got = (u, v.stage);
+                    let what =
+                        format!("n {n}, weights {weights:?}, last {last}, reverse {reverse}");
+                    for (name, got, want) in [("u", &got.0, &want.0), ("stage", &got.1, &want.1)] {
+                        let differ = got
+                            .iter()
+                            .zip(want)
+                            .filter(|(a, b)| a.to_bits() != b.to_bits());
+                        assert_eq!(differ.count(), 0, "{what}: {name} differs");
+                    }
+                }
+            }
+        }
+    }
+
+    /// [`FilmFlow::viscous_stage`] as whole-grid passes: `(u, stage)` after it, from `u`
+    /// and the stage before last `before_last`.
+    fn whole_grid_stage(
+        f: &FilmFlow,
+        u: &[f64],
+        before_last: &[f64],
+        nu: f64,
+        dt_s: f64,
+        (mu, nu_prev): (f64, f64),
+        last: bool,
+    ) -> (Vec<f64>, Vec<f64>) {
+        let (rows, n) = (&*f.rows, f.rows.n);
+        let mut z = Vec::new();
+        rows.circulation(u, &mut z, &rows.vertex_inverse_area, |z, ia| z * ia);
+        let (epf, w) = (rows.edges_per_face(), n + 1);
+        let ia = f.grid.inverse_areas_per_sr();
+        let mut div = vec![0.0; 6 * rows.padded_cells_per_face()];
+        for face in 0..6 {
+            let ue = |k: usize| u[face * epf + k];
+            for y in 0..n {
+                for x in 0..n {
+                    let [b, l, r, t] = [xs_y(n, x, y), y * w + x, y * w + x + 1, xs_y(n, x, y + 1)];
+                    let len = &rows.length;
+                    let d = 0.0 - ue(b) * len[b] - ue(l) * len[l] + ue(r) * len[r] + ue(t) * len[t];
+                    div[rows.padded_cell(face, x + 1, y + 1)] = d * ia[y * n + x];
+                }
+            }
+        }
+        for &[slot, across] in &rows.cell_halo {
+            div[slot as usize] = div[across as usize];
+        }
+        let r = f.params.radius_m;
+        let rate = dt_s * nu / (r * r);
+        let (mut out, mut stage) = (u.to_vec(), before_last.to_vec());
+        for face in 0..6 {
+            let vz = |i: usize, j: usize| z[rows.vertex_at(face, i, j)];
+            let d = |px: usize, py: usize| div[rows.padded_cell(face, px, py)];
+            // Per local edge of the face: [head, tail] vorticities, [into, from] divergences.
+            let mut fields = Vec::with_capacity(epf);
+            for y in 0..n {
+                for i in 0..=n {
+                    fields.push(([vz(i, y), vz(i, y + 1)], [d(i + 1, y + 1), d(i, y + 1)]));
+                }
+            }
+            for j in 0..=n {
+                for x in 0..n {
+                    fields.push(([vz(x + 1, j), vz(x, j)], [d(x + 1, j + 1), d(x + 1, j)]));
+                }
+            }
+            for (k, ([head, tail], [into, from])) in fields.into_iter().enumerate() {
+                let e = face * epf + k;
+                let curl_curl = (head - tail) * rows.inverse_length[k];
+                let grad_div = (into - from) * rows.inverse_dual_length[k];
+                let y = u[e];
+                let change = rate * (4.0 * grad_div - curl_curl + 2.0 * y);
+                out[e] = if nu_prev == 0.0 {
+                    y + change
+                } else {
+                    mu * y + nu_prev * before_last[e] + change
+                };
+                if !last {
+                    stage[e] = y;
+                }
+            }
+        }
+        (out, stage)
+    }
+
+    /// Face 0's local Y-edge `(x, j)` of a grid of `n` cells a face, within the face.
+    fn xs_y(n: usize, x: usize, j: usize) -> usize {
+        n * (n + 1) + j * n + x
+    }
+
     /// The stages keep each edge on the faces' borders the same in both its copies (its
     /// value, or its negation, bit for bit): they read the same shared constants
     /// ([`FaceRows`](super::super::face_rows::FaceRows)). A rough field, at n = 5 and 32.
@@ -399,7 +652,7 @@ mod tests {
             // Plain forward-Euler sub-steps, not through the stage weights under test.
             s.stage.resize(u.len(), 0.0);
             for _ in 0..100 {
-                f.viscous_stage(u, &mut s, nu, dt / 100.0, 1.0, 0.0);
+                f.viscous_stage(u, &mut s, nu, dt / 100.0, (1.0, 0.0), (true, false));
             }
         };
         on_rows(&mut f, &mut euler_steps);
