@@ -179,14 +179,15 @@ pub(super) fn relax_from_zero<T: Real>(layout: &Layout, inv_diag: &[T], r: &[T],
     for ((zi, ri), di) in z[range].iter_mut().zip(r).zip(inv_diag) {
         *zi = *ri * *di;
     }
-    let half = layout.half as u32;
-    for &[halo, source] in &layout.halos[0] {
-        z[halo as usize] = if source < half {
-            z[source as usize]
+    let half = layout.half;
+    // SAFETY: as in `refresh`.
+    for_each_copy(layout, 0, z, |base, halo, source| unsafe {
+        *base.add(halo) = if source < half {
+            *base.add(source)
         } else {
             T::ZERO
         };
-    }
+    });
 }
 
 /// `out = (diag(mass) + L_w) x` (`RESIDUAL` false) or `r − (diag(mass) + L_w) x`
@@ -362,9 +363,11 @@ fn round_run(scale: f64, range: std::ops::Range<usize>, values: &[f64], out: &mu
 /// Copies into the halo cells of colour `c` their sources' values.
 #[inline(always)]
 pub(super) fn refresh<T: Real>(layout: &Layout, c: usize, field: &mut [T]) {
-    for &[halo, source] in &layout.halos[c] {
-        field[halo as usize] = field[source as usize];
-    }
+    // SAFETY: `for_each_copy` passes positions inside the field; a halo cell is never a
+    // source, so the read and the write do not overlap.
+    for_each_copy(layout, c, field, |base, halo, source| unsafe {
+        *base.add(halo) = *base.add(source);
+    });
 }
 
 /// Both colours' halo cells refreshed.
@@ -372,6 +375,36 @@ pub(super) fn refresh<T: Real>(layout: &Layout, c: usize, field: &mut [T]) {
 pub(super) fn refresh_all<T: Real>(layout: &Layout, field: &mut [T]) {
     refresh(layout, 0, field);
     refresh(layout, 1, field);
+}
+
+/// Each copy of colour `c`'s halo runs: `set(field, halo, source)` on the field's
+/// pointer and the copy's positions, every one inside `field`.
+///
+/// Why raw positions: a run walks two constant strides through one array, which safe
+/// slices can only do with a check a copy (the index pairs did two) or a division a run
+/// (`chunks_exact`), and at the coarse levels, where a run is one to eight copies, the
+/// latter costs more than the copies. The layout checked when it was built that every
+/// run stays inside its `len()` ([`Layout::halo_runs`]), so checking `field` against
+/// that length once makes every position of every run valid.
+#[inline(always)]
+fn for_each_copy<T: Copy>(
+    layout: &Layout,
+    c: usize,
+    field: &mut [T],
+    set: impl Fn(*mut T, usize, usize),
+) {
+    let field = &mut field[..layout.len()];
+    let base = field.as_mut_ptr();
+    for run in layout.halo_runs(c) {
+        let (mut halo, mut source) = (run.halo as usize, run.source as usize);
+        let (halo_step, source_step) = (run.halo_step as usize, run.source_step as isize);
+        for _ in 0..run.count {
+            set(base, halo, source);
+            // Past the last copy these may leave the field; they are not used then.
+            halo = halo.wrapping_add(halo_step);
+            source = source.wrapping_add_signed(source_step);
+        }
+    }
 }
 
 /// `coarse` = the sum of each coarse cell's four children in `fine` (the equations are

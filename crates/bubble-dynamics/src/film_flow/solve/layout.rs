@@ -8,6 +8,10 @@
 //! and the residual are then each one loop over contiguous slices (no neighbour
 //! indices, no rim cells taken one by one, no runs to set up), and the restriction and
 //! the coarse correction walk face rows whose children are contiguous too.
+//!
+//! The halo is refreshed by runs ([`HaloRun`]): a face's side's halo cells of one
+//! colour, and their sources along the neighbouring face's side, lie a constant step
+//! apart in the split arrays, so each side and colour is one strided copy loop.
 
 use std::ops::Range;
 
@@ -19,6 +23,46 @@ pub(super) const RIGHT_W: usize = 0;
 /// The one holding each cell's TOP side's weight (and, at the bottom halo row, the rim
 /// cells' BOTTOM seam weights).
 pub(super) const TOP_W: usize = 1;
+
+/// A run of halo copies: `count` halo cells of one colour along one side of a face, at
+/// `halo + i·halo_step` in the split arrays, each taking the value at
+/// `source + i·source_step`.
+///
+/// Why runs: along a face's side the halo cells of one colour are every other padded
+/// cell, and their sources every other cell along the neighbouring face's side, so both
+/// advance by a constant step in the split arrays (a padded step of ±2 along a row,
+/// ±`2·stride` along a column: ±1 or ±`stride` positions in one colour's array). A refresh is then a few tight loops
+/// rather than a list of index pairs, each loaded and bounds-checked per copy.
+///
+/// # Guarantees
+/// - `halo_step ≥ 1` and `count ≥ 1`; every position of the run lies in the split arrays.
+/// - A run's sources all have one colour (a step of 2 padded cells keeps the parity).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct HaloRun {
+    /// The first halo cell's position.
+    pub(super) halo: u32,
+    /// The step between consecutive halo cells' positions.
+    pub(super) halo_step: u32,
+    /// The first source's position.
+    pub(super) source: u32,
+    /// The step between consecutive sources' positions (negative where the neighbouring
+    /// face's side runs the other way).
+    pub(super) source_step: i32,
+    /// The number of copies.
+    pub(super) count: u32,
+}
+
+impl HaloRun {
+    /// The run's copies, `[halo, source]` positions, in order.
+    #[cfg(test)]
+    pub(super) fn copies(&self) -> impl Iterator<Item = [u32; 2]> + '_ {
+        (0..self.count).map(|i| {
+            let halo = self.halo + i * self.halo_step;
+            let source = self.source as i64 + i64::from(i) * i64::from(self.source_step);
+            [halo, source as u32]
+        })
+    }
+}
 
 /// A level's padded, colour-split layout.
 ///
@@ -43,9 +87,10 @@ pub(super) struct Layout {
     /// Each cell's position in the split arrays, in the grid's numbering
     /// (`face·m² + y·m + x`).
     pub(super) position: Vec<u32>,
-    /// Per colour of the halo cell: `(halo, source)` positions of the copies that
-    /// refresh the halo cells of that colour.
-    pub(super) halos: [Vec<[u32; 2]>; 2],
+    /// Per colour of the halo cell: the runs of copies that refresh the halo cells of
+    /// that colour, one a face's side (see [`HaloRun`]); private, as the refresh relies
+    /// on every position in them being inside the level ([`Layout::halo_runs`]).
+    halos: [Vec<HaloRun>; 2],
     /// Per cell in the grid's numbering, the cell across each side.
     pub(super) neighbour: Vec<[u32; 4]>,
 }
@@ -88,8 +133,28 @@ impl Layout {
             let p = layout.index(layout.padded(c));
             layout.position.push(p as u32);
         }
-        layout.halos = layout.halo_copies();
+        layout.halos = layout.runs_of_halo_copies();
+        let len = layout.len() as i64;
+        for run in layout.halos.iter().flatten() {
+            let last = i64::from(run.count) - 1;
+            let halo_end = i64::from(run.halo) + last * i64::from(run.halo_step);
+            let source_end = i64::from(run.source) + last * i64::from(run.source_step);
+            assert!(
+                run.count >= 1 && halo_end < len && (0..len).contains(&source_end),
+                "halo run {run:?} outside a level of length {len}"
+            );
+        }
         layout
+    }
+
+    /// The runs of copies that refresh the halo cells of colour `c`.
+    ///
+    /// # Guarantees
+    /// Every halo and source position of every run is below [`Layout::len`] (checked
+    /// when the layout was built; the kernels index by them unchecked); no halo cell is
+    /// a source.
+    pub(super) fn halo_runs(&self, c: usize) -> &[HaloRun] {
+        &self.halos[c]
     }
 
     /// The layout of the grid `sides` describes.
@@ -193,8 +258,71 @@ impl Layout {
         }
     }
 
-    /// The halo copies by the colour of the halo cell: each rim cell's halo neighbour on
+    /// The halo runs by the colour of the halo cell: along each side of each face, each
+    /// rim cell's halo neighbour across the seam takes that neighbour's value; the
+    /// copies of one colour along one side, in order along it, merged into runs of
+    /// constant steps (one a side and colour, where the seams are regular, as they are:
+    /// a run is only cut where the steps change).
+    fn runs_of_halo_copies(&self) -> [Vec<HaloRun>; 2] {
+        let m = self.m;
+        let step = [-1, 1, -(self.stride as isize), self.stride as isize];
+        let mut runs: [Vec<HaloRun>; 2] = [Vec::new(), Vec::new()];
+        for face in 0..6 {
+            for (k, &step) in step.iter().enumerate() {
+                let mut open: [Option<HaloRun>; 2] = [None, None];
+                for i in 0..m {
+                    // The i-th rim cell along side k.
+                    let (x, y) = match k {
+                        LEFT => (0, i),
+                        RIGHT => (m - 1, i),
+                        BOTTOM => (i, 0),
+                        _ => (i, m - 1),
+                    };
+                    let c = face * m * m + y * m + x;
+                    let halo = (self.padded(c) as isize + step) as usize;
+                    let source = self.padded(self.neighbour[c][k] as usize);
+                    let (halo_at, source_at) = (self.index(halo), self.index(source));
+                    let colour = halo & 1;
+                    match &mut open[colour] {
+                        Some(run) if run.count == 1 && halo_at > run.halo as usize => {
+                            run.halo_step = (halo_at - run.halo as usize) as u32;
+                            run.source_step = (source_at as i64 - i64::from(run.source)) as i32;
+                            run.count = 2;
+                        }
+                        Some(run)
+                            if run.count > 1
+                                && halo_at as i64
+                                    == i64::from(run.halo)
+                                        + i64::from(run.count * run.halo_step)
+                                && source_at as i64
+                                    == i64::from(run.source)
+                                        + i64::from(run.count) * i64::from(run.source_step) =>
+                        {
+                            run.count += 1;
+                        }
+                        slot => {
+                            runs[colour].extend(slot.take());
+                            *slot = Some(HaloRun {
+                                halo: halo_at as u32,
+                                halo_step: 1,
+                                source: source_at as u32,
+                                source_step: 1,
+                                count: 1,
+                            });
+                        }
+                    }
+                }
+                for (colour, run) in open.into_iter().enumerate() {
+                    runs[colour].extend(run);
+                }
+            }
+        }
+        runs
+    }
+
+    /// The halo copies, one by one, by the colour of the halo cell: each rim cell's halo neighbour on
     /// a side across a seam takes that neighbour's value.
+    #[cfg(test)]
     fn halo_copies(&self) -> [Vec<[u32; 2]>; 2] {
         let m = self.m;
         let step = [-1, 1, -(self.stride as isize), self.stride as isize];
@@ -242,7 +370,7 @@ mod tests {
             let mut level = Layout::of_grid(&sides);
             loop {
                 let mut copies = std::collections::HashMap::new();
-                for &[halo, source] in level.halos.iter().flatten() {
+                for [halo, source] in level.halos.iter().flatten().flat_map(HaloRun::copies) {
                     assert!(copies.insert(halo, source).is_none(), "halo {halo} twice");
                 }
                 for (c, &p) in level.position.iter().enumerate() {
@@ -275,6 +403,52 @@ mod tests {
                             }
                         }
                     }
+                }
+                if level.m % 2 == 1 || level.m <= 1 {
+                    break;
+                }
+                level = level.coarser();
+            }
+        }
+    }
+
+    /// The halo runs make exactly the copies that the one-by-one list makes (each halo
+    /// cell once, from the same source, in the same colour's list), on every level of
+    /// the hierarchy's sizes; and a side's copies of one colour make one run, as the
+    /// steps along a seam are constant.
+    #[test]
+    fn halo_runs_make_the_copies_one_by_one() {
+        for n in [1, 2, 3, 5, 6, 16, 64] {
+            let sides = CellSides::new(&CubeSphere::new(n));
+            let mut level = Layout::of_grid(&sides);
+            loop {
+                let singles = level.halo_copies();
+                for (colour, mut expected) in singles.into_iter().enumerate() {
+                    let mut from_runs: Vec<[u32; 2]> = level.halos[colour]
+                        .iter()
+                        .flat_map(HaloRun::copies)
+                        .collect();
+                    from_runs.sort_unstable();
+                    expected.sort_unstable();
+                    assert_eq!(from_runs, expected, "n {n} m {} colour {colour}", level.m);
+                    for run in &level.halos[colour] {
+                        assert!(run.count >= 1 && run.halo_step >= 1, "{run:?}");
+                        let last = run.copies().last().expect("a copy");
+                        assert!(last.iter().all(|&p| (p as usize) < level.len()), "{run:?}");
+                        let half = level.half as u32;
+                        for [halo, source] in run.copies() {
+                            assert!(
+                                !level.is_cell(halo as usize) && level.is_cell(source as usize)
+                            );
+                        }
+                        assert!(run.copies().all(|[_, s]| (s < half) == (run.source < half)));
+                    }
+                    assert!(
+                        level.halos[colour].len() <= 24,
+                        "n {n} m {} colour {colour}: {} runs",
+                        level.m,
+                        level.halos[colour].len()
+                    );
                 }
                 if level.m % 2 == 1 || level.m <= 1 {
                     break;
