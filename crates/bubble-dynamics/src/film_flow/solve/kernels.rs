@@ -543,9 +543,22 @@ fn run_halves<'a, T>(
 fn scatter_run<T: Real>(layout: &Layout, first: usize, values: &[T], out: &mut [T]) {
     let len = values.len();
     let (even, odd) = run_halves(layout, first, len, out);
-    let pairs = values.chunks_exact(2);
-    for ((e, o), pair) in even.iter_mut().zip(odd.iter_mut()).zip(pairs) {
-        (*e, *o) = (pair[0], pair[1]);
+    // Eight pairs at a time in chunks of constant length, so the compiler splits them
+    // with shuffles (zipped two-value chunks were left a value at a time), then the
+    // rest a pair at a time.
+    let pairs = len / 2;
+    let mut e8 = even[..pairs].chunks_exact_mut(8);
+    let mut o8 = odd[..pairs].chunks_exact_mut(8);
+    let v16 = values[..2 * pairs].chunks_exact(16);
+    let v_rest = v16.remainder();
+    for ((e, o), v) in (&mut e8).zip(&mut o8).zip(v16) {
+        for k in 0..8 {
+            (e[k], o[k]) = (v[2 * k], v[2 * k + 1]);
+        }
+    }
+    let (e_rest, o_rest) = (e8.into_remainder(), o8.into_remainder());
+    for ((e, o), v) in e_rest.iter_mut().zip(o_rest).zip(v_rest.chunks_exact(2)) {
+        (*e, *o) = (v[0], v[1]);
     }
     if len % 2 == 1 {
         even[len / 2] = values[len - 1];
