@@ -32,7 +32,7 @@ pub(crate) const INFLOW: [f64; 4] = [1.0, -1.0, 1.0, -1.0];
 ///   edge between them; `is_a[c][k]` says whether `c` is that edge's `a` cell.
 /// - Inside a face these follow [`FaceLayout`]: `c ∓ 1` and `c ∓ n` across the x and y
 ///   sides, with the signs [`INFLOW`].
-/// - `edge_runs` holds every edge inside a face once, in increasing order, each run with
+/// - `edge_runs` holds every edge inside a face once, face by face, each run with
 ///   the side it is of its `a` cells and of its `b` cells; [`CellSides::seams`] the seam
 ///   edges, from [`FaceLayout::first_seam_edge`] on.
 #[derive(Clone, Debug)]
@@ -53,8 +53,8 @@ pub(crate) struct CellSides {
     pub(crate) rim_cells: Vec<u32>,
     /// The rim cells' tables side by side, in the order of `rim_cells` ([`Rim`]).
     rim_tables: RimTables,
-    /// Every edge inside a face once, in increasing order, as runs: each face row's
-    /// x-edges, each face's y-edges ([`EdgeRun`]).
+    /// Every edge inside a face once, as runs face by face: each face row's x-edges,
+    /// then the face's y-edges ([`EdgeRun`]).
     pub(crate) edge_runs: Vec<EdgeRun>,
     /// The seam edges' cells and sides ([`Seams`]).
     seam_tables: SeamTables,
@@ -627,8 +627,13 @@ impl CellSides {
     }
 }
 
-/// The edges inside the faces as [`EdgeRun`]s: each face row's x-edges, each face's
-/// y-edges.
+/// The edges inside the faces as [`EdgeRun`]s: each face row's x-edges, then that
+/// face's y-edges, face by face.
+///
+/// Why face by face: an edge pass reads its cells' values at both ends, and in the
+/// grid's edge order (every face's x-edges, then every face's y-edges) it read each
+/// cell field twice from beyond L2 (0.2 MB a field at n = 64); a face's y-edges right
+/// after its x-edges find the face's cells (32 KB a field) still in L2.
 fn face_edge_runs(grid: &CubeSphere) -> Vec<EdgeRun> {
     let layout = grid.layout();
     let n = layout.n;
@@ -648,8 +653,6 @@ fn face_edge_runs(grid: &CubeSphere) -> Vec<EdgeRun> {
                 on_face: y * (n - 1),
             });
         }
-    }
-    for face in 0..6 {
         let a = face * n * n;
         let start = 6 * n * (n - 1) + face * n * (n - 1);
         let sides = [TOP, BOTTOM];
@@ -765,6 +768,7 @@ mod tests {
         let mut edges: Vec<usize> = sides.edge_runs.iter().flat_map(|r| r.edges()).collect();
         let seams = sides.seams();
         edges.extend(seams.start..seams.start + seams.len);
+        edges.sort_unstable();
         assert_eq!(edges, (0..grid.edges().len()).collect::<Vec<_>>());
         let ea = grid.edge_arrays();
         for i in 0..seams.len {
