@@ -15,7 +15,7 @@
 
 use super::compare::{largest, pick, smaller};
 use super::face_geometry::FaceGeometry;
-use super::fluxes::{GatherScratch, apply_limited, net_inflow};
+use super::fluxes::{FromArray, GatherScratch, apply_limited, net_inflow};
 use super::grid::CubeSphere;
 use super::sides::{CellSides, EdgeBlock, SeamEnds};
 use crate::avx2::with_avx2;
@@ -143,7 +143,13 @@ fn substep(
         #[inline(always)]
         || differences_block(seams, ends, fg, &mut s.flux),
     );
-    net_inflow(sides, &s.flux, &mut s.laplacian, &mut s.gather);
+    net_inflow(
+        sides,
+        (&mut FromArray(&s.flux), h_m),
+        &mut s.laplacian,
+        &mut s.gather,
+        |_, _, _| {},
+    );
     let per_r2 = 1.0 / (radius_m * radius_m);
     // A face at a time, each with face 0's inverse areas (the same on every face).
     let per_area = &fg.inverse_area_per_sr;
@@ -182,7 +188,14 @@ fn substep(
         || volumes.block(seams, [ha, hb, la, lb], &mut s.flux),
     );
     // Each donor gives at most half its content: h stays ≥ 0.
-    apply_limited(sides, grid, &s.flux, 1.0, h_m, &mut s.gather);
+    apply_limited(
+        sides,
+        grid,
+        &mut FromArray(&s.flux),
+        1.0,
+        h_m,
+        &mut s.gather,
+    );
 }
 
 /// `(h_a − h_b) l/d` over a block of edges with thicknesses `[ha, hb]` at their ends,

@@ -27,7 +27,7 @@ use super::meniscus::MeniscusState;
 use super::sides::{CellSides, EdgeBlock, SeamEnds};
 use super::solve::{Hierarchy, SolveReport, Work};
 use super::thermal::{ThermalParams, up_from};
-use super::upwind::{RimRises, UpwindGeometry};
+use super::upwind::{Rises, UpwindGeometry};
 use super::viscosity::{ViscousScratch, viscous_bound};
 use crate::avx2::with_avx2;
 
@@ -177,11 +177,8 @@ pub(super) struct Scratch {
     pub(super) u_start: Vec<f64>,
     pub(super) stiffness: Vec<f64>,
     pub(super) guess: Vec<f64>,
-    /// Per side `k` and cell: how far the cell's limited gradient carries its thickness
-    /// to that side's midpoint, m.
-    pub(super) limited_rise: [Vec<f64>; 4],
-    /// The rim's values for the limited rises ([`RimRises`]).
-    pub(super) rim_rises: RimRises,
+    /// The thickness transport's limited rises ([`Rises`]).
+    pub(super) rises: Rises,
     pub(super) drag: Vec<f64>,
     /// The edge velocities in the face rows during the explicit momentum step, m/s.
     rows_u: Vec<f64>,

@@ -77,32 +77,26 @@ impl FilmFlow {
 
     /// One transport of `h` over `dt_s`: second-order upwind (the upwind cell's
     /// Green–Gauss gradient, limited to its neighbours' range, carried to the edge
-    /// midpoint and clamped between the two cells' values), outflow-limited. Four passes,
-    /// each structured inside the faces ([`super::upwind`]).
+    /// midpoint and clamped between the two cells' values), outflow-limited: one limited
+    /// apply of the [`upwind::Volumes`], face by face.
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn upwind_substep(&mut self, s: &mut Scratch, dt_s: f64, drain: Drain) {
-        let (sides, geo) = (&*self.sides, &*self.transport);
-        let dt_per_r = dt_s / self.params.radius_m;
-        with_avx2(
-            #[inline(always)]
-            || {
-                let rises = (&mut s.limited_rise, &mut s.rim_rises);
-                upwind::limited_rises(sides, geo, &self.h_m, rises);
-                let speeds = upwind::EdgeSpeeds {
-                    u: &self.u_m_per_s,
-                    drain,
-                    dt_per_r,
-                };
-                let fg = self.grid.face_geometry();
-                let volume = (&mut s.edge2, &mut s.seam_ends);
-                upwind::volumes(sides, fg, &self.h_m, &s.limited_rise, speeds, volume);
-                let (volume, h) = (&s.edge2, &mut self.h_m);
-                apply_limited(sides, &self.grid, volume, 1.0, h, &mut s.gather);
+        let mut volumes = upwind::Volumes {
+            sides: &self.sides,
+            geo: &self.transport,
+            fg: self.grid.face_geometry(),
+            speeds: upwind::EdgeSpeeds {
+                u: &self.u_m_per_s,
+                drain,
+                dt_per_r: dt_s / self.params.radius_m,
             },
-        )
+            rises: &mut s.rises,
+            seam_ends: &mut s.seam_ends,
+        };
+        let (h, gather) = (&mut self.h_m, &mut s.gather);
+        apply_limited(&self.sides, &self.grid, &mut volumes, 1.0, h, gather);
     }
 }
-
 /// [`FilmFlow::courant`]'s pass over a block of edges with thicknesses `[ha, hb]` at
 /// their ends: the edges' speeds into `speed`.
 #[inline(always)]
