@@ -53,10 +53,11 @@ pub(crate) trait EdgeValues {
     fn run(&mut self, run: EdgeRun, rows: Range<usize>, cells: &[f64], out: &mut [f64]);
 }
 
-/// A per-edge array's values as an [`EdgeValues`] (the tests' volumes, and a pass's
-/// values kept whole for a later pass).
+/// A per-edge array's values as an [`EdgeValues`] (the tests' volumes).
+#[cfg(test)]
 pub(crate) struct FromArray<'a>(pub(crate) &'a [f64]);
 
+#[cfg(test)]
 impl EdgeValues for FromArray<'_> {
     #[inline(always)]
     fn seams(&mut self, seams: Seams, _cells: &[f64], out: &mut [f64]) {
