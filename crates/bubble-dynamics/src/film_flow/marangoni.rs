@@ -15,7 +15,7 @@ use std::ops::Range;
 use super::compare::{larger, pick};
 use super::face_geometry::{EdgeConstant, FaceGeometry};
 use super::flow::{
-    FilmFlow, FilmGradient, H_FLOOR_M, SOLVE_MAX_ITERATIONS, SOLVE_TOLERANCE, Scratch,
+    Drag, FilmFlow, FilmGradient, H_FLOOR_M, SOLVE_MAX_ITERATIONS, SOLVE_TOLERANCE, Scratch,
 };
 use super::fluxes::{EdgeValues, apply_limited, net_inflow};
 use super::grid::CubeSphere;
@@ -116,7 +116,11 @@ impl FilmFlow {
     /// ([`net_inflow`]); with the normal gradient they are also kept whole in `s.edge`
     /// (the defect correction adds to them), with the two-point one the velocity
     /// correction takes them again from the velocities (the same bits).
-    fn fluxes_weights_and_right_hand_side<const NORMAL: bool>(&self, s: &mut Scratch, dt_s: f64) {
+    fn fluxes_weights_and_right_hand_side<const NORMAL: bool>(
+        &mut self,
+        s: &mut Scratch,
+        dt_s: f64,
+    ) {
         let p = &self.params;
         let g = &self.grid;
         let n = g.edge_arrays().cells.len();
@@ -130,9 +134,9 @@ impl FilmFlow {
         let mut fluxes = CentralFluxes::<NORMAL> {
             edges: CentralEdges {
                 grid: g,
-                u: &self.u_m_per_s,
+                u: &mut self.u_m_per_s,
                 u0: &s.u_start,
-                drag: &s.drag,
+                drag: (s.drag_by, &s.drag),
                 vertex: &s.vertex,
                 c: EdgeConstants {
                     // `dt E/ρ`: over the edge's thickness, the stiffness `k`.
@@ -351,12 +355,14 @@ struct CentralFluxes<'a, const NORMAL: bool> {
 struct CentralEdges<'a, const NORMAL: bool> {
     /// The grid (its constants, and its edges' vertices for the cross term).
     grid: &'a CubeSphere,
-    /// The velocity after the explicit forces and the drag, m/s.
-    u: &'a [f64],
+    /// The velocity after the explicit forces, m/s: dragged here where the drag was
+    /// left to this pass ([`Drag::Deferred`]).
+    u: &'a mut [f64],
     /// The step's starting velocity, m/s.
     u0: &'a [f64],
-    /// Each edge's drag factor ([`FilmFlow::air_shear`]).
-    drag: &'a [f64],
+    /// Where each edge's drag comes from, and the factors where they are kept
+    /// ([`FilmFlow::air_shear`]).
+    drag: (Drag, &'a [f64]),
     /// The surfactant at the vertices (the cross term's, with the normal gradient).
     vertex: &'a [f64],
     /// The pass's constants.
@@ -387,37 +393,67 @@ impl<const NORMAL: bool> EdgeValues for CentralFluxes<'_, NORMAL> {
 
 impl<const NORMAL: bool> CentralEdges<'_, NORMAL> {
     /// The pass over a block of edges, with the surfactant and thickness at their ends:
-    /// the fluxes (per R) into `flux`.
+    /// the fluxes (per R) into `flux`. A loop for each source of the drag
+    /// ([`Drag`]), so that each vectorises.
     #[inline(always)]
-    fn block(&mut self, run: impl EdgeBlock, [ga, gb, ha, hb]: [&[f64]; 4], flux: &mut [f64]) {
+    fn block(&mut self, run: impl EdgeBlock, ends: [&[f64]; 4], flux: &mut [f64]) {
+        let len = run.count();
+        match self.drag {
+            (Drag::None, _) => self.block_with::<false>(run, ends, flux, |_, u, _| (u, 1.0)),
+            (Drag::Stored, factors) => {
+                let factors = &run.values(factors)[..len];
+                self.block_with::<false>(run, ends, flux, |i, u, _| (u, factors[i]));
+            }
+            (Drag::Deferred(shear), _) => {
+                let along = shear.along(self.grid.face_geometry(), &run);
+                self.block_with::<true>(run, ends, flux, |i, u, h| along.drag(i, u, h));
+            }
+        }
+    }
+
+    /// [`Self::block`] with each edge's velocity dragged and its factor by `drag(i, u,
+    /// h)` (the edge, its velocity and its floored thickness), the dragged velocities
+    /// written back where `DRAGGED`.
+    #[inline(always)]
+    fn block_with<const DRAGGED: bool>(
+        &mut self,
+        run: impl EdgeBlock,
+        [ga, gb, ha, hb]: [&[f64]; 4],
+        flux: &mut [f64],
+        drag: impl Fn(usize, f64, f64) -> (f64, f64),
+    ) {
         let (ea, fg, c) = (self.grid.edge_arrays(), self.grid.face_geometry(), self.c);
         let len = run.count();
         let (ga, gb, ha, hb) = (&ga[..len], &gb[..len], &ha[..len], &hb[..len]);
-        let (u, u0) = (run.values(self.u), run.values(self.u0));
-        let (drag, l) = (run.values(self.drag), run.constant(&fg.length));
+        let l = run.constant(&fg.length);
         let inverse_dual = if NORMAL {
             &fg.inverse_normal_dual_length
         } else {
             &fg.inverse_dual_length
         };
         let id = run.constant(inverse_dual);
-        let (u, u0, drag, l, id) = (&u[..len], &u0[..len], &drag[..len], &l[..len], &id[..len]);
+        let (u0, l, id) = (&run.values(self.u0)[..len], &l[..len], &id[..len]);
         let flux = &mut flux[..len];
+        let u = &mut run.values_mut(self.u)[..len];
         let stiffness = run.values_mut(self.stiffness);
         let weight = run.values_mut(self.weight);
         for i in 0..len {
             let gamma_c = 0.5 * (ga[i] + gb[i]);
             let h_edge = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
-            let k = c.dt_e_per_rho / h_edge * drag[i];
+            let (u_dragged, factor) = drag(i, u[i], h_edge);
+            if DRAGGED {
+                u[i] = u_dragged;
+            }
+            let k = c.dt_e_per_rho / h_edge * factor;
             let u = if NORMAL {
                 let e = run.first() + i;
                 let [v0, v1] = ea.vertices[e];
                 let along = self.vertex[v1 as usize] - self.vertex[v0 as usize];
                 let du = k * ea.cross_per_length[e] * along * c.per_r;
                 self.cross[e] = du / gamma_c.max(f64::MIN_POSITIVE);
-                u[i] + self.cross[e]
+                u_dragged + self.cross[e]
             } else {
-                u[i]
+                u_dragged
             };
             flux[i] = gamma_c * (u - u0[i]) * l[i];
             stiffness[i] = k;
