@@ -137,28 +137,31 @@ fn limiter(h: f64, nb: [f64; 4], rise: [f64; 4]) -> f64 {
 }
 
 /// The limited rises: the rim's, kept for the sub-step (the seams' volumes read them),
-/// and each face's band's, taken just before the band's volumes.
+/// and a face's band's, taken just before the band's volumes.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Rises {
-    /// Per face and side `k`, a window of [`WINDOW`] rows of `n`: the band's rows' cells'
-    /// rises to that side and the row's before, window row `w` for face row `first − 1
-    /// + w`, at `((face·4 + k)·WINDOW + w)·n`, m.
+    /// Per side `k`, a window of [`WINDOW`] rows of `n`: the band's rows' cells' rises
+    /// to that side and the row's before, window row `w` for face row `first − 1 + w`,
+    /// at `(k·WINDOW + w)·n`, m. One window serves the six faces in turn.
     rows: Vec<f64>,
-    /// Per face: its band's first row.
-    first: [usize; 6],
+    /// Per face: its band's last row's rises (`4·n`, side by side), the row before its
+    /// next band.
+    carried: [Vec<f64>; 6],
+    /// The band's first row.
+    first: usize,
     /// The rim's ([`RimRises`]).
     rim: RimRises,
 }
 
-/// Rows in a face's window of rises ([`Rises`]): a band's and the row before (the
-/// y-edges below the band's first row read it).
+/// Rows in the window of rises ([`Rises`]): a band's and the row before (the y-edges
+/// below the band's first row read it).
 const WINDOW: usize = BAND + 1;
 
 impl Rises {
-    /// Where face `face`'s row `y`'s cells' rises to side `k` start in `rows`.
+    /// Where row `y`'s cells' rises to side `k` start in `rows`.
     #[inline(always)]
-    fn at(&self, n: usize, (face, k): (usize, usize), y: usize) -> usize {
-        ((face * 4 + k) * WINDOW + y + 1 - self.first[face]) * n
+    fn at(&self, n: usize, k: usize, y: usize) -> usize {
+        (k * WINDOW + y + 1 - self.first) * n
     }
 }
 
@@ -195,9 +198,9 @@ fn rim_rises(sides: &CellSides, geo: &UpwindGeometry, h: &[f64], rim_rises: &mut
 }
 
 /// Face `face`'s band `band`'s cells' limited rises to each side, into `rises`' window
-/// (moved on from the band before), m: the inside rows in one run, their end cells among
-/// the run's (their neighbours there are not theirs) then taken from the rim's, as the
-/// first and last rows'.
+/// (the row before from the face's band before), m: the inside rows in one run, their
+/// end cells among the run's (their neighbours there are not theirs) then taken from the
+/// rim's, as the first and last rows'.
 // Inlined into the sub-step's `with_avx2` closure, so compiled for AVX2 there.
 #[inline(always)]
 fn band_rises(
@@ -207,19 +210,27 @@ fn band_rises(
     rises: &mut Rises,
 ) {
     let n = sides.n();
-    rises.rows.resize(6 * 4 * WINDOW * n, 0.0);
-    let face_rows = &mut rises.rows[face * 4 * WINDOW * n..(face + 1) * 4 * WINDOW * n];
-    if band.start > 0 {
-        // The band before's last row (all bands but the last are `BAND` rows).
-        for side in face_rows.chunks_exact_mut(WINDOW * n) {
-            side.copy_within(BAND * n..WINDOW * n, 0);
-        }
-    }
-    rises.first[face] = band.start;
-    let w = |y: usize| (y + 1 - band.start) * n;
-    let (o0, rest) = face_rows.split_at_mut(WINDOW * n);
+    let Rises {
+        rows,
+        carried,
+        first,
+        rim,
+    } = rises;
+    rows.resize(4 * WINDOW * n, 0.0);
+    let carried = &mut carried[face];
+    let (o0, rest) = rows.split_at_mut(WINDOW * n);
     let (o1, rest) = rest.split_at_mut(WINDOW * n);
     let (o2, o3) = rest.split_at_mut(WINDOW * n);
+    if band.start > 0 {
+        for (o, c) in [&mut *o0, &mut *o1, &mut *o2, &mut *o3]
+            .into_iter()
+            .zip(carried.chunks_exact(n))
+        {
+            o[..n].copy_from_slice(c);
+        }
+    }
+    *first = band.start;
+    let w = |y: usize| (y + 1 - band.start) * n;
     let inside = band.start.max(1)..band.end.min(n.saturating_sub(1));
     if !inside.is_empty() {
         let cells = inside.start * n..inside.end * n;
@@ -242,10 +253,18 @@ fn band_rises(
     for y in band.clone() {
         let on_row = sides.rim_of_row(y);
         let at = face * m + on_row.start..face * m + on_row.end;
-        let r = rises.rim.rise.each_ref().map(|r| &r[at.clone()]);
+        let r = rim.rise.each_ref().map(|r| &r[at.clone()]);
         for (j, &p) in sides.rim_cells[on_row].iter().enumerate() {
             let x = w(y) + p as usize - y * n;
             (o0[x], o1[x], o2[x], o3[x]) = (r[0][j], r[1][j], r[2][j], r[3][j]);
+        }
+    }
+    if band.end < n {
+        // The band's last row, the row before the next band.
+        let last = w(band.end - 1);
+        carried.clear();
+        for o in [&*o0, &*o1, &*o2, &*o3] {
+            carried.extend_from_slice(&o[last..last + n]);
         }
     }
 }
@@ -371,20 +390,14 @@ impl EdgeValues for Volumes<'_> {
 
     #[inline(always)]
     fn run(&mut self, run: EdgeRun, rows: Range<usize>, h: &[f64], out: &mut [f64]) {
-        let (n, face, [ka, kb]) = (self.sides.n(), run.face, run.sides);
+        let (n, [ka, kb]) = (self.sides.n(), run.sides);
         let r = &*self.rises;
         // A row's x-edges join its cells from the first on to those from the second;
         // the y-edges below rows, the rows below's cells to theirs.
         let (a, b) = if ka == RIGHT {
-            (
-                r.at(n, (face, ka), rows.start),
-                r.at(n, (face, kb), rows.start) + 1,
-            )
+            (r.at(n, ka, rows.start), r.at(n, kb, rows.start) + 1)
         } else {
-            (
-                r.at(n, (face, ka), rows.start - 1),
-                r.at(n, (face, kb), rows.start),
-            )
+            (r.at(n, ka, rows.start - 1), r.at(n, kb, rows.start))
         };
         let (ra, rb) = (&r.rows[a..], &r.rows[b..]);
         let (ha, hb) = run.ends(h);
@@ -415,7 +428,115 @@ fn volumes_block(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::film_flow::face_geometry::to_face_frame;
+    use crate::film_flow::fluxes::{BAND, GatherScratch, net_inflow};
+    use crate::film_flow::grid::dot_at;
     use glam::DVec3;
+
+    /// An [`EdgeValues`] that keeps what another gives, by edge.
+    struct Kept<'a, P> {
+        /// The pass.
+        pass: P,
+        /// Its values by edge.
+        values: &'a mut [f64],
+    }
+
+    impl<P: EdgeValues> EdgeValues for Kept<'_, P> {
+        fn seams(&mut self, seams: Seams, cells: &[f64], out: &mut [f64]) {
+            self.pass.seams(seams, cells, out);
+            self.values[seams.start..seams.start + seams.len].copy_from_slice(out);
+        }
+        fn rows(&mut self, face: usize, rows: Range<usize>, cells: &[f64]) {
+            self.pass.rows(face, rows, cells);
+        }
+        fn run(&mut self, run: EdgeRun, rows: Range<usize>, cells: &[f64], out: &mut [f64]) {
+            self.pass.run(run, rows, cells, out);
+            self.values[run.edges()].copy_from_slice(out);
+        }
+    }
+
+    /// The volumes taken band by band, each face's limited rises a band at a time and
+    /// the rim's apart, against each edge's taken directly from every cell's limited
+    /// rises (the same arithmetic, so the same bits): on grids of one band and of three,
+    /// the last short, so that the rises carried from band to band are checked.
+    #[test]
+    fn the_volumes_by_bands_are_each_edges_own() {
+        for n in [5, 2 * BAND + 3] {
+            let grid = CubeSphere::new(n);
+            let sides = CellSides::new(&grid);
+            let geo = UpwindGeometry::new(&grid, &sides);
+            let (fg, ea, layout) = (grid.face_geometry(), grid.edge_arrays(), grid.layout());
+            let c = grid.centres();
+            let h: Vec<f64> = c
+                .iter()
+                .map(|c| 1.0 + 0.3 * (5.0 * c.x + 3.0 * c.y * c.z).sin())
+                .collect();
+            let u: Vec<f64> = (0..ea.cells.len())
+                .map(|e| ((e * 37 % 23) as f64 - 11.0) * 0.01)
+                .collect();
+            let drain = Drain {
+                drain: 0.02,
+                g_eff: DVec3::new(0.3, -9.8, 0.5),
+            };
+            let speeds = EdgeSpeeds {
+                u: &u,
+                drain,
+                dt_per_r: 0.4,
+            };
+            // Every cell's limited rises, directly.
+            let rise = |cell: usize| -> [f64; 4] {
+                let nb = sides.neighbour[cell].map(|j| h[j as usize]);
+                let w = |k: usize, j: usize| geo.rise[k][j][cell % (n * n)];
+                let r = [0, 1, 2, 3].map(|k| rise_of([0, 1, 2, 3].map(|j| w(k, j)), h[cell], nb));
+                let phi = limiter(h[cell], nb, r);
+                r.map(|r| r * phi)
+            };
+            let mut want = vec![0.0; ea.cells.len()];
+            for (e, [a, b]) in ea.cells.iter().enumerate() {
+                let (a, b) = (*a as usize, *b as usize);
+                let side = |cell: usize| {
+                    sides.edge[cell]
+                        .iter()
+                        .position(|&x| x as usize == e)
+                        .unwrap()
+                };
+                let (ra, rb) = (rise(a)[side(a)], rise(b)[side(b)]);
+                let (l, c) = if e >= layout.first_seam_edge() {
+                    let i = e - layout.first_seam_edge();
+                    let normal = fg.normal.seams.each_ref().map(|x| &x[i..]);
+                    (
+                        fg.length.seams[i],
+                        drain.drain * dot_at(drain.g_eff, normal, 0),
+                    )
+                } else {
+                    let (face, i) = layout.on_face(e);
+                    let normal = fg.normal.face.each_ref().map(|x| &x[i..]);
+                    let g = to_face_frame(face, drain.g_eff);
+                    (fg.length.face[i], drain.drain * dot_at(g, normal, 0))
+                };
+                want[e] = edge_volume([h[a], h[b]], [ra, rb], [u[e], c, l], speeds.dt_per_r);
+            }
+            let mut got = vec![f64::NAN; ea.cells.len()];
+            let (mut rises, mut seam_ends) = (Rises::default(), SeamEnds::default());
+            let volumes = Volumes {
+                sides: &sides,
+                geo: &geo,
+                fg,
+                speeds,
+                rises: &mut rises,
+                seam_ends: &mut seam_ends,
+            };
+            let mut kept = Kept {
+                pass: volumes,
+                values: &mut got,
+            };
+            let mut out = Vec::new();
+            let scratch = &mut GatherScratch::default();
+            net_inflow(&sides, (&mut kept, &h), &mut out, scratch, |_, _, _| {});
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&got), bits(&want), "n = {n}");
+        }
+    }
 
     /// The rises the weights give against the gradient taken directly: Green–Gauss over
     /// the cell's edges, projected, dotted with the reach.
