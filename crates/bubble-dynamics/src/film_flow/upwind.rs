@@ -25,7 +25,7 @@ use super::face_geometry::FaceGeometry;
 use super::fluxes::{BAND, EdgeValues};
 use super::grid::CubeSphere;
 use super::sides::{CellSides, EdgeBlock, EdgeRun, RIGHT, SeamEnds, Seams};
-use super::transport::Drain;
+use super::transport::{Drain, Fastest};
 
 /// The transport's weights, fixed by the grid: face 0's, which every face reads.
 ///
@@ -372,6 +372,8 @@ pub(crate) struct Volumes<'a> {
     pub(crate) rises: &'a mut Rises,
     /// The seams' ends.
     pub(crate) seam_ends: &'a mut SeamEnds,
+    /// Where the Courant number is taken alongside, its fastest edge so far.
+    pub(crate) fastest: Option<&'a mut Fastest>,
 }
 
 impl EdgeValues for Volumes<'_> {
@@ -381,6 +383,10 @@ impl EdgeValues for Volumes<'_> {
         rim_rises(self.sides, self.geo, h, rim);
         let [h_ends, rises] = self.seam_ends.gather_with_rim_sides(seams, h, &rim.rise);
         volumes_block(seams, h_ends, rises, (self.fg, self.speeds), out);
+        if let Some(fastest) = self.fastest.as_deref_mut() {
+            let (u, drain) = (self.speeds.u, self.speeds.drain);
+            fastest.block(seams, h_ends, (self.fg, u), drain);
+        }
     }
 
     #[inline(always)]
@@ -402,6 +408,10 @@ impl EdgeValues for Volumes<'_> {
         let (ra, rb) = (&r.rows[a..], &r.rows[b..]);
         let (ha, hb) = run.ends(h);
         volumes_block(run, [ha, hb], [ra, rb], (self.fg, self.speeds), out);
+        if let Some(fastest) = self.fastest.as_deref_mut() {
+            let (u, drain) = (self.speeds.u, self.speeds.drain);
+            fastest.block(run, [ha, hb], (self.fg, u), drain);
+        }
     }
 }
 
@@ -525,6 +535,7 @@ mod tests {
                 speeds,
                 rises: &mut rises,
                 seam_ends: &mut seam_ends,
+                fastest: None,
             };
             let mut kept = Kept {
                 pass: volumes,
