@@ -3,8 +3,10 @@
 //! fluxes that sum to zero.
 //!
 //! First the surfactant moves upwind with the step's starting velocity, in sub-steps of
-//! its own (`transport_surfactant`). Then the edges are walked: the fluxes' central part
-//! with the system's edge weights and right-hand side; with the normal gradient
+//! its own (`transport_surfactant`). Then the edges are walked: the air's drag where it
+//! was left to this pass ([`super::flow::Drag`]), the fluxes' central part with the
+//! system's edge weights and right-hand side (gathered band by band,
+//! [`super::fluxes::net_inflow`]); with the normal gradient
 //! ([`FilmGradient::Normal`]) the cross term of the gradient again from each solution
 //! until the system with it is solved (defect correction, `correct_the_cross_term`); the
 //! velocity correction with the surfactant's move (into a copy, so the correction still

@@ -871,6 +871,72 @@ mod tests {
         }
     }
 
+    /// The rim's tables: each face row's rim cells (the whole first and last rows, the
+    /// ends of the others) at the places `rim_of_row` gives, every face alike; each seam's
+    /// ends' places; each pad's seam edge on its face's outer side, its sign the cell's
+    /// inflow's against the inside's; each rim cell's sides on a seam and the cell across.
+    #[test]
+    fn the_rims_tables_place_its_cells_and_seams() {
+        for n in [1, 2, 3, 8] {
+            let grid = CubeSphere::new(n);
+            let sides = CellSides::new(&grid);
+            let m = sides.rim_per_face();
+            for face in 0..6 {
+                for y in 0..n {
+                    let xs: Vec<usize> = if y == 0 || y + 1 == n {
+                        (0..n).collect()
+                    } else {
+                        vec![0, n - 1]
+                    };
+                    let at = sides.rim_of_row(y);
+                    let cells = &sides.rim_cells[face * m + at.start..face * m + at.end];
+                    let want: Vec<u32> = xs
+                        .iter()
+                        .map(|x| (face * n * n + y * n + x) as u32)
+                        .collect();
+                    assert_eq!(cells, &want[..], "n = {n}, face {face}, row {y}");
+                }
+                let first_seam = sides.layout.first_seam_edge();
+                let [left, right, bottom, top] = sides.face_pads(face);
+                for i in 0..n {
+                    let outer = [
+                        (left[i], i * n, LEFT),
+                        (right[i], i * n + n - 1, RIGHT),
+                        (bottom[i], i, BOTTOM),
+                        (top[i], (n - 1) * n + i, TOP),
+                    ];
+                    for (pad, c, k) in outer {
+                        let c = face * n * n + c;
+                        assert_eq!(pad.seam as usize + first_seam, sides.edge[c][k] as usize);
+                        assert_eq!(pad.sign, sides.inflow(c)[k] * INFLOW[k], "cell {c}");
+                    }
+                }
+            }
+            let seams = sides.seams();
+            for i in 0..seams.len {
+                let places = seams.rim_ends(i).map(|p| sides.rim_cells[p] as usize);
+                assert_eq!(places, seams.cells(i), "n = {n}, seam {i}");
+            }
+            let first_seam = sides.layout.first_seam_edge();
+            let on_seam = |c: &u32| {
+                sides.edge[*c as usize]
+                    .iter()
+                    .filter(|&&e| e as usize >= first_seam)
+                    .count()
+            };
+            let on_seams: usize = sides.rim_cells.iter().map(on_seam).sum();
+            assert_eq!(sides.rim_seam_sides().len(), on_seams, "n = {n}");
+            for s in sides.rim_seam_sides() {
+                let (c, k) = (
+                    sides.rim_cells[s.rim as usize] as usize,
+                    usize::from(s.side),
+                );
+                let across = sides.rim_cells[s.across as usize];
+                assert_eq!(sides.neighbour[c][k], across, "n = {n}, cell {c} side {k}");
+            }
+        }
+    }
+
     /// Every cell of a row run lies in a face span, with the neighbours the span gives it
     /// its own, and whatever else a span holds is on the rim.
     fn spans_hold_every_inside_cell_with_its_neighbours(sides: &CellSides) {

@@ -3,9 +3,11 @@
 //! the upwind cell's Barth–Jespersen-limited gradient), in sub-steps under a Courant
 //! bound, each donor's outflow limited to a fraction of its content.
 //!
-//! A sub-step is four passes ([`super::upwind`]): each cell's limited rises to its sides;
-//! the volume across each edge; each donor's outflow factor; each cell's gathered
-//! volumes. Inside a face each pass reads slices and vectorises.
+//! A sub-step is one limited apply of the volumes, taken a band of face rows at a time
+//! ([`super::upwind`], [`super::fluxes`]): each cell's limited rises to its sides, the
+//! volume across each edge, each donor's outflow factor and each cell's gathered volumes,
+//! the band's scratch never leaving the cache. Inside a face each stretch reads slices
+//! and vectorises. The first sub-step takes the Courant number too ([`Fastest`]).
 
 use glam::DVec3;
 
