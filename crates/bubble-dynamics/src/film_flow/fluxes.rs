@@ -33,7 +33,8 @@ use crate::avx2::with_avx2;
 /// the face-0 constants (the thickness transport's, about 13 KB a row at n = 64) it
 /// reads for the six faces to reuse from L2. At n = 64, 8, 12, 16 and 32 rows gave 758,
 /// 751, 746 and 740 M instructions and 22.65, 22.70, 22.76 and 22.95 M LL misses over
-/// 40 steps (`film_profile 64 0 9.81`); 16 keeps a band's constants at 0.2 MB up to
+/// 40 steps (`film_profile 64 0 9.81`, before the transport's Courant number joined its
+/// first sub-step); 16 keeps a band's constants at 0.2 MB at n = 64 and 0.4 MB at
 /// n = 128. A constant: taken from `n` at run time, the bands' loops no longer
 /// vectorised (850 M instructions at 32 rows).
 pub(crate) const BAND: usize = 16;
@@ -48,8 +49,8 @@ const BEHIND: usize = 3;
 /// first, for the band's rows ([`Self::rows`]), each row's x-edges
 /// ([`CellSides::x_run`]) and the y-edges below the band's rows ([`CellSides::y_run`]).
 /// `cells` is the cell field the gather moves or the values are taken from: when a pass
-/// is asked for a band, the gather has changed no cell of it or of the row before, nor
-/// any rim cell.
+/// is asked for a band, the gather has changed no cell of it or of the two rows before
+/// it, nor any rim cell.
 pub(crate) trait EdgeValues {
     /// The seam edges' values into `out` (`seams.len` long); asked first.
     fn seams(&mut self, seams: Seams, cells: &[f64], out: &mut [f64]);
