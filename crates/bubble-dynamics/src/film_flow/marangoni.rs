@@ -439,6 +439,18 @@ impl<const NORMAL: bool> CentralEdges<'_, NORMAL> {
         let u = &mut run.values_mut(self.u)[..len];
         let stiffness = run.values_mut(self.stiffness);
         let weight = run.values_mut(self.weight);
+        // The cross term's arrays along the block (empty with the two-point gradient).
+        let (vertices, cross_per_length, cross) = if NORMAL {
+            let edges = run.first()..run.first() + len;
+            let cross = &mut self.cross[edges.clone()];
+            (
+                &ea.vertices[edges.clone()],
+                &ea.cross_per_length[edges],
+                cross,
+            )
+        } else {
+            (&[][..], &[][..], &mut [][..])
+        };
         for i in 0..len {
             let gamma_c = 0.5 * (ga[i] + gb[i]);
             let h_edge = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
@@ -448,12 +460,11 @@ impl<const NORMAL: bool> CentralEdges<'_, NORMAL> {
             }
             let k = c.dt_e_per_rho / h_edge * factor;
             let u = if NORMAL {
-                let e = run.first() + i;
-                let [v0, v1] = ea.vertices[e];
+                let [v0, v1] = vertices[i];
                 let along = self.vertex[v1 as usize] - self.vertex[v0 as usize];
-                let du = k * ea.cross_per_length[e] * along * c.per_r;
-                self.cross[e] = du / gamma_c.max(f64::MIN_POSITIVE);
-                u_dragged + self.cross[e]
+                let du = k * cross_per_length[i] * along * c.per_r;
+                cross[i] = du / gamma_c.max(f64::MIN_POSITIVE);
+                u_dragged + cross[i]
             } else {
                 u_dragged
             };
@@ -530,22 +541,25 @@ impl<const NORMAL: bool> CorrectionEdges<'_, NORMAL> {
         let (id, l) = (run.constant(self.inverse_dual), run.constant(self.length));
         let (id, l, k) = (&id[..len], &l[..len], &run.values(self.stiffness)[..len]);
         let u0 = &run.values(self.u0)[..len];
-        let (u, moved) = (run.values_mut(self.u), &mut moved[..len]);
+        let (u, moved) = (&mut run.values_mut(self.u)[..len], &mut moved[..len]);
         let (per_r, scale) = (self.per_r, self.scale);
+        // The kept fluxes and cross term along the block (empty with the two-point
+        // gradient).
+        let (flux, cross) = if NORMAL {
+            (run.values(self.flux), run.values(self.cross))
+        } else {
+            (&[][..], &[][..])
+        };
         for i in 0..len {
             let gamma_c = 0.5 * (ga[i] + gb[i]);
             let f_adv = if NORMAL {
-                self.flux[run.first() + i]
+                flux[i]
             } else {
                 gamma_c * (u[i] - u0[i]) * l[i]
             };
             let slope = (xb[i] - xa[i]) * id[i] * per_r;
             let du = -k[i] * slope / larger(gamma_c, f64::MIN_POSITIVE);
-            u[i] += if NORMAL {
-                du + self.cross[run.first() + i]
-            } else {
-                du
-            };
+            u[i] += if NORMAL { du + cross[i] } else { du };
             moved[i] = scale * (f_adv + gamma_c * du * l[i]);
         }
     }
