@@ -13,12 +13,13 @@
 //! keep the exact law. Fluxes that sum to zero keep liquid conserved to rounding, each
 //! donor limited to half its content keeps h ≥ 0.
 
+use std::ops::Range;
+
 use super::compare::{largest, pick, smaller};
 use super::face_geometry::FaceGeometry;
-use super::fluxes::{GatherScratch, apply_limited, net_inflow};
+use super::fluxes::{EdgeValues, GatherScratch, apply_limited, net_inflow};
 use super::grid::CubeSphere;
-use super::sides::{CellSides, EdgeBlock, SeamEnds};
-use crate::avx2::with_avx2;
+use super::sides::{CellSides, EdgeBlock, EdgeRun, SeamEnds, Seams};
 
 /// Most explicit sub-steps a film step spends on capillary smoothing.
 pub(crate) const MAX_SUBSTEPS: u32 = 64;
@@ -47,8 +48,8 @@ pub(crate) struct CapillaryScratch {
     /// The grid's Laplacian ∞-norm on the unit sphere and the cell count it is for (it
     /// depends on the grid alone).
     laplacian_norm: Option<(usize, f64)>,
+    /// The thickness's Laplacian per cell, per m.
     laplacian: Vec<f64>,
-    flux: Vec<f64>,
     /// The gathers' buffers.
     gather: GatherScratch,
     /// The seam edges' end values.
@@ -116,8 +117,9 @@ struct Mobility {
     cap: f64,
 }
 
-/// One forward-Euler sub-step of `∂h/∂t = −∇·(M ∇(−∇²h))`: two passes over the edges
-/// (the thickness's differences, then the volumes), each followed by the cells' gathers.
+/// One forward-Euler sub-step of `∂h/∂t = −∇·(M ∇(−∇²h))`: two gathers by bands
+/// ([`super::fluxes`]), of the thickness's differences into the Laplacian, then of the
+/// volumes into the thickness.
 fn substep(
     (grid, sides): (&CubeSphere, &CellSides),
     radius_m: f64,
@@ -127,31 +129,28 @@ fn substep(
     s: &mut CapillaryScratch,
 ) {
     let fg = grid.face_geometry();
-    s.flux.resize(grid.edges().len(), 0.0);
     // ∇²h as the net inflow of the differences `(h_b − h_a) l/d` (their sum out of a
-    // cell, with the sign of an inflow: a cell below its neighbours gains).
-    sides.for_each_edge_run(
-        #[inline(always)]
-        |run| {
-            let (ha, hb) = run.ends(h_m);
-            differences_block(run, [ha, hb], fg, &mut s.flux);
+    // cell, with the sign of an inflow: a cell below its neighbours gains), over the
+    // cells' areas and R²: face 0's inverse areas (the same on every face).
+    let (per_r2, n) = (1.0 / (radius_m * radius_m), sides.n());
+    let per_area = &fg.inverse_area_per_sr;
+    let mut differences = Differences {
+        fg,
+        seam_ends: &mut s.seam_ends,
+    };
+    let pass = (&mut differences, &h_m[..]);
+    net_inflow(
+        sides,
+        pass,
+        &mut s.laplacian,
+        &mut s.gather,
+        |_, rows, lap| {
+            let per_area = &per_area[rows.start * n..rows.end * n];
+            for (lap, per_area) in lap.iter_mut().zip(per_area) {
+                *lap *= per_area * per_r2;
+            }
         },
     );
-    let seams = sides.seams();
-    let ends = s.seam_ends.gather(seams, h_m);
-    with_avx2(
-        #[inline(always)]
-        || differences_block(seams, ends, fg, &mut s.flux),
-    );
-    net_inflow(sides, &s.flux, &mut s.laplacian, &mut s.gather);
-    let per_r2 = 1.0 / (radius_m * radius_m);
-    // A face at a time, each with face 0's inverse areas (the same on every face).
-    let per_area = &fg.inverse_area_per_sr;
-    for face in s.laplacian.chunks_exact_mut(per_area.len()) {
-        for (lap, per_area) in face.iter_mut().zip(per_area) {
-            *lap *= per_area * per_r2;
-        }
-    }
     // Volume from a to b over the sub-step, per R² (m·sr): the flux runs down the
     // pressure −(σ/2)∇²h, i.e. up the gradient of ∇²h (the ½σ is in the mobility), so
     // out of a bump, whose top has the lowest ∇²h.
@@ -161,28 +160,37 @@ fn substep(
     // a mean-thickness mobility drew liquid out of the thin film one cell further at the
     // pool's rate, emptying it in a step (bubbles resting on the ground burst within a
     // second). At the donor's, a thin cell gives at its own slow rate.
-    let laplacian = &s.laplacian[..];
-    let per_length = dt_s / (radius_m * radius_m);
-    let volumes = Volumes {
+    let mut volumes = Volumes {
         fg,
         mobility,
-        per_length,
+        per_length: dt_s / (radius_m * radius_m),
+        laplacian: &s.laplacian,
+        seam_ends: &mut s.seam_ends,
     };
-    sides.for_each_edge_run(
-        #[inline(always)]
-        |run| {
-            let ((ha, hb), (la, lb)) = (run.ends(h_m), run.ends(laplacian));
-            volumes.block(run, [ha, hb, la, lb], &mut s.flux);
-        },
-    );
-    let seams = sides.seams();
-    let [[ha, hb], [la, lb]] = s.seam_ends.gather_many(seams, [h_m, laplacian]);
-    with_avx2(
-        #[inline(always)]
-        || volumes.block(seams, [ha, hb, la, lb], &mut s.flux),
-    );
     // Each donor gives at most half its content: h stays ≥ 0.
-    apply_limited(sides, grid, &s.flux, 1.0, h_m, &mut s.gather);
+    apply_limited(sides, grid, &mut volumes, 1.0, h_m, &mut s.gather);
+}
+
+/// The Laplacian's differences across every edge, from the thickness ([`EdgeValues`]).
+struct Differences<'a> {
+    /// The grid's constants.
+    fg: &'a FaceGeometry,
+    /// The seams' ends.
+    seam_ends: &'a mut SeamEnds,
+}
+
+impl EdgeValues for Differences<'_> {
+    #[inline(always)]
+    fn seams(&mut self, seams: Seams, h: &[f64], out: &mut [f64]) {
+        let ends = self.seam_ends.gather(seams, h);
+        differences_block(seams, ends, self.fg, out);
+    }
+
+    #[inline(always)]
+    fn run(&mut self, run: EdgeRun, _rows: Range<usize>, h: &[f64], out: &mut [f64]) {
+        let (ha, hb) = run.ends(h);
+        differences_block(run, [ha, hb], self.fg, out);
+    }
 }
 
 /// `(h_a − h_b) l/d` over a block of edges with thicknesses `[ha, hb]` at their ends,
@@ -199,13 +207,14 @@ fn differences_block(
         run.constant(&fg.length),
         run.constant(&fg.inverse_dual_length),
     );
-    let (ha, hb, out) = (&ha[..len], &hb[..len], run.values_mut(out));
+    let (ha, hb, out) = (&ha[..len], &hb[..len], &mut out[..len]);
     for i in 0..len {
         out[i] = (ha[i] - hb[i]) * l[i] * per_d[i];
     }
 }
 
-/// The sub-step's volumes across the edges ([`substep`]).
+/// The sub-step's volumes across the edges ([`substep`]), from the thickness
+/// ([`EdgeValues`]).
 struct Volumes<'a> {
     /// The grid's constants.
     fg: &'a FaceGeometry,
@@ -213,26 +222,58 @@ struct Volumes<'a> {
     mobility: Mobility,
     /// The sub-step over `R²`.
     per_length: f64,
+    /// The thickness's Laplacian per cell, per m.
+    laplacian: &'a [f64],
+    /// The seams' ends.
+    seam_ends: &'a mut SeamEnds,
 }
 
-impl Volumes<'_> {
-    /// The volumes over a block of edges with thicknesses and Laplacians `[ha, hb, la,
-    /// lb]` at their ends, into `out`.
+impl EdgeValues for Volumes<'_> {
     #[inline(always)]
-    fn block(&self, run: impl EdgeBlock, [ha, hb, la, lb]: [&[f64]; 4], out: &mut [f64]) {
-        let len = run.count();
-        let (fg, Mobility { per_cubed, cap }) = (self.fg, self.mobility);
-        let (l, per_d) = (
-            run.constant(&fg.length),
-            run.constant(&fg.inverse_dual_length),
+    fn seams(&mut self, seams: Seams, h: &[f64], out: &mut [f64]) {
+        let [[ha, hb], [la, lb]] = self.seam_ends.gather_many(seams, [h, self.laplacian]);
+        volumes_block(
+            (self.fg, self.mobility, self.per_length),
+            seams,
+            [ha, hb, la, lb],
+            out,
         );
-        let (ha, hb, la, lb) = (&ha[..len], &hb[..len], &la[..len], &lb[..len]);
-        let out = run.values_mut(out);
-        for i in 0..len {
-            let rise = lb[i] - la[i];
-            let donor = pick(rise >= 0.0, ha[i], hb[i]);
-            let m = smaller(per_cubed * donor * donor * donor, cap);
-            out[i] = m * rise * per_d[i] * l[i] * self.per_length;
-        }
+    }
+
+    #[inline(always)]
+    fn run(&mut self, run: EdgeRun, _rows: Range<usize>, h: &[f64], out: &mut [f64]) {
+        let ((ha, hb), (la, lb)) = (run.ends(h), run.ends(self.laplacian));
+        volumes_block(
+            (self.fg, self.mobility, self.per_length),
+            run,
+            [ha, hb, la, lb],
+            out,
+        );
+    }
+}
+
+/// The volumes over a block of edges with thicknesses and Laplacians `[ha, hb, la, lb]`
+/// at their ends, into `out` (the grid's constants, the mobility and the sub-step over
+/// R², [`Volumes`]).
+#[inline(always)]
+fn volumes_block(
+    (fg, mobility, per_length): (&FaceGeometry, Mobility, f64),
+    run: impl EdgeBlock,
+    [ha, hb, la, lb]: [&[f64]; 4],
+    out: &mut [f64],
+) {
+    let len = run.count();
+    let Mobility { per_cubed, cap } = mobility;
+    let (l, per_d) = (
+        run.constant(&fg.length),
+        run.constant(&fg.inverse_dual_length),
+    );
+    let (ha, hb, la, lb) = (&ha[..len], &hb[..len], &la[..len], &lb[..len]);
+    let out = &mut out[..len];
+    for i in 0..len {
+        let rise = lb[i] - la[i];
+        let donor = pick(rise >= 0.0, ha[i], hb[i]);
+        let m = smaller(per_cubed * donor * donor * donor, cap);
+        out[i] = m * rise * per_d[i] * l[i] * per_length;
     }
 }

@@ -19,7 +19,7 @@ use super::advect::{AdvectionGeometry, AdvectionScratch, advect_momentum};
 use super::burst::{BurstParams, BurstState, Hole};
 use super::capillary::{Capillary, CapillaryScratch, smooth_thickness};
 use super::compare::larger;
-use super::face_geometry::EdgeVector;
+use super::face_geometry::{EdgeVector, FaceGeometry};
 use super::face_rows::FaceRows;
 use super::fluxes::GatherScratch;
 use super::grid::{CubeSphere, dot_at};
@@ -27,7 +27,7 @@ use super::meniscus::MeniscusState;
 use super::sides::{CellSides, EdgeBlock, SeamEnds};
 use super::solve::{Hierarchy, SolveReport, Work};
 use super::thermal::{ThermalParams, up_from};
-use super::upwind::{RimRises, UpwindGeometry};
+use super::upwind::{Rises, UpwindGeometry};
 use super::viscosity::{ViscousScratch, viscous_bound};
 use crate::avx2::with_avx2;
 
@@ -177,12 +177,16 @@ pub(super) struct Scratch {
     pub(super) u_start: Vec<f64>,
     pub(super) stiffness: Vec<f64>,
     pub(super) guess: Vec<f64>,
-    /// Per side `k` and cell: how far the cell's limited gradient carries its thickness
-    /// to that side's midpoint, m.
-    pub(super) limited_rise: [Vec<f64>; 4],
-    /// The rim's values for the limited rises ([`RimRises`]).
-    pub(super) rim_rises: RimRises,
+    /// The thickness transport's limited rises ([`Rises`]).
+    pub(super) rises: Rises,
+    /// Per edge: the air's drag factor, where [`FilmFlow::air_shear`] took the drag
+    /// ([`Drag::Stored`]).
     pub(super) drag: Vec<f64>,
+    /// Where the Marangoni step takes the drag from ([`Drag`]).
+    pub(super) drag_by: Drag,
+    /// Tests: take the drag in [`FilmFlow::air_shear`] even without a meniscus.
+    #[cfg(test)]
+    drag_here: bool,
     /// The edge velocities in the face rows during the explicit momentum step, m/s.
     rows_u: Vec<f64>,
     /// The viscous step's buffers.
@@ -470,48 +474,72 @@ impl FilmFlow {
     /// the potential flow's `1.5 (U − (U·n)n)`; inside, the gas moving with the bubble.
     /// Each side's shear is `μ_air Δu/δ` through a laminar boundary layer
     /// `δ = √(ν_air ℓ/|Δu|)` over the eddy scale `ℓ = R/4`, at most R. Implicit per edge
-    /// (with δ from the step's starting slip), so stable however thin the film. Records
-    /// each edge's implicit factor `1/(1 + dt k)`, by which the Marangoni step's own
-    /// velocity change is damped too: drag and Marangoni stress are then one backward-Euler
-    /// step, and a film they hold together stays at rest.
+    /// (with δ from the step's starting slip), so stable however thin the film. Each
+    /// edge's implicit factor `1/(1 + dt k)` damps the Marangoni step's own velocity
+    /// change too: drag and Marangoni stress are then one backward-Euler step, and a film
+    /// they hold together stays at rest.
+    ///
+    /// Without a meniscus the drag is left to the Marangoni step's edge pass, which
+    /// reads each edge's velocity and thickness anyway and drags it there ([`Drag`]): a
+    /// pass of its own read and wrote the velocities and wrote the factors (0.4 MB each
+    /// at n = 64), which that pass read back. A meniscus holds its walls with the
+    /// factors ([`super::meniscus::MeniscusState::hold`]), so with one the drag is taken
+    /// here and its factors kept.
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn air_shear(&mut self, s: &mut Scratch, dt_s: f64, air_m_per_s: DVec3) {
         let p = &self.params;
         if p.air_viscosity_pa_s <= 0.0 {
-            s.drag.clear();
-            s.drag.resize(self.u_m_per_s.len(), 1.0);
+            s.drag_by = Drag::None;
+            if self.meniscus.is_some() {
+                s.drag.clear();
+                s.drag.resize(self.u_m_per_s.len(), 1.0);
+                s.drag_by = Drag::Stored;
+            }
             return;
         }
-        // Every factor is written below: the buffer needs its length, not a fill.
-        s.drag.resize(self.u_m_per_s.len(), 1.0);
         let nu_air = p.air_viscosity_pa_s / p.air_density_kg_per_m3.max(f64::MIN_POSITIVE);
         let (r, eddy) = (p.radius_m, 0.25 * p.radius_m);
-        let fg = self.grid.face_geometry();
         let shear = AirShear {
             per_slip: 1.0 / (nu_air * eddy),
             floor: 1.0 / r,
             per_layer: p.air_viscosity_pa_s / p.density_kg_per_m3,
             dt_s,
             air: air_m_per_s,
-            slopes: match p.gradient {
-                FilmGradient::TwoPoint => &fg.centre_gradient,
-                FilmGradient::Normal => &fg.centre_normal_gradient,
-            },
+            gradient: p.gradient,
         };
+        if self.drag_deferrable(s) {
+            s.drag_by = Drag::Deferred(shear);
+            return;
+        }
+        s.drag_by = Drag::Stored;
+        // Every factor is written below: the buffer needs its length, not a fill.
+        s.drag.resize(self.u_m_per_s.len(), 1.0);
+        let fg = self.grid.face_geometry();
         let (sides, u, drag) = (&self.sides, &mut self.u_m_per_s, &mut s.drag);
         sides.for_each_edge_run(
             #[inline(always)]
             |run| {
                 let (ha, hb) = run.ends(&self.h_m);
-                shear.block(run, [ha, hb], u, drag);
+                shear.block(fg, run, [ha, hb], (u, drag));
             },
         );
         let seams = sides.seams();
         let ends = s.seam_ends.gather(seams, &self.h_m);
         with_avx2(
             #[inline(always)]
-            || shear.block(seams, ends, u, drag),
+            || shear.block(fg, seams, ends, (u, drag)),
         );
+    }
+
+    /// Whether the drag may be left to the Marangoni step: no meniscus holds its walls
+    /// with the factors (and, in tests, none asked for it here to compare).
+    fn drag_deferrable(&self, s: &Scratch) -> bool {
+        #[cfg(test)]
+        if s.drag_here {
+            return false;
+        }
+        let _ = s;
+        self.meniscus.is_none()
     }
 
     /// The capillary pressure's flow relative to the surfaces (module `capillary`); none
@@ -533,8 +561,22 @@ impl FilmFlow {
     }
 }
 
+/// Where the Marangoni step's edge pass takes each edge's drag from
+/// ([`FilmFlow::air_shear`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) enum Drag {
+    /// No air: every factor is 1.
+    #[default]
+    None,
+    /// The velocities are dragged and their factors in [`Scratch::drag`].
+    Stored,
+    /// Not taken yet: the pass drags each velocity as it reads it, and takes its factor.
+    Deferred(AirShear),
+}
+
 /// The air shear's constants ([`FilmFlow::air_shear`]).
-struct AirShear<'a> {
+#[derive(Clone, Copy, Debug)]
+pub(super) struct AirShear {
     /// `1/(ν_air ℓ)`: the slip times this is `1/δ²`.
     per_slip: f64,
     /// `1/R`, the least `1/δ`.
@@ -545,12 +587,42 @@ struct AirShear<'a> {
     dt_s: f64,
     /// The air's velocity far from the bubble, m/s.
     air: DVec3,
-    /// The slopes of a linear potential across the edges, as components in each block's
-    /// frame ([`EdgeBlock::vector`]).
-    slopes: &'a EdgeVector,
+    /// The film's gradient: the potential flow's surface velocity is taken with it.
+    gradient: FilmGradient,
 }
 
-impl AirShear<'_> {
+/// [`AirShear`] along a block of edges: the potential flow's slopes there.
+#[derive(Clone, Copy)]
+pub(super) struct AirShearAlong<'a> {
+    /// The constants.
+    shear: AirShear,
+    /// The air's velocity in the block's frame ([`EdgeBlock::frame`]).
+    air: DVec3,
+    /// The slopes of a linear potential across the edges, as components in that frame
+    /// ([`EdgeBlock::vector`]).
+    slopes: [&'a [f64]; 3],
+}
+
+impl AirShear {
+    /// The constants along `block`, with the grid's constants `fg`.
+    #[inline(always)]
+    pub(super) fn along<'a>(
+        &self,
+        fg: &'a FaceGeometry,
+        block: &impl EdgeBlock,
+    ) -> AirShearAlong<'a> {
+        let slopes: &EdgeVector = match self.gradient {
+            FilmGradient::TwoPoint => &fg.centre_gradient,
+            FilmGradient::Normal => &fg.centre_normal_gradient,
+        };
+        let len = block.count();
+        AirShearAlong {
+            shear: *self,
+            air: block.frame(self.air),
+            slopes: block.vector(slopes).map(|c| &c[..len]),
+        }
+    }
+
     /// `1/δ = max(√(|Δu|/(ν_air ℓ)), 1/R)` at slip `slip`: a multiply where `1/δ` was a
     /// division.
     #[inline(always)]
@@ -561,23 +633,38 @@ impl AirShear<'_> {
     /// The shear over a block of edges with thicknesses `[ha, hb]` at their ends: each
     /// edge's velocity `u` dragged, its implicit factor into `drag`.
     #[inline(always)]
-    fn block(&self, block: impl EdgeBlock, [ha, hb]: [&[f64]; 2], u: &mut [f64], drag: &mut [f64]) {
+    fn block(
+        &self,
+        fg: &FaceGeometry,
+        block: impl EdgeBlock,
+        [ha, hb]: [&[f64]; 2],
+        (u, drag): (&mut [f64], &mut [f64]),
+    ) {
         let len = block.count();
         let (ha, hb) = (&ha[..len], &hb[..len]);
-        let (slopes, air) = (block.vector(self.slopes), block.frame(self.air));
+        let along = self.along(fg, &block);
         let (u, factor) = (block.values_mut(u), block.values_mut(drag));
-        let dt_s = self.dt_s;
         for i in 0..len {
-            // The potential flow's surface velocity is the gradient of 1.5 U·x: taken as
-            // the discrete gradient between cell centres, curl-free like the real one.
-            let outside = 1.5 * dot_at(air, slopes, i);
             let h = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
-            let k = self.per_layer / h;
-            let k_out = k * self.per_layer_depth((u[i] - outside).abs());
-            let k_in = k * self.per_layer_depth(u[i].abs());
-            factor[i] = 1.0 / (1.0 + dt_s * (k_out + k_in));
-            u[i] = (u[i] + dt_s * k_out * outside) * factor[i];
+            (u[i], factor[i]) = along.drag(i, u[i], h);
         }
+    }
+}
+
+impl AirShearAlong<'_> {
+    /// Edge `i` of the block's velocity `u` dragged, and its implicit factor, at its
+    /// thickness `h` (floored at [`H_FLOOR_M`]).
+    #[inline(always)]
+    pub(super) fn drag(&self, i: usize, u: f64, h: f64) -> (f64, f64) {
+        let s = &self.shear;
+        // The potential flow's surface velocity is the gradient of 1.5 U·x: taken as
+        // the discrete gradient between cell centres, curl-free like the real one.
+        let outside = 1.5 * dot_at(self.air, self.slopes, i);
+        let k = s.per_layer / h;
+        let k_out = k * s.per_layer_depth((u - outside).abs());
+        let k_in = k * s.per_layer_depth(u.abs());
+        let factor = 1.0 / (1.0 + s.dt_s * (k_out + k_in));
+        ((u + s.dt_s * k_out * outside) * factor, factor)
     }
 }
 
@@ -602,6 +689,38 @@ mod tests {
         f.set_velocity(|d| DVec3::Y.cross(d) * 0.05);
         f.set_surfactant(|d| 1.0 + 0.1 * d.z);
         f
+    }
+
+    /// The drag left to the Marangoni step's edge pass gives the bits of the drag taken
+    /// in a pass of its own, as with a meniscus ([`Drag`]), with either gradient.
+    #[test]
+    fn the_drag_left_to_the_marangoni_pass_gives_the_drag_pass_bits() {
+        let forcing = Forcing {
+            g_eff_m_per_s2: DVec3::new(0.0, -9.81, 0.0),
+            air_m_per_s: DVec3::new(0.3, 0.0, 0.1),
+        };
+        for gradient in [FilmGradient::TwoPoint, FilmGradient::Normal] {
+            let run = |here: bool| {
+                let mut f = film();
+                f.params.gradient = gradient;
+                f.scratch.drag_here = here;
+                for _ in 0..5 {
+                    f.step(1.0 / 60.0, &forcing);
+                }
+                assert!(matches!(f.scratch.drag_by, Drag::Deferred(_)) != here);
+                f
+            };
+            let (left, here) = (run(false), run(true));
+            let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            let what = format!("{gradient:?}");
+            assert_eq!(bits(&left.h_m), bits(&here.h_m), "{what}: thickness");
+            assert_eq!(bits(&left.gamma), bits(&here.gamma), "{what}: surfactant");
+            assert_eq!(
+                bits(&left.u_m_per_s),
+                bits(&here.u_m_per_s),
+                "{what}: velocity"
+            );
+        }
     }
 
     /// Every pass the step compiles for AVX2 gives the portable build's bits: IEEE

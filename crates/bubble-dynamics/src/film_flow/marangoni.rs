@@ -3,20 +3,25 @@
 //! fluxes that sum to zero.
 //!
 //! First the surfactant moves upwind with the step's starting velocity, in sub-steps of
-//! its own (`transport_surfactant`). Then the edges are walked: the fluxes' central part
-//! with the system's edge weights and right-hand side; with the normal gradient
+//! its own (`transport_surfactant`). Then the edges are walked: the air's drag where it
+//! was left to this pass ([`super::flow::Drag`]), the fluxes' central part with the
+//! system's edge weights and right-hand side (gathered band by band,
+//! [`super::fluxes::net_inflow`]); with the normal gradient
 //! ([`FilmGradient::Normal`]) the cross term of the gradient again from each solution
 //! until the system with it is solved (defect correction, `correct_the_cross_term`); the
 //! velocity correction with the surfactant's move (into a copy, so the correction still
 //! reads the surfactant the solve started from and the rare redo needs no restore).
 
+use std::ops::Range;
+
 use super::compare::{larger, pick};
 use super::face_geometry::{EdgeConstant, FaceGeometry};
 use super::flow::{
-    FilmFlow, FilmGradient, H_FLOOR_M, SOLVE_MAX_ITERATIONS, SOLVE_TOLERANCE, Scratch,
+    Drag, FilmFlow, FilmGradient, H_FLOOR_M, SOLVE_MAX_ITERATIONS, SOLVE_TOLERANCE, Scratch,
 };
-use super::fluxes::{apply_limited, net_inflow};
-use super::sides::{CellSides, EdgeBlock, SeamEnds};
+use super::fluxes::{EdgeValues, apply_limited, net_inflow};
+use super::grid::CubeSphere;
+use super::sides::{EdgeBlock, EdgeRun, SeamEnds, Seams};
 use super::solve::{SolveLimits, SolveReport};
 use crate::avx2::with_avx2;
 
@@ -80,13 +85,12 @@ impl FilmFlow {
         }
         let substeps = (2.0 * fastest * dt_per_r).ceil().clamp(1.0, 64.0) as u32;
         let sub_dt_per_r = dt_per_r / f64::from(substeps);
-        s.edge2.resize(s.u_start.len(), 0.0);
         let sides = &self.sides;
         for _ in 0..substeps {
-            let fields = (&self.gamma[..], &s.u_start[..]);
-            upwind_fluxes(sides, fg, fields, (&mut s.edge2, &mut s.seam_ends));
-            let (flux, gamma) = (&s.edge2, &mut self.gamma);
-            apply_limited(sides, &g, flux, sub_dt_per_r, gamma, &mut s.gather);
+            let u = &s.u_start;
+            let mut fluxes = UpwindFluxes::new(fg, u, &mut s.seam_ends);
+            let (gamma, gather) = (&mut self.gamma, &mut s.gather);
+            apply_limited(sides, &g, &mut fluxes, sub_dt_per_r, gamma, gather);
         }
     }
 
@@ -109,103 +113,66 @@ impl FilmFlow {
     /// a velocity `k·(tan θ/l)·ΔΓ` of the step's change ΔΓ that no gradient holds, and
     /// `k = dt E/(ρh)` is huge in a stiff step: a perturbed film at rest kept 3.5 mm/s
     /// forever and most film tests blew up.
-    fn fluxes_weights_and_right_hand_side<const NORMAL: bool>(&self, s: &mut Scratch, dt_s: f64) {
+    ///
+    /// The fluxes go straight into the gather of the right-hand side, band by band
+    /// ([`net_inflow`]); with the normal gradient they are also kept whole in `s.edge`
+    /// (the defect correction adds to them), with the two-point one the velocity
+    /// correction takes them again from the velocities (the same bits).
+    fn fluxes_weights_and_right_hand_side<const NORMAL: bool>(
+        &mut self,
+        s: &mut Scratch,
+        dt_s: f64,
+    ) {
         let p = &self.params;
         let g = &self.grid;
-        let ea = g.edge_arrays();
-        let n = ea.cells.len();
+        let n = g.edge_arrays().cells.len();
         if NORMAL {
             g.cells_to_vertices(&s.cell2, &mut s.vertex);
             s.cross.resize(n, 0.0);
+            s.edge.resize(n, 0.0);
         }
-        s.edge.resize(n, 0.0);
         s.stiffness.resize(n, 0.0);
         s.weight.resize(n, 0.0);
-        let edge = EdgeConstants {
-            // `dt E/ρ`: over the edge's thickness, the stiffness `k`.
-            dt_e_per_rho: dt_s * p.elasticity_n_per_m / p.density_kg_per_m3,
-            dt_per_r2: dt_s / (p.radius_m * p.radius_m),
-            per_r: 1.0 / p.radius_m,
-        };
-        let sides = &self.sides;
-        sides.for_each_edge_run(
-            #[inline(always)]
-            |run| {
-                let ((ga, gb), (ha, hb)) = (run.ends(&self.gamma), run.ends(&self.h_m));
-                self.central_fluxes_block::<NORMAL>(s, run, [ga, gb, ha, hb], edge);
+        let mut fluxes = CentralFluxes::<NORMAL> {
+            edges: CentralEdges {
+                grid: g,
+                u: &mut self.u_m_per_s,
+                u0: &s.u_start,
+                drag: (s.drag_by, &s.drag),
+                vertex: &s.vertex,
+                c: EdgeConstants {
+                    // `dt E/ρ`: over the edge's thickness, the stiffness `k`.
+                    dt_e_per_rho: dt_s * p.elasticity_n_per_m / p.density_kg_per_m3,
+                    dt_per_r2: dt_s / (p.radius_m * p.radius_m),
+                    per_r: 1.0 / p.radius_m,
+                },
+                stiffness: &mut s.stiffness,
+                weight: &mut s.weight,
+                cross: &mut s.cross,
+                flux: &mut s.edge,
             },
-        );
-        let seams = sides.seams();
-        let mut seam_ends = std::mem::take(&mut s.seam_ends);
-        let [[ga, gb], [ha, hb]] = seam_ends.gather_many(seams, [&self.gamma, &self.h_m]);
-        with_avx2(
-            #[inline(always)]
-            || self.central_fluxes_block::<NORMAL>(s, seams, [ga, gb, ha, hb], edge),
-        );
-        s.seam_ends = seam_ends;
-        // `A Γ − dt Σ F/R`: each cell's net inflow of the fluxes, gathered.
-        net_inflow(sides, &s.edge, &mut s.rhs, &mut s.gather);
+            h: &self.h_m,
+            seam_ends: &mut s.seam_ends,
+        };
+        // `A Γ − dt Σ F/R`: each cell's net inflow of the fluxes, gathered; each face's
+        // cells with face 0's areas (the same on every face).
         let dt_per_r = dt_s / p.radius_m;
-        // A face at a time, each with face 0's areas (the same on every face).
-        let areas = &g.face_geometry().area_sr[..];
-        let m = areas.len();
-        let faces = s.rhs.chunks_exact_mut(m).zip(self.gamma.chunks_exact(m));
-        with_avx2(
-            #[inline(always)]
-            || {
-                for (rhs, gamma) in faces {
-                    let (rhs, gamma) = (&mut rhs[..m], &gamma[..m]);
-                    for i in 0..m {
-                        rhs[i] = areas[i] * gamma[i] + dt_per_r * rhs[i];
-                    }
+        let (areas, gamma, n) = (&g.face_geometry().area_sr[..], &self.gamma, self.sides.n());
+        let pass = (&mut fluxes, &gamma[..]);
+        net_inflow(
+            &self.sides,
+            pass,
+            &mut s.rhs,
+            &mut s.gather,
+            |face, rows, rhs| {
+                let cells = rows.start * n..rows.end * n;
+                let gamma = &gamma[face * n * n + cells.start..face * n * n + cells.end];
+                let (areas, gamma) = (&areas[cells], &gamma[..rhs.len()]);
+                for i in 0..rhs.len() {
+                    rhs[i] = areas[i] * gamma[i] + dt_per_r * rhs[i];
                 }
             },
         );
-    }
-
-    /// [`Self::fluxes_weights_and_right_hand_side`]'s edge pass over a block of edges,
-    /// with the surfactant and thickness at their ends.
-    #[inline(always)]
-    fn central_fluxes_block<const NORMAL: bool>(
-        &self,
-        s: &mut Scratch,
-        run: impl EdgeBlock,
-        [ga, gb, ha, hb]: [&[f64]; 4],
-        c: EdgeConstants,
-    ) {
-        let (ea, fg) = (self.grid.edge_arrays(), self.grid.face_geometry());
-        let len = run.count();
-        let (ga, gb, ha, hb) = (&ga[..len], &gb[..len], &ha[..len], &hb[..len]);
-        let (u, u0) = (run.values(&self.u_m_per_s), run.values(&s.u_start));
-        let (drag, l) = (run.values(&s.drag), run.constant(&fg.length));
-        let inverse_dual = if NORMAL {
-            &fg.inverse_normal_dual_length
-        } else {
-            &fg.inverse_dual_length
-        };
-        let id = run.constant(inverse_dual);
-        let (u, u0, drag, l, id) = (&u[..len], &u0[..len], &drag[..len], &l[..len], &id[..len]);
-        let flux = run.values_mut(&mut s.edge);
-        let stiffness = run.values_mut(&mut s.stiffness);
-        let weight = run.values_mut(&mut s.weight);
-        for i in 0..len {
-            let gamma_c = 0.5 * (ga[i] + gb[i]);
-            let h_edge = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
-            let k = c.dt_e_per_rho / h_edge * drag[i];
-            let u = if NORMAL {
-                let e = run.first() + i;
-                let [v0, v1] = ea.vertices[e];
-                let along = s.vertex[v1 as usize] - s.vertex[v0 as usize];
-                let du = k * ea.cross_per_length[e] * along * c.per_r;
-                s.cross[e] = du / gamma_c.max(f64::MIN_POSITIVE);
-                u[i] + s.cross[e]
-            } else {
-                u[i]
-            };
-            flux[i] = gamma_c * (u - u0[i]) * l[i];
-            stiffness[i] = k;
-            weight[i] = c.dt_per_r2 * k * l[i] * id[i];
-        }
     }
 
     /// Solves for the surfactant the step ends with into `s.cell2`, from the last step's
@@ -315,41 +282,49 @@ impl FilmFlow {
         let sides = std::sync::Arc::clone(&self.sides);
         let (fg, sides) = (g.face_geometry(), &*sides);
         let scale = dt_s / r;
-        s.edge2.resize(s.edge.len(), 0.0);
-        let constants = (1.0 / r, scale);
-        let inverse_dual = if NORMAL {
-            &fg.inverse_normal_dual_length
-        } else {
-            &fg.inverse_dual_length
+        let mut correction = Correction::<NORMAL> {
+            edges: CorrectionEdges {
+                inverse_dual: if NORMAL {
+                    &fg.inverse_normal_dual_length
+                } else {
+                    &fg.inverse_dual_length
+                },
+                length: &fg.length,
+                u0: &s.u_start,
+                flux: &s.edge,
+                stiffness: &s.stiffness,
+                cross: &s.cross,
+                u: &mut self.u_m_per_s,
+                per_r: 1.0 / r,
+                scale,
+            },
+            solution: &s.cell2,
+            seam_ends: &mut s.seam_ends,
         };
-        let inputs = CorrectionInputs {
-            inverse_dual,
-            length: &fg.length,
-            flux: &s.edge,
-            stiffness: &s.stiffness,
-            cross: &s.cross,
-        };
-        sides.for_each_edge_run(
-            #[inline(always)]
-            |run| {
-                let ((ga, gb), (xa, xb)) = (run.ends(&self.gamma), run.ends(&s.cell2));
-                let out = (&mut self.u_m_per_s[..], &mut s.edge2[..]);
-                correct_velocity_block::<NORMAL>(run, [ga, gb, xa, xb], inputs, out, constants);
+        // Each cell's net inflow gathered band by band, and the surfactant after the
+        // step from it while the band is in cache; each face's cells with face 0's
+        // inverse areas (the same on every face).
+        let (gamma, n) = (&self.gamma[..], sides.n());
+        let change = &mut self.surfactant_change;
+        // Every entry is written below: the buffer needs its length, not a fill.
+        change.resize(gamma.len(), 0.0);
+        let (per_area, solution) = (&fg.inverse_area_per_sr[..], &s.cell2[..]);
+        let mut negative = false;
+        let pass = (&mut correction, gamma);
+        net_inflow(
+            sides,
+            pass,
+            &mut s.rhs,
+            &mut s.gather,
+            |face, rows, next| {
+                let cells = face * n * n + rows.start * n..face * n * n + rows.end * n;
+                let per_area = &per_area[rows.start * n..rows.end * n];
+                let before = (&gamma[cells.clone()], &solution[cells.clone()]);
+                let after = (next, &mut change[cells]);
+                negative |= next_surfactant(before, per_area, after);
             },
         );
-        let seams = sides.seams();
-        let mut seam_ends = std::mem::take(&mut s.seam_ends);
-        let [[ga, gb], [xa, xb]] = seam_ends.gather_many(seams, [&self.gamma, &s.cell2]);
-        let out = (&mut self.u_m_per_s[..], &mut s.edge2[..]);
-        with_avx2(
-            #[inline(always)]
-            || correct_velocity_block::<NORMAL>(seams, [ga, gb, xa, xb], inputs, out, constants),
-        );
-        s.seam_ends = seam_ends;
-        net_inflow(sides, &s.edge2, &mut s.rhs, &mut s.gather);
-        let per_area = &g.face_geometry().inverse_area_per_sr;
-        let change = &mut self.surfactant_change;
-        if !next_surfactant(&self.gamma, &s.cell2, per_area, &mut s.rhs, change) {
+        if !negative {
             std::mem::swap(&mut self.gamma, &mut s.rhs);
             return;
         }
@@ -360,55 +335,233 @@ impl FilmFlow {
         let change = &mut s.edge;
         change.clear();
         change.extend(self.u_m_per_s.iter().zip(&s.u_start).map(|(u, u0)| u - u0));
-        let out = (&mut s.edge2[..], &mut s.seam_ends);
-        upwind_fluxes(sides, fg, (&self.gamma, change), out);
-        let (flux, gamma) = (&s.edge2, &mut self.gamma);
-        apply_limited(sides, &g, flux, scale, gamma, &mut s.gather);
+        let mut fluxes = UpwindFluxes::new(fg, change, &mut s.seam_ends);
+        let (gamma, gather) = (&mut self.gamma, &mut s.gather);
+        apply_limited(sides, &g, &mut fluxes, scale, gamma, gather);
     }
 }
 
-/// What the velocity correction reads per edge besides the cells' values: the grid's
-/// constants ([`EdgeBlock::constant`]) and full per-edge arrays.
-#[derive(Clone, Copy)]
-struct CorrectionInputs<'a> {
+/// [`FilmFlow::fluxes_weights_and_right_hand_side`]'s edge pass ([`EdgeValues`]: the
+/// central fluxes, from the surfactant at the edges' ends), with the stiffnesses and
+/// weights (and, with the normal gradient, the cross term and the fluxes kept whole).
+struct CentralFluxes<'a, const NORMAL: bool> {
+    /// What it reads and writes per edge.
+    edges: CentralEdges<'a, NORMAL>,
+    /// The thickness per cell, m.
+    h: &'a [f64],
+    /// The seams' ends.
+    seam_ends: &'a mut SeamEnds,
+}
+
+/// [`CentralFluxes`]' per-edge inputs and outputs.
+struct CentralEdges<'a, const NORMAL: bool> {
+    /// The grid (its constants, and its edges' vertices for the cross term).
+    grid: &'a CubeSphere,
+    /// The velocity after the explicit forces, m/s: dragged here where the drag was
+    /// left to this pass ([`Drag::Deferred`]).
+    u: &'a mut [f64],
+    /// The step's starting velocity, m/s.
+    u0: &'a [f64],
+    /// Where each edge's drag comes from, and the factors where they are kept
+    /// ([`FilmFlow::air_shear`]).
+    drag: (Drag, &'a [f64]),
+    /// The surfactant at the vertices (the cross term's, with the normal gradient).
+    vertex: &'a [f64],
+    /// The pass's constants.
+    c: EdgeConstants,
+    /// Each edge's stiffness `k`, out.
+    stiffness: &'a mut [f64],
+    /// Each edge's weight in the system, out.
+    weight: &'a mut [f64],
+    /// The cross term's velocity, out (with the normal gradient).
+    cross: &'a mut [f64],
+    /// The fluxes kept whole, out (with the normal gradient).
+    flux: &'a mut [f64],
+}
+
+impl<const NORMAL: bool> EdgeValues for CentralFluxes<'_, NORMAL> {
+    #[inline(always)]
+    fn seams(&mut self, seams: Seams, gamma: &[f64], out: &mut [f64]) {
+        let [[ga, gb], [ha, hb]] = self.seam_ends.gather_many(seams, [gamma, self.h]);
+        self.edges.block(seams, [ga, gb, ha, hb], out);
+    }
+
+    #[inline(always)]
+    fn run(&mut self, run: EdgeRun, _rows: Range<usize>, gamma: &[f64], out: &mut [f64]) {
+        let ((ga, gb), (ha, hb)) = (run.ends(gamma), run.ends(self.h));
+        self.edges.block(run, [ga, gb, ha, hb], out);
+    }
+}
+
+impl<const NORMAL: bool> CentralEdges<'_, NORMAL> {
+    /// The pass over a block of edges, with the surfactant and thickness at their ends:
+    /// the fluxes (per R) into `flux`. A loop for each source of the drag
+    /// ([`Drag`]), so that each vectorises.
+    #[inline(always)]
+    fn block(&mut self, run: impl EdgeBlock, ends: [&[f64]; 4], flux: &mut [f64]) {
+        let len = run.count();
+        match self.drag {
+            (Drag::None, _) => self.block_with::<false>(run, ends, flux, |_, u, _| (u, 1.0)),
+            (Drag::Stored, factors) => {
+                let factors = &run.values(factors)[..len];
+                self.block_with::<false>(run, ends, flux, |i, u, _| (u, factors[i]));
+            }
+            (Drag::Deferred(shear), _) => {
+                let along = shear.along(self.grid.face_geometry(), &run);
+                self.block_with::<true>(run, ends, flux, |i, u, h| along.drag(i, u, h));
+            }
+        }
+    }
+
+    /// [`Self::block`] with each edge's velocity dragged and its factor by `drag(i, u,
+    /// h)` (the edge, its velocity and its floored thickness), the dragged velocities
+    /// written back where `DRAGGED`.
+    #[inline(always)]
+    fn block_with<const DRAGGED: bool>(
+        &mut self,
+        run: impl EdgeBlock,
+        [ga, gb, ha, hb]: [&[f64]; 4],
+        flux: &mut [f64],
+        drag: impl Fn(usize, f64, f64) -> (f64, f64),
+    ) {
+        let (ea, fg, c) = (self.grid.edge_arrays(), self.grid.face_geometry(), self.c);
+        let len = run.count();
+        let (ga, gb, ha, hb) = (&ga[..len], &gb[..len], &ha[..len], &hb[..len]);
+        let l = run.constant(&fg.length);
+        let inverse_dual = if NORMAL {
+            &fg.inverse_normal_dual_length
+        } else {
+            &fg.inverse_dual_length
+        };
+        let id = run.constant(inverse_dual);
+        let (u0, l, id) = (&run.values(self.u0)[..len], &l[..len], &id[..len]);
+        let flux = &mut flux[..len];
+        let u = &mut run.values_mut(self.u)[..len];
+        let stiffness = run.values_mut(self.stiffness);
+        let weight = run.values_mut(self.weight);
+        // The cross term's arrays along the block (empty with the two-point gradient).
+        let (vertices, cross_per_length, cross) = if NORMAL {
+            let edges = run.first()..run.first() + len;
+            let cross = &mut self.cross[edges.clone()];
+            (
+                &ea.vertices[edges.clone()],
+                &ea.cross_per_length[edges],
+                cross,
+            )
+        } else {
+            (&[][..], &[][..], &mut [][..])
+        };
+        for i in 0..len {
+            let gamma_c = 0.5 * (ga[i] + gb[i]);
+            let h_edge = larger(0.5 * (ha[i] + hb[i]), H_FLOOR_M);
+            let (u_dragged, factor) = drag(i, u[i], h_edge);
+            if DRAGGED {
+                u[i] = u_dragged;
+            }
+            let k = c.dt_e_per_rho / h_edge * factor;
+            let u = if NORMAL {
+                let [v0, v1] = vertices[i];
+                let along = self.vertex[v1 as usize] - self.vertex[v0 as usize];
+                let du = k * cross_per_length[i] * along * c.per_r;
+                cross[i] = du / gamma_c.max(f64::MIN_POSITIVE);
+                u_dragged + cross[i]
+            } else {
+                u_dragged
+            };
+            flux[i] = gamma_c * (u - u0[i]) * l[i];
+            stiffness[i] = k;
+            weight[i] = c.dt_per_r2 * k * l[i] * id[i];
+        }
+        if NORMAL {
+            run.values_mut(self.flux).copy_from_slice(flux);
+        }
+    }
+}
+
+/// [`FilmFlow::correct_velocity_and_move_surfactant`]'s edge pass ([`EdgeValues`]: the
+/// volume of surfactant the transport flux and the correction move, from the surfactant
+/// at the edges' ends), with the velocity correction.
+struct Correction<'a, const NORMAL: bool> {
+    /// What it reads and writes per edge.
+    edges: CorrectionEdges<'a, NORMAL>,
+    /// The surfactant the step ends with.
+    solution: &'a [f64],
+    /// The seams' ends.
+    seam_ends: &'a mut SeamEnds,
+}
+
+/// [`Correction`]'s per-edge inputs and outputs.
+struct CorrectionEdges<'a, const NORMAL: bool> {
     /// `1/d` (`1/(d cos θ)` with the normal gradient), per rad.
     inverse_dual: &'a EdgeConstant,
     /// The edges' lengths, rad.
     length: &'a EdgeConstant,
-    /// The transport flux from the central pass.
+    /// The step's starting velocity (the transport flux's, again), m/s.
+    u0: &'a [f64],
+    /// The transport flux kept whole (with the normal gradient only).
     flux: &'a [f64],
     /// Each edge's stiffness `k`.
     stiffness: &'a [f64],
     /// The cross term's velocity (with the normal gradient only).
     cross: &'a [f64],
+    /// The velocity, corrected in place, m/s.
+    u: &'a mut [f64],
+    /// 1/R, per m.
+    per_r: f64,
+    /// The step over R, s/m.
+    scale: f64,
 }
 
-/// [`FilmFlow::correct_velocity_and_move_surfactant`]'s edge pass over a block of edges,
-/// with the surfactant before (`g`) and after (`x`) at their ends: the velocity `u`
-/// corrected, and the volume of surfactant it and the transport flux move into `moved`.
-#[inline(always)]
-fn correct_velocity_block<const NORMAL: bool>(
-    run: impl EdgeBlock,
-    [ga, gb, xa, xb]: [&[f64]; 4],
-    e: CorrectionInputs,
-    (u, moved): (&mut [f64], &mut [f64]),
-    (per_r, scale): (f64, f64),
-) {
-    let len = run.count();
-    let (ga, gb, xa, xb) = (&ga[..len], &gb[..len], &xa[..len], &xb[..len]);
-    let (id, l) = (run.constant(e.inverse_dual), run.constant(e.length));
-    let (f_adv, k) = (run.values(e.flux), run.values(e.stiffness));
-    let (u, moved) = (run.values_mut(u), run.values_mut(moved));
-    for i in 0..len {
-        let gamma_c = 0.5 * (ga[i] + gb[i]);
-        let slope = (xb[i] - xa[i]) * id[i] * per_r;
-        let du = -k[i] * slope / larger(gamma_c, f64::MIN_POSITIVE);
-        u[i] += if NORMAL {
-            du + e.cross[run.first() + i]
+impl<const NORMAL: bool> EdgeValues for Correction<'_, NORMAL> {
+    #[inline(always)]
+    fn seams(&mut self, seams: Seams, gamma: &[f64], out: &mut [f64]) {
+        let [[ga, gb], [xa, xb]] = self.seam_ends.gather_many(seams, [gamma, self.solution]);
+        self.edges.block(seams, [ga, gb, xa, xb], out);
+    }
+
+    #[inline(always)]
+    fn run(&mut self, run: EdgeRun, _rows: Range<usize>, gamma: &[f64], out: &mut [f64]) {
+        let ((ga, gb), (xa, xb)) = (run.ends(gamma), run.ends(self.solution));
+        self.edges.block(run, [ga, gb, xa, xb], out);
+    }
+}
+
+impl<const NORMAL: bool> CorrectionEdges<'_, NORMAL> {
+    /// The pass over a block of edges, with the surfactant before (`g`) and after (`x`)
+    /// at their ends: the velocity corrected, and the volume of surfactant it and the
+    /// transport flux move into `moved`.
+    ///
+    /// The two-point gradient's transport flux is taken again as the central pass took
+    /// it, from the velocity before the correction (the same bits): kept whole, it was a
+    /// per-edge array written and read back (0.4 MB at n = 64).
+    #[inline(always)]
+    fn block(&mut self, run: impl EdgeBlock, [ga, gb, xa, xb]: [&[f64]; 4], moved: &mut [f64]) {
+        let len = run.count();
+        let (ga, gb, xa, xb) = (&ga[..len], &gb[..len], &xa[..len], &xb[..len]);
+        let (id, l) = (run.constant(self.inverse_dual), run.constant(self.length));
+        let (id, l, k) = (&id[..len], &l[..len], &run.values(self.stiffness)[..len]);
+        let u0 = &run.values(self.u0)[..len];
+        let (u, moved) = (&mut run.values_mut(self.u)[..len], &mut moved[..len]);
+        let (per_r, scale) = (self.per_r, self.scale);
+        // The kept fluxes and cross term along the block (empty with the two-point
+        // gradient).
+        let (flux, cross) = if NORMAL {
+            (run.values(self.flux), run.values(self.cross))
         } else {
-            du
+            (&[][..], &[][..])
         };
-        moved[i] = scale * (f_adv[i] + gamma_c * du * l[i]);
+        for i in 0..len {
+            let gamma_c = 0.5 * (ga[i] + gb[i]);
+            let f_adv = if NORMAL {
+                flux[i]
+            } else {
+                gamma_c * (u[i] - u0[i]) * l[i]
+            };
+            let slope = (xb[i] - xa[i]) * id[i] * per_r;
+            let du = -k[i] * slope / larger(gamma_c, f64::MIN_POSITIVE);
+            u[i] += if NORMAL { du + cross[i] } else { du };
+            moved[i] = scale * (f_adv + gamma_c * du * l[i]);
+        }
     }
 }
 
@@ -436,38 +589,26 @@ fn start_and_guess(gamma: &[f64], change: &[f64], solution: &mut Vec<f64>, guess
     );
 }
 
-/// Each cell's surfactant after the step, `Γ + inflow/area` (`next` holds the inflows and
-/// takes the result), and the step's change of the solve, `solution − Γ` (the next
-/// step's first guess), in one pass; returns whether any cell went negative. A face at
-/// a time, each with `per_area`, face 0's inverse areas (the same on every face).
+/// A stretch of cells' surfactant after the step, `Γ + inflow/area` (`next` holds the
+/// inflows and takes the result; `per_area` the cells' inverse areas), and the step's
+/// change of the solve, `solution − Γ` (the next step's first guess), in one pass;
+/// returns whether any cell went negative.
+#[inline(always)]
 fn next_surfactant(
-    gamma: &[f64],
-    solution: &[f64],
+    (gamma, solution): (&[f64], &[f64]),
     per_area: &[f64],
-    next: &mut [f64],
-    change: &mut Vec<f64>,
+    (next, change): (&mut [f64], &mut [f64]),
 ) -> bool {
-    let (n, m) = (gamma.len(), per_area.len());
-    // Every entry is written below: the buffer needs its length, not a fill.
-    change.resize(n, 0.0);
-    let before = gamma.chunks_exact(m).zip(solution.chunks_exact(m));
-    let after = next.chunks_exact_mut(m).zip(change.chunks_exact_mut(m));
-    with_avx2(
-        #[inline(always)]
-        || {
-            let mut negative = false;
-            for ((gamma, solution), (next, change)) in before.zip(after) {
-                let (gamma, solution) = (&gamma[..m], &solution[..m]);
-                let (next, change) = (&mut next[..m], &mut change[..m]);
-                for i in 0..m {
-                    change[i] = solution[i] - gamma[i];
-                    next[i] = gamma[i] + next[i] * per_area[i];
-                    negative |= next[i] < 0.0;
-                }
-            }
-            negative
-        },
-    )
+    let m = next.len();
+    let (gamma, solution, per_area) = (&gamma[..m], &solution[..m], &per_area[..m]);
+    let change = &mut change[..m];
+    let mut negative = false;
+    for i in 0..m {
+        change[i] = solution[i] - gamma[i];
+        next[i] = gamma[i] + next[i] * per_area[i];
+        negative |= next[i] < 0.0;
+    }
+    negative
 }
 
 /// The constants of the Marangoni step's edge pass.
@@ -481,30 +622,40 @@ struct EdgeConstants {
     per_r: f64,
 }
 
-/// The upwind volume `Γ_up·u·l` (per R and time) across every edge at speeds `u`, into
-/// `out` (the seams' ends gathered into `seam_ends`).
-fn upwind_fluxes(
-    sides: &CellSides,
-    fg: &FaceGeometry,
-    (gamma, u): (&[f64], &[f64]),
-    (out, seam_ends): (&mut [f64], &mut SeamEnds),
-) {
-    sides.for_each_edge_run(
-        #[inline(always)]
-        |run| {
-            let (ga, gb) = run.ends(gamma);
-            upwind_fluxes_block(run, [ga, gb], (fg, u), out);
-        },
-    );
-    let seams = sides.seams();
-    let ends = seam_ends.gather(seams, gamma);
-    with_avx2(
-        #[inline(always)]
-        || upwind_fluxes_block(seams, ends, (fg, u), out),
-    );
+/// The upwind volume `Γ_up·u·l` (per R and time) across every edge at speeds `u`, from
+/// the surfactant the limited apply moves ([`EdgeValues`]).
+struct UpwindFluxes<'a> {
+    /// The grid's constants.
+    fg: &'a FaceGeometry,
+    /// The speeds, m/s.
+    u: &'a [f64],
+    /// The seams' ends.
+    seam_ends: &'a mut SeamEnds,
 }
 
-/// [`upwind_fluxes`] over a block of edges, with the surfactant `[ga, gb]` at their ends.
+impl<'a> UpwindFluxes<'a> {
+    /// The fluxes at speeds `u`.
+    fn new(fg: &'a FaceGeometry, u: &'a [f64], seam_ends: &'a mut SeamEnds) -> Self {
+        Self { fg, u, seam_ends }
+    }
+}
+
+impl EdgeValues for UpwindFluxes<'_> {
+    #[inline(always)]
+    fn seams(&mut self, seams: Seams, gamma: &[f64], out: &mut [f64]) {
+        let ends = self.seam_ends.gather(seams, gamma);
+        upwind_fluxes_block(seams, ends, (self.fg, self.u), out);
+    }
+
+    #[inline(always)]
+    fn run(&mut self, run: EdgeRun, _rows: Range<usize>, gamma: &[f64], out: &mut [f64]) {
+        let (ga, gb) = run.ends(gamma);
+        upwind_fluxes_block(run, [ga, gb], (self.fg, self.u), out);
+    }
+}
+
+/// [`UpwindFluxes`] over a block of edges, with the surfactant `[ga, gb]` at their ends,
+/// into `out`.
 #[inline(always)]
 fn upwind_fluxes_block(
     run: impl EdgeBlock,
@@ -513,7 +664,7 @@ fn upwind_fluxes_block(
     out: &mut [f64],
 ) {
     let len = run.count();
-    let (u, l, f) = (run.values(u), run.constant(&fg.length), run.values_mut(out));
+    let (u, l, f) = (run.values(u), run.constant(&fg.length), &mut out[..len]);
     let (ga, gb) = (&ga[..len], &gb[..len]);
     for i in 0..len {
         f[i] = pick(u[i] >= 0.0, ga[i], gb[i]) * u[i] * l[i];

@@ -32,7 +32,7 @@ pub(crate) const INFLOW: [f64; 4] = [1.0, -1.0, 1.0, -1.0];
 ///   edge between them; `is_a[c][k]` says whether `c` is that edge's `a` cell.
 /// - Inside a face these follow [`FaceLayout`]: `c ∓ 1` and `c ∓ n` across the x and y
 ///   sides, with the signs [`INFLOW`].
-/// - `edge_runs` holds every edge inside a face once, in increasing order, each run with
+/// - `edge_runs` holds every edge inside a face once, face by face, each run with
 ///   the side it is of its `a` cells and of its `b` cells; [`CellSides::seams`] the seam
 ///   edges, from [`FaceLayout::first_seam_edge`] on.
 #[derive(Clone, Debug)]
@@ -53,11 +53,42 @@ pub(crate) struct CellSides {
     pub(crate) rim_cells: Vec<u32>,
     /// The rim cells' tables side by side, in the order of `rim_cells` ([`Rim`]).
     rim_tables: RimTables,
-    /// Every edge inside a face once, in increasing order, as runs: each face row's
-    /// x-edges, each face's y-edges ([`EdgeRun`]).
+    /// Every edge inside a face once, as runs face by face: each face row's x-edges,
+    /// then the face's y-edges ([`EdgeRun`]).
     pub(crate) edge_runs: Vec<EdgeRun>,
     /// The seam edges' cells and sides ([`Seams`]).
     seam_tables: SeamTables,
+    /// Per face, the seam edges around it ([`Pad`]): on its cells' left sides (by row),
+    /// their right sides, their bottom sides (by column), their top sides, `n` each.
+    pads: Vec<Pad>,
+    /// Every rim cell's sides on a seam ([`RimSeamSide`]).
+    rim_seam_sides: Vec<RimSeamSide>,
+    /// Where each face row's rim cells start among a face's ([`Self::rim_of_row`]),
+    /// and the face's count after the last.
+    rim_rows: Vec<u32>,
+}
+
+/// A seam edge as it borders a face ([`CellSides::face_pads`]): which seam edge (from
+/// the first), and the sign that turns its value, positive from its `a` cell to its `b`,
+/// into one positive towards the face's +x or +y, as the face's own edges' are.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Pad {
+    /// The seam edge, counted from [`FaceLayout::first_seam_edge`].
+    pub(crate) seam: u32,
+    /// ±1.
+    pub(crate) sign: f64,
+}
+
+/// A rim cell's side on a seam, and the cell across it (on another face's rim), both as
+/// places in [`CellSides::rim_cells`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct RimSeamSide {
+    /// The rim cell's place.
+    pub(crate) rim: u32,
+    /// Its side on the seam.
+    pub(crate) side: u8,
+    /// The place of the cell across.
+    pub(crate) across: u32,
 }
 
 /// Per seam edge, in the edges' order: its `a` and `b` cells and the side it is of each.
@@ -69,6 +100,9 @@ struct SeamTables {
     b: Vec<u32>,
     /// The side each seam edge is of its `a` cell and of its `b` cell.
     sides: Vec<[u8; 2]>,
+    /// Each seam edge's `a` and `b` cells' places in [`CellSides::rim_cells`] (a seam
+    /// joins two rim cells): where their values are in the rim's order.
+    rim: Vec<[u32; 2]>,
 }
 
 /// The seam edges as one block, numbered on from `start`, their cells through tables:
@@ -87,6 +121,8 @@ pub(crate) struct Seams<'a> {
     b: &'a [u32],
     /// The side each is of its `a` cell and of its `b` cell.
     sides: &'a [[u8; 2]],
+    /// Each one's `a` and `b` cells' places in the rim's order.
+    rim: &'a [[u32; 2]],
 }
 
 /// A stretch of edges an edge pass walks in one loop, its per-edge arrays as slices: a
@@ -199,10 +235,11 @@ impl SeamEnds {
         std::array::from_fn(|k| [&a[k][..], &b[k][..]])
     }
 
-    /// `field`'s values at the seams' `a` and `b` cells, and those of the fields
-    /// `per_side[k]` for the side `k` each edge is of that cell (the transport's limited
-    /// rises).
-    pub(crate) fn gather_with_sides(
+    /// `field`'s values at the seams' `a` and `b` cells, and those of the rim's fields
+    /// `per_side[k]` (in the rim's order, [`CellSides::rim_cells`]) for the side `k`
+    /// each edge is of that cell (the transport's limited rises, which only the rim
+    /// keeps whole: a face's are taken just before its runs).
+    pub(crate) fn gather_with_rim_sides(
         &mut self,
         seams: Seams,
         field: &[f64],
@@ -217,8 +254,8 @@ impl SeamEnds {
         b1.resize(m, 0.0);
         let (a1, b1) = (&mut a1[..m], &mut b1[..m]);
         for i in 0..m {
-            let ([ca, cb], [ka, kb]) = (seams.cells(i), seams.sides(i));
-            (a1[i], b1[i]) = (per_side[ka][ca], per_side[kb][cb]);
+            let ([ra, rb], [ka, kb]) = (seams.rim_ends(i), seams.sides(i));
+            (a1[i], b1[i]) = (per_side[ka][ra], per_side[kb][rb]);
         }
         [[&a0[..], &b0[..]], [&a1[..], &b1[..]]]
     }
@@ -226,7 +263,7 @@ impl SeamEnds {
 
 impl Seams<'_> {
     /// Seam edge `i`'s `a` and `b` cells.
-    #[inline(always)]
+    #[cfg(test)]
     pub(crate) fn cells(&self, i: usize) -> [usize; 2] {
         [self.a[i] as usize, self.b[i] as usize]
     }
@@ -242,6 +279,13 @@ impl Seams<'_> {
     pub(crate) fn sides(&self, i: usize) -> [usize; 2] {
         self.sides[i].map(usize::from)
     }
+
+    /// Seam edge `i`'s `a` and `b` cells' places in the rim's order
+    /// ([`CellSides::rim_cells`]).
+    #[inline(always)]
+    pub(crate) fn rim_ends(&self, i: usize) -> [usize; 2] {
+        self.rim[i].map(|r| r as usize)
+    }
 }
 
 /// The rim cells' neighbours, edges and inflow signs, one array a side in the order of
@@ -255,10 +299,8 @@ struct RimTables {
     edge: [Vec<u32>; 4],
     /// Per side: the sign of a volume across it in the cell's inflow.
     inflow: [Vec<f64>; 4],
-    /// Each rim cell's area, sr: a table in the rim's order instead of a gather from
-    /// the grid's, which touched a cache line a cell down the faces' sides.
-    area: Vec<f64>,
-    /// Each rim cell's inverse area, per sr.
+    /// Each rim cell's inverse area, per sr: a table in the rim's order instead of a
+    /// gather from the grid's, which touched a cache line a cell down the faces' sides.
     inverse_area: Vec<f64>,
 }
 
@@ -273,8 +315,6 @@ pub(crate) struct Rim<'a> {
     edge: [&'a [u32]; 4],
     /// Per side: the sign of a volume across it in the cell's inflow.
     inflow: [&'a [f64]; 4],
-    /// Each rim cell's area, sr.
-    pub(crate) area: &'a [f64],
     /// Each rim cell's inverse area, per sr.
     pub(crate) inverse_area: &'a [f64],
 }
@@ -301,21 +341,6 @@ impl Rim<'_> {
     pub(crate) fn inflow(&self, i: usize) -> [f64; 4] {
         let s = &self.inflow;
         [s[0][i], s[1][i], s[2][i], s[3][i]]
-    }
-
-    /// The signs of the rim cells' sides' volumes in their inflows, a slice a side.
-    #[inline(always)]
-    pub(crate) fn inflows(&self) -> [&[f64]; 4] {
-        self.inflow
-    }
-
-    /// A per-edge array's values on the rim cells' sides, in the rim's order, into
-    /// `out[k]` (a gather each, so that the arithmetic after runs on slices).
-    #[inline(always)]
-    pub(crate) fn gather_edges(&self, per_edge: &[f64], out: &mut [Vec<f64>; 4]) {
-        for (o, edges) in out.iter_mut().zip(self.edge) {
-            gather(per_edge, edges, o);
-        }
     }
 
     /// A cell field's values at the rim cells' neighbours, in the rim's order, into
@@ -509,11 +534,71 @@ impl CellSides {
             rim_tables: RimTables::default(),
             edge_runs: Vec::new(),
             seam_tables: seams,
+            pads: Vec::new(),
+            rim_seam_sides: Vec::new(),
+            rim_rows: Vec::new(),
         };
         (sides.cell_runs, sides.rim_cells) = sides.find_cell_runs();
         sides.rim_tables = sides.rim_tables(grid);
         sides.edge_runs = face_edge_runs(grid);
+        sides.seams_on_the_rim();
         sides
+    }
+
+    /// The tables that place the seam edges among the rim's cells: each seam's ends'
+    /// places in the rim's order, each face's [`Pad`]s, the rim's [`RimSeamSide`]s; and
+    /// where each face row's rim cells are.
+    ///
+    /// # Panics
+    /// If a face's outer side is not on a seam, or a seam's cell not on the rim.
+    fn seams_on_the_rim(&mut self) {
+        let (n, first_seam) = (self.n(), self.layout.first_seam_edge());
+        let mut place = vec![u32::MAX; self.neighbour.len()];
+        for (i, &c) in self.rim_cells.iter().enumerate() {
+            place[c as usize] = i as u32;
+        }
+        let t = &mut self.seam_tables;
+        t.rim =
+            t.a.iter()
+                .zip(&t.b)
+                .map(|(&a, &b)| [a, b].map(|c| place[c as usize]))
+                .collect();
+        assert!(
+            t.rim.iter().flatten().all(|&r| r != u32::MAX),
+            "a seam off the rim"
+        );
+        for face in 0..6 {
+            let outer = |side: usize, i: usize| match side {
+                LEFT => i * n,
+                RIGHT => i * n + n - 1,
+                BOTTOM => i,
+                _ => (n - 1) * n + i,
+            };
+            for side in [LEFT, RIGHT, BOTTOM, TOP] {
+                for i in 0..n {
+                    let c = face * n * n + outer(side, i);
+                    let e = self.edge[c][side] as usize;
+                    assert!(e >= first_seam, "cell {c}: side {side} is not on a seam");
+                    let sign = self.inflow(c)[side] * INFLOW[side];
+                    let seam = (e - first_seam) as u32;
+                    self.pads.push(Pad { seam, sign });
+                }
+            }
+        }
+        let face_rim = &self.rim_cells[..self.rim_cells.len() / 6];
+        self.rim_rows = (0..=n)
+            .map(|y| face_rim.partition_point(|&c| (c as usize) < y * n) as u32)
+            .collect();
+        for (i, &c) in self.rim_cells.iter().enumerate() {
+            for side in 0..4 {
+                let c = c as usize;
+                if self.edge[c][side] as usize >= first_seam {
+                    let across = place[self.neighbour[c][side] as usize];
+                    let (rim, side) = (i as u32, side as u8);
+                    self.rim_seam_sides.push(RimSeamSide { rim, side, across });
+                }
+            }
+        }
     }
 
     /// The cells inside the faces as [`CellRun`]s, one a face row, and the rim's cells.
@@ -554,7 +639,6 @@ impl CellSides {
             inflow: std::array::from_fn(|k| {
                 rim.iter().map(|&c| self.inflow(c as usize)[k]).collect()
             }),
-            area: at_rim(grid.areas_sr()),
             inverse_area: at_rim(grid.inverse_areas_per_sr()),
         }
     }
@@ -571,7 +655,6 @@ impl CellSides {
             neighbour: [&n0[..m], &n1[..m], &n2[..m], &n3[..m]],
             edge: [&e0[..m], &e1[..m], &e2[..m], &e3[..m]],
             inflow: [&s0[..m], &s1[..m], &s2[..m], &s3[..m]],
-            area: &t.area[..m],
             inverse_area: &t.inverse_area[..m],
         }
     }
@@ -586,6 +669,68 @@ impl CellSides {
             n,
         });
         spans.filter(|span| span.len > 0)
+    }
+
+    /// Row `y`'s x-edges on face `face` as a run (`n − 1` of them).
+    #[inline(always)]
+    pub(crate) fn x_run(&self, face: usize, y: usize) -> EdgeRun {
+        let n = self.n();
+        let a = face * n * n + y * n;
+        EdgeRun {
+            start: face * n * (n - 1) + y * (n - 1),
+            len: n - 1,
+            a,
+            b: a + 1,
+            sides: [RIGHT, LEFT],
+            face,
+            on_face: y * (n - 1),
+        }
+    }
+
+    /// The y-edges below rows `rows` (from row 1 on) on face `face` as a run (`n` a row:
+    /// their `b` cells are the rows').
+    #[inline(always)]
+    pub(crate) fn y_run(&self, face: usize, rows: std::ops::Range<usize>) -> EdgeRun {
+        let n = self.n();
+        let below = rows.start - 1;
+        let a = face * n * n + below * n;
+        EdgeRun {
+            start: 6 * n * (n - 1) + face * n * (n - 1) + below * n,
+            len: rows.len() * n,
+            a,
+            b: a + n,
+            sides: [TOP, BOTTOM],
+            face,
+            on_face: n * (n - 1) + below * n,
+        }
+    }
+
+    /// Face row `y`'s rim cells' places among a face's ([`Self::rim_per_face`]): the
+    /// whole of the first and last rows, the ends of the others.
+    #[inline(always)]
+    pub(crate) fn rim_of_row(&self, y: usize) -> std::ops::Range<usize> {
+        self.rim_rows[y] as usize..self.rim_rows[y + 1] as usize
+    }
+
+    /// The seam edges around face `face` ([`Pad`]): on its cells' left sides (by row),
+    /// right sides, bottom sides (by column) and top sides, `n` each.
+    #[inline(always)]
+    pub(crate) fn face_pads(&self, face: usize) -> [&[Pad]; 4] {
+        let n = self.n();
+        let pads = &self.pads[4 * n * face..4 * n * (face + 1)];
+        [0, 1, 2, 3].map(|k| &pads[k * n..(k + 1) * n])
+    }
+
+    /// How many rim cells each face has, `m`: face `f`'s are the places `f·m..(f + 1)·m`
+    /// of [`Self::rim_cells`], and face 0's cell numbers are also every face's rim
+    /// cells' places on their face (each face's rim lists its cells at the same places).
+    pub(crate) fn rim_per_face(&self) -> usize {
+        self.rim_cells.len() / 6
+    }
+
+    /// Every rim cell's sides on a seam ([`RimSeamSide`]).
+    pub(crate) fn rim_seam_sides(&self) -> &[RimSeamSide] {
+        &self.rim_seam_sides
     }
 
     /// The sign of each side's volume in cell `c`'s inflow (as [`INFLOW`] inside a face).
@@ -608,6 +753,7 @@ impl CellSides {
             a: &t.a[..len],
             b: &t.b[..len],
             sides: &t.sides[..len],
+            rim: &t.rim[..len],
         }
     }
 
@@ -627,8 +773,13 @@ impl CellSides {
     }
 }
 
-/// The edges inside the faces as [`EdgeRun`]s: each face row's x-edges, each face's
-/// y-edges.
+/// The edges inside the faces as [`EdgeRun`]s: each face row's x-edges, then that
+/// face's y-edges, face by face.
+///
+/// Why face by face: an edge pass reads its cells' values at both ends, and in the
+/// grid's edge order (every face's x-edges, then every face's y-edges) it read each
+/// cell field twice from beyond L2 (0.2 MB a field at n = 64); a face's y-edges right
+/// after its x-edges find the face's cells (32 KB a field) still in L2.
 fn face_edge_runs(grid: &CubeSphere) -> Vec<EdgeRun> {
     let layout = grid.layout();
     let n = layout.n;
@@ -648,8 +799,6 @@ fn face_edge_runs(grid: &CubeSphere) -> Vec<EdgeRun> {
                 on_face: y * (n - 1),
             });
         }
-    }
-    for face in 0..6 {
         let a = face * n * n;
         let start = 6 * n * (n - 1) + face * n * (n - 1);
         let sides = [TOP, BOTTOM];
@@ -722,6 +871,72 @@ mod tests {
         }
     }
 
+    /// The rim's tables: each face row's rim cells (the whole first and last rows, the
+    /// ends of the others) at the places `rim_of_row` gives, every face alike; each seam's
+    /// ends' places; each pad's seam edge on its face's outer side, its sign the cell's
+    /// inflow's against the inside's; each rim cell's sides on a seam and the cell across.
+    #[test]
+    fn the_rims_tables_place_its_cells_and_seams() {
+        for n in [1, 2, 3, 8] {
+            let grid = CubeSphere::new(n);
+            let sides = CellSides::new(&grid);
+            let m = sides.rim_per_face();
+            for face in 0..6 {
+                for y in 0..n {
+                    let xs: Vec<usize> = if y == 0 || y + 1 == n {
+                        (0..n).collect()
+                    } else {
+                        vec![0, n - 1]
+                    };
+                    let at = sides.rim_of_row(y);
+                    let cells = &sides.rim_cells[face * m + at.start..face * m + at.end];
+                    let want: Vec<u32> = xs
+                        .iter()
+                        .map(|x| (face * n * n + y * n + x) as u32)
+                        .collect();
+                    assert_eq!(cells, &want[..], "n = {n}, face {face}, row {y}");
+                }
+                let first_seam = sides.layout.first_seam_edge();
+                let [left, right, bottom, top] = sides.face_pads(face);
+                for i in 0..n {
+                    let outer = [
+                        (left[i], i * n, LEFT),
+                        (right[i], i * n + n - 1, RIGHT),
+                        (bottom[i], i, BOTTOM),
+                        (top[i], (n - 1) * n + i, TOP),
+                    ];
+                    for (pad, c, k) in outer {
+                        let c = face * n * n + c;
+                        assert_eq!(pad.seam as usize + first_seam, sides.edge[c][k] as usize);
+                        assert_eq!(pad.sign, sides.inflow(c)[k] * INFLOW[k], "cell {c}");
+                    }
+                }
+            }
+            let seams = sides.seams();
+            for i in 0..seams.len {
+                let places = seams.rim_ends(i).map(|p| sides.rim_cells[p] as usize);
+                assert_eq!(places, seams.cells(i), "n = {n}, seam {i}");
+            }
+            let first_seam = sides.layout.first_seam_edge();
+            let on_seam = |c: &u32| {
+                sides.edge[*c as usize]
+                    .iter()
+                    .filter(|&&e| e as usize >= first_seam)
+                    .count()
+            };
+            let on_seams: usize = sides.rim_cells.iter().map(on_seam).sum();
+            assert_eq!(sides.rim_seam_sides().len(), on_seams, "n = {n}");
+            for s in sides.rim_seam_sides() {
+                let (c, k) = (
+                    sides.rim_cells[s.rim as usize] as usize,
+                    usize::from(s.side),
+                );
+                let across = sides.rim_cells[s.across as usize];
+                assert_eq!(sides.neighbour[c][k], across, "n = {n}, cell {c} side {k}");
+            }
+        }
+    }
+
     /// Every cell of a row run lies in a face span, with the neighbours the span gives it
     /// its own, and whatever else a span holds is on the rim.
     fn spans_hold_every_inside_cell_with_its_neighbours(sides: &CellSides) {
@@ -765,6 +980,7 @@ mod tests {
         let mut edges: Vec<usize> = sides.edge_runs.iter().flat_map(|r| r.edges()).collect();
         let seams = sides.seams();
         edges.extend(seams.start..seams.start + seams.len);
+        edges.sort_unstable();
         assert_eq!(edges, (0..grid.edges().len()).collect::<Vec<_>>());
         let ea = grid.edge_arrays();
         for i in 0..seams.len {

@@ -3,20 +3,21 @@
 //! the upwind cell's Barth–Jespersen-limited gradient), in sub-steps under a Courant
 //! bound, each donor's outflow limited to a fraction of its content.
 //!
-//! A sub-step is four passes ([`super::upwind`]): each cell's limited rises to its sides;
-//! the volume across each edge; each donor's outflow factor; each cell's gathered
-//! volumes. Inside a face each pass reads slices and vectorises.
+//! A sub-step is one limited apply of the volumes, taken a band of face rows at a time
+//! ([`super::upwind`], [`super::fluxes`]): each cell's limited rises to its sides, the
+//! volume across each edge, each donor's outflow factor and each cell's gathered volumes,
+//! the band's scratch never leaving the cache. Inside a face each stretch reads slices
+//! and vectorises. The first sub-step takes the Courant number too ([`Fastest`]).
 
 use glam::DVec3;
 
-use super::compare::{larger, largest};
+use super::compare::larger;
 use super::face_geometry::FaceGeometry;
 use super::flow::{FilmFlow, Scratch};
 use super::fluxes::apply_limited;
 use super::grid::dot_at;
-use super::sides::{EdgeBlock, SeamEnds};
+use super::sides::EdgeBlock;
 use super::upwind;
-use crate::avx2::with_avx2;
 
 /// Most sub-steps one thickness transport takes.
 const MAX_SUBSTEPS: u32 = 64;
@@ -24,6 +25,13 @@ const MAX_SUBSTEPS: u32 = 64;
 impl FilmFlow {
     /// Moves liquid with the surfaces (upwind) and by the drainage flux relative to them,
     /// in sub-steps that keep each cell's outflow below half its content.
+    ///
+    /// The common case first: one sub-step, whose volumes' pass takes the Courant number
+    /// too ([`Fastest`]), from the thickness it starts from; should that ask for more
+    /// sub-steps, the thickness is put back (kept in `s.cell`, free by now) and they run.
+    /// Why: a pass of its own for the Courant number read the velocities, thicknesses and
+    /// normals again (14 k cache lines a step at n = 64) for the one sub-step a film in
+    /// the optics' range takes.
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     pub(super) fn transport_thickness(&mut self, s: &mut Scratch, dt_s: f64, g_eff: DVec3) {
         let p = self.params;
@@ -33,78 +41,104 @@ impl FilmFlow {
             0.0
         };
         let drain = Drain { drain, g_eff };
-        // `edge2` is the sub-steps' volumes: free until they start.
-        let courant = self.courant((&mut s.edge2, &mut s.seam_ends), drain, dt_s);
+        s.cell.clear();
+        s.cell.extend_from_slice(&self.h_m);
+        let courant = self.upwind_substep(s, dt_s, drain, true) * dt_s / p.radius_m;
         // A cell drains through at most two edges of a smooth flow: 2·courant per step, kept
         // within one sub-step's content; the outflow limit guards the rest.
         let substeps = (2.0 * courant).ceil().clamp(1.0, f64::from(MAX_SUBSTEPS)) as u32;
+        if substeps == 1 {
+            return;
+        }
+        self.h_m.copy_from_slice(&s.cell);
         let h_dt = dt_s / f64::from(substeps);
         for _ in 0..substeps {
-            self.upwind_substep(s, h_dt, drain);
+            self.upwind_substep(s, h_dt, drain, false);
         }
-    }
-
-    /// The largest fraction of a cell's width any edge's characteristic speed, `|u|` plus
-    /// the drainage's `3|c|h²` (`c` its coefficient, [`DrainAlong::at`]), carries over
-    /// `dt_s`: one pass over the edges, their speeds into `speed`.
-    fn courant(
-        &self,
-        (speed, seam_ends): (&mut Vec<f64>, &mut SeamEnds),
-        drain: Drain,
-        dt_s: f64,
-    ) -> f64 {
-        let fg = self.grid.face_geometry();
-        let (h, u) = (&self.h_m, &self.u_m_per_s);
-        // Every entry is written below: the buffer needs its length, not a fill.
-        speed.resize(u.len(), 0.0);
-        self.sides.for_each_edge_run(
-            #[inline(always)]
-            |run| {
-                let (ha, hb) = run.ends(h);
-                courant_block(run, [ha, hb], (fg, u), drain, speed);
-            },
-        );
-        let seams = self.sides.seams();
-        let ends = seam_ends.gather(seams, h);
-        with_avx2(
-            #[inline(always)]
-            || courant_block(seams, ends, (fg, u), drain, speed),
-        );
-        // The speeds' maximum in a pass of its own: taken in the loop above, the
-        // compiler vectorised neither.
-        largest(speed) * dt_s / self.params.radius_m
     }
 
     /// One transport of `h` over `dt_s`: second-order upwind (the upwind cell's
     /// Green–Gauss gradient, limited to its neighbours' range, carried to the edge
-    /// midpoint and clamped between the two cells' values), outflow-limited. Four passes,
-    /// each structured inside the faces ([`super::upwind`]).
+    /// midpoint and clamped between the two cells' values), outflow-limited: one limited
+    /// apply of the [`upwind::Volumes`], band by band. Returns the fastest edge's
+    /// characteristic speed over its smaller cell's width ([`Fastest`]) where `courant`,
+    /// else 0.
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
-    fn upwind_substep(&mut self, s: &mut Scratch, dt_s: f64, drain: Drain) {
-        let (sides, geo) = (&*self.sides, &*self.transport);
-        let dt_per_r = dt_s / self.params.radius_m;
-        with_avx2(
-            #[inline(always)]
-            || {
-                let rises = (&mut s.limited_rise, &mut s.rim_rises);
-                upwind::limited_rises(sides, geo, &self.h_m, rises);
-                let speeds = upwind::EdgeSpeeds {
-                    u: &self.u_m_per_s,
-                    drain,
-                    dt_per_r,
-                };
-                let fg = self.grid.face_geometry();
-                let volume = (&mut s.edge2, &mut s.seam_ends);
-                upwind::volumes(sides, fg, &self.h_m, &s.limited_rise, speeds, volume);
-                let (volume, h) = (&s.edge2, &mut self.h_m);
-                apply_limited(sides, &self.grid, volume, 1.0, h, &mut s.gather);
+    fn upwind_substep(&mut self, s: &mut Scratch, dt_s: f64, drain: Drain, courant: bool) -> f64 {
+        let mut fastest = Fastest {
+            speed: std::mem::take(&mut s.edge2),
+            fastest: 0.0,
+        };
+        let mut volumes = upwind::Volumes {
+            sides: &self.sides,
+            geo: &self.transport,
+            fg: self.grid.face_geometry(),
+            speeds: upwind::EdgeSpeeds {
+                u: &self.u_m_per_s,
+                drain,
+                dt_per_r: dt_s / self.params.radius_m,
             },
-        )
+            rises: &mut s.rises,
+            seam_ends: &mut s.seam_ends,
+            fastest: courant.then_some(&mut fastest),
+        };
+        let (h, gather) = (&mut self.h_m, &mut s.gather);
+        apply_limited(&self.sides, &self.grid, &mut volumes, 1.0, h, gather);
+        s.edge2 = fastest.speed;
+        fastest.fastest
     }
 }
 
-/// [`FilmFlow::courant`]'s pass over a block of edges with thicknesses `[ha, hb]` at
-/// their ends: the edges' speeds into `speed`.
+/// The Courant number's fastest edge, taken block by block alongside a pass: each
+/// edge's characteristic speed, `|u|` plus the drainage's `3|c|h²` (`c` its coefficient,
+/// [`DrainAlong::at`]), over its smaller cell's width, a block's into `speed` and their
+/// maximum taken while they are in L1 (taken in the speeds' loop, the compiler
+/// vectorised neither).
+pub(crate) struct Fastest {
+    /// A block's speeds (scratch).
+    speed: Vec<f64>,
+    /// The fastest so far, per s (0 before any).
+    fastest: f64,
+}
+
+impl Fastest {
+    /// A block of edges with thicknesses `[ha, hb]` at their ends, at surface speeds `u`
+    /// and drainage `drain` (`fg`: the grid's constants).
+    #[inline(always)]
+    pub(crate) fn block(
+        &mut self,
+        block: impl EdgeBlock,
+        [ha, hb]: [&[f64]; 2],
+        (fg, u): (&FaceGeometry, &[f64]),
+        drain: Drain,
+    ) {
+        let len = block.count();
+        if self.speed.len() < len {
+            self.speed.resize(len, 0.0);
+        }
+        let speed = &mut self.speed[..len];
+        courant_block(block, [ha, hb], (fg, u), drain, speed);
+        self.fastest = largest_of(speed, self.fastest);
+    }
+}
+
+/// The largest of `values` and `start` (NaN passed over, as `f64::max` does), in four
+/// running maxima that vectorise (a maximum is exact in any order).
+#[inline(always)]
+fn largest_of(values: &[f64], start: f64) -> f64 {
+    let mut lanes = [start; 4];
+    let quads = values.chunks_exact(4);
+    let rest = quads.remainder().iter().fold(start, |a, &b| larger(b, a));
+    for quad in quads {
+        for k in 0..4 {
+            lanes[k] = larger(quad[k], lanes[k]);
+        }
+    }
+    lanes.into_iter().fold(rest, |a, b| larger(b, a))
+}
+
+/// [`Fastest`]'s speeds over a block of edges with thicknesses `[ha, hb]` at their ends,
+/// into `speed` (`block.count()` long).
 #[inline(always)]
 fn courant_block(
     block: impl EdgeBlock,
@@ -117,7 +151,7 @@ fn courant_block(
     let (ha, hb, u) = (&ha[..len], &hb[..len], block.values(u));
     let per_area = block.constant(&fg.length_per_smaller_area);
     let rate = drain.along(&block, fg);
-    let speed = block.values_mut(speed);
+    let speed = &mut speed[..len];
     for i in 0..len {
         speed[i] = edge_speed(u[i], rate.at(i), ha[i], hb[i], per_area[i]);
     }
@@ -176,4 +210,45 @@ impl DrainAlong<'_> {
 fn edge_speed(u: f64, c: f64, ha: f64, hb: f64, per_area: f64) -> f64 {
     let h = larger(hb, ha);
     (u.abs() + 3.0 * c.abs() * h * h) * per_area
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::film_flow::{CubeSphere, FlowParams, Hierarchy};
+
+    /// A film whose Courant number asks for several sub-steps takes them all from the
+    /// thickness it started from: the speculative single sub-step's is put back.
+    #[test]
+    fn a_fast_film_takes_its_sub_steps_from_its_starting_thickness() {
+        let grid = std::sync::Arc::new(CubeSphere::new(12));
+        let hierarchy = std::sync::Arc::new(Hierarchy::new(&grid));
+        let params = FlowParams {
+            drainage_viscosity_pa_s: 1e-6,
+            ..FlowParams::water_film(0.05)
+        };
+        let mut film = FilmFlow::new(grid, hierarchy, params, |d| {
+            20e-6 * (1.0 + 0.3 * (4.0 * d.x + d.y).sin())
+        });
+        film.set_velocity(|d| DVec3::Y.cross(d) * 3.0);
+        let (dt_s, g_eff) = (1.0 / 60.0, DVec3::new(0.0, -9.81, 0.0));
+        let drain = Drain {
+            drain: params.density_kg_per_m3 / (3.0 * params.drainage_viscosity_pa_s),
+            g_eff,
+        };
+        let mut taken = film.clone();
+        taken.transport_thickness(&mut Scratch::default(), dt_s, g_eff);
+        // The Courant number from a sub-step of its own, then the sub-steps from the start.
+        let fastest = film
+            .clone()
+            .upwind_substep(&mut Scratch::default(), dt_s, drain, true);
+        let substeps = (2.0 * fastest * dt_s / params.radius_m).ceil() as u32;
+        assert!(substeps > 1, "{substeps} sub-step: the test is idle");
+        let mut s = Scratch::default();
+        for _ in 0..substeps {
+            film.upwind_substep(&mut s, dt_s / f64::from(substeps), drain, false);
+        }
+        let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&taken.h_m), bits(&film.h_m));
+    }
 }

@@ -3,18 +3,29 @@
 //! neighbours and edges as slices, which vectorise; the cells on a face's rim and the
 //! seam edges take the same arithmetic through [`CellSides`]' tables.
 //!
-//! 1. [`limited_rises`]: each cell's rise to each side's midpoint (its Green–Gauss
-//!    gradient, in its tangent plane, dotted with the reach), Barth–Jespersen limited.
-//! 2. [`volumes`]: the volume across each edge, each part upwind along its own
-//!    characteristic.
-//! 3. [`super::fluxes::apply_limited`]: each donor's factor that keeps its outflow
-//!    within its budget, and each cell's gathered volumes.
+//! The sub-step is one limited apply ([`super::fluxes::apply_limited`]) of the
+//! [`Volumes`], which it takes row by row:
+//! 1. first the rim's limited rises ([`rim_rises`]: each cell's rise to each side's
+//!    midpoint, its Green–Gauss gradient in its tangent plane dotted with the reach,
+//!    Barth–Jespersen limited) and the seams' volumes;
+//! 2. then, row by row on all the faces together, the row's limited rises
+//!    ([`row_rises`]) and its edges' volumes, each part upwind along its own
+//!    characteristic, which the rows' cells gather a row or two behind (each donor's
+//!    factor that keeps its outflow within its budget, each cell's gathered volumes).
+//!
+//! Why by rows: the rises were four per-cell arrays (0.8 MB at n = 64) and the volumes a
+//! per-edge one (0.4 MB), each written out and read back from beyond the core's 1 MB L2;
+//! a face row's are 2.5 KB, and six faces' rows read one row of face 0's weights
+//! (8 KB of the 0.5 MB) while it is in L1.
+
+use std::ops::Range;
 
 use super::compare::{larger, smaller};
 use super::face_geometry::FaceGeometry;
+use super::fluxes::{BAND, EdgeValues};
 use super::grid::CubeSphere;
-use super::sides::{CellSides, EdgeBlock, SeamEnds};
-use super::transport::Drain;
+use super::sides::{CellSides, EdgeBlock, EdgeRun, RIGHT, SeamEnds, Seams};
+use super::transport::{Drain, Fastest};
 
 /// The transport's weights, fixed by the grid: face 0's, which every face reads.
 ///
@@ -125,29 +136,41 @@ fn limiter(h: f64, nb: [f64; 4], rise: [f64; 4]) -> f64 {
     larger(smaller(up_factor, down_factor), 0.0)
 }
 
-/// Every cell's limited rise to each side, `out[k][c]`, m.
+/// The limited rises: the rim's, kept for the sub-step (the seams' volumes read them),
+/// and a face's band's, taken just before the band's volumes.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Rises {
+    /// Per side `k`, a window of [`WINDOW`] rows of `n`: the band's rows' cells' rises
+    /// to that side and the row's before, window row `w` for face row `first − 1 + w`,
+    /// at `(k·WINDOW + w)·n`, m. One window serves the six faces in turn.
+    rows: Vec<f64>,
+    /// Per face: its band's last row's rises (`4·n`, side by side), the row before its
+    /// next band.
+    carried: [Vec<f64>; 6],
+    /// The band's first row.
+    first: usize,
+    /// The rim's ([`RimRises`]).
+    rim: RimRises,
+}
+
+/// Rows in the window of rises ([`Rises`]): a band's and the row before (the y-edges
+/// below the band's first row read it).
+const WINDOW: usize = BAND + 1;
+
+impl Rises {
+    /// Where row `y`'s cells' rises to side `k` start in `rows`.
+    #[inline(always)]
+    fn at(&self, n: usize, k: usize, y: usize) -> usize {
+        (k * WINDOW + y + 1 - self.first) * n
+    }
+}
+
+/// Every rim cell's limited rise to each side, into `rim_rises.rise[k]` in the rim's
+/// order ([`CellSides::rim_cells`]), m: the cells' values gathered, the faces'
+/// arithmetic on slices.
 // Inlined into the sub-step's `with_avx2` closure, so compiled for AVX2 there.
 #[inline(always)]
-pub(crate) fn limited_rises(
-    sides: &CellSides,
-    geo: &UpwindGeometry,
-    h: &[f64],
-    (out, rim_rises): (&mut [Vec<f64>; 4], &mut RimRises),
-) {
-    for o in out.iter_mut() {
-        o.resize(h.len(), 0.0);
-    }
-    // A face at a time, its rim cells among the rest ([`CellSpan`]): they are redone
-    // below, and the runs' set-up and odd ends, row by row, cost a third of the pass.
-    for span in sides.face_spans() {
-        let cells = span.cells();
-        let [o0, o1, o2, o3] = out.each_mut().map(|o| &mut o[cells.clone()]);
-        let w = |k: usize, j: usize| span.on_face(&geo.rise[k][j]);
-        let w = [0, 1, 2, 3].map(|k| [w(k, 0), w(k, 1), w(k, 2), w(k, 3)]);
-        let nb = [0, 1, 2, 3].map(|j| &h[span.neighbours(j)]);
-        rises_run(w, &h[cells.clone()], nb, [o0, o1, o2, o3]);
-    }
-    // The rim: its values gathered, the same arithmetic on slices, the rises scattered.
+fn rim_rises(sides: &CellSides, geo: &UpwindGeometry, h: &[f64], rim_rises: &mut RimRises) {
     let rim = sides.rim();
     let m = rim.cells.len();
     let RimRises {
@@ -172,9 +195,76 @@ pub(crate) fn limited_rises(
         let out = rise.each_mut().map(|r| &mut r[at.clone()]);
         rises_run(w, &own[at.clone()], nb, out);
     }
-    for (o, r) in out.iter_mut().zip(&*rise) {
-        for (&c, &r) in rim.cells.iter().zip(r) {
-            o[c as usize] = r;
+}
+
+/// Face `face`'s band `band`'s cells' limited rises to each side, into `rises`' window
+/// (the row before from the face's band before), m: the inside rows in one run, their
+/// end cells among the run's (their neighbours there are not theirs) then taken from the
+/// rim's, as the first and last rows'.
+// Inlined into the sub-step's `with_avx2` closure, so compiled for AVX2 there.
+#[inline(always)]
+fn band_rises(
+    (sides, geo): (&CellSides, &UpwindGeometry),
+    h: &[f64],
+    (face, band): (usize, Range<usize>),
+    rises: &mut Rises,
+) {
+    let n = sides.n();
+    let Rises {
+        rows,
+        carried,
+        first,
+        rim,
+    } = rises;
+    rows.resize(4 * WINDOW * n, 0.0);
+    let carried = &mut carried[face];
+    let (o0, rest) = rows.split_at_mut(WINDOW * n);
+    let (o1, rest) = rest.split_at_mut(WINDOW * n);
+    let (o2, o3) = rest.split_at_mut(WINDOW * n);
+    if band.start > 0 {
+        for (o, c) in [&mut *o0, &mut *o1, &mut *o2, &mut *o3]
+            .into_iter()
+            .zip(carried.chunks_exact(n))
+        {
+            o[..n].copy_from_slice(c);
+        }
+    }
+    *first = band.start;
+    let w = |y: usize| (y + 1 - band.start) * n;
+    let inside = band.start.max(1)..band.end.min(n.saturating_sub(1));
+    if !inside.is_empty() {
+        let cells = inside.start * n..inside.end * n;
+        let first = face * n * n + cells.start;
+        let len = cells.len();
+        let w_kj = |k: usize, j: usize| &geo.rise[k][j][cells.clone()];
+        let weights = [0, 1, 2, 3].map(|k| [w_kj(k, 0), w_kj(k, 1), w_kj(k, 2), w_kj(k, 3)]);
+        let nb = [first - 1, first + 1, first - n, first + n].map(|c| &h[c..c + len]);
+        let at = w(inside.start)..w(inside.start) + len;
+        let out = [
+            &mut o0[at.clone()],
+            &mut o1[at.clone()],
+            &mut o2[at.clone()],
+            &mut o3[at],
+        ];
+        rises_run(weights, &h[first..first + len], nb, out);
+    }
+    // Face 0's rim cells are every face's places ([`CellSides::rim_per_face`]).
+    let m = sides.rim_per_face();
+    for y in band.clone() {
+        let on_row = sides.rim_of_row(y);
+        let at = face * m + on_row.start..face * m + on_row.end;
+        let r = rim.rise.each_ref().map(|r| &r[at.clone()]);
+        for (j, &p) in sides.rim_cells[on_row].iter().enumerate() {
+            let x = w(y) + p as usize - y * n;
+            (o0[x], o1[x], o2[x], o3[x]) = (r[0][j], r[1][j], r[2][j], r[3][j]);
+        }
+    }
+    if band.end < n {
+        // The band's last row, the row before the next band.
+        let last = w(band.end - 1);
+        carried.clear();
+        for o in [&*o0, &*o1, &*o2, &*o3] {
+            carried.extend_from_slice(&o[last..last + n]);
         }
     }
 }
@@ -267,42 +357,77 @@ fn edge_volume([ha, hb]: [f64; 2], [ra, rb]: [f64; 2], [u, c, l]: [f64; 3], dt_p
     (u * plug + c * drain * drain * drain) * l * dt_per_r
 }
 
-/// The volume across every edge over the sub-step, into `volume` (per R² m × sr; the
-/// seams' ends gathered into `seam_ends`).
-// Inlined into the sub-step's `with_avx2` closure, so compiled for AVX2 there.
-#[inline(always)]
-pub(crate) fn volumes(
-    sides: &CellSides,
-    fg: &FaceGeometry,
-    h: &[f64],
-    rise: &[Vec<f64>; 4],
-    speeds: EdgeSpeeds,
-    (volume, seam_ends): (&mut Vec<f64>, &mut SeamEnds),
-) {
-    volume.resize(speeds.u.len(), 0.0);
-    for run in &sides.edge_runs {
-        let [ka, kb] = run.sides;
-        let (ra, rb) = (&rise[ka][run.a_cells()], &rise[kb][run.b_cells()]);
-        let (ha, hb) = run.ends(h);
-        volumes_block(*run, [ha, hb], [ra, rb], (fg, speeds), volume);
-    }
-    let seams = sides.seams();
-    let [h_ends, rises] = seam_ends.gather_with_sides(seams, h, rise);
-    volumes_block(seams, h_ends, rises, (fg, speeds), volume);
+/// The volume across every edge over a sub-step, band by band ([`EdgeValues`]): the
+/// rim's limited rises with the seams', a face's band's just before its runs'.
+pub(crate) struct Volumes<'a> {
+    /// The cells' sides.
+    pub(crate) sides: &'a CellSides,
+    /// The rises' weights.
+    pub(crate) geo: &'a UpwindGeometry,
+    /// The grid's constants.
+    pub(crate) fg: &'a FaceGeometry,
+    /// What moves the liquid.
+    pub(crate) speeds: EdgeSpeeds<'a>,
+    /// The limited rises.
+    pub(crate) rises: &'a mut Rises,
+    /// The seams' ends.
+    pub(crate) seam_ends: &'a mut SeamEnds,
+    /// Where the Courant number is taken alongside, its fastest edge so far.
+    pub(crate) fastest: Option<&'a mut Fastest>,
 }
 
-/// [`volumes`] over a block of edges, with their ends' thicknesses and rises.
+impl EdgeValues for Volumes<'_> {
+    #[inline(always)]
+    fn seams(&mut self, seams: Seams, h: &[f64], out: &mut [f64]) {
+        let rim = &mut self.rises.rim;
+        rim_rises(self.sides, self.geo, h, rim);
+        let [h_ends, rises] = self.seam_ends.gather_with_rim_sides(seams, h, &rim.rise);
+        volumes_block(seams, h_ends, rises, (self.fg, self.speeds), out);
+        if let Some(fastest) = self.fastest.as_deref_mut() {
+            let (u, drain) = (self.speeds.u, self.speeds.drain);
+            fastest.block(seams, h_ends, (self.fg, u), drain);
+        }
+    }
+
+    #[inline(always)]
+    fn rows(&mut self, face: usize, band: Range<usize>, h: &[f64]) {
+        band_rises((self.sides, self.geo), h, (face, band), self.rises);
+    }
+
+    #[inline(always)]
+    fn run(&mut self, run: EdgeRun, rows: Range<usize>, h: &[f64], out: &mut [f64]) {
+        let (n, [ka, kb]) = (self.sides.n(), run.sides);
+        let r = &*self.rises;
+        // A row's x-edges join its cells from the first on to those from the second;
+        // the y-edges below rows, the rows below's cells to theirs.
+        let (a, b) = if ka == RIGHT {
+            (r.at(n, ka, rows.start), r.at(n, kb, rows.start) + 1)
+        } else {
+            (r.at(n, ka, rows.start - 1), r.at(n, kb, rows.start))
+        };
+        let (ra, rb) = (&r.rows[a..], &r.rows[b..]);
+        let (ha, hb) = run.ends(h);
+        volumes_block(run, [ha, hb], [ra, rb], (self.fg, self.speeds), out);
+        if let Some(fastest) = self.fastest.as_deref_mut() {
+            let (u, drain) = (self.speeds.u, self.speeds.drain);
+            fastest.block(run, [ha, hb], (self.fg, u), drain);
+        }
+    }
+}
+
+/// [`Volumes`] over a block of edges, with their ends' thicknesses and rises, into
+/// `out`.
 #[inline(always)]
 fn volumes_block(
     block: impl EdgeBlock,
     [ha, hb]: [&[f64]; 2],
     [ra, rb]: [&[f64]; 2],
     (fg, speeds): (&FaceGeometry, EdgeSpeeds),
-    volume: &mut [f64],
+    out: &mut [f64],
 ) {
     let len = block.count();
     let (u, c) = (block.values(speeds.u), speeds.drain.along(&block, fg));
-    let (l, out) = (block.constant(&fg.length), block.values_mut(volume));
+    let (l, out) = (block.constant(&fg.length), &mut out[..len]);
     let (ha, hb, ra, rb) = (&ha[..len], &hb[..len], &ra[..len], &rb[..len]);
     for i in 0..len {
         let speed = [u[i], c.at(i), l[i]];
@@ -313,7 +438,116 @@ fn volumes_block(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::film_flow::face_geometry::to_face_frame;
+    use crate::film_flow::fluxes::{BAND, GatherScratch, net_inflow};
+    use crate::film_flow::grid::dot_at;
     use glam::DVec3;
+
+    /// An [`EdgeValues`] that keeps what another gives, by edge.
+    struct Kept<'a, P> {
+        /// The pass.
+        pass: P,
+        /// Its values by edge.
+        values: &'a mut [f64],
+    }
+
+    impl<P: EdgeValues> EdgeValues for Kept<'_, P> {
+        fn seams(&mut self, seams: Seams, cells: &[f64], out: &mut [f64]) {
+            self.pass.seams(seams, cells, out);
+            self.values[seams.start..seams.start + seams.len].copy_from_slice(out);
+        }
+        fn rows(&mut self, face: usize, rows: Range<usize>, cells: &[f64]) {
+            self.pass.rows(face, rows, cells);
+        }
+        fn run(&mut self, run: EdgeRun, rows: Range<usize>, cells: &[f64], out: &mut [f64]) {
+            self.pass.run(run, rows, cells, out);
+            self.values[run.edges()].copy_from_slice(out);
+        }
+    }
+
+    /// The volumes taken band by band, each face's limited rises a band at a time and
+    /// the rim's apart, against each edge's taken directly from every cell's limited
+    /// rises (the same arithmetic, so the same bits): on grids of one band and of three,
+    /// the last short, so that the rises carried from band to band are checked.
+    #[test]
+    fn the_volumes_by_bands_are_each_edges_own() {
+        for n in [5, 2 * BAND + 3] {
+            let grid = CubeSphere::new(n);
+            let sides = CellSides::new(&grid);
+            let geo = UpwindGeometry::new(&grid, &sides);
+            let (fg, ea, layout) = (grid.face_geometry(), grid.edge_arrays(), grid.layout());
+            let c = grid.centres();
+            let h: Vec<f64> = c
+                .iter()
+                .map(|c| 1.0 + 0.3 * (5.0 * c.x + 3.0 * c.y * c.z).sin())
+                .collect();
+            let u: Vec<f64> = (0..ea.cells.len())
+                .map(|e| ((e * 37 % 23) as f64 - 11.0) * 0.01)
+                .collect();
+            let drain = Drain {
+                drain: 0.02,
+                g_eff: DVec3::new(0.3, -9.8, 0.5),
+            };
+            let speeds = EdgeSpeeds {
+                u: &u,
+                drain,
+                dt_per_r: 0.4,
+            };
+            // Every cell's limited rises, directly.
+            let rise = |cell: usize| -> [f64; 4] {
+                let nb = sides.neighbour[cell].map(|j| h[j as usize]);
+                let w = |k: usize, j: usize| geo.rise[k][j][cell % (n * n)];
+                let r = [0, 1, 2, 3].map(|k| rise_of([0, 1, 2, 3].map(|j| w(k, j)), h[cell], nb));
+                let phi = limiter(h[cell], nb, r);
+                r.map(|r| r * phi)
+            };
+            let mut want = vec![0.0; ea.cells.len()];
+            for (e, [a, b]) in ea.cells.iter().enumerate() {
+                let (a, b) = (*a as usize, *b as usize);
+                let side = |cell: usize| {
+                    sides.edge[cell]
+                        .iter()
+                        .position(|&x| x as usize == e)
+                        .unwrap()
+                };
+                let (ra, rb) = (rise(a)[side(a)], rise(b)[side(b)]);
+                let (l, c) = if e >= layout.first_seam_edge() {
+                    let i = e - layout.first_seam_edge();
+                    let normal = fg.normal.seams.each_ref().map(|x| &x[i..]);
+                    (
+                        fg.length.seams[i],
+                        drain.drain * dot_at(drain.g_eff, normal, 0),
+                    )
+                } else {
+                    let (face, i) = layout.on_face(e);
+                    let normal = fg.normal.face.each_ref().map(|x| &x[i..]);
+                    let g = to_face_frame(face, drain.g_eff);
+                    (fg.length.face[i], drain.drain * dot_at(g, normal, 0))
+                };
+                want[e] = edge_volume([h[a], h[b]], [ra, rb], [u[e], c, l], speeds.dt_per_r);
+            }
+            let mut got = vec![f64::NAN; ea.cells.len()];
+            let (mut rises, mut seam_ends) = (Rises::default(), SeamEnds::default());
+            let volumes = Volumes {
+                sides: &sides,
+                geo: &geo,
+                fg,
+                speeds,
+                rises: &mut rises,
+                seam_ends: &mut seam_ends,
+                fastest: None,
+            };
+            let mut kept = Kept {
+                pass: volumes,
+                values: &mut got,
+            };
+            let mut out = Vec::new();
+            let scratch = &mut GatherScratch::default();
+            net_inflow(&sides, (&mut kept, &h), &mut out, scratch, |_, _, _| {});
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&got), bits(&want), "n = {n}");
+        }
+    }
 
     /// The rises the weights give against the gradient taken directly: Green–Gauss over
     /// the cell's edges, projected, dotted with the reach.
