@@ -449,7 +449,13 @@ mod tests {
 
     /// A 1 cm film of viscosity 0.5 Pa·s on the n = 32 grid, at rest.
     fn viscous_film() -> (FilmFlow, f64) {
-        let grid = Arc::new(CubeSphere::new(32));
+        viscous_film_of(32)
+    }
+
+    /// A 1 cm film of viscosity 0.5 Pa·s on a grid of `n` cells a face, at rest, and
+    /// its kinematic viscosity, m²/s.
+    fn viscous_film_of(n: usize) -> (FilmFlow, f64) {
+        let grid = Arc::new(CubeSphere::new(n));
         let hierarchy = Arc::new(Hierarchy::new(&grid));
         let p = FlowParams {
             viscosity_pa_s: 0.5,
@@ -481,13 +487,8 @@ mod tests {
     #[test]
     fn a_stage_is_the_whole_grid_passes() {
         for n in [5, 16] {
-            let grid = Arc::new(CubeSphere::new(n));
-            let hierarchy = Arc::new(Hierarchy::new(&grid));
-            let p = FlowParams {
-                viscosity_pa_s: 0.5,
-                ..FlowParams::water_film(0.01)
-            };
-            let f = FilmFlow::new(grid.clone(), hierarchy, p, |_| 1e-6);
+            let (f, nu) = viscous_film_of(n);
+            let grid = Arc::clone(&f.grid);
             let rough = |seed: usize| -> Vec<f64> {
                 let values = (0..grid.edges().len()).map(|e| ((e * seed) % 1000) as f64 * 1e-6);
                 let mut out = Vec::new();
@@ -495,7 +496,6 @@ mod tests {
                 out
             };
             let (start, before_last) = (rough(7919), rough(104_729));
-            let nu = p.viscosity_pa_s / p.density_kg_per_m3;
             for (weights, last) in [
                 ((1.0, 0.0), false),
                 ((1.5, -0.5), false),
@@ -600,20 +600,14 @@ mod tests {
     #[test]
     fn the_stages_keep_a_border_edges_copies_alike() {
         for n in [5, 32] {
-            let grid = Arc::new(CubeSphere::new(n));
-            let hierarchy = Arc::new(Hierarchy::new(&grid));
-            let p = FlowParams {
-                viscosity_pa_s: 0.5,
-                ..FlowParams::water_film(0.01)
-            };
-            let f = FilmFlow::new(grid.clone(), hierarchy, p, |_| 1e-6);
+            let (f, nu) = viscous_film_of(n);
+            let grid = Arc::clone(&f.grid);
             let rough: Vec<f64> = (0..grid.edges().len())
                 .map(|e| ((e * 7919) % 1000) as f64 * 1e-6 - 4e-4)
                 .collect();
             let (mut u, mut start) = (Vec::new(), Vec::new());
             f.rows.to_rows(&rough, &mut u);
             f.rows.to_rows(&rough, &mut start);
-            let nu = p.viscosity_pa_s / p.density_kg_per_m3;
             f.viscous_step(&mut u, &mut ViscousScratch::default(), nu, 0.05);
             assert_ne!(u, start, "n {n}: nothing moved");
             for e in &f.rows.seam_edges {

@@ -207,11 +207,7 @@ pub(super) fn operator<T: Real, const RESIDUAL: bool>(
     out: &mut [T],
 ) {
     let range = both_sweeps(layout);
-    let half = layout.half;
-    for colour in out[..layout.len()].chunks_exact_mut(half) {
-        colour[..range.start].fill(T::ZERO);
-        colour[range.end..].fill(T::ZERO);
-    }
+    zero_outside(layout, &range, out);
     in_blocks(
         layout,
         range,
@@ -226,6 +222,16 @@ pub(super) fn operator<T: Real, const RESIDUAL: bool>(
     );
 }
 
+/// Zeroes each colour of `out` outside `range`, the part the sweeps cover (so the dot
+/// products see zero there).
+#[inline(always)]
+fn zero_outside<T: Real>(layout: &Layout, range: &std::ops::Range<usize>, out: &mut [T]) {
+    for colour in out[..layout.len()].chunks_exact_mut(layout.half) {
+        colour[..range.start].fill(T::ZERO);
+        colour[range.end..].fill(T::ZERO);
+    }
+}
+
 /// `out = b − (diag(mass) + L_w) x` for each start `x` given ([`operator`]'s residual),
 /// in one pass over the system: each block's numbers are read once for every start.
 #[inline(always)]
@@ -236,13 +242,9 @@ pub(super) fn residuals<T: Real>(
     outs: [&mut [T]; 2],
 ) {
     let range = both_sweeps(layout);
-    let half = layout.half;
     let mut pairs: Vec<_> = starts.into_iter().zip(outs).collect();
     for (_, out) in &mut pairs {
-        for colour in out[..layout.len()].chunks_exact_mut(half) {
-            colour[..range.start].fill(T::ZERO);
-            colour[range.end..].fill(T::ZERO);
-        }
+        zero_outside(layout, &range, out);
     }
     in_blocks(
         layout,
