@@ -206,30 +206,7 @@ pub(super) fn operator<T: Real, const RESIDUAL: bool>(
     x: &[T],
     out: &mut [T],
 ) {
-    let range = both_sweeps(layout);
-    zero_outside(layout, &range, out);
-    in_blocks(
-        layout,
-        range,
-        mass.per_face,
-        #[inline(always)]
-        |face, start, len| {
-            for c in 0..2 {
-                let at = (face, start, len);
-                operator_run::<T, RESIDUAL>(layout, c, at, (mass, w, r), x, out);
-            }
-        },
-    );
-}
-
-/// Zeroes each colour of `out` outside `range`, the part the sweeps cover (so the dot
-/// products see zero there).
-#[inline(always)]
-fn zero_outside<T: Real>(layout: &Layout, range: &std::ops::Range<usize>, out: &mut [T]) {
-    for colour in out[..layout.len()].chunks_exact_mut(layout.half) {
-        colour[..range.start].fill(T::ZERO);
-        colour[range.end..].fill(T::ZERO);
-    }
+    operator_blocks::<T, RESIDUAL>(layout, (mass, w, r), &mut [(Some(x), out)]);
 }
 
 /// `out = b − (diag(mass) + L_w) x` for each start `x` given ([`operator`]'s residual),
@@ -241,10 +218,26 @@ pub(super) fn residuals<T: Real>(
     starts: [Option<&[T]>; 2],
     outs: [&mut [T]; 2],
 ) {
+    let [a, b_out] = outs;
+    let [x_a, x_b] = starts;
+    operator_blocks::<T, true>(layout, (mass, w, b), &mut [(x_a, a), (x_b, b_out)]);
+}
+
+/// [`operator`] of each start given in `pairs` into its output (the others' outputs only
+/// zeroed outside the cells), both colours a block at a time: each block's numbers are
+/// read once for every start.
+#[inline(always)]
+fn operator_blocks<T: Real, const RESIDUAL: bool>(
+    layout: &Layout,
+    (mass, w, r): (LevelField<T>, &Stencil<T>, &[T]),
+    pairs: &mut [(Option<&[T]>, &mut [T])],
+) {
     let range = both_sweeps(layout);
-    let mut pairs: Vec<_> = starts.into_iter().zip(outs).collect();
-    for (_, out) in &mut pairs {
-        zero_outside(layout, &range, out);
+    for (_, out) in pairs.iter_mut() {
+        for colour in out[..layout.len()].chunks_exact_mut(layout.half) {
+            colour[..range.start].fill(T::ZERO);
+            colour[range.end..].fill(T::ZERO);
+        }
     }
     in_blocks(
         layout,
@@ -252,11 +245,11 @@ pub(super) fn residuals<T: Real>(
         mass.per_face,
         #[inline(always)]
         |face, start, len| {
-            for (x, out) in &mut pairs {
+            for (x, out) in pairs.iter_mut() {
                 let Some(x) = x else { continue };
                 for c in 0..2 {
                     let at = (face, start, len);
-                    operator_run::<T, true>(layout, c, at, (mass, w, b), x, out);
+                    operator_run::<T, RESIDUAL>(layout, c, at, (mass, w, r), x, out);
                 }
             }
         },
