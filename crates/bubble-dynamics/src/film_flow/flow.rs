@@ -623,6 +623,25 @@ impl AirShear {
         }
     }
 
+    /// Whether the air is still: the potential flow's surface velocity is then zero on
+    /// every edge ([`Self::drag_in_still_air`]).
+    #[inline(always)]
+    pub(super) fn still(&self) -> bool {
+        self.air == DVec3::ZERO
+    }
+
+    /// [`AirShearAlong::drag`] in still air ([`Self::still`]), without the potential
+    /// flow's slopes: its surface velocity is ±0, so the slip outside is `|u|` as inside,
+    /// and `u + dt k_out·(±0)` is `u + 0` (but for a velocity of exactly −0, which may
+    /// come out +0 where the full drag kept −0: the sign of a zero).
+    #[inline(always)]
+    pub(super) fn drag_in_still_air(&self, u: f64, h: f64) -> (f64, f64) {
+        let k = self.per_layer / h;
+        let k_in = k * self.per_layer_depth(u.abs());
+        let factor = 1.0 / (1.0 + self.dt_s * (k_in + k_in));
+        ((u + 0.0) * factor, factor)
+    }
+
     /// `1/δ = max(√(|Δu|/(ν_air ℓ)), 1/R)` at slip `slip`: a multiply where `1/δ` was a
     /// division.
     #[inline(always)]
@@ -692,14 +711,19 @@ mod tests {
     }
 
     /// The drag left to the Marangoni step's edge pass gives the bits of the drag taken
-    /// in a pass of its own, as with a meniscus ([`Drag`]), with either gradient.
+    /// in a pass of its own, as with a meniscus ([`Drag`]), with either gradient, in a
+    /// wind and in still air ([`AirShear::drag_in_still_air`]).
     #[test]
     fn the_drag_left_to_the_marangoni_pass_gives_the_drag_pass_bits() {
-        let forcing = Forcing {
-            g_eff_m_per_s2: DVec3::new(0.0, -9.81, 0.0),
-            air_m_per_s: DVec3::new(0.3, 0.0, 0.1),
-        };
-        for gradient in [FilmGradient::TwoPoint, FilmGradient::Normal] {
+        let airs = [DVec3::new(0.3, 0.0, 0.1), DVec3::ZERO];
+        let cases = airs.into_iter().flat_map(|air| {
+            [FilmGradient::TwoPoint, FilmGradient::Normal].map(|gradient| (air, gradient))
+        });
+        for (air, gradient) in cases {
+            let forcing = Forcing {
+                g_eff_m_per_s2: DVec3::new(0.0, -9.81, 0.0),
+                air_m_per_s: air,
+            };
             let run = |here: bool| {
                 let mut f = film();
                 f.params.gradient = gradient;
@@ -712,7 +736,7 @@ mod tests {
             };
             let (left, here) = (run(false), run(true));
             let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
-            let what = format!("{gradient:?}");
+            let what = format!("{gradient:?}, air {air}");
             assert_eq!(bits(&left.h_m), bits(&here.h_m), "{what}: thickness");
             assert_eq!(bits(&left.gamma), bits(&here.gamma), "{what}: surfactant");
             assert_eq!(

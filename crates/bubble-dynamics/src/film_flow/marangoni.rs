@@ -408,6 +408,9 @@ impl<const NORMAL: bool> CentralEdges<'_, NORMAL> {
                 let factors = &run.values(factors)[..len];
                 self.block_with::<false>(run, ends, flux, |i, u, _| (u, factors[i]));
             }
+            (Drag::Deferred(shear), _) if shear.still() => {
+                self.block_with::<true>(run, ends, flux, |_, u, h| shear.drag_in_still_air(u, h));
+            }
             (Drag::Deferred(shear), _) => {
                 let along = shear.along(self.grid.face_geometry(), &run);
                 self.block_with::<true>(run, ends, flux, |i, u, h| along.drag(i, u, h));
