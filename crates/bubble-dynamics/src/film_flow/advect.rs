@@ -39,7 +39,7 @@ use glam::DVec3;
 use crate::avx2::{OTHERS, QUAD_WEIGHTS, coriolis_row, quad_starts, with_avx2};
 
 use super::compare::larger;
-use super::face_rows::{FaceRows, SIDES, Side, face_order};
+use super::face_rows::{AxisGravity, FaceRows, SIDES, Side, face_order};
 use super::grid::{CubeSphere, FaceLayout};
 
 /// Largest fraction of the narrowest dual edge the fastest cell may cross in a sub-step.
@@ -360,6 +360,11 @@ impl StageWork {
 /// where it is in all three stages and reads its starting velocities from `grid`
 /// ([`Start::Grid`]), where otherwise it writes a stage buffer of the rows from cold
 /// (0.4 MB at n = 64); the same bits either way.
+///
+/// Then `gravity`, where given, is added as [`FaceRows::add_gravity`] adds it (the same
+/// bits): by the last stage, to each edge as it moves it, where a pass of its own read
+/// and wrote every edge again (0.4 MB each way at n = 64, beyond L2).
+#[allow(clippy::too_many_arguments)] // each is a separate input of the step
 pub(crate) fn advect_momentum(
     rows: &FaceRows,
     geo: &AdvectionGeometry,
@@ -367,9 +372,13 @@ pub(crate) fn advect_momentum(
     dt_s: f64,
     u: &mut [f64],
     grid: Option<&[f64]>,
+    gravity: Option<&AxisGravity>,
     s: &mut AdvectionScratch,
 ) {
     let Some(substeps) = substeps(rows, geo, radius_m, dt_s, u, s) else {
+        if let Some(gravity) = gravity {
+            rows.add_axis_gravity(u, gravity);
+        }
         return;
     };
     let h = dt_s / f64::from(substeps);
@@ -391,7 +400,8 @@ pub(crate) fn advect_momentum(
             rows.seam_circulation(u, &mut w.vorticity, scale, |z, ia| z * ia);
             for k in 1..=substeps {
                 let buffers = (&mut *u, grid.ok_or(&mut s.stage));
-                ssp_rk3(rows, geo, scale, h, buffers, w, k < substeps);
+                let last = gravity.filter(|_| k == substeps);
+                ssp_rk3(rows, geo, scale, h, buffers, w, (k < substeps, last));
             }
         },
     );
@@ -441,7 +451,8 @@ fn substeps(
 
 /// One Shu–Osher third-order step of `u`: `u₁ = u + hL(u)`, `u₂ = ¾u + ¼(u₁ + hL(u₁))`,
 /// `u ← ⅓u + ⅔(u₂ + hL(u₂))`, from `u`'s vorticity on the faces' borders in
-/// `w.vorticity`; it leaves the new `u`'s there where `next` (for the next sub-step).
+/// `w.vorticity`; it leaves the new `u`'s there where `next` (for the next sub-step),
+/// and adds `gravity` to the new `u` where given (the last sub-step).
 /// A stage reads no edge of its source once it has moved it, so it may move them where
 /// they are: with `Ok(grid)` (`u` in the grid's numbering) every stage does, the
 /// starting velocities read from `grid`; with `Err(stage)`, `u₁`, then `u₂`, goes to
@@ -455,7 +466,7 @@ fn ssp_rk3(
     h: f64,
     (u, stage): (&mut [f64], Result<&[f64], &mut Vec<f64>>),
     w: &mut StageWork,
-    next: bool,
+    (next, gravity): (bool, Option<&AxisGravity>),
 ) {
     let on = Stage { rows, geo, scale };
     // The stages' faces in alternate directions, the first in reverse ([`face_order`]).
@@ -466,18 +477,18 @@ fn ssp_rk3(
     let step3 = |u, u0, r| (1.0 / 3.0) * u0 + (2.0 / 3.0) * (u + h * r);
     match stage {
         Ok(grid) => {
-            on.stage(None, u, Start::Dst, w, (true, true), step1);
-            on.stage(None, u, Start::Grid(grid), w, (true, false), step2);
-            on.stage(None, u, Start::Grid(grid), w, (next, true), step3);
+            on.stage(None, u, Start::Dst, w, (true, true, None), step1);
+            on.stage(None, u, Start::Grid(grid), w, (true, false, None), step2);
+            on.stage(None, u, Start::Grid(grid), w, (next, true, gravity), step3);
         }
         Err(stage) => {
             // Stage 1 (what `stage` held is passed over) ignores the starting velocities:
             // given `u`'s, the rows may move the border copies too (see `Stage::stage`).
-            on.stage(Some(u), stage, Start::Rows(u), w, (true, true), step1);
+            on.stage(Some(u), stage, Start::Rows(u), w, (true, true, None), step1);
             // Stage 2, `u₁` into `u₂` where it is.
-            on.stage(None, stage, Start::Rows(u), w, (true, false), step2);
+            on.stage(None, stage, Start::Rows(u), w, (true, false, None), step2);
             // Stage 3, onto `u`.
-            on.stage(Some(stage), u, Start::Dst, w, (next, true), step3);
+            on.stage(Some(stage), u, Start::Dst, w, (next, true, gravity), step3);
         }
     }
 }
@@ -554,7 +565,10 @@ impl Stage<'_> {
     /// lower-numbered cell's term first), `u0` the edge's starting velocity ([`Start`]);
     /// where `next`, the vorticity of `dst` on the
     /// faces' borders then replaces it. The faces in reverse order where `reverse`
-    /// ([`face_order`]).
+    /// ([`face_order`]). Where `gravity` is given, each row adds it to the edges it has
+    /// just moved, and the seam pass to each border edge's first copy, the second then
+    /// the first's in its orientation (as [`FaceRows::add_gravity`] leaves them); no row
+    /// reads a moved edge, so the stage's rates are the same.
     ///
     /// Row `y` of a face takes the vorticity of its vertex row `y + 1` from `src` (row
     /// `y`'s it took the row before), then its cells' terms, then moves its X-edges (both
@@ -573,10 +587,11 @@ impl Stage<'_> {
         dst: &mut [f64],
         u0: Start,
         w: &mut StageWork,
-        (next, reverse): (bool, bool),
+        (next, reverse, gravity): (bool, bool, Option<&AxisGravity>),
         step: impl Fn(f64, f64, f64) -> f64,
     ) {
         let (rows, n) = (self.rows, self.rows.n);
+        let epf = rows.edges_per_face();
         let (vorticity, border) = (&w.vorticity, &mut w.border_rate);
         let [even, odd] = &mut w.row_rate;
         let [z_even, z_odd] = &mut w.vertex_rows;
@@ -601,7 +616,9 @@ impl Stage<'_> {
                 let border_copy = dst[k.end - 1];
                 let u0x = u0.run(rows, (f, y, true), k.clone());
                 let srcx = src.map(|s| &s[k.clone()]);
-                move_edges(&mut dst[k.clone()], srcx, u0x, right, &left[1..], &step);
+                let rates = (&right[..], &left[1..]);
+                let at = (f, k.start - f * epf);
+                move_edges(&mut dst[k.clone()], srcx, u0x, rates, &step, gravity, at);
                 dst[k.end - 1] = border_copy;
                 if y == 0 {
                     continue;
@@ -611,10 +628,18 @@ impl Stage<'_> {
                 let (top, bottom) = (&before[Side::Top as usize], &rate[Side::Bottom as usize]);
                 let u0y = u0.run(rows, (f, y, false), k.clone());
                 let srcy = src.map(|s| &s[k.clone()]);
-                move_edges(&mut dst[k], srcy, u0y, top, bottom, &step);
+                let at = (f, k.start - f * epf);
+                move_edges(&mut dst[k], srcy, u0y, (top, bottom), &step, gravity, at);
             }
         }
         self.move_seam_edges(src, dst, u0, &w.border_rate, &step);
+        if let Some(gravity) = gravity {
+            for e in &self.geo.seams {
+                let ([first, second], [sa, sb]) = (e.edges.map(|k| k as usize), e.signs);
+                gravity.add_to(first, &mut dst[first]);
+                dst[second] = dst[first] * sa * sb;
+            }
+        }
         if next {
             rows.seam_circulation(dst, &mut w.vorticity, self.scale, |z, ia| z * ia);
         }
@@ -710,15 +735,37 @@ fn border_slot(n: usize, c: usize, side: Side) -> u32 {
 }
 
 /// `dst ← step(src, u0, (0 + ra) + rb)` edge by edge over `dst`, `src` and `u0` the
-/// edge's entries of them, or of `dst` before it is written where `None`.
+/// edge's entries of them, or of `dst` before it is written where `None`; plus
+/// `dt·(g·c)` where `gravity` is given (`dst` face `f`'s local edges from `from`), as
+/// [`FaceRows::add_gravity`] adds it.
 #[inline(always)]
 fn move_edges(
     dst: &mut [f64],
     src: Option<&[f64]>,
     u0: Option<&[f64]>,
-    ra: &[f64],
-    rb: &[f64],
+    rates: (&[f64], &[f64]),
     step: &impl Fn(f64, f64, f64) -> f64,
+    gravity: Option<&AxisGravity>,
+    (f, from): (usize, usize),
+) {
+    match gravity {
+        None => move_edges_by(dst, src, u0, rates, |_, u, u0, r| step(u, u0, r)),
+        Some(gravity) => {
+            let (dt, g, c) = gravity.row(f, from, dst.len());
+            let step = |i: usize, u, u0, r| step(u, u0, r) + dt * (g * c[i]);
+            move_edges_by(dst, src, u0, rates, step);
+        }
+    }
+}
+
+/// [`move_edges`], each edge's `dst ← step(i, src, u0, rate)` given its index `i`.
+#[inline(always)]
+fn move_edges_by(
+    dst: &mut [f64],
+    src: Option<&[f64]>,
+    u0: Option<&[f64]>,
+    (ra, rb): (&[f64], &[f64]),
+    step: impl Fn(usize, f64, f64, f64) -> f64,
 ) {
     let len = dst.len();
     let (ra, rb) = (&ra[..len], &rb[..len]);
@@ -726,24 +773,24 @@ fn move_edges(
         (Some(src), Some(u0)) => {
             let (src, u0) = (&src[..len], &u0[..len]);
             for i in 0..len {
-                dst[i] = step(src[i], u0[i], (0.0 + ra[i]) + rb[i]);
+                dst[i] = step(i, src[i], u0[i], (0.0 + ra[i]) + rb[i]);
             }
         }
         (Some(src), None) => {
             let src = &src[..len];
             for i in 0..len {
-                dst[i] = step(src[i], dst[i], (0.0 + ra[i]) + rb[i]);
+                dst[i] = step(i, src[i], dst[i], (0.0 + ra[i]) + rb[i]);
             }
         }
         (None, Some(u0)) => {
             let u0 = &u0[..len];
             for i in 0..len {
-                dst[i] = step(dst[i], u0[i], (0.0 + ra[i]) + rb[i]);
+                dst[i] = step(i, dst[i], u0[i], (0.0 + ra[i]) + rb[i]);
             }
         }
         (None, None) => {
             for i in 0..len {
-                dst[i] = step(dst[i], dst[i], (0.0 + ra[i]) + rb[i]);
+                dst[i] = step(i, dst[i], dst[i], (0.0 + ra[i]) + rb[i]);
             }
         }
     }
@@ -955,7 +1002,16 @@ mod tests {
         let mut in_rows = Vec::new();
         rows.to_rows(&u, &mut in_rows);
         for _ in 0..240 {
-            advect_momentum(&rows, &geo, 0.01, 1.0 / 960.0, &mut in_rows, None, &mut s);
+            advect_momentum(
+                &rows,
+                &geo,
+                0.01,
+                1.0 / 960.0,
+                &mut in_rows,
+                None,
+                None,
+                &mut s,
+            );
         }
         rows.to_grid(&in_rows, &mut u);
         let change = energy(&u) / e0 - 1.0;
@@ -987,6 +1043,7 @@ mod tests {
                     0.01,
                     1.0 / 60.0,
                     &mut u,
+                    None,
                     None,
                     &mut AdvectionScratch::default(),
                 );
@@ -1098,7 +1155,7 @@ mod tests {
                 } else {
                     Start::Rows(&u0)
                 };
-                on.stage(from, &mut dst, start, &mut w, (true, reverse), step);
+                on.stage(from, &mut dst, start, &mut w, (true, reverse, None), step);
                 (dst, w.vorticity)
             };
             let apart = run(false, false, false);
@@ -1202,7 +1259,7 @@ mod tests {
                     let mut u = start.clone();
                     let g = from_grid.then_some(&start_grid[..]);
                     let s = &mut AdvectionScratch::default();
-                    advect_momentum(&rows, &geo, radius, 1.0 / 60.0, &mut u, g, s);
+                    advect_momentum(&rows, &geo, radius, 1.0 / 60.0, &mut u, g, None, s);
                     u
                 };
                 let (through, from_grid) = (run(false), run(true));
@@ -1212,6 +1269,51 @@ mod tests {
                     .zip(&from_grid)
                     .filter(|(a, b)| a.to_bits() != b.to_bits());
                 assert_eq!(differ.count(), 0, "n {n}, radius {radius}: edges differ");
+            }
+        }
+    }
+
+    /// Gravity added by the advection's last stage gives the bits of the advection and
+    /// then a pass of gravity of its own: one sub-step and several, through the stage
+    /// buffer and from the grid's numbering, a film at rest (no advection), gravity along
+    /// each axis, at n = 2, 5 and 16.
+    #[test]
+    fn gravity_in_the_last_stage_is_a_pass_of_its_own() {
+        use super::super::flow::FilmGradient;
+        for n in [2, 5, 16] {
+            let grid = CubeSphere::new(n);
+            let rows = FaceRows::new(&grid);
+            let geo = AdvectionGeometry::new(&grid, &rows);
+            let rough = rough_rows(&rows, &grid, 7919);
+            for start in [rough, vec![0.0; rows.edge.len()]] {
+                let mut start_grid = vec![0.0; grid.edges().len()];
+                rows.to_grid(&start, &mut start_grid);
+                let cases = [1.0, 1e-4].into_iter().zip([false, true]);
+                let axes = [DVec3::X, DVec3::NEG_Y, DVec3::Z].map(|axis| axis * 9.81);
+                for ((radius, from_grid), g) in cases.flat_map(|c| axes.map(|g| (c, g))) {
+                    let kind = FilmGradient::TwoPoint;
+                    let gravity = rows.gravity(&grid, kind, g, 1.0 / 60.0);
+                    let along = gravity.along_axes().expect("gravity along an axis");
+                    let run = |fused: bool| {
+                        let mut u = start.clone();
+                        let from = from_grid.then_some(&start_grid[..]);
+                        let s = &mut AdvectionScratch::default();
+                        let g = fused.then_some(&along);
+                        advect_momentum(&rows, &geo, radius, 1.0 / 60.0, &mut u, from, g, s);
+                        if !fused {
+                            rows.add_gravity(&mut u, &gravity);
+                        }
+                        u
+                    };
+                    let (fused, apart) = (run(true), run(false));
+                    assert_ne!(fused, start, "n {n}, radius {radius}: nothing moved");
+                    let differ = fused
+                        .iter()
+                        .zip(&apart)
+                        .filter(|(a, b)| a.to_bits() != b.to_bits());
+                    let what = format!("n {n}, radius {radius}, from grid {from_grid}, g {g}");
+                    assert_eq!(differ.count(), 0, "{what}: edges differ");
+                }
             }
         }
     }

@@ -284,10 +284,8 @@ impl FaceRows {
 
     /// `u += dt_s·(g·c)` on every local edge, `c` its grid edge's centre gradient for
     /// `kind` (`grid`'s, from which the rows were derived) in its own orientation, to
-    /// rounding: each face takes `g` into its own frame and reads face 0's gradients in
-    /// face 0's ([`Self::gradients`]). A border edge's second copy is then its first's,
-    /// or its negation, exactly ([`Self::match_seam_copies`]). The gradients are taken
-    /// into the rows the first time `kind` is asked for.
+    /// rounding ([`Gravity`]). A border edge's second copy is then its first's, or its
+    /// negation, exactly ([`Self::match_seam_copies`]).
     pub(crate) fn add_gradient(
         &self,
         u: &mut [f64],
@@ -296,27 +294,64 @@ impl FaceRows {
         g: DVec3,
         dt_s: f64,
     ) {
-        let ea = grid.edge_arrays();
-        let (per_edge, rows) = match kind {
-            FilmGradient::TwoPoint => (&ea.centre_gradient, &self.gradients[0]),
-            FilmGradient::Normal => (&ea.centre_normal_gradient, &self.gradients[1]),
-        };
-        let [a, b, c] = rows.get_or_init(|| self.local_gradients(per_edge, 1));
+        self.add_gravity(u, &self.gravity(grid, kind, g, dt_s));
+    }
+
+    /// `u += gravity` on every local edge ([`Self::add_gradient`]).
+    pub(crate) fn add_gravity(&self, u: &mut [f64], gravity: &Gravity) {
         let epf = self.edges_per_face();
-        let (a, b, c) = (&a[..epf], &b[..epf], &c[..epf]);
         with_avx2(
             #[inline(always)]
             || {
                 for (f, u) in u.chunks_exact_mut(epf).enumerate() {
-                    // Exact: each axis picks one of g's components, or its negation.
-                    let [ga, gb, gc] = face_axes(f).map(|axis| g.dot(axis));
+                    gravity.add(f, 0, u);
+                }
+            },
+        );
+        self.match_seam_copies(u);
+    }
+
+    /// [`Self::add_gravity`] of gravity along the faces' axes ([`Gravity::along_axes`]):
+    /// the same bits.
+    pub(crate) fn add_axis_gravity(&self, u: &mut [f64], gravity: &AxisGravity) {
+        let epf = self.edges_per_face();
+        with_avx2(
+            #[inline(always)]
+            || {
+                for (f, u) in u.chunks_exact_mut(epf).enumerate() {
+                    let (dt, g, c) = gravity.row(f, 0, epf);
                     for i in 0..epf {
-                        u[i] += dt_s * (ga * a[i] + gb * b[i] + gc * c[i]);
+                        u[i] += dt * (g * c[i]);
                     }
                 }
             },
         );
         self.match_seam_copies(u);
+    }
+
+    /// The term `dt_s·(g·c)` of [`Self::add_gradient`], for passes that add it to the
+    /// edges they move. The gradients are taken into the rows the first time `kind` is
+    /// asked for.
+    pub(crate) fn gravity(
+        &self,
+        grid: &CubeSphere,
+        kind: FilmGradient,
+        g: DVec3,
+        dt_s: f64,
+    ) -> Gravity<'_> {
+        let ea = grid.edge_arrays();
+        let (per_edge, rows) = match kind {
+            FilmGradient::TwoPoint => (&ea.centre_gradient, &self.gradients[0]),
+            FilmGradient::Normal => (&ea.centre_normal_gradient, &self.gradients[1]),
+        };
+        let epf = self.edges_per_face();
+        let [a, b, c] = rows.get_or_init(|| self.local_gradients(per_edge, 1));
+        Gravity {
+            dt_s,
+            // Exact: each axis picks one of g's components, or its negation.
+            along: std::array::from_fn(|f| face_axes(f).map(|axis| g.dot(axis))),
+            components: [&a[..epf], &b[..epf], &c[..epf]],
+        }
     }
 
     /// The centre gradients `per_edge` (per grid edge) of the first `faces` faces' local
@@ -569,6 +604,100 @@ impl FaceRows {
                 out[k as usize] = z;
             }
         }
+    }
+}
+
+/// Gravity's `dt·(g·c)` on the local edges ([`FaceRows::gravity`]): each face takes `g`
+/// into its own frame and reads face 0's gradients in face 0's ([`FaceRows::gradients`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Gravity<'a> {
+    /// The step, s.
+    dt_s: f64,
+    /// Per face: `g` along its axes ([`face_axes`]), m/s².
+    along: [[f64; 3]; 6],
+    /// Face 0's gradients' components along its axes, per local edge of a face.
+    components: [&'a [f64]; 3],
+}
+
+impl<'a> Gravity<'a> {
+    /// `u[i] += dt·(g·c)` for the local edges `from..from + u.len()` of face `f`, as
+    /// `dt·((ga·a + gb·b) + gc·c)`, or as its one term where it has one
+    /// ([`Self::one_term`]).
+    #[inline(always)]
+    pub(crate) fn add(&self, f: usize, from: usize, u: &mut [f64]) {
+        let (dt, len) = (self.dt_s, u.len());
+        if let Some((gk, ck)) = self.one_term(f) {
+            let ck = &ck[from..from + len];
+            for i in 0..len {
+                u[i] += dt * (gk * ck[i]);
+            }
+            return;
+        }
+        let [ga, gb, gc] = self.along[f];
+        let [a, b, c] = self.components.map(|s| &s[from..from + len]);
+        for i in 0..len {
+            u[i] += dt * (ga * a[i] + gb * b[i] + gc * c[i]);
+        }
+    }
+
+    /// Where `g` lies along one of face `f`'s axes (gravity along the world's, as it
+    /// mostly is), that axis's `g` and face 0's gradient component along it: the other
+    /// terms are zeros, which leave the sum's bits as they are unless the one term is
+    /// itself zero (then the velocity is kept; only a zero velocity's sign could
+    /// differ). One of face 0's three gradient arrays is read where the sum read all
+    /// three.
+    #[inline(always)]
+    fn one_term(&self, f: usize) -> Option<(f64, &'a [f64])> {
+        let [ga, gb, gc] = self.along[f];
+        let [a, b, c] = self.components;
+        match [ga, gb, gc].map(|g| g != 0.0) {
+            [true, false, false] => Some((ga, a)),
+            [false, true, false] => Some((gb, b)),
+            [false, false, true] => Some((gc, c)),
+            _ => None,
+        }
+    }
+
+    /// The gravity as one term on every face ([`Self::one_term`]), where it is.
+    pub(crate) fn along_axes(&self) -> Option<AxisGravity<'a>> {
+        let terms = [0, 1, 2, 3, 4, 5].map(|f| self.one_term(f));
+        Some(AxisGravity {
+            dt_s: self.dt_s,
+            terms: terms
+                .into_iter()
+                .collect::<Option<Vec<_>>>()?
+                .try_into()
+                .ok()?,
+        })
+    }
+}
+
+/// Gravity along one of each face's axes ([`Gravity::along_axes`]), for passes that add
+/// it to each edge as they move it: the same bits as [`Gravity::add`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct AxisGravity<'a> {
+    /// The step, s.
+    dt_s: f64,
+    /// Per face: its axis's `g`, m/s², and face 0's gradient component along it, per
+    /// local edge of a face.
+    terms: [(f64, &'a [f64]); 6],
+}
+
+impl<'a> AxisGravity<'a> {
+    /// The step, face `f`'s `g` and its gradient component of the local edges
+    /// `from..from + len`: each edge's `u` becomes `u + dt·(g·c[i])`.
+    #[inline(always)]
+    pub(crate) fn row(&self, f: usize, from: usize, len: usize) -> (f64, f64, &'a [f64]) {
+        let (g, c) = self.terms[f];
+        (self.dt_s, g, &c[from..from + len])
+    }
+
+    /// `u += dt·(g·c)` for local edge `k` (of any face).
+    #[inline(always)]
+    pub(crate) fn add_to(&self, k: usize, u: &mut f64) {
+        let epf = self.terms[0].1.len();
+        let (g, c) = self.terms[k / epf];
+        *u += self.dt_s * (g * c[k % epf]);
     }
 }
 
@@ -919,6 +1048,36 @@ mod tests {
                         (got - want).abs() <= tolerance,
                         "n {n}, {kind:?}, edge {e}: {got} against {want}"
                     );
+                }
+            }
+        }
+    }
+
+    /// Gravity along one of a face's axes, taken as its one term, gives the bits of the
+    /// three terms' sum on every edge of a rough field: gravity along each world axis
+    /// (every face then has one term), at n = 5 and 16.
+    #[test]
+    fn gravity_along_an_axis_is_the_sum_of_its_terms() {
+        for n in [5, 16] {
+            let grid = CubeSphere::new(n);
+            let rows = FaceRows::new(&grid);
+            let start: Vec<f64> = (0..rows.edge.len())
+                .map(|k| ((k * 7919) % 1000) as f64 * 1e-3 - 0.4005)
+                .collect();
+            let epf = rows.edges_per_face();
+            for g in [DVec3::X, DVec3::NEG_Y, DVec3::Z].map(|axis| axis * 9.81) {
+                let gravity = rows.gravity(&grid, FilmGradient::TwoPoint, g, 0.02);
+                let mut got = start.clone();
+                for (f, u) in got.chunks_exact_mut(epf).enumerate() {
+                    gravity.add(f, 0, u);
+                }
+                assert!(gravity.along_axes().is_some(), "g {g}: along an axis");
+                let [a, b, c] = gravity.components;
+                for (k, (got, u)) in got.iter().zip(&start).enumerate() {
+                    let [ga, gb, gc] = gravity.along[k / epf];
+                    let i = k % epf;
+                    let want = u + 0.02 * (ga * a[i] + gb * b[i] + gc * c[i]);
+                    assert_eq!(got.to_bits(), want.to_bits(), "n {n}, g {g}, edge {k}");
                 }
             }
         }

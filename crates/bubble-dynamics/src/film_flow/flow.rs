@@ -418,6 +418,19 @@ impl FilmFlow {
         // rows are written back below).
         self.rows.to_rows(&s.u_start, u);
         let start = Some(&s.u_start[..]);
+        let nu = self.params.viscosity_pa_s / self.params.density_kg_per_m3;
+        let g = forcing.g_eff_m_per_s2;
+        let two_point = matches!(self.params.gradient, FilmGradient::TwoPoint);
+        // Gravity as the discrete gradient of the potential g·x between cell centres, so a
+        // discrete Marangoni gradient can balance it exactly (the edge projection g·n
+        // carries an O(Δx) curl that no tension gradient can hold): added by the
+        // advection's last stage, edge by edge (`advect_momentum`), where it is along an
+        // axis of every face (else in a pass of its own).
+        let gravity = two_point.then(|| {
+            self.rows
+                .gravity(&self.grid, FilmGradient::TwoPoint, g, dt_s)
+        });
+        let along = gravity.as_ref().and_then(|g| g.along_axes());
         advect_momentum(
             &self.rows,
             &self.advection,
@@ -425,18 +438,14 @@ impl FilmFlow {
             dt_s,
             u,
             start,
+            along.as_ref(),
             &mut s.advect,
         );
-        let nu = self.params.viscosity_pa_s / self.params.density_kg_per_m3;
-        let g = forcing.g_eff_m_per_s2;
+        if let (Some(gravity), None) = (&gravity, &along) {
+            self.rows.add_gravity(u, gravity);
+        }
         match self.params.gradient {
             FilmGradient::TwoPoint => {
-                // Gravity as the discrete gradient of the potential g·x between cell
-                // centres, so a discrete Marangoni gradient can balance it exactly (the
-                // edge projection g·n carries an O(Δx) curl that no tension gradient can
-                // hold).
-                let kind = FilmGradient::TwoPoint;
-                self.rows.add_gradient(u, &self.grid, kind, g, dt_s);
                 if !self.temperature_k.is_empty() {
                     self.rows.to_grid(u, &mut self.u_m_per_s);
                     self.thermal_stress(dt_s, &mut s.vertex);
