@@ -203,6 +203,15 @@ impl Work {
     }
 }
 
+/// Where [`Hierarchy::solve_prepared_from`] starts.
+#[derive(Clone, Copy)]
+enum Start<'a> {
+    /// From the answer's own values, and the guess where one is given.
+    Values(Option<&'a [f64]>),
+    /// From the start given, and its sum with the change where one is given as the guess.
+    Changed(&'a [f64], Option<&'a [f64]>),
+}
+
 /// When a solve stops.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolveLimits {
@@ -306,6 +315,51 @@ impl Hierarchy {
         guess: Option<&[f64]>,
         limits: SolveLimits,
     ) -> SolveReport {
+        let nc = self.levels[0].position.len();
+        assert!(x.len() == nc, "system size mismatch");
+        let guess = guess.filter(|g| g.len() == nc);
+        self.solve_prepared_from(work, b, Start::Values(guess), x, limits)
+    }
+
+    /// As [`Hierarchy::solve_with_guess`] from `start`, with the guess `start + change`
+    /// where `change` is given (and of the system's size), the answer written to `x`
+    /// (its values not read): the start and the guess go straight into the solve's
+    /// layout, in one pass, where a caller's own pass would write both out in the grid's
+    /// numbering first and the solve read them back.
+    ///
+    /// # Panics
+    /// If a slice's length does not match the finest level.
+    #[allow(clippy::too_many_arguments)] // the system's three arrays, its start, answer, limits
+    pub fn solve_from_start_and_change(
+        &self,
+        work: &mut Work,
+        (alpha, weight, b): (&[f64], &[f64], &[f64]),
+        (start, change): (&[f64], Option<&[f64]>),
+        x: &mut [f64],
+        limits: SolveLimits,
+    ) -> SolveReport {
+        let nc = self.levels[0].position.len();
+        assert!(
+            alpha.len() == nc && start.len() == nc,
+            "system size mismatch"
+        );
+        assert_eq!(x.len(), nc, "system size mismatch");
+        self.prepare(work, alpha, weight);
+        let change = change.filter(|c| c.len() == nc);
+        self.solve_prepared_from(work, b, Start::Changed(start, change), x, limits)
+    }
+
+    /// [`Hierarchy::solve_prepared`] from `start` ([`Start`]), the answer into `x`: the
+    /// right-hand side, the start and the guess put in the split layout, solved there, and
+    /// the answer put back.
+    fn solve_prepared_from(
+        &self,
+        work: &mut Work,
+        b: &[f64],
+        start: Start,
+        x: &mut [f64],
+        limits: SolveLimits,
+    ) -> SolveReport {
         let fine = &self.levels[0];
         let nc = fine.position.len();
         assert!(b.len() == nc && x.len() == nc, "system size mismatch");
@@ -315,18 +369,32 @@ impl Hierarchy {
             std::mem::take(&mut work.x),
             std::mem::take(&mut work.guess),
         );
-        let guess = guess.filter(|g| g.len() == nc);
-        with_avx2(
+        let mut row = std::mem::take(&mut work.row64);
+        let guessed = with_avx2(
             #[inline(always)]
             || {
                 to_split(fine, b, &mut bs);
-                to_split(fine, x, &mut xs);
-                if let Some(g) = guess {
-                    to_split(fine, g, &mut gs);
+                match start {
+                    Start::Values(guess) => {
+                        to_split(fine, x, &mut xs);
+                        if let Some(g) = guess {
+                            to_split(fine, g, &mut gs);
+                        }
+                        guess.is_some()
+                    }
+                    Start::Changed(start, None) => {
+                        to_split(fine, start, &mut xs);
+                        false
+                    }
+                    Start::Changed(start, Some(change)) => {
+                        start_and_guess_split(fine, (start, change), (&mut xs, &mut gs), &mut row);
+                        true
+                    }
                 }
             },
         );
-        let guess = guess.map(|_| &mut gs);
+        work.row64 = row;
+        let guess = guessed.then_some(&mut gs);
         let report = self.solve_split(work, &bs, &mut xs, guess, limits);
         with_avx2(
             #[inline(always)]
@@ -731,6 +799,32 @@ fn to_split(layout: &Layout, values: &[f64], out: &mut Vec<f64>) {
     }
 }
 
+/// `xs` = `start` and `gs` = `start + change` (grid-numbered) in `layout`'s split arrays,
+/// a face row at a time (the sum formed in `row`), the halo untouched.
+#[inline(always)]
+fn start_and_guess_split(
+    layout: &Layout,
+    (start, change): (&[f64], &[f64]),
+    (xs, gs): (&mut Vec<f64>, &mut Vec<f64>),
+    row: &mut Vec<f64>,
+) {
+    xs.resize(layout.len(), 0.0);
+    gs.resize(layout.len(), 0.0);
+    let m = layout.m;
+    row.resize(m, 0.0);
+    for face in 0..6 {
+        for y in 0..m {
+            let cells = (face * m + y) * m..(face * m + y + 1) * m;
+            let (start, change) = (&start[cells.clone()], &change[cells]);
+            scatter_row(layout, face, y, start, xs);
+            for ((g, s), c) in row.iter_mut().zip(start).zip(change) {
+                *g = s + c;
+            }
+            scatter_row(layout, face, y, row, gs);
+        }
+    }
+}
+
 /// `out` = `layout`'s split field in the grid's numbering.
 #[inline(always)]
 fn from_split(layout: &Layout, field: &mut [f64], out: &mut [f64]) {
@@ -949,6 +1043,68 @@ mod tests {
             assert_eq!(guessed.iterations > 0, iterating, "{guessed:?}");
             assert!(guessed.relative_residual <= 1e-6, "{guessed:?}");
             assert!(worst(&x) < 1e-8, "error {}", worst(&x));
+        }
+    }
+
+    /// [`Hierarchy::solve_from_start_and_change`] is [`Hierarchy::solve_with_guess`] from
+    /// the start with the guess `start + change` (summed in the grid's numbering), to the
+    /// bit: with a change that is taken, one that is not (worse than the start) and none.
+    #[test]
+    fn a_start_and_change_solve_as_the_start_and_its_guess() {
+        let n = 16;
+        let (grid, h, alpha, weight, b) = stiff_system(n, |c| (2.0 * c.x - c.y * c.z).sin());
+        let limits = SolveLimits {
+            tolerance: 1e-9,
+            max_iterations: 50,
+        };
+        let start: Vec<f64> = grid.centres().iter().map(|c| c.x * c.y).collect();
+        let mut answer = start.clone();
+        h.solve(
+            &mut Work::default(),
+            &alpha,
+            &weight,
+            &b,
+            &mut answer,
+            limits,
+        );
+        // Near the answer (the guess taken), and far from it (not taken).
+        let near: Vec<f64> = answer
+            .iter()
+            .zip(&start)
+            .map(|(a, s)| 0.9 * (a - s))
+            .collect();
+        let far: Vec<f64> = near.iter().map(|v| 1e3 * v).collect();
+        for change in [Some(&near), Some(&far), None] {
+            let mut work = Work::default();
+            let guess: Option<Vec<f64>> =
+                change.map(|c| start.iter().zip(c).map(|(s, c)| s + c).collect());
+            let mut plain = start.clone();
+            let system = (&alpha[..], &weight[..], &b[..]);
+            let expected = h.solve_with_guess(
+                &mut work,
+                &alpha,
+                &weight,
+                &b,
+                &mut plain,
+                guess.as_deref(),
+                limits,
+            );
+            let mut x = vec![f64::NAN; grid.cells()];
+            let change = change.map(|c| &c[..]);
+            let report = h.solve_from_start_and_change(
+                &mut Work::default(),
+                system,
+                (&start, change),
+                &mut x,
+                limits,
+            );
+            assert_eq!(report, expected);
+            assert!(report.iterations >= 1, "{report:?}");
+            let differ = x
+                .iter()
+                .zip(&plain)
+                .filter(|(a, b)| a.to_bits() != b.to_bits());
+            assert_eq!(differ.count(), 0, "change {:?}", change.map(|c| c[0]));
         }
     }
 
