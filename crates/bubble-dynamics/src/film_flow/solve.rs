@@ -510,18 +510,6 @@ impl Hierarchy {
             work.correction[k].resize(level.len(), 0.0);
         }
         self.fine_numbers(work, alpha, weight);
-        for k in 1..count {
-            let (fine, coarse) = (&self.levels[k - 1], &self.levels[k]);
-            let per_face = k == 1 && work.mass_per_face;
-            let (done, rest) = work.mass.split_at_mut(k);
-            let fine_mass = LevelField {
-                values: &done[k - 1],
-                per_face,
-            };
-            restrict_field(fine, fine_mass, coarse, &mut rest[0], &mut work.row64);
-            let (done, rest) = work.stencil.split_at_mut(k);
-            kernels::restrict_weights(fine, &done[k - 1], coarse, &mut rest[0], &mut work.row64);
-        }
         // One level: the dense solve is the whole preconditioner, in `f64`, unscaled.
         work.scale = if count == 1 {
             1.0
@@ -533,7 +521,21 @@ impl Hierarchy {
             let diagonal = first + w0 + w1 + w2 + w3;
             power_of_two_below(diagonal).recip()
         };
-        self.round_for_the_v_cycle(work);
+        // Each level rounded as soon as it is made, while its numbers are in cache.
+        self.round_for_the_v_cycle(work, 0);
+        for k in 1..count {
+            let (fine, coarse) = (&self.levels[k - 1], &self.levels[k]);
+            let per_face = k == 1 && work.mass_per_face;
+            let (done, rest) = work.mass.split_at_mut(k);
+            let fine_mass = LevelField {
+                values: &done[k - 1],
+                per_face,
+            };
+            restrict_field(fine, fine_mass, coarse, &mut rest[0], &mut work.row64);
+            let (done, rest) = work.stencil.split_at_mut(k);
+            kernels::restrict_weights(fine, &done[k - 1], coarse, &mut rest[0], &mut work.row64);
+            self.round_for_the_v_cycle(work, k);
+        }
         let last = count - 1;
         let (mass, stencil) = (&work.mass[last], &work.stencil[last]);
         dense_cholesky(
@@ -583,34 +585,36 @@ impl Hierarchy {
         work.row64 = row;
     }
 
-    /// The smoothed levels' numbers scaled by [`Work::scale`] and rounded to `f32`, the
-    /// inverse diagonal summed in `f64` from the unrounded numbers and rounded once (zero
-    /// outside the cells: [`rounded_level`]).
+    /// Level `k`'s numbers scaled by [`Work::scale`] and rounded to `f32`, the inverse
+    /// diagonal summed in `f64` from the unrounded numbers and rounded once (zero outside
+    /// the cells: [`rounded_level`]); nothing for the coarsest level, solved densely.
     #[inline(always)]
-    fn round_for_the_v_cycle(&self, work: &mut Work) {
+    fn round_for_the_v_cycle(&self, work: &mut Work, k: usize) {
         let (scale, smoothed) = (work.scale, self.levels.len() - 1);
+        if k >= smoothed {
+            return;
+        }
         work.mass32.resize(smoothed, Vec::new());
         work.inv_diag.resize(smoothed, Vec::new());
         work.stencil32.resize(smoothed, Stencil::default());
-        for (k, level) in self.levels[..smoothed].iter().enumerate() {
-            let n = level.len();
-            work.mass32[k].resize(n, 0.0);
-            work.inv_diag[k].resize(n, 0.0);
-            for w in &mut work.stencil32[k] {
-                w.resize(n, 0.0);
-            }
-            let mass = LevelField {
-                values: &work.mass[k],
-                per_face: k == 0 && work.mass_per_face,
-            };
-            rounded_level(
-                level,
-                scale,
-                (mass, &work.stencil[k]),
-                (&mut work.mass32[k], &mut work.stencil32[k]),
-                &mut work.inv_diag[k],
-            );
+        let level = &self.levels[k];
+        let n = level.len();
+        work.mass32[k].resize(n, 0.0);
+        work.inv_diag[k].resize(n, 0.0);
+        for w in &mut work.stencil32[k] {
+            w.resize(n, 0.0);
         }
+        let mass = LevelField {
+            values: &work.mass[k],
+            per_face: k == 0 && work.mass_per_face,
+        };
+        rounded_level(
+            level,
+            scale,
+            (mass, &work.stencil[k]),
+            (&mut work.mass32[k], &mut work.stencil32[k]),
+            &mut work.inv_diag[k],
+        );
     }
 
     /// `z` = the preconditioner applied to the conjugate gradients' residual `r`, whose
