@@ -47,8 +47,8 @@ use crate::avx2::with_avx2;
 use dense::{dense_cholesky, dense_solve};
 use kernels::{
     LevelField, NOT_A_CELL, Stencil, correct, dot, gather_row, operator, refresh, refresh_all,
-    relax, relax_from_zero, residuals, restrict, restrict_field, rounded_level, scatter_row,
-    update_and_norm2, update_direction, widened_dot,
+    relax, relax_from_zero, residuals_in_place, restrict, restrict_field, rounded_level,
+    scatter_row, update_and_norm2, update_direction, widened_dot,
 };
 use layout::Layout;
 
@@ -180,15 +180,14 @@ pub struct Work {
     row: Vec<f32>,
     /// One face row of the finest level's numbers.
     row64: Vec<f64>,
-    /// The conjugate gradients' residual, direction and the operator's product with it
-    /// (at the start, the guess's residual).
+    /// The conjugate gradients' residual (before the start, `b`), direction and the
+    /// operator's product with it (at the start, the guess's residual).
     r: Vec<f64>,
     p: Vec<f64>,
     q: Vec<f64>,
     /// The preconditioned residual where the finest level is solved densely (in `f64`).
     z: Vec<f64>,
-    /// `b`, `x` and the guess in the finest level's layout.
-    b: Vec<f64>,
+    /// `x` and the guess in the finest level's layout (`b` is put in [`Work::r`]).
     x: Vec<f64>,
     guess: Vec<f64>,
 }
@@ -364,8 +363,9 @@ impl Hierarchy {
         let nc = fine.position.len();
         assert!(b.len() == nc && x.len() == nc, "system size mismatch");
         assert!(!work.stencil.is_empty(), "no system prepared");
+        // `b` goes into the residual's field: the residual is taken from it in place.
         let (mut bs, mut xs, mut gs) = (
-            std::mem::take(&mut work.b),
+            std::mem::take(&mut work.r),
             std::mem::take(&mut work.x),
             std::mem::take(&mut work.guess),
         );
@@ -395,22 +395,22 @@ impl Hierarchy {
         );
         work.row64 = row;
         let guess = guessed.then_some(&mut gs);
-        let report = self.solve_split(work, &bs, &mut xs, guess, limits);
+        work.r = bs;
+        let report = self.solve_split(work, &mut xs, guess, limits);
         with_avx2(
             #[inline(always)]
             || from_split(fine, &mut xs, x),
         );
-        (work.b, work.x, work.guess) = (bs, xs, gs);
+        (work.x, work.guess) = (xs, gs);
         report
     }
 
     /// The conjugate gradients in the finest level's split layout, compiled for AVX2
-    /// where the processor has it ([`with_avx2`]). Where the guess is taken, it and `x`
-    /// trade places (a swap, not a copy of the field).
+    /// where the processor has it ([`with_avx2`]), from `b` in [`Work::r`]. Where the
+    /// guess is taken, it and `x` trade places (a swap, not a copy of the field).
     fn solve_split(
         &self,
         work: &mut Work,
-        b: &[f64],
         x: &mut Vec<f64>,
         guess: Option<&mut Vec<f64>>,
         limits: SolveLimits,
@@ -433,10 +433,10 @@ impl Hierarchy {
                     refresh_all(fine, g);
                 }
                 // Both starts' residuals in one pass over the system: `x`'s into `r`, the
-                // guess's into `q`.
+                // guess's into `q`, from the `b` that `r` holds.
                 let starts = [Some(&x[..]), guess.as_deref().map(|g| &g[..])];
                 let mass = work.mass_term(0);
-                residuals(fine, (mass, stencil, b), starts, [&mut r, &mut q]);
+                residuals_in_place(fine, (mass, stencil), starts, [&mut r, &mut q]);
                 // Relative to the start's residual: the step's change, not the whole field.
                 let mut start_norm = dot(&r, &r).sqrt();
                 let b_norm = if start_norm > 0.0 { start_norm } else { 1.0 };
@@ -1266,6 +1266,53 @@ mod tests {
             }
             for (p, v) in out.iter().enumerate() {
                 assert!(fine.is_cell(p) || *v == 0.0, "n {n} position {p}: {v}");
+            }
+        }
+    }
+
+    /// Both starts' residuals taken in place from the `b` the first output holds are the
+    /// operator's residuals from `b` apart, to the bit, and zero outside the cells: with
+    /// both starts, and with the first alone (the second output then only zeroed there).
+    #[test]
+    fn residuals_in_place_are_the_operators_residuals() {
+        for n in [3, 16] {
+            let grid = CubeSphere::new(n);
+            let h = Hierarchy::new(&grid);
+            let cells = grid.cells();
+            let weight: Vec<f64> = (0..grid.edges().len())
+                .map(|e| 10.0 + (e % 13) as f64)
+                .collect();
+            let alpha: Vec<f64> = (0..cells).map(|c| 1.0 + (c % 5) as f64).collect();
+            let field = |k: usize| -> Vec<f64> {
+                (0..cells)
+                    .map(|c| (((c * k) % 11) as f64 - 5.0) / 3.0)
+                    .collect()
+            };
+            let mut work = Work::default();
+            h.prepare(&mut work, &alpha, &weight);
+            let fine = &h.levels[0];
+            let [mut b, mut x, mut g] = [Vec::new(), Vec::new(), Vec::new()];
+            for (values, split) in [(field(7), &mut b), (field(37), &mut x), (field(53), &mut g)] {
+                to_split(fine, &values, split);
+                refresh_all(fine, split);
+            }
+            let (mass, w) = (work.mass_term(0), &work.stencil[0]);
+            let plain = |start: &[f64]| {
+                let mut out = vec![f64::NAN; fine.len()];
+                operator::<f64, true>(fine, mass, w, &b, start, &mut out);
+                out
+            };
+            let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            for guess in [Some(&g[..]), None] {
+                let (mut r, mut q) = (b.clone(), vec![f64::NAN; fine.len()]);
+                residuals_in_place(fine, (mass, w), [Some(&x[..]), guess], [&mut r, &mut q]);
+                assert_eq!(bits(&r), bits(&plain(&x)), "n {n}");
+                if let Some(g) = guess {
+                    assert_eq!(bits(&q), bits(&plain(g)), "n {n}");
+                }
+                for p in (0..fine.len()).filter(|&p| !fine.is_cell(p)) {
+                    assert_eq!(r[p], 0.0, "n {n} position {p}");
+                }
             }
         }
     }
