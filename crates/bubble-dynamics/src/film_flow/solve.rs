@@ -48,7 +48,7 @@ use dense::{dense_cholesky, dense_solve};
 use kernels::{
     LevelField, NOT_A_CELL, Stencil, correct, dot, gather_row, operator, refresh, refresh_all,
     relax, relax_from_zero, residuals_in_place, restrict, restrict_field, rounded_level,
-    scatter_row, update_and_norm2, update_direction, widened_dot,
+    scatter_row, scatter_run, update_and_norm2, update_direction, widened_dot,
 };
 use layout::Layout;
 
@@ -556,8 +556,6 @@ impl Hierarchy {
     fn fine_numbers(&self, work: &mut Work, alpha: &[f64], weight: &[f64]) {
         let fine = &self.levels[0];
         let n = fine.m;
-        let mut row = std::mem::take(&mut work.row64);
-        row.resize(n, 0.0);
         let [right, top] = &mut work.stencil[0];
         work.mass_per_face = self.levels.len() > 1 && fine.faces_alike() && faces_alike(alpha);
         let mass_faces = if work.mass_per_face { 1 } else { 6 };
@@ -567,10 +565,13 @@ impl Hierarchy {
                     let alpha_row = &alpha[(face * n + y) * n..][..n];
                     scatter_row(fine, face, y, alpha_row, &mut work.mass[0]);
                 }
-                // The last cell's RIGHT entry is a seam's, written below.
+                // The last cell's RIGHT entry is a seam's, written below: the run stops
+                // before it.
                 let (xs, first) = inside_a_face(n, face, y, RIGHT);
-                row[xs.clone()].copy_from_slice(&weight[first..][..xs.len()]);
-                scatter_row(fine, face, y, &row, right);
+                if !xs.is_empty() {
+                    let at = fine.padded_at(face, y + 1, 1 + xs.start);
+                    scatter_run(fine, at, &weight[first..][..xs.len()], right);
+                }
                 let (xs, first) = inside_a_face(n, face, y, TOP);
                 if !xs.is_empty() {
                     scatter_row(fine, face, y, &weight[first..][..n], top);
@@ -582,7 +583,6 @@ impl Hierarchy {
                 field[p as usize] = weight[e as usize];
             }
         }
-        work.row64 = row;
     }
 
     /// Level `k`'s numbers scaled by [`Work::scale`] and rounded to `f32`, the inverse

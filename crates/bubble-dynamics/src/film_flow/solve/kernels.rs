@@ -573,7 +573,7 @@ fn run_halves<'a, T>(
 
 /// Writes `values[j]` to padded index `first + j`, for each `j`.
 #[inline(always)]
-fn scatter_run<T: Real>(layout: &Layout, first: usize, values: &[T], out: &mut [T]) {
+pub(super) fn scatter_run<T: Real>(layout: &Layout, first: usize, values: &[T], out: &mut [T]) {
     let len = values.len();
     let (even, odd) = run_halves(layout, first, len, out);
     // Eight pairs at a time in chunks of constant length, so the compiler splits them
