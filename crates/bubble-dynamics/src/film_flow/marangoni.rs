@@ -22,7 +22,7 @@ use super::flow::{
 use super::fluxes::{EdgeValues, apply_limited, net_inflow};
 use super::grid::CubeSphere;
 use super::sides::{EdgeBlock, EdgeRun, SeamEnds, Seams};
-use super::solve::{SolveLimits, SolveReport};
+use super::solve::{MassTerm, SolveLimits, SolveReport};
 
 /// Most solves a step's defect correction of the cross term takes (it takes about 11 on
 /// the swirl film at n = 64: each cuts the error by about 0.35, the cross operator's
@@ -181,9 +181,12 @@ impl FilmFlow {
         let g = &self.grid;
         let change = Some(&self.surfactant_change[..]).filter(|c| !c.is_empty());
         s.cell2.resize(self.gamma.len(), 0.0);
+        // The cells' areas, alike on every face to the bit: face 0's.
+        let n = self.sides.n();
+        let areas = MassTerm::EveryFace(&g.areas_sr()[..n * n]);
         self.hierarchy.solve_from_start_and_change(
             &mut s.work,
-            (g.areas_sr(), &s.weight, &s.rhs),
+            (areas, &s.weight, &s.rhs),
             (&self.gamma, change),
             &mut s.cell2,
             SolveLimits {

@@ -202,6 +202,16 @@ impl Work {
     }
 }
 
+/// A system's mass term `α` as [`Hierarchy::solve_from_start_and_change`] is given it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum MassTerm<'a> {
+    /// Per cell, in the grid's numbering.
+    Cells(&'a [f64]),
+    /// Face 0's cells' values alone, every face's the same to the bit (as the grid's
+    /// cell areas are): the solve need not read the other faces to find that out.
+    EveryFace(&'a [f64]),
+}
+
 /// Where [`Hierarchy::solve_prepared_from`] starts.
 #[derive(Clone, Copy)]
 enum Start<'a> {
@@ -328,22 +338,18 @@ impl Hierarchy {
     ///
     /// # Panics
     /// If a slice's length does not match the finest level.
-    #[allow(clippy::too_many_arguments)] // the system's three arrays, its start, answer, limits
-    pub fn solve_from_start_and_change(
+    pub(crate) fn solve_from_start_and_change(
         &self,
         work: &mut Work,
-        (alpha, weight, b): (&[f64], &[f64], &[f64]),
+        (alpha, weight, b): (MassTerm, &[f64], &[f64]),
         (start, change): (&[f64], Option<&[f64]>),
         x: &mut [f64],
         limits: SolveLimits,
     ) -> SolveReport {
         let nc = self.levels[0].position.len();
-        assert!(
-            alpha.len() == nc && start.len() == nc,
-            "system size mismatch"
-        );
+        assert!(start.len() == nc, "system size mismatch");
         assert_eq!(x.len(), nc, "system size mismatch");
-        self.prepare(work, alpha, weight);
+        self.prepare_mass(work, alpha, weight);
         let change = change.filter(|c| c.len() == nc);
         self.solve_prepared_from(work, b, Start::Changed(start, change), x, limits)
     }
@@ -484,18 +490,32 @@ impl Hierarchy {
         )
     }
 
+    /// [`Hierarchy::prepare_mass`] of a mass term given per cell.
+    fn prepare(&self, work: &mut Work, alpha: &[f64], weight: &[f64]) {
+        self.prepare_mass(work, MassTerm::Cells(alpha), weight);
+    }
+
     /// Restricts the system's numbers to every level, and rounds them to `f32` for the
     /// V-cycle (see [`Work`]).
-    fn prepare(&self, work: &mut Work, alpha: &[f64], weight: &[f64]) {
+    ///
+    /// # Panics
+    /// If the mass term's length does not match the finest level (its cells, or a face's).
+    fn prepare_mass(&self, work: &mut Work, alpha: MassTerm, weight: &[f64]) {
+        let m = self.levels[0].m;
+        let len = match alpha {
+            MassTerm::Cells(a) => a.len() / 6,
+            MassTerm::EveryFace(a) => a.len(),
+        };
+        assert_eq!(len, m * m, "system size mismatch");
         with_avx2(
             #[inline(always)]
             || self.prepare_here(work, alpha, weight),
         );
     }
 
-    /// [`Hierarchy::prepare`]'s work, inlined into the AVX2 build where there is one.
+    /// [`Hierarchy::prepare_mass`]'s work, inlined into the AVX2 build where there is one.
     #[inline(always)]
-    fn prepare_here(&self, work: &mut Work, alpha: &[f64], weight: &[f64]) {
+    fn prepare_here(&self, work: &mut Work, alpha: MassTerm, weight: &[f64]) {
         let count = self.levels.len();
         work.mass.resize(count, Vec::new());
         work.stencil.resize(count, Stencil::default());
@@ -553,16 +573,24 @@ impl Hierarchy {
     /// row's) are a slice of the grid's edges ([`inside_a_face`]); then the entries that
     /// hold seam edges ([`Hierarchy::seam_weights`]).
     #[inline(always)]
-    fn fine_numbers(&self, work: &mut Work, alpha: &[f64], weight: &[f64]) {
+    fn fine_numbers(&self, work: &mut Work, alpha: MassTerm, weight: &[f64]) {
         let fine = &self.levels[0];
         let n = fine.m;
         let [right, top] = &mut work.stencil[0];
-        work.mass_per_face = self.levels.len() > 1 && fine.faces_alike() && faces_alike(alpha);
+        // Checked where the caller does not say so: a pass over every face's values.
+        let alike = match alpha {
+            MassTerm::Cells(a) => faces_alike(a),
+            MassTerm::EveryFace(_) => true,
+        };
+        work.mass_per_face = self.levels.len() > 1 && fine.faces_alike() && alike;
         let mass_faces = if work.mass_per_face { 1 } else { 6 };
         for face in 0..6 {
             for y in 0..n {
                 if face < mass_faces {
-                    let alpha_row = &alpha[(face * n + y) * n..][..n];
+                    let alpha_row = match alpha {
+                        MassTerm::Cells(a) => &a[(face * n + y) * n..][..n],
+                        MassTerm::EveryFace(a) => &a[y * n..][..n],
+                    };
                     scatter_row(fine, face, y, alpha_row, &mut work.mass[0]);
                 }
                 // The last cell's RIGHT entry is a seam's, written below: the run stops
@@ -1052,10 +1080,18 @@ mod tests {
 
     /// [`Hierarchy::solve_from_start_and_change`] is [`Hierarchy::solve_with_guess`] from
     /// the start with the guess `start + change` (summed in the grid's numbering), to the
-    /// bit: with a change that is taken, one that is not (worse than the start) and none.
+    /// bit: with a change that is taken, one that is not (worse than the start) and none;
+    /// the mass term given per cell or as face 0's (every face's the same), at n = 16 (the
+    /// mass term then held per face) and 3 (one level, where it cannot be).
     #[test]
     fn a_start_and_change_solve_as_the_start_and_its_guess() {
-        let n = 16;
+        for n in [16, 3] {
+            start_and_change_solve_alike(n);
+        }
+    }
+
+    /// [`a_start_and_change_solve_as_the_start_and_its_guess`] at `n` cells a face.
+    fn start_and_change_solve_alike(n: usize) {
         let (grid, h, alpha, weight, b) = stiff_system(n, |c| (2.0 * c.x - c.y * c.z).sin());
         let limits = SolveLimits {
             tolerance: 1e-9,
@@ -1078,12 +1114,17 @@ mod tests {
             .map(|(a, s)| 0.9 * (a - s))
             .collect();
         let far: Vec<f64> = near.iter().map(|v| 1e3 * v).collect();
-        for change in [Some(&near), Some(&far), None] {
+        let face = MassTerm::EveryFace(&alpha[..n * n]);
+        let changes = [Some(&near), Some(&far), None];
+        for (mass, change) in [MassTerm::Cells(&alpha), face]
+            .into_iter()
+            .flat_map(|m| changes.map(|c| (m, c)))
+        {
             let mut work = Work::default();
             let guess: Option<Vec<f64>> =
                 change.map(|c| start.iter().zip(c).map(|(s, c)| s + c).collect());
             let mut plain = start.clone();
-            let system = (&alpha[..], &weight[..], &b[..]);
+            let system = (mass, &weight[..], &b[..]);
             let expected = h.solve_with_guess(
                 &mut work,
                 &alpha,
@@ -1102,7 +1143,8 @@ mod tests {
                 &mut x,
                 limits,
             );
-            assert_eq!(report, expected);
+            let face = matches!(mass, MassTerm::EveryFace(_));
+            assert_eq!(report, expected, "n {n}, face 0's mass term: {face}");
             assert!(report.iterations >= 1, "{report:?}");
             let differ = x
                 .iter()
