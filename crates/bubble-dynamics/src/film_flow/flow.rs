@@ -176,7 +176,6 @@ pub(super) struct Scratch {
     pub(super) weight: Vec<f64>,
     pub(super) u_start: Vec<f64>,
     pub(super) stiffness: Vec<f64>,
-    pub(super) guess: Vec<f64>,
     /// The thickness transport's limited rises ([`Rises`]).
     pub(super) rises: Rises,
     /// Per edge: the air's drag factor, where [`FilmFlow::air_shear`] took the drag

@@ -22,8 +22,7 @@ use super::flow::{
 use super::fluxes::{EdgeValues, apply_limited, net_inflow};
 use super::grid::CubeSphere;
 use super::sides::{EdgeBlock, EdgeRun, SeamEnds, Seams};
-use super::solve::{SolveLimits, SolveReport};
-use crate::avx2::with_avx2;
+use super::solve::{MassTerm, SolveLimits, SolveReport};
 
 /// Most solves a step's defect correction of the cross term takes (it takes about 11 on
 /// the swirl film at n = 64: each cuts the error by about 0.35, the cross operator's
@@ -181,15 +180,16 @@ impl FilmFlow {
     /// to step; the tolerance stays relative to Γⁿ's residual).
     fn solve_surfactant(&self, s: &mut Scratch) -> SolveReport {
         let g = &self.grid;
-        let (guess, solution) = (&mut s.guess, &mut s.cell2);
-        start_and_guess(&self.gamma, &self.surfactant_change, solution, guess);
-        self.hierarchy.solve_with_guess(
+        let change = Some(&self.surfactant_change[..]).filter(|c| !c.is_empty());
+        s.cell2.resize(self.gamma.len(), 0.0);
+        // The cells' areas, alike on every face to the bit: face 0's.
+        let n = self.sides.n();
+        let areas = MassTerm::EveryFace(&g.areas_sr()[..n * n]);
+        self.hierarchy.solve_from_start_and_change(
             &mut s.work,
-            g.areas_sr(),
-            &s.weight,
-            &s.rhs,
-            solution,
-            Some(guess.as_slice()),
+            (areas, &s.weight, &s.rhs),
+            (&self.gamma, change),
+            &mut s.cell2,
             SolveLimits {
                 tolerance: SOLVE_TOLERANCE,
                 max_iterations: SOLVE_MAX_ITERATIONS,
@@ -584,30 +584,6 @@ impl<const NORMAL: bool> CorrectionEdges<'_, NORMAL> {
             moved[i] = scale * (f_adv + gamma_c * du * l[i]);
         }
     }
-}
-
-/// The surfactant a solve starts from (`gamma`, into `solution`) and its first guess, the
-/// start plus the last step's `change` (none before the first step), in one pass.
-fn start_and_guess(gamma: &[f64], change: &[f64], solution: &mut Vec<f64>, guess: &mut Vec<f64>) {
-    let n = gamma.len();
-    // Every entry is written below: the buffers need their lengths, not a fill.
-    solution.resize(n, 0.0);
-    if change.len() != n {
-        guess.clear();
-        solution.copy_from_slice(gamma);
-        return;
-    }
-    guess.resize(n, 0.0);
-    let (solution, guess, change) = (&mut solution[..n], &mut guess[..n], &change[..n]);
-    with_avx2(
-        #[inline(always)]
-        || {
-            for i in 0..n {
-                solution[i] = gamma[i];
-                guess[i] = gamma[i] + change[i];
-            }
-        },
-    );
 }
 
 /// A stretch of cells' surfactant after the step, `Γ + inflow/area` (`next` holds the

@@ -47,8 +47,8 @@ use crate::avx2::with_avx2;
 use dense::{dense_cholesky, dense_solve};
 use kernels::{
     LevelField, NOT_A_CELL, Stencil, correct, dot, gather_row, operator, refresh, refresh_all,
-    relax, relax_from_zero, residuals, restrict, restrict_field, rounded_level, scatter_row,
-    update_and_norm2, update_direction, widened_dot,
+    relax, relax_from_zero, residuals_in_place, restrict, restrict_field, rounded_level,
+    scatter_row, scatter_run, update_and_norm2, update_direction, widened_dot,
 };
 use layout::Layout;
 
@@ -180,15 +180,14 @@ pub struct Work {
     row: Vec<f32>,
     /// One face row of the finest level's numbers.
     row64: Vec<f64>,
-    /// The conjugate gradients' residual, direction and the operator's product with it
-    /// (at the start, the guess's residual).
+    /// The conjugate gradients' residual (before the start, `b`), direction and the
+    /// operator's product with it (at the start, the guess's residual).
     r: Vec<f64>,
     p: Vec<f64>,
     q: Vec<f64>,
     /// The preconditioned residual where the finest level is solved densely (in `f64`).
     z: Vec<f64>,
-    /// `b`, `x` and the guess in the finest level's layout.
-    b: Vec<f64>,
+    /// `x` and the guess in the finest level's layout (`b` is put in [`Work::r`]).
     x: Vec<f64>,
     guess: Vec<f64>,
 }
@@ -201,6 +200,25 @@ impl Work {
             per_face: k == 0 && self.mass_per_face,
         }
     }
+}
+
+/// A system's mass term `α` as [`Hierarchy::solve_from_start_and_change`] is given it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum MassTerm<'a> {
+    /// Per cell, in the grid's numbering.
+    Cells(&'a [f64]),
+    /// Face 0's cells' values alone, every face's the same to the bit (as the grid's
+    /// cell areas are): the solve need not read the other faces to find that out.
+    EveryFace(&'a [f64]),
+}
+
+/// Where [`Hierarchy::solve_prepared_from`] starts.
+#[derive(Clone, Copy)]
+enum Start<'a> {
+    /// From the answer's own values, and the guess where one is given.
+    Values(Option<&'a [f64]>),
+    /// From the start given, and its sum with the change where one is given as the guess.
+    Changed(&'a [f64], Option<&'a [f64]>),
 }
 
 /// When a solve stops.
@@ -306,43 +324,99 @@ impl Hierarchy {
         guess: Option<&[f64]>,
         limits: SolveLimits,
     ) -> SolveReport {
+        let nc = self.levels[0].position.len();
+        assert!(x.len() == nc, "system size mismatch");
+        let guess = guess.filter(|g| g.len() == nc);
+        self.solve_prepared_from(work, b, Start::Values(guess), x, limits)
+    }
+
+    /// As [`Hierarchy::solve_with_guess`] from `start`, with the guess `start + change`
+    /// where `change` is given (and of the system's size), the answer written to `x`
+    /// (its values not read): the start and the guess go straight into the solve's
+    /// layout, in one pass, where a caller's own pass would write both out in the grid's
+    /// numbering first and the solve read them back.
+    ///
+    /// # Panics
+    /// If a slice's length does not match the finest level.
+    pub(crate) fn solve_from_start_and_change(
+        &self,
+        work: &mut Work,
+        (alpha, weight, b): (MassTerm, &[f64], &[f64]),
+        (start, change): (&[f64], Option<&[f64]>),
+        x: &mut [f64],
+        limits: SolveLimits,
+    ) -> SolveReport {
+        let nc = self.levels[0].position.len();
+        assert!(start.len() == nc, "system size mismatch");
+        assert_eq!(x.len(), nc, "system size mismatch");
+        self.prepare_mass(work, alpha, weight);
+        let change = change.filter(|c| c.len() == nc);
+        self.solve_prepared_from(work, b, Start::Changed(start, change), x, limits)
+    }
+
+    /// [`Hierarchy::solve_prepared`] from `start` ([`Start`]), the answer into `x`: the
+    /// right-hand side, the start and the guess put in the split layout, solved there, and
+    /// the answer put back.
+    fn solve_prepared_from(
+        &self,
+        work: &mut Work,
+        b: &[f64],
+        start: Start,
+        x: &mut [f64],
+        limits: SolveLimits,
+    ) -> SolveReport {
         let fine = &self.levels[0];
         let nc = fine.position.len();
         assert!(b.len() == nc && x.len() == nc, "system size mismatch");
         assert!(!work.stencil.is_empty(), "no system prepared");
+        // `b` goes into the residual's field: the residual is taken from it in place.
         let (mut bs, mut xs, mut gs) = (
-            std::mem::take(&mut work.b),
+            std::mem::take(&mut work.r),
             std::mem::take(&mut work.x),
             std::mem::take(&mut work.guess),
         );
-        let guess = guess.filter(|g| g.len() == nc);
-        with_avx2(
+        let mut row = std::mem::take(&mut work.row64);
+        let guessed = with_avx2(
             #[inline(always)]
             || {
                 to_split(fine, b, &mut bs);
-                to_split(fine, x, &mut xs);
-                if let Some(g) = guess {
-                    to_split(fine, g, &mut gs);
+                match start {
+                    Start::Values(guess) => {
+                        to_split(fine, x, &mut xs);
+                        if let Some(g) = guess {
+                            to_split(fine, g, &mut gs);
+                        }
+                        guess.is_some()
+                    }
+                    Start::Changed(start, None) => {
+                        to_split(fine, start, &mut xs);
+                        false
+                    }
+                    Start::Changed(start, Some(change)) => {
+                        start_and_guess_split(fine, (start, change), (&mut xs, &mut gs), &mut row);
+                        true
+                    }
                 }
             },
         );
-        let guess = guess.map(|_| &mut gs);
-        let report = self.solve_split(work, &bs, &mut xs, guess, limits);
+        work.row64 = row;
+        let guess = guessed.then_some(&mut gs);
+        work.r = bs;
+        let report = self.solve_split(work, &mut xs, guess, limits);
         with_avx2(
             #[inline(always)]
             || from_split(fine, &mut xs, x),
         );
-        (work.b, work.x, work.guess) = (bs, xs, gs);
+        (work.x, work.guess) = (xs, gs);
         report
     }
 
     /// The conjugate gradients in the finest level's split layout, compiled for AVX2
-    /// where the processor has it ([`with_avx2`]). Where the guess is taken, it and `x`
-    /// trade places (a swap, not a copy of the field).
+    /// where the processor has it ([`with_avx2`]), from `b` in [`Work::r`]. Where the
+    /// guess is taken, it and `x` trade places (a swap, not a copy of the field).
     fn solve_split(
         &self,
         work: &mut Work,
-        b: &[f64],
         x: &mut Vec<f64>,
         guess: Option<&mut Vec<f64>>,
         limits: SolveLimits,
@@ -365,10 +439,10 @@ impl Hierarchy {
                     refresh_all(fine, g);
                 }
                 // Both starts' residuals in one pass over the system: `x`'s into `r`, the
-                // guess's into `q`.
+                // guess's into `q`, from the `b` that `r` holds.
                 let starts = [Some(&x[..]), guess.as_deref().map(|g| &g[..])];
                 let mass = work.mass_term(0);
-                residuals(fine, (mass, stencil, b), starts, [&mut r, &mut q]);
+                residuals_in_place(fine, (mass, stencil), starts, [&mut r, &mut q]);
                 // Relative to the start's residual: the step's change, not the whole field.
                 let mut start_norm = dot(&r, &r).sqrt();
                 let b_norm = if start_norm > 0.0 { start_norm } else { 1.0 };
@@ -416,18 +490,32 @@ impl Hierarchy {
         )
     }
 
+    /// [`Hierarchy::prepare_mass`] of a mass term given per cell.
+    fn prepare(&self, work: &mut Work, alpha: &[f64], weight: &[f64]) {
+        self.prepare_mass(work, MassTerm::Cells(alpha), weight);
+    }
+
     /// Restricts the system's numbers to every level, and rounds them to `f32` for the
     /// V-cycle (see [`Work`]).
-    fn prepare(&self, work: &mut Work, alpha: &[f64], weight: &[f64]) {
+    ///
+    /// # Panics
+    /// If the mass term's length does not match the finest level (its cells, or a face's).
+    fn prepare_mass(&self, work: &mut Work, alpha: MassTerm, weight: &[f64]) {
+        let m = self.levels[0].m;
+        let len = match alpha {
+            MassTerm::Cells(a) => a.len() / 6,
+            MassTerm::EveryFace(a) => a.len(),
+        };
+        assert_eq!(len, m * m, "system size mismatch");
         with_avx2(
             #[inline(always)]
             || self.prepare_here(work, alpha, weight),
         );
     }
 
-    /// [`Hierarchy::prepare`]'s work, inlined into the AVX2 build where there is one.
+    /// [`Hierarchy::prepare_mass`]'s work, inlined into the AVX2 build where there is one.
     #[inline(always)]
-    fn prepare_here(&self, work: &mut Work, alpha: &[f64], weight: &[f64]) {
+    fn prepare_here(&self, work: &mut Work, alpha: MassTerm, weight: &[f64]) {
         let count = self.levels.len();
         work.mass.resize(count, Vec::new());
         work.stencil.resize(count, Stencil::default());
@@ -442,18 +530,6 @@ impl Hierarchy {
             work.correction[k].resize(level.len(), 0.0);
         }
         self.fine_numbers(work, alpha, weight);
-        for k in 1..count {
-            let (fine, coarse) = (&self.levels[k - 1], &self.levels[k]);
-            let per_face = k == 1 && work.mass_per_face;
-            let (done, rest) = work.mass.split_at_mut(k);
-            let fine_mass = LevelField {
-                values: &done[k - 1],
-                per_face,
-            };
-            restrict_field(fine, fine_mass, coarse, &mut rest[0], &mut work.row64);
-            let (done, rest) = work.stencil.split_at_mut(k);
-            kernels::restrict_weights(fine, &done[k - 1], coarse, &mut rest[0], &mut work.row64);
-        }
         // One level: the dense solve is the whole preconditioner, in `f64`, unscaled.
         work.scale = if count == 1 {
             1.0
@@ -465,7 +541,21 @@ impl Hierarchy {
             let diagonal = first + w0 + w1 + w2 + w3;
             power_of_two_below(diagonal).recip()
         };
-        self.round_for_the_v_cycle(work);
+        // Each level rounded as soon as it is made, while its numbers are in cache.
+        self.round_for_the_v_cycle(work, 0);
+        for k in 1..count {
+            let (fine, coarse) = (&self.levels[k - 1], &self.levels[k]);
+            let per_face = k == 1 && work.mass_per_face;
+            let (done, rest) = work.mass.split_at_mut(k);
+            let fine_mass = LevelField {
+                values: &done[k - 1],
+                per_face,
+            };
+            restrict_field(fine, fine_mass, coarse, &mut rest[0], &mut work.row64);
+            let (done, rest) = work.stencil.split_at_mut(k);
+            kernels::restrict_weights(fine, &done[k - 1], coarse, &mut rest[0], &mut work.row64);
+            self.round_for_the_v_cycle(work, k);
+        }
         let last = count - 1;
         let (mass, stencil) = (&work.mass[last], &work.stencil[last]);
         dense_cholesky(
@@ -483,24 +573,33 @@ impl Hierarchy {
     /// row's) are a slice of the grid's edges ([`inside_a_face`]); then the entries that
     /// hold seam edges ([`Hierarchy::seam_weights`]).
     #[inline(always)]
-    fn fine_numbers(&self, work: &mut Work, alpha: &[f64], weight: &[f64]) {
+    fn fine_numbers(&self, work: &mut Work, alpha: MassTerm, weight: &[f64]) {
         let fine = &self.levels[0];
         let n = fine.m;
-        let mut row = std::mem::take(&mut work.row64);
-        row.resize(n, 0.0);
         let [right, top] = &mut work.stencil[0];
-        work.mass_per_face = self.levels.len() > 1 && fine.faces_alike() && faces_alike(alpha);
+        // Checked where the caller does not say so: a pass over every face's values.
+        let alike = match alpha {
+            MassTerm::Cells(a) => faces_alike(a),
+            MassTerm::EveryFace(_) => true,
+        };
+        work.mass_per_face = self.levels.len() > 1 && fine.faces_alike() && alike;
         let mass_faces = if work.mass_per_face { 1 } else { 6 };
         for face in 0..6 {
             for y in 0..n {
                 if face < mass_faces {
-                    let alpha_row = &alpha[(face * n + y) * n..][..n];
+                    let alpha_row = match alpha {
+                        MassTerm::Cells(a) => &a[(face * n + y) * n..][..n],
+                        MassTerm::EveryFace(a) => &a[y * n..][..n],
+                    };
                     scatter_row(fine, face, y, alpha_row, &mut work.mass[0]);
                 }
-                // The last cell's RIGHT entry is a seam's, written below.
+                // The last cell's RIGHT entry is a seam's, written below: the run stops
+                // before it.
                 let (xs, first) = inside_a_face(n, face, y, RIGHT);
-                row[xs.clone()].copy_from_slice(&weight[first..][..xs.len()]);
-                scatter_row(fine, face, y, &row, right);
+                if !xs.is_empty() {
+                    let at = fine.padded_at(face, y + 1, 1 + xs.start);
+                    scatter_run(fine, at, &weight[first..][..xs.len()], right);
+                }
                 let (xs, first) = inside_a_face(n, face, y, TOP);
                 if !xs.is_empty() {
                     scatter_row(fine, face, y, &weight[first..][..n], top);
@@ -512,37 +611,38 @@ impl Hierarchy {
                 field[p as usize] = weight[e as usize];
             }
         }
-        work.row64 = row;
     }
 
-    /// The smoothed levels' numbers scaled by [`Work::scale`] and rounded to `f32`, the
-    /// inverse diagonal summed in `f64` from the unrounded numbers and rounded once (zero
-    /// outside the cells: [`rounded_level`]).
+    /// Level `k`'s numbers scaled by [`Work::scale`] and rounded to `f32`, the inverse
+    /// diagonal summed in `f64` from the unrounded numbers and rounded once (zero outside
+    /// the cells: [`rounded_level`]); nothing for the coarsest level, solved densely.
     #[inline(always)]
-    fn round_for_the_v_cycle(&self, work: &mut Work) {
+    fn round_for_the_v_cycle(&self, work: &mut Work, k: usize) {
         let (scale, smoothed) = (work.scale, self.levels.len() - 1);
+        if k >= smoothed {
+            return;
+        }
         work.mass32.resize(smoothed, Vec::new());
         work.inv_diag.resize(smoothed, Vec::new());
         work.stencil32.resize(smoothed, Stencil::default());
-        for (k, level) in self.levels[..smoothed].iter().enumerate() {
-            let n = level.len();
-            work.mass32[k].resize(n, 0.0);
-            work.inv_diag[k].resize(n, 0.0);
-            for w in &mut work.stencil32[k] {
-                w.resize(n, 0.0);
-            }
-            let mass = LevelField {
-                values: &work.mass[k],
-                per_face: k == 0 && work.mass_per_face,
-            };
-            rounded_level(
-                level,
-                scale,
-                (mass, &work.stencil[k]),
-                (&mut work.mass32[k], &mut work.stencil32[k]),
-                &mut work.inv_diag[k],
-            );
+        let level = &self.levels[k];
+        let n = level.len();
+        work.mass32[k].resize(n, 0.0);
+        work.inv_diag[k].resize(n, 0.0);
+        for w in &mut work.stencil32[k] {
+            w.resize(n, 0.0);
         }
+        let mass = LevelField {
+            values: &work.mass[k],
+            per_face: k == 0 && work.mass_per_face,
+        };
+        rounded_level(
+            level,
+            scale,
+            (mass, &work.stencil[k]),
+            (&mut work.mass32[k], &mut work.stencil32[k]),
+            &mut work.inv_diag[k],
+        );
     }
 
     /// `z` = the preconditioner applied to the conjugate gradients' residual `r`, whose
@@ -727,6 +827,32 @@ fn to_split(layout: &Layout, values: &[f64], out: &mut Vec<f64>) {
         for y in 0..m {
             let row = &values[(face * m + y) * m..][..m];
             scatter_row(layout, face, y, row, out);
+        }
+    }
+}
+
+/// `xs` = `start` and `gs` = `start + change` (grid-numbered) in `layout`'s split arrays,
+/// a face row at a time (the sum formed in `row`), the halo untouched.
+#[inline(always)]
+fn start_and_guess_split(
+    layout: &Layout,
+    (start, change): (&[f64], &[f64]),
+    (xs, gs): (&mut Vec<f64>, &mut Vec<f64>),
+    row: &mut Vec<f64>,
+) {
+    xs.resize(layout.len(), 0.0);
+    gs.resize(layout.len(), 0.0);
+    let m = layout.m;
+    row.resize(m, 0.0);
+    for face in 0..6 {
+        for y in 0..m {
+            let cells = (face * m + y) * m..(face * m + y + 1) * m;
+            let (start, change) = (&start[cells.clone()], &change[cells]);
+            scatter_row(layout, face, y, start, xs);
+            for ((g, s), c) in row.iter_mut().zip(start).zip(change) {
+                *g = s + c;
+            }
+            scatter_row(layout, face, y, row, gs);
         }
     }
 }
@@ -952,6 +1078,82 @@ mod tests {
         }
     }
 
+    /// [`Hierarchy::solve_from_start_and_change`] is [`Hierarchy::solve_with_guess`] from
+    /// the start with the guess `start + change` (summed in the grid's numbering), to the
+    /// bit: with a change that is taken, one that is not (worse than the start) and none;
+    /// the mass term given per cell or as face 0's (every face's the same), at n = 16 (the
+    /// mass term then held per face) and 3 (one level, where it cannot be).
+    #[test]
+    fn a_start_and_change_solve_as_the_start_and_its_guess() {
+        for n in [16, 3] {
+            start_and_change_solve_alike(n);
+        }
+    }
+
+    /// [`a_start_and_change_solve_as_the_start_and_its_guess`] at `n` cells a face.
+    fn start_and_change_solve_alike(n: usize) {
+        let (grid, h, alpha, weight, b) = stiff_system(n, |c| (2.0 * c.x - c.y * c.z).sin());
+        let limits = SolveLimits {
+            tolerance: 1e-9,
+            max_iterations: 50,
+        };
+        let start: Vec<f64> = grid.centres().iter().map(|c| c.x * c.y).collect();
+        let mut answer = start.clone();
+        h.solve(
+            &mut Work::default(),
+            &alpha,
+            &weight,
+            &b,
+            &mut answer,
+            limits,
+        );
+        // Near the answer (the guess taken), and far from it (not taken).
+        let near: Vec<f64> = answer
+            .iter()
+            .zip(&start)
+            .map(|(a, s)| 0.9 * (a - s))
+            .collect();
+        let far: Vec<f64> = near.iter().map(|v| 1e3 * v).collect();
+        let face = MassTerm::EveryFace(&alpha[..n * n]);
+        let changes = [Some(&near), Some(&far), None];
+        for (mass, change) in [MassTerm::Cells(&alpha), face]
+            .into_iter()
+            .flat_map(|m| changes.map(|c| (m, c)))
+        {
+            let mut work = Work::default();
+            let guess: Option<Vec<f64>> =
+                change.map(|c| start.iter().zip(c).map(|(s, c)| s + c).collect());
+            let mut plain = start.clone();
+            let system = (mass, &weight[..], &b[..]);
+            let expected = h.solve_with_guess(
+                &mut work,
+                &alpha,
+                &weight,
+                &b,
+                &mut plain,
+                guess.as_deref(),
+                limits,
+            );
+            let mut x = vec![f64::NAN; grid.cells()];
+            let change = change.map(|c| &c[..]);
+            let report = h.solve_from_start_and_change(
+                &mut Work::default(),
+                system,
+                (&start, change),
+                &mut x,
+                limits,
+            );
+            let face = matches!(mass, MassTerm::EveryFace(_));
+            assert_eq!(report, expected, "n {n}, face 0's mass term: {face}");
+            assert!(report.iterations >= 1, "{report:?}");
+            let differ = x
+                .iter()
+                .zip(&plain)
+                .filter(|(a, b)| a.to_bits() != b.to_bits());
+            assert_eq!(differ.count(), 0, "change {:?}", change.map(|c| c[0]));
+        }
+    }
+
     /// Level `k`'s mass term at cell `c`, read as the kernels read it ([`LevelField`]).
     fn mass_at(h: &Hierarchy, work: &Work, k: usize, c: usize) -> f64 {
         let level = &h.levels[k];
@@ -1106,6 +1308,53 @@ mod tests {
             }
             for (p, v) in out.iter().enumerate() {
                 assert!(fine.is_cell(p) || *v == 0.0, "n {n} position {p}: {v}");
+            }
+        }
+    }
+
+    /// Both starts' residuals taken in place from the `b` the first output holds are the
+    /// operator's residuals from `b` apart, to the bit, and zero outside the cells: with
+    /// both starts, and with the first alone (the second output then only zeroed there).
+    #[test]
+    fn residuals_in_place_are_the_operators_residuals() {
+        for n in [3, 16] {
+            let grid = CubeSphere::new(n);
+            let h = Hierarchy::new(&grid);
+            let cells = grid.cells();
+            let weight: Vec<f64> = (0..grid.edges().len())
+                .map(|e| 10.0 + (e % 13) as f64)
+                .collect();
+            let alpha: Vec<f64> = (0..cells).map(|c| 1.0 + (c % 5) as f64).collect();
+            let field = |k: usize| -> Vec<f64> {
+                (0..cells)
+                    .map(|c| (((c * k) % 11) as f64 - 5.0) / 3.0)
+                    .collect()
+            };
+            let mut work = Work::default();
+            h.prepare(&mut work, &alpha, &weight);
+            let fine = &h.levels[0];
+            let [mut b, mut x, mut g] = [Vec::new(), Vec::new(), Vec::new()];
+            for (values, split) in [(field(7), &mut b), (field(37), &mut x), (field(53), &mut g)] {
+                to_split(fine, &values, split);
+                refresh_all(fine, split);
+            }
+            let (mass, w) = (work.mass_term(0), &work.stencil[0]);
+            let plain = |start: &[f64]| {
+                let mut out = vec![f64::NAN; fine.len()];
+                operator::<f64, true>(fine, mass, w, &b, start, &mut out);
+                out
+            };
+            let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            for guess in [Some(&g[..]), None] {
+                let (mut r, mut q) = (b.clone(), vec![f64::NAN; fine.len()]);
+                residuals_in_place(fine, (mass, w), [Some(&x[..]), guess], [&mut r, &mut q]);
+                assert_eq!(bits(&r), bits(&plain(&x)), "n {n}");
+                if let Some(g) = guess {
+                    assert_eq!(bits(&q), bits(&plain(g)), "n {n}");
+                }
+                for p in (0..fine.len()).filter(|&p| !fine.is_cell(p)) {
+                    assert_eq!(r[p], 0.0, "n {n} position {p}");
+                }
             }
         }
     }

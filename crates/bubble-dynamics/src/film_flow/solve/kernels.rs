@@ -210,17 +210,50 @@ pub(super) fn operator<T: Real, const RESIDUAL: bool>(
 }
 
 /// `out = b − (diag(mass) + L_w) x` for each start `x` given ([`operator`]'s residual),
-/// in one pass over the system: each block's numbers are read once for every start.
+/// `b` held in the first output on entry (each output given a start holds `b` there and
+/// takes its residual in place, the second's read from the first's `b` before the first's
+/// own is written), in one pass over the system: each block's numbers are read once for
+/// every start, and `b` needs no field of its own.
 #[inline(always)]
-pub(super) fn residuals<T: Real>(
+pub(super) fn residuals_in_place<T: Real>(
     layout: &Layout,
-    (mass, w, b): (LevelField<T>, &Stencil<T>, &[T]),
-    starts: [Option<&[T]>; 2],
-    outs: [&mut [T]; 2],
+    (mass, w): (LevelField<T>, &Stencil<T>),
+    [x_a, x_b]: [Option<&[T]>; 2],
+    [a, b_out]: [&mut [T]; 2],
 ) {
-    let [a, b_out] = outs;
-    let [x_a, x_b] = starts;
-    operator_blocks::<T, true>(layout, (mass, w, b), &mut [(x_a, a), (x_b, b_out)]);
+    let range = both_sweeps(layout);
+    // Outside the cells `b` is read by no one.
+    zero_outside(layout, range.clone(), a);
+    zero_outside(layout, range.clone(), b_out);
+    in_blocks(
+        layout,
+        range,
+        mass.per_face,
+        #[inline(always)]
+        |face, start, len| {
+            for c in 0..2 {
+                let at = (face, start, len);
+                if let Some(x) = x_b {
+                    operator_run::<T, true, false>(layout, c, at, (mass, w, &*a), x, b_out);
+                }
+            }
+            for c in 0..2 {
+                let at = (face, start, len);
+                if let Some(x) = x_a {
+                    operator_run::<T, true, true>(layout, c, at, (mass, w, &[]), x, a);
+                }
+            }
+        },
+    );
+}
+
+/// Zero at the positions before and after `range` in each colour's array.
+#[inline(always)]
+fn zero_outside<T: Real>(layout: &Layout, range: std::ops::Range<usize>, out: &mut [T]) {
+    for colour in out[..layout.len()].chunks_exact_mut(layout.half) {
+        colour[..range.start].fill(T::ZERO);
+        colour[range.end..].fill(T::ZERO);
+    }
 }
 
 /// [`operator`] of each start given in `pairs` into its output (the others' outputs only
@@ -234,10 +267,7 @@ fn operator_blocks<T: Real, const RESIDUAL: bool>(
 ) {
     let range = both_sweeps(layout);
     for (_, out) in pairs.iter_mut() {
-        for colour in out[..layout.len()].chunks_exact_mut(layout.half) {
-            colour[..range.start].fill(T::ZERO);
-            colour[range.end..].fill(T::ZERO);
-        }
+        zero_outside(layout, range.clone(), out);
     }
     in_blocks(
         layout,
@@ -249,16 +279,17 @@ fn operator_blocks<T: Real, const RESIDUAL: bool>(
                 let Some(x) = x else { continue };
                 for c in 0..2 {
                     let at = (face, start, len);
-                    operator_run::<T, RESIDUAL>(layout, c, at, (mass, w, r), x, out);
+                    operator_run::<T, RESIDUAL, false>(layout, c, at, (mass, w, r), x, out);
                 }
             }
         },
     );
 }
 
-/// [`operator`] at the `len` positions from `start` of colour `c`, of face `face`.
+/// [`operator`] at the `len` positions from `start` of colour `c`, of face `face`; the
+/// residual's `b` read from `out` itself where `IN_PLACE` (`r` then unread).
 #[inline(always)]
-fn operator_run<T: Real, const RESIDUAL: bool>(
+fn operator_run<T: Real, const RESIDUAL: bool, const IN_PLACE: bool>(
     layout: &Layout,
     c: usize,
     (face, start, len): (usize, usize, usize),
@@ -276,7 +307,7 @@ fn operator_run<T: Real, const RESIDUAL: bool>(
     let (m, xs, r) = (
         mass.at(layout, face, base, len),
         &own[start..][..len],
-        &r[base..][..len],
+        if IN_PLACE { &[] } else { &r[base..][..len] },
     );
     let out = &mut out[base..][..len];
     let [n0, n1, n2, n3] = near;
@@ -288,7 +319,14 @@ fn operator_run<T: Real, const RESIDUAL: bool>(
         sum += w1[i] * (xi - n1[i]);
         sum += w2[i] * (xi - n2[i]);
         sum += w3[i] * (xi - n3[i]);
-        let value = if RESIDUAL { r[i] - sum } else { sum };
+        let b = if IN_PLACE {
+            out[i]
+        } else if RESIDUAL {
+            r[i]
+        } else {
+            T::ZERO
+        };
+        let value = if RESIDUAL { b - sum } else { sum };
         // A select, so the loop vectorises: a halo cell's weights are seam weights.
         out[i] = if m[i] >= T::ZERO { value } else { T::ZERO };
     }
@@ -535,7 +573,7 @@ fn run_halves<'a, T>(
 
 /// Writes `values[j]` to padded index `first + j`, for each `j`.
 #[inline(always)]
-fn scatter_run<T: Real>(layout: &Layout, first: usize, values: &[T], out: &mut [T]) {
+pub(super) fn scatter_run<T: Real>(layout: &Layout, first: usize, values: &[T], out: &mut [T]) {
     let len = values.len();
     let (even, odd) = run_halves(layout, first, len, out);
     // Eight pairs at a time in chunks of constant length, so the compiler splits them
