@@ -91,33 +91,26 @@ impl FilmFlow {
 
 /// The Courant number's fastest edge, taken block by block alongside a pass: each
 /// edge's characteristic speed, `|u|` plus the drainage's `3|c|h²` (`c` its coefficient,
-/// [`DrainAlong::at`]), over its smaller cell's width, a block's into `speed` and their
-/// maximum taken while they are in L1 (taken in the speeds' loop, the compiler
-/// vectorised neither).
+/// [`DrainAlong::at`]), over its smaller cell's width ([`edge_speed`]), a block's into
+/// `speed` by the volumes' loop ([`super::upwind`]) and their maximum taken while they
+/// are in L1 (taken in that loop, the compiler vectorised neither).
 pub(crate) struct Fastest {
     /// A block's speeds (scratch).
-    speed: Vec<f64>,
+    pub(super) speed: Vec<f64>,
     /// The fastest so far, per s (0 before any).
-    fastest: f64,
+    pub(super) fastest: f64,
 }
 
 impl Fastest {
-    /// A block of edges with thicknesses `[ha, hb]` at their ends, at surface speeds `u`
-    /// and drainage `drain` (`fg`: the grid's constants).
+    /// A block of `len` edges: `speeds` writes their speeds into a buffer `len` long,
+    /// whose largest is then taken while it is in L1.
     #[inline(always)]
-    pub(crate) fn block(
-        &mut self,
-        block: impl EdgeBlock,
-        [ha, hb]: [&[f64]; 2],
-        (fg, u): (&FaceGeometry, &[f64]),
-        drain: Drain,
-    ) {
-        let len = block.count();
+    pub(crate) fn take(&mut self, len: usize, speeds: impl FnOnce(&mut [f64])) {
         if self.speed.len() < len {
             self.speed.resize(len, 0.0);
         }
         let speed = &mut self.speed[..len];
-        courant_block(block, [ha, hb], (fg, u), drain, speed);
+        speeds(speed);
         self.fastest = largest_of(speed, self.fastest);
     }
 }
@@ -135,26 +128,6 @@ fn largest_of(values: &[f64], start: f64) -> f64 {
         }
     }
     lanes.into_iter().fold(rest, |a, b| larger(b, a))
-}
-
-/// [`Fastest`]'s speeds over a block of edges with thicknesses `[ha, hb]` at their ends,
-/// into `speed` (`block.count()` long).
-#[inline(always)]
-fn courant_block(
-    block: impl EdgeBlock,
-    [ha, hb]: [&[f64]; 2],
-    (fg, u): (&FaceGeometry, &[f64]),
-    drain: Drain,
-    speed: &mut [f64],
-) {
-    let len = block.count();
-    let (ha, hb, u) = (&ha[..len], &hb[..len], block.values(u));
-    let per_area = block.constant(&fg.length_per_smaller_area);
-    let rate = drain.along(&block, fg);
-    let speed = &mut speed[..len];
-    for i in 0..len {
-        speed[i] = edge_speed(u[i], rate.at(i), ha[i], hb[i], per_area[i]);
-    }
 }
 
 /// The drainage: its speed `c·h²` and flux `c·h³` along an edge's normal, with
@@ -207,7 +180,7 @@ impl DrainAlong<'_> {
 /// drainage's `3|c|h²` at the thicker end, times `length/smaller area` (NaN skipped by
 /// the maximum that takes it, as `max` does).
 #[inline(always)]
-fn edge_speed(u: f64, c: f64, ha: f64, hb: f64, per_area: f64) -> f64 {
+pub(crate) fn edge_speed(u: f64, c: f64, ha: f64, hb: f64, per_area: f64) -> f64 {
     let h = larger(hb, ha);
     (u.abs() + 3.0 * c.abs() * h * h) * per_area
 }
