@@ -259,10 +259,12 @@ fn band_rises(
             .into_iter()
             .zip(&rim.rise)
         {
+            let o = &mut o[x..x + n];
             if on_row.len() == n {
-                o[x..x + n].copy_from_slice(&r[at..at + n]);
+                o.copy_from_slice(&r[at..at + n]);
             } else {
-                (o[x], o[x + n - 1]) = (r[at], r[at + 1]);
+                let r = &r[at..at + 2];
+                (o[0], o[n - 1]) = (r[0], r[1]);
             }
         }
     }
