@@ -286,16 +286,17 @@ fn rise_of(w: [f64; 4], h: f64, nb: [f64; 4]) -> f64 {
 }
 
 /// The limited rises of a stretch of cells from their weights `w[k][j]`, thicknesses
-/// `centre` and neighbours' `nb`, as slices: each side's rises in a loop of their own,
+/// `centre` and neighbours' `nb`, as slices: two sides' rises in a loop of their own,
 /// then the limit (one loop over all sixteen weights kept the compiler from vectorising
-/// it: it spilled them to the stack cell by cell).
+/// it: it spilled them to the stack cell by cell; a loop a side took each cell's four
+/// sums `h + h_j` four times where two sides share them).
 #[inline(always)]
-fn rises_run(w: [[&[f64]; 4]; 4], centre: &[f64], nb: [&[f64]; 4], mut out: [&mut [f64]; 4]) {
+fn rises_run(w: [[&[f64]; 4]; 4], centre: &[f64], nb: [&[f64]; 4], out: [&mut [f64]; 4]) {
     let len = centre.len();
-    for (w, o) in w.into_iter().zip(out.iter_mut()) {
-        rise_run(w, centre, nb, o);
-    }
+    let [w0, w1, w2, w3] = w;
     let [o0, o1, o2, o3] = out;
+    rise_pair([w0, w1], centre, nb, [&mut *o0, &mut *o1]);
+    rise_pair([w2, w3], centre, nb, [&mut *o2, &mut *o3]);
     let (o0, o1, o2, o3) = (
         &mut o0[..len],
         &mut o1[..len],
@@ -310,20 +311,19 @@ fn rises_run(w: [[&[f64]; 4]; 4], centre: &[f64], nb: [&[f64]; 4], mut out: [&mu
     }
 }
 
-/// One side's rises over a run ([`rise_of`]).
+/// Two sides' rises over a run ([`rise_of`]), from their weights `w` (per side, per
+/// neighbour), into `out` (per side).
 #[inline(always)]
-fn rise_run(w: [&[f64]; 4], h: &[f64], nb: [&[f64]; 4], out: &mut [f64]) {
-    let len = out.len();
-    let (w0, w1, w2, w3) = (&w[0][..len], &w[1][..len], &w[2][..len], &w[3][..len]);
-    let (l, r, d, u, h) = (
-        &nb[0][..len],
-        &nb[1][..len],
-        &nb[2][..len],
-        &nb[3][..len],
-        &h[..len],
-    );
+fn rise_pair(w: [[&[f64]; 4]; 2], h: &[f64], nb: [&[f64]; 4], out: [&mut [f64]; 2]) {
+    let len = h.len();
+    let [a, b] = w.map(|w| w.map(|w| &w[..len]));
+    let [oa, ob] = out;
+    let (oa, ob) = (&mut oa[..len], &mut ob[..len]);
+    let (l, r, d, u) = (&nb[0][..len], &nb[1][..len], &nb[2][..len], &nb[3][..len]);
     for i in 0..len {
-        out[i] = rise_of([w0[i], w1[i], w2[i], w3[i]], h[i], [l[i], r[i], d[i], u[i]]);
+        let nb = [l[i], r[i], d[i], u[i]];
+        oa[i] = rise_of([a[0][i], a[1][i], a[2][i], a[3][i]], h[i], nb);
+        ob[i] = rise_of([b[0][i], b[1][i], b[2][i], b[3][i]], h[i], nb);
     }
 }
 
