@@ -382,10 +382,12 @@ fn seam_values(
     pass.seams(block, cells, &mut seams[..block.len]);
     let n = sides.n();
     pads.resize(6 * 4 * n, 0.0);
+    // Side by side (flattened, the four sides' iterator took 38 instructions a pad).
     for (face, out) in pads.chunks_exact_mut(4 * n).enumerate() {
-        let sides = sides.face_pads(face).into_iter().flatten();
-        for (o, pad) in out.iter_mut().zip(sides) {
-            *o = seams[pad.seam as usize] * pad.sign;
+        for (out, side) in out.chunks_exact_mut(n).zip(sides.face_pads(face)) {
+            for (o, pad) in out.iter_mut().zip(side) {
+                *o = seams[pad.seam as usize] * pad.sign;
+            }
         }
     }
 }
