@@ -14,7 +14,7 @@ use glam::DVec3;
 use super::compare::larger;
 use super::face_geometry::FaceGeometry;
 use super::flow::{FilmFlow, Scratch};
-use super::fluxes::apply_limited;
+use super::fluxes::{OutOfPlace, apply_limited, apply_limited_to};
 use super::grid::dot_at;
 use super::sides::EdgeBlock;
 use super::upwind;
@@ -27,11 +27,12 @@ impl FilmFlow {
     /// in sub-steps that keep each cell's outflow below half its content.
     ///
     /// The common case first: one sub-step, whose volumes' pass takes the Courant number
-    /// too ([`Fastest`]), from the thickness it starts from; should that ask for more
-    /// sub-steps, the thickness is put back (kept in `s.cell`, free by now) and they run.
-    /// Why: a pass of its own for the Courant number read the velocities, thicknesses and
-    /// normals again (14 k cache lines a step at n = 64) for the one sub-step a film in
-    /// the optics' range takes.
+    /// too ([`Fastest`]), from the thickness it starts from, out of place into `s.cell`
+    /// (free by now), then swapped in; should the Courant number ask for more sub-steps,
+    /// they run from the thickness in `h_m`, untouched. Why: a pass of its own for the
+    /// Courant number read the velocities, thicknesses and normals again (14 k cache lines
+    /// a step at n = 64) for the one sub-step a film in the optics' range takes; and the
+    /// thickness copied aside in case (0.2 MB a step) cost as much.
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     pub(super) fn transport_thickness(&mut self, s: &mut Scratch, dt_s: f64, g_eff: DVec3) {
         let p = self.params;
@@ -41,16 +42,14 @@ impl FilmFlow {
             0.0
         };
         let drain = Drain { drain, g_eff };
-        s.cell.clear();
-        s.cell.extend_from_slice(&self.h_m);
         let courant = self.upwind_substep(s, dt_s, drain, true) * dt_s / p.radius_m;
         // A cell drains through at most two edges of a smooth flow: 2·courant per step, kept
         // within one sub-step's content; the outflow limit guards the rest.
         let substeps = (2.0 * courant).ceil().clamp(1.0, f64::from(MAX_SUBSTEPS)) as u32;
         if substeps == 1 {
+            std::mem::swap(&mut self.h_m, &mut s.cell);
             return;
         }
-        self.h_m.copy_from_slice(&s.cell);
         let h_dt = dt_s / f64::from(substeps);
         for _ in 0..substeps {
             self.upwind_substep(s, h_dt, drain, false);
@@ -60,9 +59,9 @@ impl FilmFlow {
     /// One transport of `h` over `dt_s`: second-order upwind (the upwind cell's
     /// Green–Gauss gradient, limited to its neighbours' range, carried to the edge
     /// midpoint and clamped between the two cells' values), outflow-limited: one limited
-    /// apply of the [`upwind::Volumes`], band by band. Returns the fastest edge's
-    /// characteristic speed over its smaller cell's width ([`Fastest`]) where `courant`,
-    /// else 0.
+    /// apply of the [`upwind::Volumes`], band by band. Where `courant`, out of place into
+    /// `s.cell` (`h_m` unchanged), returning the fastest edge's characteristic speed over
+    /// its smaller cell's width ([`Fastest`]); else in place, returning 0.
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn upwind_substep(&mut self, s: &mut Scratch, dt_s: f64, drain: Drain, courant: bool) -> f64 {
         let mut fastest = Fastest {
@@ -82,8 +81,19 @@ impl FilmFlow {
             seam_ends: &mut s.seam_ends,
             fastest: courant.then_some(&mut fastest),
         };
-        let (h, gather) = (&mut self.h_m, &mut s.gather);
-        apply_limited(&self.sides, &self.grid, &mut volumes, 1.0, h, gather);
+        let (sides, grid, gather) = (&self.sides, &self.grid, &mut s.gather);
+        if courant {
+            // Every cell of `after` is written: its length, not a fill.
+            s.cell.resize(self.h_m.len(), 0.0);
+            let after = &mut s.cell[..];
+            let h = &mut OutOfPlace {
+                before: &self.h_m,
+                after,
+            };
+            apply_limited_to(sides, grid, &mut volumes, 1.0, h, gather);
+        } else {
+            apply_limited(sides, grid, &mut volumes, 1.0, &mut self.h_m, gather);
+        }
         s.edge2 = fastest.speed;
         fastest.fastest
     }
@@ -91,33 +101,26 @@ impl FilmFlow {
 
 /// The Courant number's fastest edge, taken block by block alongside a pass: each
 /// edge's characteristic speed, `|u|` plus the drainage's `3|c|h²` (`c` its coefficient,
-/// [`DrainAlong::at`]), over its smaller cell's width, a block's into `speed` and their
-/// maximum taken while they are in L1 (taken in the speeds' loop, the compiler
-/// vectorised neither).
+/// [`DrainAlong::at`]), over its smaller cell's width ([`edge_speed`]), a block's into
+/// `speed` by the volumes' loop ([`super::upwind`]) and their maximum taken while they
+/// are in L1 (taken in that loop, the compiler vectorised neither).
 pub(crate) struct Fastest {
     /// A block's speeds (scratch).
-    speed: Vec<f64>,
+    pub(super) speed: Vec<f64>,
     /// The fastest so far, per s (0 before any).
-    fastest: f64,
+    pub(super) fastest: f64,
 }
 
 impl Fastest {
-    /// A block of edges with thicknesses `[ha, hb]` at their ends, at surface speeds `u`
-    /// and drainage `drain` (`fg`: the grid's constants).
+    /// A block of `len` edges: `speeds` writes their speeds into a buffer `len` long,
+    /// whose largest is then taken while it is in L1.
     #[inline(always)]
-    pub(crate) fn block(
-        &mut self,
-        block: impl EdgeBlock,
-        [ha, hb]: [&[f64]; 2],
-        (fg, u): (&FaceGeometry, &[f64]),
-        drain: Drain,
-    ) {
-        let len = block.count();
+    pub(crate) fn take(&mut self, len: usize, speeds: impl FnOnce(&mut [f64])) {
         if self.speed.len() < len {
             self.speed.resize(len, 0.0);
         }
         let speed = &mut self.speed[..len];
-        courant_block(block, [ha, hb], (fg, u), drain, speed);
+        speeds(speed);
         self.fastest = largest_of(speed, self.fastest);
     }
 }
@@ -135,26 +138,6 @@ fn largest_of(values: &[f64], start: f64) -> f64 {
         }
     }
     lanes.into_iter().fold(rest, |a, b| larger(b, a))
-}
-
-/// [`Fastest`]'s speeds over a block of edges with thicknesses `[ha, hb]` at their ends,
-/// into `speed` (`block.count()` long).
-#[inline(always)]
-fn courant_block(
-    block: impl EdgeBlock,
-    [ha, hb]: [&[f64]; 2],
-    (fg, u): (&FaceGeometry, &[f64]),
-    drain: Drain,
-    speed: &mut [f64],
-) {
-    let len = block.count();
-    let (ha, hb, u) = (&ha[..len], &hb[..len], block.values(u));
-    let per_area = block.constant(&fg.length_per_smaller_area);
-    let rate = drain.along(&block, fg);
-    let speed = &mut speed[..len];
-    for i in 0..len {
-        speed[i] = edge_speed(u[i], rate.at(i), ha[i], hb[i], per_area[i]);
-    }
 }
 
 /// The drainage: its speed `c·h²` and flux `c·h³` along an edge's normal, with
@@ -207,7 +190,7 @@ impl DrainAlong<'_> {
 /// drainage's `3|c|h²` at the thicker end, times `length/smaller area` (NaN skipped by
 /// the maximum that takes it, as `max` does).
 #[inline(always)]
-fn edge_speed(u: f64, c: f64, ha: f64, hb: f64, per_area: f64) -> f64 {
+pub(crate) fn edge_speed(u: f64, c: f64, ha: f64, hb: f64, per_area: f64) -> f64 {
     let h = larger(hb, ha);
     (u.abs() + 3.0 * c.abs() * h * h) * per_area
 }

@@ -25,7 +25,7 @@ use super::face_geometry::FaceGeometry;
 use super::fluxes::{BAND, EdgeValues};
 use super::grid::CubeSphere;
 use super::sides::{CellSides, EdgeBlock, EdgeRun, RIGHT, SeamEnds, Seams};
-use super::transport::{Drain, Fastest};
+use super::transport::{Drain, Fastest, edge_speed};
 
 /// The transport's weights, fixed by the grid: face 0's, which every face reads.
 ///
@@ -248,15 +248,24 @@ fn band_rises(
         ];
         rises_run(weights, &h[first..first + len], nb, out);
     }
-    // Face 0's rim cells are every face's places ([`CellSides::rim_per_face`]).
+    // Face 0's rim cells are every face's places ([`CellSides::rim_per_face`]): a row's
+    // are the whole row or its two ends ([`CellSides::rim_of_row`]), copied as such
+    // (cell by cell through the rim's table, they took 30 instructions a cell).
     let m = sides.rim_per_face();
     for y in band.clone() {
         let on_row = sides.rim_of_row(y);
-        let at = face * m + on_row.start..face * m + on_row.end;
-        let r = rim.rise.each_ref().map(|r| &r[at.clone()]);
-        for (j, &p) in sides.rim_cells[on_row].iter().enumerate() {
-            let x = w(y) + p as usize - y * n;
-            (o0[x], o1[x], o2[x], o3[x]) = (r[0][j], r[1][j], r[2][j], r[3][j]);
+        let (at, x) = (face * m + on_row.start, w(y));
+        for (o, r) in [&mut *o0, &mut *o1, &mut *o2, &mut *o3]
+            .into_iter()
+            .zip(&rim.rise)
+        {
+            let o = &mut o[x..x + n];
+            if on_row.len() == n {
+                o.copy_from_slice(&r[at..at + n]);
+            } else {
+                let r = &r[at..at + 2];
+                (o[0], o[n - 1]) = (r[0], r[1]);
+            }
         }
     }
     if band.end < n {
@@ -277,16 +286,17 @@ fn rise_of(w: [f64; 4], h: f64, nb: [f64; 4]) -> f64 {
 }
 
 /// The limited rises of a stretch of cells from their weights `w[k][j]`, thicknesses
-/// `centre` and neighbours' `nb`, as slices: each side's rises in a loop of their own,
+/// `centre` and neighbours' `nb`, as slices: two sides' rises in a loop of their own,
 /// then the limit (one loop over all sixteen weights kept the compiler from vectorising
-/// it: it spilled them to the stack cell by cell).
+/// it: it spilled them to the stack cell by cell; a loop a side took each cell's four
+/// sums `h + h_j` four times where two sides share them).
 #[inline(always)]
-fn rises_run(w: [[&[f64]; 4]; 4], centre: &[f64], nb: [&[f64]; 4], mut out: [&mut [f64]; 4]) {
+fn rises_run(w: [[&[f64]; 4]; 4], centre: &[f64], nb: [&[f64]; 4], out: [&mut [f64]; 4]) {
     let len = centre.len();
-    for (w, o) in w.into_iter().zip(out.iter_mut()) {
-        rise_run(w, centre, nb, o);
-    }
+    let [w0, w1, w2, w3] = w;
     let [o0, o1, o2, o3] = out;
+    rise_pair([w0, w1], centre, nb, [&mut *o0, &mut *o1]);
+    rise_pair([w2, w3], centre, nb, [&mut *o2, &mut *o3]);
     let (o0, o1, o2, o3) = (
         &mut o0[..len],
         &mut o1[..len],
@@ -301,20 +311,19 @@ fn rises_run(w: [[&[f64]; 4]; 4], centre: &[f64], nb: [&[f64]; 4], mut out: [&mu
     }
 }
 
-/// One side's rises over a run ([`rise_of`]).
+/// Two sides' rises over a run ([`rise_of`]), from their weights `w` (per side, per
+/// neighbour), into `out` (per side).
 #[inline(always)]
-fn rise_run(w: [&[f64]; 4], h: &[f64], nb: [&[f64]; 4], out: &mut [f64]) {
-    let len = out.len();
-    let (w0, w1, w2, w3) = (&w[0][..len], &w[1][..len], &w[2][..len], &w[3][..len]);
-    let (l, r, d, u, h) = (
-        &nb[0][..len],
-        &nb[1][..len],
-        &nb[2][..len],
-        &nb[3][..len],
-        &h[..len],
-    );
+fn rise_pair(w: [[&[f64]; 4]; 2], h: &[f64], nb: [&[f64]; 4], out: [&mut [f64]; 2]) {
+    let len = h.len();
+    let [a, b] = w.map(|w| w.map(|w| &w[..len]));
+    let [oa, ob] = out;
+    let (oa, ob) = (&mut oa[..len], &mut ob[..len]);
+    let (l, r, d, u) = (&nb[0][..len], &nb[1][..len], &nb[2][..len], &nb[3][..len]);
     for i in 0..len {
-        out[i] = rise_of([w0[i], w1[i], w2[i], w3[i]], h[i], [l[i], r[i], d[i], u[i]]);
+        let nb = [l[i], r[i], d[i], u[i]];
+        oa[i] = rise_of([a[0][i], a[1][i], a[2][i], a[3][i]], h[i], nb);
+        ob[i] = rise_of([b[0][i], b[1][i], b[2][i], b[3][i]], h[i], nb);
     }
 }
 
@@ -382,11 +391,8 @@ impl EdgeValues for Volumes<'_> {
         let rim = &mut self.rises.rim;
         rim_rises(self.sides, self.geo, h, rim);
         let [h_ends, rises] = self.seam_ends.gather_with_rim_sides(seams, h, &rim.rise);
-        volumes_block(seams, h_ends, rises, (self.fg, self.speeds), out);
-        if let Some(fastest) = self.fastest.as_deref_mut() {
-            let (u, drain) = (self.speeds.u, self.speeds.drain);
-            fastest.block(seams, h_ends, (self.fg, u), drain);
-        }
+        let fastest = self.fastest.as_deref_mut();
+        volumes_block(seams, h_ends, rises, (self.fg, self.speeds), (out, fastest));
     }
 
     #[inline(always)]
@@ -407,31 +413,73 @@ impl EdgeValues for Volumes<'_> {
         };
         let (ra, rb) = (&r.rows[a..], &r.rows[b..]);
         let (ha, hb) = run.ends(h);
-        volumes_block(run, [ha, hb], [ra, rb], (self.fg, self.speeds), out);
-        if let Some(fastest) = self.fastest.as_deref_mut() {
-            let (u, drain) = (self.speeds.u, self.speeds.drain);
-            fastest.block(run, [ha, hb], (self.fg, u), drain);
-        }
+        let fastest = self.fastest.as_deref_mut();
+        volumes_block(
+            run,
+            [ha, hb],
+            [ra, rb],
+            (self.fg, self.speeds),
+            (out, fastest),
+        );
     }
 }
 
 /// [`Volumes`] over a block of edges, with their ends' thicknesses and rises, into
-/// `out`.
+/// `out`, and their characteristic speeds into `fastest` where it is taken.
+///
+/// Why the speeds here: a loop of their own read the velocities, thicknesses and normals
+/// again and took each edge's drainage coefficient a second time (0.12 M instructions a
+/// step at n = 64), where this loop has them in registers.
 #[inline(always)]
 fn volumes_block(
     block: impl EdgeBlock,
-    [ha, hb]: [&[f64]; 2],
-    [ra, rb]: [&[f64]; 2],
+    ends: [&[f64]; 2],
+    rises: [&[f64]; 2],
+    (fg, speeds): (&FaceGeometry, EdgeSpeeds),
+    (out, fastest): (&mut [f64], Option<&mut Fastest>),
+) {
+    let edges = (block, ends, rises);
+    match fastest {
+        None => volumes_loop::<false>(edges, (fg, speeds), out, &mut []),
+        Some(fastest) => fastest.take(
+            block.count(),
+            #[inline(always)]
+            |speed| volumes_loop::<true>(edges, (fg, speeds), out, speed),
+        ),
+    }
+}
+
+/// [`volumes_block`]'s loop: the volumes into `out`, and where `COURANT` the edges'
+/// [`edge_speed`]s into `speed` (`block.count()` long then), each from the same
+/// drainage coefficient.
+#[inline(always)]
+fn volumes_loop<const COURANT: bool>(
+    (block, [ha, hb], [ra, rb]): (impl EdgeBlock, [&[f64]; 2], [&[f64]; 2]),
     (fg, speeds): (&FaceGeometry, EdgeSpeeds),
     out: &mut [f64],
+    speed: &mut [f64],
 ) {
     let len = block.count();
     let (u, c) = (block.values(speeds.u), speeds.drain.along(&block, fg));
     let (l, out) = (block.constant(&fg.length), &mut out[..len]);
     let (ha, hb, ra, rb) = (&ha[..len], &hb[..len], &ra[..len], &rb[..len]);
+    let per_area = block.constant(&fg.length_per_smaller_area);
+    let (per_area, speed) = if COURANT {
+        (&per_area[..len], &mut speed[..len])
+    } else {
+        (&per_area[..0], &mut speed[..0])
+    };
     for i in 0..len {
-        let speed = [u[i], c.at(i), l[i]];
-        out[i] = edge_volume([ha[i], hb[i]], [ra[i], rb[i]], speed, speeds.dt_per_r);
+        let c = c.at(i);
+        out[i] = edge_volume(
+            [ha[i], hb[i]],
+            [ra[i], rb[i]],
+            [u[i], c, l[i]],
+            speeds.dt_per_r,
+        );
+        if COURANT {
+            speed[i] = edge_speed(u[i], c, ha[i], hb[i], per_area[i]);
+        }
     }
 }
 
@@ -468,7 +516,8 @@ mod tests {
     /// The volumes taken band by band, each face's limited rises a band at a time and
     /// the rim's apart, against each edge's taken directly from every cell's limited
     /// rises (the same arithmetic, so the same bits): on grids of one band and of three,
-    /// the last short, so that the rises carried from band to band are checked.
+    /// the last short, so that the rises carried from band to band are checked. The
+    /// fastest edge taken alongside against the largest of every edge's [`edge_speed`].
     #[test]
     fn the_volumes_by_bands_are_each_edges_own() {
         for n in [5, 2 * BAND + 3] {
@@ -501,7 +550,7 @@ mod tests {
                 let phi = limiter(h[cell], nb, r);
                 r.map(|r| r * phi)
             };
-            let mut want = vec![0.0; ea.cells.len()];
+            let (mut want, mut want_fastest) = (vec![0.0; ea.cells.len()], 0.0_f64);
             for (e, [a, b]) in ea.cells.iter().enumerate() {
                 let (a, b) = (*a as usize, *b as usize);
                 let side = |cell: usize| {
@@ -511,23 +560,27 @@ mod tests {
                         .unwrap()
                 };
                 let (ra, rb) = (rise(a)[side(a)], rise(b)[side(b)]);
-                let (l, c) = if e >= layout.first_seam_edge() {
+                let (l, c, per_area) = if e >= layout.first_seam_edge() {
                     let i = e - layout.first_seam_edge();
                     let normal = fg.normal.seams.each_ref().map(|x| &x[i..]);
-                    (
-                        fg.length.seams[i],
-                        drain.drain * dot_at(drain.g_eff, normal, 0),
-                    )
+                    let c = drain.drain * dot_at(drain.g_eff, normal, 0);
+                    (fg.length.seams[i], c, fg.length_per_smaller_area.seams[i])
                 } else {
                     let (face, i) = layout.on_face(e);
                     let normal = fg.normal.face.each_ref().map(|x| &x[i..]);
                     let g = to_face_frame(face, drain.g_eff);
-                    (fg.length.face[i], drain.drain * dot_at(g, normal, 0))
+                    let c = drain.drain * dot_at(g, normal, 0);
+                    (fg.length.face[i], c, fg.length_per_smaller_area.face[i])
                 };
                 want[e] = edge_volume([h[a], h[b]], [ra, rb], [u[e], c, l], speeds.dt_per_r);
+                want_fastest = want_fastest.max(edge_speed(u[e], c, h[a], h[b], per_area));
             }
             let mut got = vec![f64::NAN; ea.cells.len()];
             let (mut rises, mut seam_ends) = (Rises::default(), SeamEnds::default());
+            let mut fastest = Fastest {
+                speed: Vec::new(),
+                fastest: 0.0,
+            };
             let volumes = Volumes {
                 sides: &sides,
                 geo: &geo,
@@ -535,7 +588,7 @@ mod tests {
                 speeds,
                 rises: &mut rises,
                 seam_ends: &mut seam_ends,
-                fastest: None,
+                fastest: Some(&mut fastest),
             };
             let mut kept = Kept {
                 pass: volumes,
@@ -546,6 +599,12 @@ mod tests {
             net_inflow(&sides, (&mut kept, &h), &mut out, scratch, |_, _, _| {});
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&got), bits(&want), "n = {n}");
+            let fastest = fastest.fastest;
+            assert_eq!(
+                fastest.to_bits(),
+                want_fastest.to_bits(),
+                "n = {n}: fastest"
+            );
         }
     }
 
