@@ -107,18 +107,22 @@ const DENSE_CELLS: usize = 6 * 8 * 8;
 /// n = 64, 209 at 32 and 250 at 128, against 227, 204 and 248 down to 6·4² cells).
 const COARSEST_FACE: usize = 2;
 
-/// Gauss–Seidel sweeps a side of the V-cycle's coarse correction on the finest level,
-/// the next one and every coarser one ([`sweeps`]). More on the coarse levels, where a
-/// sweep is cheap, and on the finest, where a PCG iteration saved streams the `f64`
-/// fields once less: over `film_profile 64 0 9.81`'s 40 steps 5, 4 and 8 took 132 PCG
-/// iterations (3 a step from step 30 on), 752.2 M instructions and 17.3 M LL misses,
-/// against 3, 3 and 3's 176 (3.9 a step), 747.5 M and 18.9 M. (One sweep everywhere
-/// took 531 iterations, two 230, four 155.)
-const SWEEPS: [usize; 3] = [5, 4, 8];
-
-/// The sweeps a side on level `k` ([`SWEEPS`]).
-fn sweeps(k: usize) -> usize {
-    SWEEPS[k.min(SWEEPS.len() - 1)]
+/// Gauss–Seidel sweeps a side of the V-cycle's coarse correction on a level of face size
+/// `m`: more where a sweep is cheap (the small levels, and a level whose fields stay in
+/// L2) than a PCG iteration it saves, which streams the finest level's `f64` fields once
+/// more. Over `film_profile n 0 9.81`'s 40 steps, at n = 64 (5, 4 and 8 sweeps on the
+/// levels of 64, 32 and ≤ 16) 132 PCG iterations (3 a step from step 30 on), 751.0 M
+/// instructions and 17.3 M LL misses, against three sweeps everywhere's 176 (3.9 a
+/// step), 747.2 M and 18.8 M; at n = 128 (3 on the finest) 2.97 G and 204 M against
+/// 2.93 G and 212 M, where 5 on it too took 2.98 G and 220 M. (Three sweeps everywhere:
+/// one took 531 iterations at n = 64, two 230, four 155.)
+fn sweeps(m: usize) -> usize {
+    match m {
+        0..=16 => 8,
+        17..=32 => 4,
+        33..=64 => 5,
+        _ => 3,
+    }
 }
 
 /// The multigrid hierarchy of a cube-sphere, built once per grid size.
@@ -607,7 +611,7 @@ impl Hierarchy {
     }
 
     /// One symmetric V-cycle on level `k` for residual `r`, result in `z`, in `f32`:
-    /// [`sweeps`]`(k)` forward sweeps (colour 0 then 1, the first from zero), the coarse
+    /// [`sweeps`] forward sweeps (colour 0 then 1, the first from zero), the coarse
     /// correction, as many backward sweeps (colour 1 then 0). Before each half-sweep the
     /// halo cells it reads are refreshed.
     fn v_cycle(&self, work: &mut Work, k: usize, r: &[f32], z: &mut [f32]) {
@@ -622,7 +626,7 @@ impl Hierarchy {
                 let (inv_diag, w) = (&work.inv_diag[k], &work.stencil32[k]);
                 relax_from_zero(level, inv_diag, r, z);
                 relax(level, 1, inv_diag, w, r, z);
-                for _ in 1..sweeps(k) {
+                for _ in 1..sweeps(level.m) {
                     for c in [0, 1] {
                         refresh(level, 1 - c, z);
                         relax(level, c, inv_diag, w, r, z);
@@ -648,7 +652,7 @@ impl Hierarchy {
                 correct(level, coarse, &mut zc, z, &mut row);
                 (work.residual[k + 1], work.correction[k + 1], work.row) = (rc, zc, row);
                 let (inv_diag, w) = (&work.inv_diag[k], &work.stencil32[k]);
-                for _ in 0..sweeps(k) {
+                for _ in 0..sweeps(level.m) {
                     for c in [1, 0] {
                         refresh(level, 1 - c, z);
                         relax(level, c, inv_diag, w, r, z);
@@ -1167,7 +1171,7 @@ mod tests {
     /// The V-cycle is a symmetric map, as the conjugate gradients need of their
     /// preconditioner: `⟨V(a), b⟩ = ⟨a, V(b)⟩` up to its `f32` rounding, for fields `a`
     /// and `b` of the stiff system at n = 8 (two levels) and 32 (four), each level's
-    /// sweeps ([`SWEEPS`]) run forward before the coarse correction and backward after it.
+    /// sweeps ([`sweeps`]) run forward before the coarse correction and backward after it.
     #[test]
     fn the_v_cycle_is_symmetric() {
         for n in [8, 32] {
@@ -1182,7 +1186,7 @@ mod tests {
             let (ab, ba) = (cell_dot(fine, &va, &b), cell_dot(fine, &a, &vb));
             let scale = cell_dot(fine, &va, &va).sqrt() * cell_dot(fine, &b, &b).sqrt();
             let asymmetry = (ab - ba).abs() / scale;
-            assert!(asymmetry < 1e-8, "n {n}: {ab} vs {ba}, {asymmetry:e}");
+            assert!(asymmetry < 1e-7, "n {n}: {ab} vs {ba}, {asymmetry:e}");
         }
     }
 
