@@ -108,16 +108,20 @@ const DENSE_CELLS: usize = 6 * 8 * 8;
 const COARSEST_FACE: usize = 2;
 
 /// Gauss–Seidel sweeps a side of the V-cycle's coarse correction on a level of face size
-/// `m`: more where a sweep is cheap (the small levels, and a level whose fields stay in
-/// L2) than a PCG iteration it saves, which streams the finest level's `f64` fields once
-/// more. Over `film_profile n 0 9.81`'s 40 steps, at n = 64 (5, 4 and 8 sweeps on the
-/// levels of 64, 32 and ≤ 16) 132 PCG iterations (3 a step from step 30 on), 751.0 M
-/// instructions and 17.3 M LL misses, against three sweeps everywhere's 176 (3.9 a
+/// `m` in a hierarchy whose finest level's is `finest`. Where the finest level's fields
+/// outgrow the L2 (`finest` 64 and up), a PCG iteration saved saves their streaming from
+/// memory, and more sweeps pay where a sweep is cheap (the small levels, and a level
+/// whose fields stay in L2); below, the whole solve stays in L2 and three everywhere took
+/// the fewest instructions. Over `film_profile n 0 9.81`'s 40 steps, at n = 64 (5, 4 and
+/// 8 on the levels of 64, 32 and ≤ 16) 132 PCG iterations (3 a step from step 30 on),
+/// 751.1 M instructions and 17.3 M LL misses, against three everywhere's 176 (3.9 a
 /// step), 747.2 M and 18.8 M; at n = 128 (3 on the finest) 2.97 G and 204 M against
-/// 2.93 G and 212 M, where 5 on it too took 2.98 G and 220 M. (Three sweeps everywhere:
-/// one took 531 iterations at n = 64, two 230, four 155.)
-fn sweeps(m: usize) -> usize {
+/// 2.93 G and 212 M, where 5 on it too took 2.98 G and 220 M; at n = 32 these counts
+/// took 235 M instructions against 223 M, the same misses. (Three everywhere: one took
+/// 531 iterations at n = 64, two 230, four 155.)
+fn sweeps(m: usize, finest: usize) -> usize {
     match m {
+        _ if finest < 64 => 3,
         0..=16 => 8,
         17..=32 => 4,
         33..=64 => 5,
@@ -626,7 +630,7 @@ impl Hierarchy {
                 let (inv_diag, w) = (&work.inv_diag[k], &work.stencil32[k]);
                 relax_from_zero(level, inv_diag, r, z);
                 relax(level, 1, inv_diag, w, r, z);
-                for _ in 1..sweeps(level.m) {
+                for _ in 1..sweeps(level.m, self.levels[0].m) {
                     for c in [0, 1] {
                         refresh(level, 1 - c, z);
                         relax(level, c, inv_diag, w, r, z);
@@ -652,7 +656,7 @@ impl Hierarchy {
                 correct(level, coarse, &mut zc, z, &mut row);
                 (work.residual[k + 1], work.correction[k + 1], work.row) = (rc, zc, row);
                 let (inv_diag, w) = (&work.inv_diag[k], &work.stencil32[k]);
-                for _ in 0..sweeps(level.m) {
+                for _ in 0..sweeps(level.m, self.levels[0].m) {
                     for c in [1, 0] {
                         refresh(level, 1 - c, z);
                         relax(level, c, inv_diag, w, r, z);
@@ -1170,11 +1174,12 @@ mod tests {
 
     /// The V-cycle is a symmetric map, as the conjugate gradients need of their
     /// preconditioner: `⟨V(a), b⟩ = ⟨a, V(b)⟩` up to its `f32` rounding, for fields `a`
-    /// and `b` of the stiff system at n = 8 (two levels) and 32 (four), each level's
-    /// sweeps ([`sweeps`]) run forward before the coarse correction and backward after it.
+    /// and `b` of the stiff system at n = 8 (two levels), 32 (four) and 64 (five, more
+    /// sweeps on each: [`sweeps`]), each level's sweeps run forward before the coarse
+    /// correction and backward after it.
     #[test]
     fn the_v_cycle_is_symmetric() {
-        for n in [8, 32] {
+        for n in [8, 32, 64] {
             let (_, h, alpha, weight, _) = stiff_system(n, |c| c.x);
             let mut work = Work::default();
             h.prepare(&mut work, &alpha, &weight);
