@@ -107,6 +107,28 @@ const DENSE_CELLS: usize = 6 * 8 * 8;
 /// n = 64, 209 at 32 and 250 at 128, against 227, 204 and 248 down to 6·4² cells).
 const COARSEST_FACE: usize = 2;
 
+/// Gauss–Seidel sweeps a side of the V-cycle's coarse correction on a level of face size
+/// `m` in a hierarchy whose finest level's is `finest`. Where the finest level's fields
+/// outgrow the L2 (`finest` 64 and up), a PCG iteration saved saves their streaming from
+/// memory, and more sweeps pay where a sweep is cheap (the small levels, and a level
+/// whose fields stay in L2); below, the whole solve stays in L2 and three everywhere took
+/// the fewest instructions. Over `film_profile n 0 9.81`'s 40 steps, at n = 64 (5, 4 and
+/// 8 on the levels of 64, 32 and ≤ 16) 132 PCG iterations (3 a step from step 30 on),
+/// 751.1 M instructions and 17.3 M LL misses, against three everywhere's 176 (3.9 a
+/// step), 747.2 M and 18.8 M; at n = 128 (3 on the finest) 2.97 G and 204 M against
+/// 2.93 G and 212 M, where 5 on it too took 2.98 G and 220 M; at n = 32 these counts
+/// took 235 M instructions against 223 M, the same misses. (Three everywhere: one took
+/// 531 iterations at n = 64, two 230, four 155.)
+fn sweeps(m: usize, finest: usize) -> usize {
+    match m {
+        _ if finest < 64 => 3,
+        0..=16 => 8,
+        17..=32 => 4,
+        33..=64 => 5,
+        _ => 3,
+    }
+}
+
 /// The multigrid hierarchy of a cube-sphere, built once per grid size.
 #[derive(Clone, Debug)]
 pub struct Hierarchy {
@@ -692,12 +714,10 @@ impl Hierarchy {
         }
     }
 
-    /// One symmetric V-cycle on level `k` for residual `r`, result in `z`, in `f32`: three
-    /// forward sweeps (colour 0 then 1, the first from zero), the coarse correction, three
-    /// backward sweeps (colour 1 then 0). Before each half-sweep the halo cells it reads
-    /// are refreshed. Three sweeps a side, not two: the swirl film's solves took 176 PCG
-    /// iterations over `film_profile 64 0 9.81`'s 40 steps against 230, for 2 % fewer
-    /// instructions a step (one sweep a side took 531; four, 155 but more instructions).
+    /// One symmetric V-cycle on level `k` for residual `r`, result in `z`, in `f32`:
+    /// [`sweeps`] forward sweeps (colour 0 then 1, the first from zero), the coarse
+    /// correction, as many backward sweeps (colour 1 then 0). Before each half-sweep the
+    /// halo cells it reads are refreshed.
     fn v_cycle(&self, work: &mut Work, k: usize, r: &[f32], z: &mut [f32]) {
         with_avx2(
             #[inline(always)]
@@ -710,9 +730,11 @@ impl Hierarchy {
                 let (inv_diag, w) = (&work.inv_diag[k], &work.stencil32[k]);
                 relax_from_zero(level, inv_diag, r, z);
                 relax(level, 1, inv_diag, w, r, z);
-                for c in [0, 1, 0, 1] {
-                    refresh(level, 1 - c, z);
-                    relax(level, c, inv_diag, w, r, z);
+                for _ in 1..sweeps(level.m, self.levels[0].m) {
+                    for c in [0, 1] {
+                        refresh(level, 1 - c, z);
+                        relax(level, c, inv_diag, w, r, z);
+                    }
                 }
                 refresh_all(level, z);
                 let coarse = &self.levels[k + 1];
@@ -734,9 +756,11 @@ impl Hierarchy {
                 correct(level, coarse, &mut zc, z, &mut row);
                 (work.residual[k + 1], work.correction[k + 1], work.row) = (rc, zc, row);
                 let (inv_diag, w) = (&work.inv_diag[k], &work.stencil32[k]);
-                for c in [1, 0, 1, 0, 1, 0] {
-                    refresh(level, 1 - c, z);
-                    relax(level, c, inv_diag, w, r, z);
+                for _ in 0..sweeps(level.m, self.levels[0].m) {
+                    for c in [1, 0] {
+                        refresh(level, 1 - c, z);
+                        relax(level, c, inv_diag, w, r, z);
+                    }
                 }
             },
         )
@@ -1375,6 +1399,81 @@ mod tests {
             for field in [RIGHT_W, TOP_W] {
                 if !read[field][p] {
                     assert_eq!(w[field][p], 0.0, "m {} field {field} at {p}", level.m);
+                }
+            }
+        }
+    }
+
+    /// A field in level `level`'s split layout, `f32`, zero outside the cells and at
+    /// each cell a number in `[-1, 1)` from `seed` (a fixed hash, not a generator).
+    fn cell_field(level: &Layout, seed: usize) -> Vec<f32> {
+        let mut field = vec![0.0; level.len()];
+        for (c, &p) in level.position.iter().enumerate() {
+            let hash = (c * 2_654_435_761 + seed * 40_503) % 1_000_003;
+            field[p as usize] = hash as f32 / 500_001.5 - 1.0;
+        }
+        field
+    }
+
+    /// `a·b` over a level's cells, in `f64`.
+    fn cell_dot(level: &Layout, a: &[f32], b: &[f32]) -> f64 {
+        let at = |v: &[f32], p: u32| f64::from(v[p as usize]);
+        level.position.iter().map(|&p| at(a, p) * at(b, p)).sum()
+    }
+
+    /// The V-cycle is a symmetric map, as the conjugate gradients need of their
+    /// preconditioner: `⟨V(a), b⟩ = ⟨a, V(b)⟩` up to its `f32` rounding, for fields `a`
+    /// and `b` of the stiff system at n = 8 (two levels), 32 (four) and 64 (five, more
+    /// sweeps on each: [`sweeps`]), each level's sweeps run forward before the coarse
+    /// correction and backward after it.
+    #[test]
+    fn the_v_cycle_is_symmetric() {
+        for n in [8, 32, 64] {
+            let (_, h, alpha, weight, _) = stiff_system(n, |c| c.x);
+            let mut work = Work::default();
+            h.prepare(&mut work, &alpha, &weight);
+            let fine = &h.levels[0];
+            let (a, b) = (cell_field(fine, 1), cell_field(fine, 2));
+            let (mut va, mut vb) = (vec![0.0; fine.len()], vec![0.0; fine.len()]);
+            h.v_cycle(&mut work, 0, &a, &mut va);
+            h.v_cycle(&mut work, 0, &b, &mut vb);
+            let (ab, ba) = (cell_dot(fine, &va, &b), cell_dot(fine, &a, &vb));
+            let scale = cell_dot(fine, &va, &va).sqrt() * cell_dot(fine, &b, &b).sqrt();
+            let asymmetry = (ab - ba).abs() / scale;
+            assert!(asymmetry < 1e-7, "n {n}: {ab} vs {ba}, {asymmetry:e}");
+        }
+    }
+
+    /// The V-cycle's restriction is its coarse correction's transpose, to the bit: each
+    /// fine cell takes its parent's value (and no other) and gives its residual to its
+    /// parent (and no other), at coarse faces of 1, 2 and 4 cells.
+    #[test]
+    fn the_restriction_is_the_corrections_transpose() {
+        for n in [2, 4, 8] {
+            let fine = Layout::of_grid(&CellSides::new(&CubeSphere::new(n)));
+            let coarse = fine.coarser();
+            let (nf, nc) = (fine.position.len(), coarse.position.len());
+            let mut row = Vec::new();
+            let mut prolong = vec![vec![0.0; nc]; nf];
+            for c in 0..nc {
+                let mut zc = vec![0.0; coarse.len()];
+                zc[coarse.position[c] as usize] = 1.0;
+                let mut z = vec![0.0; fine.len()];
+                correct(&fine, &coarse, &mut zc, &mut z, &mut row);
+                for (f, p) in fine.position.iter().enumerate() {
+                    prolong[f][c] = z[*p as usize];
+                }
+            }
+            for f in 0..nf {
+                let mut d = vec![0.0f32; fine.len()];
+                d[fine.position[f] as usize] = 1.0;
+                let mut out = vec![0.0; coarse.len()];
+                restrict(&fine, &d, &coarse, &mut out, &mut row);
+                for c in 0..nc {
+                    let given = out[coarse.position[c] as usize];
+                    let parent = if parent_cell(n, f) == c { 1.0 } else { 0.0 };
+                    assert_eq!(prolong[f][c], parent, "n {n} fine {f} coarse {c}");
+                    assert_eq!(given.to_bits(), prolong[f][c].to_bits(), "n {n} {f} {c}");
                 }
             }
         }
