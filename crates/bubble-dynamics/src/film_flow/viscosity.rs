@@ -429,9 +429,7 @@ fn border_fields(grid: &CubeSphere, rows: &FaceRows, u: &[f64], v: &mut ViscousS
         for y in [0, n - 1] {
             divergence_cells(rows, u, ia, y, 0, &mut out[(y + 1) * pw + 1..][..n]);
         }
-        for x in [0, n - 1] {
-            divergence_column(rows, u, ia, x, out);
-        }
+        divergence_columns(rows, u, ia, out);
     }
     for &[slot, across] in &rows.cell_halo {
         divergence[slot as usize] = divergence[across as usize];
@@ -447,18 +445,29 @@ fn divergence_cells(rows: &FaceRows, u: &[f64], ia: &[f64], y: usize, x: usize, 
     divergence_row(out, sides(u, at), sides(&rows.length, at), &ia[y * n + x..]);
 }
 
-/// The divergences of cells `(x, 1..n − 1)` of a face (its local edges `u`) into its
-/// padded cells `out`, as [`divergence_row`] takes each (the same sum in the same order),
-/// with face 0's lengths and cells' inverse areas `ia`: a column of the face's border
-/// cells, where a call of [`divergence_cells`] a cell cost several times the sum.
+/// The divergences of the cells `(0, y)` and `(n − 1, y)`, `y` in `1..n − 1`, of a face
+/// (its local edges `u`) into its padded cells `out`, as [`divergence_row`] takes each
+/// (the same sum in the same order), with face 0's lengths and cells' inverse areas `ia`:
+/// the columns of the face's border cells, where a call of [`divergence_cells`] a cell
+/// cost several times the sum. Both columns a row at a time, the rows from iterators:
+/// indexing the arrays cost a cell as much again in bounds checks.
 #[inline(always)]
-fn divergence_column(rows: &FaceRows, u: &[f64], ia: &[f64], x: usize, out: &mut [f64]) {
-    let n = rows.n;
-    let ((ux, uy), (lx, ly)) = (u.split_at(n * (n + 1)), rows.length.split_at(n * (n + 1)));
-    for y in 1..n.saturating_sub(1) {
-        let (b, l, t) = (y * n + x, y * (n + 1) + x, (y + 1) * n + x);
-        let d = 0.0 - uy[b] * ly[b] - ux[l] * lx[l] + ux[l + 1] * lx[l + 1] + uy[t] * ly[t];
-        out[(y + 1) * (n + 2) + 1 + x] = d * ia[b];
+fn divergence_columns(rows: &FaceRows, u: &[f64], ia: &[f64], out: &mut [f64]) {
+    let (n, w) = (rows.n, rows.n + 1);
+    let ((ux, uy), (lx, ly)) = (u.split_at(n * w), rows.length.split_at(n * w));
+    // From cell row 1: its bottom and top Y-edge rows, its X-edge row, its padded row.
+    let bottom = uy[n..].chunks_exact(n).zip(ly[n..].chunks_exact(n));
+    let top = uy[2 * n..].chunks_exact(n).zip(ly[2 * n..].chunks_exact(n));
+    let sides = ux[w..].chunks_exact(w).zip(lx[w..].chunks_exact(w));
+    let cells = ia[n..]
+        .chunks_exact(n)
+        .zip(out[2 * (n + 2)..].chunks_exact_mut(n + 2));
+    let rows = bottom.zip(top).zip(sides).zip(cells);
+    for ((((ub, lb), (ut, lt)), (us, ls)), (ia, out)) in rows.take(n.saturating_sub(2)) {
+        for x in [0, n - 1] {
+            let d = 0.0 - ub[x] * lb[x] - us[x] * ls[x] + us[x + 1] * ls[x + 1] + ut[x] * lt[x];
+            out[1 + x] = d * ia[x];
+        }
     }
 }
 
