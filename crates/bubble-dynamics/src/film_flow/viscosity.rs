@@ -229,11 +229,23 @@ impl Blend {
             if y < n {
                 face.take_vertex_row(z_next, (u_x, u_y), y + 1);
             }
-            face.take_cell_row(into, (u_x, u_y), y + 1);
             // Y-edge (x, y): tail the vertex (x, y), head (x + 1, y); from cell (x, y − 1)
-            // (padded row y) into (x, y).
-            let u = &mut u_y[y * n..][..n];
-            self.row::<BLEND, KEEP>(u, p, [&z[1..], z], [&into[1..], &from[1..]], [il, id]);
+            // (padded row y) into (x, y) (padded row y + 1: the halo row, or taken in the
+            // edges' loop).
+            if y == n {
+                face.take_cell_row(into, (u_x, u_y), y + 1);
+            }
+            let (u, above) = u_y[y * n..].split_at_mut(n);
+            let (vertices, from_cells) = ([&z[1..], &*z], &from[1..]);
+            if y < n {
+                let sides = (&u_x[y * w..][..w], &above[..n]);
+                let (u, metric) = ((u, p), [il, id]);
+                self.y_row_taking_cells::<BLEND, KEEP>(
+                    face, u, vertices, from_cells, into, metric, sides, y,
+                );
+            } else {
+                self.row::<BLEND, KEEP>(u, p, vertices, [&into[1..], from_cells], [il, id]);
+            }
             let Some((p, (il, id))) = x_rows.next() else {
                 break;
             };
@@ -243,6 +255,78 @@ impl Blend {
             self.x_row::<BLEND, KEEP>(u, p, [z, z_next], into, [il, id]);
             (z, z_next) = (z_next, z);
             (from, into) = (into, from);
+        }
+    }
+
+    /// Y-edge row `y < n` (`u` and `y_prev`) as [`Self::row`] takes it, and in the same
+    /// loop padded cell row `y + 1` into `into` as [`Face::take_cell_row`] takes it, from
+    /// its cells' sides: the edges (their bottoms, read before they move), X-edge row `y`
+    /// and Y-edge row `y + 1` (`sides`). One loop where two each loaded the edges and
+    /// cost a row's set-up.
+    #[allow(clippy::too_many_arguments)] // the row's slices, each its own (see `row`)
+    #[inline(always)]
+    fn y_row_taking_cells<const BLEND: bool, const KEEP: bool>(
+        self,
+        face: Face,
+        (u, y_prev): (&mut [f64], &mut [f64]),
+        vertices: [&[f64]; 2],
+        from: &[f64],
+        into: &mut [f64],
+        metric: [&[f64]; 2],
+        (ux, above): (&[f64], &[f64]),
+        y: usize,
+    ) {
+        let (n, w) = (u.len(), u.len() + 1);
+        let [lx, ly] = face.length;
+        let (lx, ly) = (&lx[y * w..][..w], &ly[y * n..][..2 * n]);
+        let ls = [&ly[..n], &lx[..n], &lx[1..], &ly[n..]];
+        let border = &face.borders.1[(y + 1) * (w + 1)..][..w + 1];
+        (into[0], into[n + 1]) = (border[0], border[n + 1]);
+        let cells = (
+            [&ux[..n], &ux[1..], above],
+            ls,
+            &face.inverse_areas[y * n..][..n],
+        );
+        let out = &mut into[1..=n];
+        self.y_row_cells::<BLEND, KEEP>(u, y_prev, out, vertices, from, metric, cells);
+    }
+
+    /// The loop of [`Self::y_row_taking_cells`]: the cells' `out`, their `[left, right,
+    /// top]` sides' velocities, `[bottom, left, right, top]` lengths (the bottoms'
+    /// velocities are `u`'s) and inverse areas. The outputs are arguments of their own
+    /// (see [`Self::row`]; in a tuple, the compiler lost that they overlap nothing and
+    /// did not vectorise the loop).
+    #[allow(clippy::too_many_arguments)] // the outputs, each its own argument
+    #[inline(always)]
+    fn y_row_cells<const BLEND: bool, const KEEP: bool>(
+        self,
+        u: &mut [f64],
+        y_prev: &mut [f64],
+        out: &mut [f64],
+        [head, tail]: [&[f64]; 2],
+        from: &[f64],
+        [il, id]: [&[f64]; 2],
+        ([left, right, top], l, ia): ([&[f64]; 3], [&[f64]; 4], &[f64]),
+    ) {
+        let len = u.len();
+        let (y_prev, out, head, tail, from) = (
+            &mut y_prev[..len],
+            &mut out[..len],
+            &head[..len],
+            &tail[..len],
+            &from[..len],
+        );
+        let (il, id, ia) = (&il[..len], &id[..len], &ia[..len]);
+        let (left, right, top) = (&left[..len], &right[..len], &top[..len]);
+        let [lb, ll, lr, lt] = l.map(|l| &l[..len]);
+        for x in 0..len {
+            let b = u[x];
+            let d = 0.0 - b * lb[x] - left[x] * ll[x] + right[x] * lr[x] + top[x] * lt[x];
+            let into = d * ia[x];
+            out[x] = into;
+            let curl_curl = (head[x] - tail[x]) * il[x];
+            let grad_div = (into - from[x]) * id[x];
+            self.step::<BLEND, KEEP>(&mut u[x], &mut y_prev[x], curl_curl, grad_div);
         }
     }
 
