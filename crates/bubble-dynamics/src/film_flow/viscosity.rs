@@ -191,10 +191,11 @@ impl Blend {
     /// One face's edges (`u` and `y_prev` its local edges), row by row: Y-edge row `y`
     /// reads vertex row `y` and padded cell rows `y` and `y + 1`, X-edge row `y` vertex
     /// rows `y` (heads) and `y + 1` (tails) and padded cell row `y + 1`. Vertex row
-    /// `y + 1` and padded cell row `y + 1` are taken into `window` before those edge rows
-    /// move, from edges that have not moved yet: vertex row `j` reads X-edge rows `j − 1`
-    /// and `j` and Y-edge row `j`, padded cell row `p` X-edge row `p − 1` and Y-edge rows
-    /// `p − 1` and `p`. Every row of edges whole, the faces' borders' too: their cells across
+    /// `y + 1` and padded cell row `y + 1` are taken into `window` from edges that have
+    /// not moved yet: vertex row `j` reads X-edge rows `j − 1` and `j` and Y-edge row `j`
+    /// (taken before Y-edge row `y` moves), padded cell row `p` X-edge row `p − 1` and
+    /// Y-edge rows `p − 1` and `p` (taken in Y-edge row `y`'s loop, each cell just before
+    /// its bottom edge moves). Every row of edges whole, the faces' borders' too: their cells across
     /// the border are in the divergence's halo. Every face reads face 0's metric
     /// `[1/length, 1/dual length]` ([`FaceRows`] says why).
     ///
