@@ -140,11 +140,8 @@ impl FilmFlow {
         // it was to spare.
         for f in face_order(reverse) {
             let (u, stage) = (&mut u[f * epf..][..epf], &mut stage[f * epf..][..epf]);
-            let face = Face {
-                rows,
-                inverse_areas: ia,
-                borders: (&vorticity[f * vpf..][..vpf], &divergence[f * cpf..][..cpf]),
-            };
+            let borders = (&vorticity[f * vpf..][..vpf], &divergence[f * cpf..][..cpf]);
+            let face = Face::new(rows, ia, borders);
             match (nu_prev != 0.0, !last) {
                 (false, false) => blend.face::<false, false>(face, u, stage, window),
                 (false, true) => blend.face::<false, true>(face, u, stage, window),
@@ -194,12 +191,18 @@ impl Blend {
     /// One face's edges (`u` and `y_prev` its local edges), row by row: Y-edge row `y`
     /// reads vertex row `y` and padded cell rows `y` and `y + 1`, X-edge row `y` vertex
     /// rows `y` (heads) and `y + 1` (tails) and padded cell row `y + 1`. Vertex row
-    /// `y + 1` and padded cell row `y + 1` are taken into `window` before those edge rows
-    /// move, from edges that have not moved yet: vertex row `j` reads X-edge rows `j − 1`
-    /// and `j` and Y-edge row `j`, padded cell row `p` X-edge row `p − 1` and Y-edge rows
-    /// `p − 1` and `p`. Every row of edges whole, the faces' borders' too: their cells across
+    /// `y + 1` and padded cell row `y + 1` are taken into `window` from edges that have
+    /// not moved yet: vertex row `j` reads X-edge rows `j − 1` and `j` and Y-edge row `j`
+    /// (taken before Y-edge row `y` moves), padded cell row `p` X-edge row `p − 1` and
+    /// Y-edge rows `p − 1` and `p` (taken in Y-edge row `y`'s loop, each cell just before
+    /// its bottom edge moves). Every row of edges whole, the faces' borders' too: their cells across
     /// the border are in the divergence's halo. Every face reads face 0's metric
     /// `[1/length, 1/dual length]` ([`FaceRows`] says why).
+    ///
+    /// The face's arrays are split into their X- and Y-edge halves once, the rows of the
+    /// metric and of `y_prev` come from iterators, and the window's two rows of each kind
+    /// swap places: each a bounds check or several a row less, where a row's set-up was
+    /// a third of the stage's instructions.
     #[inline(always)]
     fn face<const BLEND: bool, const KEEP: bool>(
         self,
@@ -210,33 +213,152 @@ impl Blend {
     ) {
         let rows = face.rows;
         let (n, w, xs) = (rows.n, rows.n + 1, rows.n * (rows.n + 1));
-        let (il, id) = (&rows.inverse_length[..], &rows.inverse_dual_length[..]);
-        window.take_vertex_row(face, u, 0);
-        window.take_cell_row(face, u, 0);
-        for y in 0..=n {
+        let (u_x, u_y) = u.split_at_mut(xs);
+        let (p_x, p_y) = y_prev.split_at_mut(xs);
+        let (il_x, il_y) = rows.inverse_length.split_at(xs);
+        let (id_x, id_y) = rows.inverse_dual_length.split_at(xs);
+        let metric_y = il_y.chunks_exact(n).zip(id_y.chunks_exact(n));
+        let metric_x = il_x.chunks_exact(w).zip(id_x.chunks_exact(w));
+        let mut x_rows = p_x.chunks_exact_mut(w).zip(metric_x);
+        let [va, vb] = &mut window.vertex;
+        let (mut z, mut z_next) = (&mut va[..w], &mut vb[..w]);
+        let [ca, cb] = &mut window.cell;
+        let (mut from, mut into) = (&mut ca[..w + 1], &mut cb[..w + 1]);
+        face.take_vertex_row(z, (u_x, u_y), 0);
+        face.take_cell_row(from, (u_x, u_y), 0);
+        for (y, (p, (il, id))) in p_y.chunks_exact_mut(n).zip(metric_y).enumerate() {
             if y < n {
-                window.take_vertex_row(face, u, y + 1);
+                face.take_vertex_row(z_next, (u_x, u_y), y + 1);
             }
-            window.take_cell_row(face, u, y + 1);
-            let (u_x, u_y) = u.split_at_mut(xs);
-            let (p_x, p_y) = y_prev.split_at_mut(xs);
-            let z = &window.vertex[y % 2];
-            let (from, into) = (&window.cell[y % 2], &window.cell[(y + 1) % 2]);
             // Y-edge (x, y): tail the vertex (x, y), head (x + 1, y); from cell (x, y − 1)
-            // (padded row y) into (x, y).
-            let metric = [&il[xs + y * n..][..n], &id[xs + y * n..][..n]];
-            let (u, p) = (&mut u_y[y * n..][..n], &mut p_y[y * n..][..n]);
-            self.row::<BLEND, KEEP>(u, p, [&z[1..], z], [&into[1..], &from[1..]], metric);
+            // (padded row y) into (x, y) (padded row y + 1: the halo row, or taken in the
+            // edges' loop).
             if y == n {
-                break;
+                face.take_cell_row(into, (u_x, u_y), y + 1);
             }
+            let (u, above) = u_y[y * n..].split_at_mut(n);
+            let (vertices, from_cells) = ([&z[1..], &*z], &from[1..]);
+            if y < n {
+                let sides = (&u_x[y * w..][..w], &above[..n]);
+                let (u, metric) = ((u, p), [il, id]);
+                self.y_row_taking_cells::<BLEND, KEEP>(
+                    face, u, vertices, from_cells, into, metric, sides, y,
+                );
+            } else {
+                self.row::<BLEND, KEEP>(u, p, vertices, [&into[1..], from_cells], [il, id]);
+            }
+            let Some((p, (il, id))) = x_rows.next() else {
+                break;
+            };
             // X-edge (i, y): tail the vertex (i, y + 1), head (i, y); from cell (i − 1, y)
             // into (i, y) (padded row y + 1).
-            let tail = &window.vertex[(y + 1) % 2];
-            let metric = [&il[y * w..][..w], &id[y * w..][..w]];
-            let (u, p) = (&mut u_x[y * w..][..w], &mut p_x[y * w..][..w]);
-            self.row::<BLEND, KEEP>(u, p, [z, tail], [&into[1..], into], metric);
+            let u = &mut u_x[y * w..][..w];
+            self.x_row::<BLEND, KEEP>(u, p, [z, z_next], into, [il, id]);
+            (z, z_next) = (z_next, z);
+            (from, into) = (into, from);
         }
+    }
+
+    /// Y-edge row `y < n` (`u` and `y_prev`) as [`Self::row`] takes it, and in the same
+    /// loop padded cell row `y + 1` into `into` as [`Face::take_cell_row`] takes it, from
+    /// its cells' sides: the edges (their bottoms, read before they move), X-edge row `y`
+    /// and Y-edge row `y + 1` (`sides`). One loop where two each loaded the edges and
+    /// cost a row's set-up.
+    #[allow(clippy::too_many_arguments)] // the row's slices, each its own (see `row`)
+    #[inline(always)]
+    fn y_row_taking_cells<const BLEND: bool, const KEEP: bool>(
+        self,
+        face: Face,
+        (u, y_prev): (&mut [f64], &mut [f64]),
+        vertices: [&[f64]; 2],
+        from: &[f64],
+        into: &mut [f64],
+        metric: [&[f64]; 2],
+        (ux, above): (&[f64], &[f64]),
+        y: usize,
+    ) {
+        let (n, w) = (u.len(), u.len() + 1);
+        let [lx, ly] = face.length;
+        let (lx, ly) = (&lx[y * w..][..w], &ly[y * n..][..2 * n]);
+        let ls = [&ly[..n], &lx[..n], &lx[1..], &ly[n..]];
+        let border = &face.borders.1[(y + 1) * (w + 1)..][..w + 1];
+        (into[0], into[n + 1]) = (border[0], border[n + 1]);
+        let cells = (
+            [&ux[..n], &ux[1..], above],
+            ls,
+            &face.inverse_areas[y * n..][..n],
+        );
+        let out = &mut into[1..=n];
+        self.y_row_cells::<BLEND, KEEP>(u, y_prev, out, vertices, from, metric, cells);
+    }
+
+    /// The loop of [`Self::y_row_taking_cells`]: the cells' `out`, their `[left, right,
+    /// top]` sides' velocities, `[bottom, left, right, top]` lengths (the bottoms'
+    /// velocities are `u`'s) and inverse areas. The outputs are arguments of their own
+    /// (see [`Self::row`]; in a tuple, the compiler lost that they overlap nothing and
+    /// did not vectorise the loop).
+    #[allow(clippy::too_many_arguments)] // the outputs, each its own argument
+    #[inline(always)]
+    fn y_row_cells<const BLEND: bool, const KEEP: bool>(
+        self,
+        u: &mut [f64],
+        y_prev: &mut [f64],
+        out: &mut [f64],
+        [head, tail]: [&[f64]; 2],
+        from: &[f64],
+        [il, id]: [&[f64]; 2],
+        ([left, right, top], l, ia): ([&[f64]; 3], [&[f64]; 4], &[f64]),
+    ) {
+        let len = u.len();
+        let (y_prev, out, head, tail, from) = (
+            &mut y_prev[..len],
+            &mut out[..len],
+            &head[..len],
+            &tail[..len],
+            &from[..len],
+        );
+        let (il, id, ia) = (&il[..len], &id[..len], &ia[..len]);
+        let (left, right, top) = (&left[..len], &right[..len], &top[..len]);
+        let [lb, ll, lr, lt] = l.map(|l| &l[..len]);
+        for x in 0..len {
+            let b = u[x];
+            let d = 0.0 - b * lb[x] - left[x] * ll[x] + right[x] * lr[x] + top[x] * lt[x];
+            let into = d * ia[x];
+            out[x] = into;
+            let curl_curl = (head[x] - tail[x]) * il[x];
+            let grad_div = (into - from[x]) * id[x];
+            self.step::<BLEND, KEEP>(&mut u[x], &mut y_prev[x], curl_curl, grad_div);
+        }
+    }
+
+    /// A row of X-edges (`n + 1`) as [`Self::row`] takes them, from padded `cells`: the
+    /// first `n` in its loop (vectorised whole where `n` is a multiple of the vector's
+    /// width) and the last on its own, where the loop's scalar tail cost a row several
+    /// times as much.
+    #[inline(always)]
+    fn x_row<const BLEND: bool, const KEEP: bool>(
+        self,
+        u: &mut [f64],
+        y_prev: &mut [f64],
+        [head, tail]: [&[f64]; 2],
+        cells: &[f64],
+        [il, id]: [&[f64]; 2],
+    ) {
+        let n = u.len() - 1;
+        let (y_prev, head, tail, cells) =
+            (&mut y_prev[..=n], &head[..=n], &tail[..=n], &cells[..n + 2]);
+        let (il, id) = (&il[..=n], &id[..=n]);
+        let ([into, from], metric) = ([&cells[1..], cells], [il, id]);
+        self.row::<BLEND, KEEP>(
+            &mut u[..n],
+            &mut y_prev[..n],
+            [head, tail],
+            [into, from],
+            metric,
+        );
+        let curl_curl = (head[n] - tail[n]) * il[n];
+        let grad_div = (into[n] - from[n]) * id[n];
+        self.step::<BLEND, KEEP>(&mut u[n], &mut y_prev[n], curl_curl, grad_div);
     }
 
     /// A row of edges: the vorticities at their `[head, tail]`, the divergences of the
@@ -270,9 +392,92 @@ struct Face<'a> {
     rows: &'a FaceRows,
     /// Face 0's cells' inverse areas, per sr, which every face reads.
     inverse_areas: &'a [f64],
+    /// Face 0's edges' `[X-edge, Y-edge]` lengths ([`FaceRows::length`]), split once.
+    length: [&'a [f64]; 2],
+    /// Face 0's edges' `[X-edge, Y-edge]` dual lengths, split once.
+    dual_length: [&'a [f64]; 2],
     /// The face's vertices' vorticities and padded cells' divergences on its borders and
     /// halo ([`ViscousScratch::vorticity`], [`ViscousScratch::divergence`]).
     borders: (&'a [f64], &'a [f64]),
+}
+
+impl<'a> Face<'a> {
+    /// The face whose borders' fields are `borders`, with face 0's constants.
+    fn new(rows: &'a FaceRows, inverse_areas: &'a [f64], borders: (&'a [f64], &'a [f64])) -> Self {
+        let halves = |a: &'a [f64]| {
+            let (x, y) = a.split_at(rows.n * (rows.n + 1));
+            [x, y]
+        };
+        Face {
+            rows,
+            inverse_areas,
+            length: halves(&rows.length),
+            dual_length: halves(&rows.dual_length),
+            borders,
+        }
+    }
+
+    /// Vertex row `j` of the face (its local edges' `[X, Y]` halves `u`) into `out`
+    /// (`n + 1`): an inner row's circulation as
+    /// [`FaceRows::face_circulation_row`] sums it, its ends (on the face's borders) and
+    /// the border rows `0` and `n` from the face's border vorticities.
+    #[inline(always)]
+    fn take_vertex_row(self, out: &mut [f64], (ux, uy): (&[f64], &[f64]), j: usize) {
+        let (n, w) = (self.rows.n, self.rows.n + 1);
+        let border = &self.borders.0[j * w..][..w];
+        if j == 0 || j == n {
+            out.copy_from_slice(border);
+            return;
+        }
+        let [dx, dy] = self.dual_length;
+        // X-edge rows j − 1 (below) and j (above) at once; Y-edge row j and the edge
+        // before it (vertex 0's left, junk: the border's value replaces it).
+        let (ux, dx) = (&ux[(j - 1) * w..][..w + n], &dx[(j - 1) * w..][..w + n]);
+        let (uy, dy) = (&uy[j * n - 1..][..=n], &dy[j * n - 1..][..=n]);
+        let u = [&ux[..n], &uy[..n], &uy[1..], &ux[w..]];
+        let d = [&dx[..n], &dy[..n], &dy[1..], &dx[w..]];
+        let scale = &self.rows.vertex_inverse_area[j * w..][..n];
+        circulation_row(&mut out[..n], u, d, scale);
+        (out[0], out[n]) = (border[0], border[n]);
+    }
+
+    /// Padded cell row `p` of the face (its local edges' `[X, Y]` halves `u`) into `out`
+    /// (`n + 2`): cell row `p − 1`'s divergences, the halo at its ends and the halo rows
+    /// `0` and `n + 1` from the face's border divergences.
+    #[inline(always)]
+    fn take_cell_row(self, out: &mut [f64], (ux, uy): (&[f64], &[f64]), p: usize) {
+        let (n, w) = (self.rows.n, self.rows.n + 1);
+        let border = &self.borders.1[p * (w + 1)..][..w + 1];
+        if p == 0 || p == n + 1 {
+            out.copy_from_slice(border);
+            return;
+        }
+        let (y, [lx, ly]) = (p - 1, self.length);
+        // X-edge row y (the cells' left and right sides), Y-edge rows y and y + 1 (bottom
+        // and top) at once.
+        let (ux, lx) = (&ux[y * w..][..w], &lx[y * w..][..w]);
+        let (uy, ly) = (&uy[y * n..][..2 * n], &ly[y * n..][..2 * n]);
+        let u = [&uy[..n], &ux[..n], &ux[1..], &uy[n..]];
+        let l = [&ly[..n], &lx[..n], &lx[1..], &ly[n..]];
+        divergence_row(&mut out[1..=n], u, l, &self.inverse_areas[y * n..][..n]);
+        (out[0], out[n + 1]) = (border[0], border[n + 1]);
+    }
+}
+
+/// A row of vertices' circulations times `scale` into `out`, from their sides'
+/// velocities and dual lengths in the order `[below, left, right, above]`: the sum of
+/// [`FaceRows::face_circulation_row`], in the same order. `out` is an argument of its
+/// own, as in [`divergence_row`].
+#[inline(always)]
+fn circulation_row(out: &mut [f64], u: [&[f64]; 4], d: [&[f64]; 4], scale: &[f64]) {
+    let len = out.len();
+    let [ub, ul, ur, ua] = u.map(|u| &u[..len]);
+    let [db, dl, dr, da] = d.map(|d| &d[..len]);
+    let scale = &scale[..len];
+    for i in 0..len {
+        let z = 0.0 - ub[i] * db[i] + ul[i] * dl[i] - ur[i] * dr[i] + ua[i] * da[i];
+        out[i] = z * scale[i];
+    }
 }
 
 impl Window {
@@ -280,41 +485,6 @@ impl Window {
     fn prepare(&mut self, n: usize) {
         self.vertex.iter_mut().for_each(|r| r.resize(n + 1, 0.0));
         self.cell.iter_mut().for_each(|r| r.resize(n + 2, 0.0));
-    }
-
-    /// Vertex row `j` of the face (local edges `u`) into `vertex[j mod 2]`: an inner
-    /// row's circulation, its ends (on the face's borders) and the border rows `0` and
-    /// `n` from the face's border vorticities.
-    #[inline(always)]
-    fn take_vertex_row(&mut self, face: Face, u: &[f64], j: usize) {
-        let (rows, border) = (face.rows, face.borders.0);
-        let (n, w) = (rows.n, rows.n + 1);
-        let out = &mut self.vertex[j % 2];
-        let border = &border[j * w..][..w];
-        if j == 0 || j == n {
-            out.copy_from_slice(border);
-            return;
-        }
-        let scale = &rows.vertex_inverse_area[j * w..][..n];
-        rows.face_circulation_row(u, j, &mut out[..n], scale, |z, ia| z * ia);
-        (out[0], out[n]) = (border[0], border[n]);
-    }
-
-    /// Padded cell row `p` of the face (local edges `u`) into `cell[p mod 2]`: cell row
-    /// `p − 1`'s divergences, the halo at its ends and the halo rows `0` and `n + 1` from
-    /// the face's border divergences.
-    #[inline(always)]
-    fn take_cell_row(&mut self, face: Face, u: &[f64], p: usize) {
-        let (rows, border) = (face.rows, face.borders.1);
-        let (n, pw) = (rows.n, rows.n + 2);
-        let out = &mut self.cell[p % 2];
-        let border = &border[p * pw..][..pw];
-        if p == 0 || p == n + 1 {
-            out.copy_from_slice(border);
-            return;
-        }
-        divergence_cells(rows, u, face.inverse_areas, p - 1, 0, &mut out[1..=n]);
-        (out[0], out[n + 1]) = (border[0], border[n + 1]);
     }
 }
 
@@ -344,9 +514,7 @@ fn border_fields(grid: &CubeSphere, rows: &FaceRows, u: &[f64], v: &mut ViscousS
         for y in [0, n - 1] {
             divergence_cells(rows, u, ia, y, 0, &mut out[(y + 1) * pw + 1..][..n]);
         }
-        for x in [0, n - 1] {
-            divergence_column(rows, u, ia, x, out);
-        }
+        divergence_columns(rows, u, ia, out);
     }
     for &[slot, across] in &rows.cell_halo {
         divergence[slot as usize] = divergence[across as usize];
@@ -362,18 +530,29 @@ fn divergence_cells(rows: &FaceRows, u: &[f64], ia: &[f64], y: usize, x: usize, 
     divergence_row(out, sides(u, at), sides(&rows.length, at), &ia[y * n + x..]);
 }
 
-/// The divergences of cells `(x, 1..n − 1)` of a face (its local edges `u`) into its
-/// padded cells `out`, as [`divergence_row`] takes each (the same sum in the same order),
-/// with face 0's lengths and cells' inverse areas `ia`: a column of the face's border
-/// cells, where a call of [`divergence_cells`] a cell cost several times the sum.
+/// The divergences of the cells `(0, y)` and `(n − 1, y)`, `y` in `1..n − 1`, of a face
+/// (its local edges `u`) into its padded cells `out`, as [`divergence_row`] takes each
+/// (the same sum in the same order), with face 0's lengths and cells' inverse areas `ia`:
+/// the columns of the face's border cells, where a call of [`divergence_cells`] a cell
+/// cost several times the sum. Both columns a row at a time, the rows from iterators:
+/// indexing the arrays cost a cell as much again in bounds checks.
 #[inline(always)]
-fn divergence_column(rows: &FaceRows, u: &[f64], ia: &[f64], x: usize, out: &mut [f64]) {
-    let n = rows.n;
-    let ((ux, uy), (lx, ly)) = (u.split_at(n * (n + 1)), rows.length.split_at(n * (n + 1)));
-    for y in 1..n.saturating_sub(1) {
-        let (b, l, t) = (y * n + x, y * (n + 1) + x, (y + 1) * n + x);
-        let d = 0.0 - uy[b] * ly[b] - ux[l] * lx[l] + ux[l + 1] * lx[l + 1] + uy[t] * ly[t];
-        out[(y + 1) * (n + 2) + 1 + x] = d * ia[b];
+fn divergence_columns(rows: &FaceRows, u: &[f64], ia: &[f64], out: &mut [f64]) {
+    let (n, w) = (rows.n, rows.n + 1);
+    let ((ux, uy), (lx, ly)) = (u.split_at(n * w), rows.length.split_at(n * w));
+    // From cell row 1: its bottom and top Y-edge rows, its X-edge row, its padded row.
+    let bottom = uy[n..].chunks_exact(n).zip(ly[n..].chunks_exact(n));
+    let top = uy[2 * n..].chunks_exact(n).zip(ly[2 * n..].chunks_exact(n));
+    let sides = ux[w..].chunks_exact(w).zip(lx[w..].chunks_exact(w));
+    let cells = ia[n..]
+        .chunks_exact(n)
+        .zip(out[2 * (n + 2)..].chunks_exact_mut(n + 2));
+    let rows = bottom.zip(top).zip(sides).zip(cells);
+    for ((((ub, lb), (ut, lt)), (us, ls)), (ia, out)) in rows.take(n.saturating_sub(2)) {
+        for x in [0, n - 1] {
+            let d = 0.0 - ub[x] * lb[x] - us[x] * ls[x] + us[x + 1] * ls[x + 1] + ut[x] * lt[x];
+            out[1 + x] = d * ia[x];
+        }
     }
 }
 
