@@ -1199,6 +1199,13 @@ mod tests {
         field.values[p - shift]
     }
 
+    /// Edge weights of 10 to 22 in a pattern that repeats every 13 edges.
+    fn test_weights(grid: &CubeSphere) -> Vec<f64> {
+        (0..grid.edges().len())
+            .map(|e| 10.0 + (e % 13) as f64)
+            .collect()
+    }
+
     /// A mass term whose faces differ (`1 + c mod 7`), and one whose faces are alike
     /// (`1 + (c mod n²) mod 7`), on `n` cells a face.
     fn mass_terms(n: usize) -> [(Vec<f64>, bool); 2] {
@@ -1221,9 +1228,7 @@ mod tests {
         for n in [3, 6, 16] {
             let grid = CubeSphere::new(n);
             let h = Hierarchy::new(&grid);
-            let weight: Vec<f64> = (0..grid.edges().len())
-                .map(|e| 10.0 + (e % 13) as f64)
-                .collect();
+            let weight = test_weights(&grid);
             let mut work = Work::default();
             for (alpha, alike) in mass_terms(n) {
                 h.prepare(&mut work, &alpha, &weight);
@@ -1311,9 +1316,7 @@ mod tests {
             let grid = CubeSphere::new(n);
             let h = Hierarchy::new(&grid);
             let cells = grid.cells();
-            let weight: Vec<f64> = (0..grid.edges().len())
-                .map(|e| 10.0 + (e % 13) as f64)
-                .collect();
+            let weight = test_weights(&grid);
             let x: Vec<f64> = (0..cells).map(|c| ((c * 37) % 11) as f64 - 5.0).collect();
             let mut work = Work::default();
             h.prepare(&mut work, &alpha, &weight);
@@ -1345,9 +1348,7 @@ mod tests {
             let grid = CubeSphere::new(n);
             let h = Hierarchy::new(&grid);
             let cells = grid.cells();
-            let weight: Vec<f64> = (0..grid.edges().len())
-                .map(|e| 10.0 + (e % 13) as f64)
-                .collect();
+            let weight = test_weights(&grid);
             let alpha: Vec<f64> = (0..cells).map(|c| 1.0 + (c % 5) as f64).collect();
             let field = |k: usize| -> Vec<f64> {
                 (0..cells)
