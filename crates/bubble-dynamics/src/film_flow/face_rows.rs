@@ -299,30 +299,37 @@ impl FaceRows {
 
     /// `u += gravity` on every local edge ([`Self::add_gradient`]).
     pub(crate) fn add_gravity(&self, u: &mut [f64], gravity: &Gravity) {
-        let epf = self.edges_per_face();
-        with_avx2(
+        self.add_by_face(
+            u,
             #[inline(always)]
-            || {
-                for (f, u) in u.chunks_exact_mut(epf).enumerate() {
-                    gravity.add(f, 0, u);
-                }
-            },
+            |f, u| gravity.add(f, 0, u),
         );
-        self.match_seam_copies(u);
     }
 
     /// [`Self::add_gravity`] of gravity along the faces' axes ([`Gravity::along_axes`]):
     /// the same bits.
     pub(crate) fn add_axis_gravity(&self, u: &mut [f64], gravity: &AxisGravity) {
+        self.add_by_face(
+            u,
+            #[inline(always)]
+            |f, u| {
+                let (dt, g, c) = gravity.row(f, 0, u.len());
+                add_term(dt, g, c, u);
+            },
+        );
+    }
+
+    /// `add(f, edges)` on each face's local edges, compiled for AVX2 where the processor
+    /// has it; then each border edge's second copy made its first's
+    /// ([`Self::match_seam_copies`]).
+    #[inline(always)]
+    fn add_by_face(&self, u: &mut [f64], add: impl Fn(usize, &mut [f64])) {
         let epf = self.edges_per_face();
         with_avx2(
             #[inline(always)]
             || {
                 for (f, u) in u.chunks_exact_mut(epf).enumerate() {
-                    let (dt, g, c) = gravity.row(f, 0, epf);
-                    for i in 0..epf {
-                        u[i] += dt * (g * c[i]);
-                    }
+                    add(f, u);
                 }
             },
         );
@@ -627,10 +634,7 @@ impl<'a> Gravity<'a> {
     pub(crate) fn add(&self, f: usize, from: usize, u: &mut [f64]) {
         let (dt, len) = (self.dt_s, u.len());
         if let Some((gk, ck)) = self.one_term(f) {
-            let ck = &ck[from..from + len];
-            for i in 0..len {
-                u[i] += dt * (gk * ck[i]);
-            }
+            add_term(dt, gk, &ck[from..from + len], u);
             return;
         }
         let [ga, gb, gc] = self.along[f];
@@ -669,6 +673,16 @@ impl<'a> Gravity<'a> {
                 .try_into()
                 .ok()?,
         })
+    }
+}
+
+/// `u[i] += dt·(g·c[i])`: one axis's gravity term on a row of edges, the arithmetic
+/// every pass that adds it keeps (so that they give the same bits).
+#[inline(always)]
+fn add_term(dt_s: f64, g: f64, c: &[f64], u: &mut [f64]) {
+    let c = &c[..u.len()];
+    for i in 0..u.len() {
+        u[i] += dt_s * (g * c[i]);
     }
 }
 
