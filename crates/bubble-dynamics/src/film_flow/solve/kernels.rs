@@ -231,15 +231,14 @@ pub(super) fn residuals_in_place<T: Real>(
         mass.per_face,
         #[inline(always)]
         |face, start, len| {
-            for c in 0..2 {
-                let at = (face, start, len);
-                if let Some(x) = x_b {
+            let at = (face, start, len);
+            if let Some(x) = x_b {
+                for c in 0..2 {
                     operator_run::<T, true, false>(layout, c, at, (mass, w, &*a), x, b_out);
                 }
             }
-            for c in 0..2 {
-                let at = (face, start, len);
-                if let Some(x) = x_a {
+            if let Some(x) = x_a {
+                for c in 0..2 {
                     operator_run::<T, true, true>(layout, c, at, (mass, w, &[]), x, a);
                 }
             }
