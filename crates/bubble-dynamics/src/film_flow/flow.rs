@@ -695,24 +695,30 @@ impl AirShearAlong<'_> {
     }
 }
 
+/// A film of 20 µm ± 30 % under `params` on a grid of n = 12 (rows of ten inside cells:
+/// vector chunks and odd ends, the rim, the seams), the tests' common start.
+#[cfg(test)]
+pub(super) fn test_film(params: FlowParams) -> FilmFlow {
+    let grid = std::sync::Arc::new(CubeSphere::new(12));
+    let hierarchy = std::sync::Arc::new(Hierarchy::new(&grid));
+    FilmFlow::new(grid, hierarchy, params, |d| {
+        20e-6 * (1.0 + 0.3 * (4.0 * d.x + d.y).sin())
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// A warmed, draining, evaporating film turning in a wind, at n = 12 (rows of ten
-    /// inside cells: vector chunks and odd ends, the rim, the seams).
+    /// A warmed, draining, evaporating film turning in a wind ([`test_film`]).
     fn film() -> FilmFlow {
-        let grid = std::sync::Arc::new(CubeSphere::new(12));
-        let hierarchy = std::sync::Arc::new(Hierarchy::new(&grid));
         let mut params = FlowParams {
             drainage_viscosity_pa_s: 1e-6,
             evaporation_nm_per_s: 40.0,
             ..FlowParams::water_film(0.05)
         };
         params.thermal.bottom_warming_k = 5.0;
-        let mut f = FilmFlow::new(grid, hierarchy, params, |d| {
-            20e-6 * (1.0 + 0.3 * (4.0 * d.x + d.y).sin())
-        });
+        let mut f = test_film(params);
         f.set_velocity(|d| DVec3::Y.cross(d) * 0.05);
         f.set_surfactant(|d| 1.0 + 0.1 * d.z);
         f

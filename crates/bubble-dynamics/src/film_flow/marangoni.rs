@@ -672,20 +672,13 @@ fn upwind_fluxes_block(
 mod tests {
     use super::*;
     use crate::DVec3;
-    use crate::film_flow::flow::{FlowParams, Forcing};
-    use crate::film_flow::solve::Hierarchy;
+    use crate::film_flow::flow::{FlowParams, Forcing, test_film};
 
-    /// A draining film turning in a wind at n = 12 (rows of ten inside cells: vector
-    /// chunks and odd ends, the rim, the seams), a few steps in.
+    /// A draining film turning in a wind ([`test_film`]), a few steps in.
     fn film() -> FilmFlow {
-        let grid = std::sync::Arc::new(CubeSphere::new(12));
-        let hierarchy = std::sync::Arc::new(Hierarchy::new(&grid));
-        let params = FlowParams {
+        let mut f = test_film(FlowParams {
             drainage_viscosity_pa_s: 1e-6,
             ..FlowParams::water_film(0.05)
-        };
-        let mut f = FilmFlow::new(grid, hierarchy, params, |d| {
-            20e-6 * (1.0 + 0.3 * (4.0 * d.x + d.y).sin())
         });
         f.set_velocity(|d| DVec3::Y.cross(d) * 0.05);
         f.set_surfactant(|d| 1.0 + 0.1 * d.z);

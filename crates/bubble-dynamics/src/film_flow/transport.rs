@@ -198,21 +198,18 @@ pub(crate) fn edge_speed(u: f64, c: f64, ha: f64, hb: f64, per_area: f64) -> f64
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::film_flow::{CubeSphere, FlowParams, Hierarchy};
+    use crate::film_flow::FlowParams;
+    use crate::film_flow::flow::test_film;
 
     /// A film whose Courant number asks for several sub-steps takes them all from the
     /// thickness it started from: the speculative single sub-step's is put back.
     #[test]
     fn a_fast_film_takes_its_sub_steps_from_its_starting_thickness() {
-        let grid = std::sync::Arc::new(CubeSphere::new(12));
-        let hierarchy = std::sync::Arc::new(Hierarchy::new(&grid));
         let params = FlowParams {
             drainage_viscosity_pa_s: 1e-6,
             ..FlowParams::water_film(0.05)
         };
-        let mut film = FilmFlow::new(grid, hierarchy, params, |d| {
-            20e-6 * (1.0 + 0.3 * (4.0 * d.x + d.y).sin())
-        });
+        let mut film = test_film(params);
         film.set_velocity(|d| DVec3::Y.cross(d) * 3.0);
         let (dt_s, g_eff) = (1.0 / 60.0, DVec3::new(0.0, -9.81, 0.0));
         let drain = Drain {
