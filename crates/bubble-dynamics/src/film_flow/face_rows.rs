@@ -244,9 +244,15 @@ impl FaceRows {
 
     /// The rows' edge values back into the grid's numbering and orientation (a border
     /// edge's two copies agree: its first is taken), the faces in reverse order
-    /// ([`face_order`]: the viscous step's last stage ends at face 5).
+    /// ([`face_order`]).
     pub(crate) fn to_grid(&self, rows: &[f64], grid: &mut [f64]) {
-        self.for_each_inner_run(face_order(true), |local, at| {
+        self.to_grid_in(rows, grid, true);
+    }
+
+    /// [`Self::to_grid`], the faces in reverse order where `reverse` (so that it starts
+    /// on the faces the pass before ended on, [`face_order`]).
+    pub(crate) fn to_grid_in(&self, rows: &[f64], grid: &mut [f64], reverse: bool) {
+        self.for_each_inner_run(face_order(reverse), |local, at| {
             grid[at..at + local.len()].copy_from_slice(&rows[local]);
         });
         for e in &self.seam_edges {

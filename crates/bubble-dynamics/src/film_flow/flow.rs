@@ -440,8 +440,13 @@ impl FilmFlow {
             along.as_ref(),
             &mut s.advect,
         );
+        // Whether the last pass over the rows ended on face 5 ([`face_order`]), where the
+        // next should start: the advection's last stage ends on face 0, a gravity pass of
+        // its own (or the rows taken anew after the thermal stress) on face 5.
+        let mut after_face_5 = false;
         if let (Some(gravity), None) = (&gravity, &along) {
             self.rows.add_gravity(u, gravity);
+            after_face_5 = true;
         }
         match self.params.gradient {
             FilmGradient::TwoPoint => {
@@ -449,15 +454,17 @@ impl FilmFlow {
                     self.rows.to_grid(u, &mut self.u_m_per_s);
                     self.thermal_stress(dt_s, &mut s.vertex);
                     self.rows.to_rows(&self.u_m_per_s, u);
+                    after_face_5 = true;
                 }
                 if nu > 0.0 {
-                    self.viscous_step(u, &mut s.viscous, nu, dt_s);
+                    let ended_on_face_0 =
+                        self.viscous_step(u, &mut s.viscous, nu, dt_s, after_face_5);
                     // Into the viscous stage buffer, whose lines its last stage read (L2 has
                     // many still), which then holds the grid's velocities; the grid's old
                     // buffer is the next step's stage buffer.
                     let out = &mut s.viscous.stage;
                     out.truncate(self.u_m_per_s.len());
-                    self.rows.to_grid(u, out);
+                    self.rows.to_grid_in(u, out, !ended_on_face_0);
                     std::mem::swap(out, &mut self.u_m_per_s);
                 } else {
                     self.rows.to_grid(u, &mut self.u_m_per_s);
@@ -465,7 +472,7 @@ impl FilmFlow {
             }
             FilmGradient::Normal => {
                 if nu > 0.0 {
-                    self.viscous_step(u, &mut s.viscous, nu, dt_s);
+                    self.viscous_step(u, &mut s.viscous, nu, dt_s, after_face_5);
                 }
                 // Gravity as the normal gradient of the cells' g·x, after the viscous
                 // stress: that gradient has a grid-scale circulation where grid lines are askew,

@@ -52,7 +52,11 @@ struct Window {
 
 impl FilmFlow {
     /// `u ← u + ∫ viscous dt` over `dt_s` for kinematic viscosity `nu_m2_per_s`, on the
-    /// edge velocities `u` in the face rows ([`FaceRows`]).
+    /// edge velocities `u` in the face rows ([`FaceRows`]). The stages' faces go in
+    /// alternate directions, the first in reverse where `first_reverse` ([`face_order`]:
+    /// each stage starts on the faces the pass before ended on, so the first's reverse
+    /// where that pass ended on face 5); it gives the last's direction (`true`: reverse,
+    /// ending on face 0).
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     pub(super) fn viscous_step(
         &self,
@@ -60,7 +64,8 @@ impl FilmFlow {
         v: &mut ViscousScratch,
         nu_m2_per_s: f64,
         dt_s: f64,
-    ) {
+        first_reverse: bool,
+    ) -> bool {
         let r = self.params.radius_m;
         let rate = self.viscous_bound * nu_m2_per_s / (r * r);
         let stages = legendre_stages((dt_s * rate / EULER_RATE_LIMIT).ceil().max(1.0));
@@ -72,14 +77,12 @@ impl FilmFlow {
         with_avx2(
             #[inline(always)]
             || {
-                // The stages' faces in alternate directions, the first in reverse
-                // ([`face_order`]: the gravity's pass before ends at face 5).
-                let order = (stages == 1, true);
+                let order = (stages == 1, first_reverse);
                 self.viscous_stage(u, v, nu_m2_per_s, w1 * dt_s, (1.0, 0.0), order);
                 for j in 2..=stages {
                     // Yⱼ = μⱼ Yⱼ₋₁ + νⱼ Yⱼ₋₂ + μⱼ w₁ dt M(Yⱼ₋₁), μⱼ = (2j − 1)/j,
                     // νⱼ = (1 − j)/j.
-                    let order = (j == stages, j % 2 == 1);
+                    let order = (j == stages, (j % 2 == 1) == first_reverse);
                     let j = f64::from(j);
                     let mu = (2.0 * j - 1.0) / j;
                     let weights = (mu, (1.0 - j) / j);
@@ -87,6 +90,7 @@ impl FilmFlow {
                 }
             },
         );
+        (stages % 2 == 1) == first_reverse
     }
 
     /// One stage on the rows: `u ← mu·u + nu_prev·stage + dt_s·M(u)` with the stage
@@ -167,9 +171,10 @@ struct Blend {
 impl Blend {
     /// One edge: the stage before last `y_prev` read where `BLEND` (else the stage, the
     /// first, is a plain forward-Euler step), and replaced by the edge's `u` on entry where
-    /// `KEEP` (a stage follows).
+    /// `KEEP` (a stage follows). Where `INTO` (the last stage, not `KEEP`), the new value
+    /// goes to `y_prev`, `u` left as it is ([`FilmFlow::viscous_step_to_grid`]).
     #[inline(always)]
-    fn step<const BLEND: bool, const KEEP: bool>(
+    fn step<const BLEND: bool, const KEEP: bool, const INTO: bool>(
         self,
         u: &mut f64,
         y_prev: &mut f64,
@@ -178,11 +183,16 @@ impl Blend {
     ) {
         let y = *u;
         let change = self.rate * (4.0 * grad_div - curl_curl + 2.0 * y);
-        *u = if BLEND {
+        let new = if BLEND {
             self.mu * y + self.nu_prev * *y_prev + change
         } else {
             y + change
         };
+        if INTO {
+            *y_prev = new;
+            return;
+        }
+        *u = new;
         if KEEP {
             *y_prev = y;
         }
@@ -241,11 +251,11 @@ impl Blend {
             if y < n {
                 let sides = (&u_x[y * w..][..w], &above[..n]);
                 let (u, metric) = ((u, p), [il, id]);
-                self.y_row_taking_cells::<BLEND, KEEP>(
+                self.y_row_taking_cells::<BLEND, KEEP, false>(
                     face, u, vertices, from_cells, into, metric, sides, y,
                 );
             } else {
-                self.row::<BLEND, KEEP>(u, p, vertices, [&into[1..], from_cells], [il, id]);
+                self.row::<BLEND, KEEP, false>(u, p, vertices, [&into[1..], from_cells], [il, id]);
             }
             let Some((p, (il, id))) = x_rows.next() else {
                 break;
@@ -266,7 +276,7 @@ impl Blend {
     /// cost a row's set-up.
     #[allow(clippy::too_many_arguments)] // the row's slices, each its own (see `row`)
     #[inline(always)]
-    fn y_row_taking_cells<const BLEND: bool, const KEEP: bool>(
+    fn y_row_taking_cells<const BLEND: bool, const KEEP: bool, const INTO: bool>(
         self,
         face: Face,
         (u, y_prev): (&mut [f64], &mut [f64]),
@@ -289,7 +299,7 @@ impl Blend {
             &face.inverse_areas[y * n..][..n],
         );
         let out = &mut into[1..=n];
-        self.y_row_cells::<BLEND, KEEP>(u, y_prev, out, vertices, from, metric, cells);
+        self.y_row_cells::<BLEND, KEEP, INTO>(u, y_prev, out, vertices, from, metric, cells);
     }
 
     /// The loop of [`Self::y_row_taking_cells`]: the cells' `out`, their `[left, right,
@@ -299,7 +309,7 @@ impl Blend {
     /// did not vectorise the loop).
     #[allow(clippy::too_many_arguments)] // the outputs, each its own argument
     #[inline(always)]
-    fn y_row_cells<const BLEND: bool, const KEEP: bool>(
+    fn y_row_cells<const BLEND: bool, const KEEP: bool, const INTO: bool>(
         self,
         u: &mut [f64],
         y_prev: &mut [f64],
@@ -327,7 +337,7 @@ impl Blend {
             out[x] = into;
             let curl_curl = (head[x] - tail[x]) * il[x];
             let grad_div = (into - from[x]) * id[x];
-            self.step::<BLEND, KEEP>(&mut u[x], &mut y_prev[x], curl_curl, grad_div);
+            self.step::<BLEND, KEEP, INTO>(&mut u[x], &mut y_prev[x], curl_curl, grad_div);
         }
     }
 
@@ -349,7 +359,7 @@ impl Blend {
             (&mut y_prev[..=n], &head[..=n], &tail[..=n], &cells[..n + 2]);
         let (il, id) = (&il[..=n], &id[..=n]);
         let ([into, from], metric) = ([&cells[1..], cells], [il, id]);
-        self.row::<BLEND, KEEP>(
+        self.row::<BLEND, KEEP, false>(
             &mut u[..n],
             &mut y_prev[..n],
             [head, tail],
@@ -358,7 +368,7 @@ impl Blend {
         );
         let curl_curl = (head[n] - tail[n]) * il[n];
         let grad_div = (into[n] - from[n]) * id[n];
-        self.step::<BLEND, KEEP>(&mut u[n], &mut y_prev[n], curl_curl, grad_div);
+        self.step::<BLEND, KEEP, false>(&mut u[n], &mut y_prev[n], curl_curl, grad_div);
     }
 
     /// A row of edges: the vorticities at their `[head, tail]`, the divergences of the
@@ -366,7 +376,7 @@ impl Blend {
     /// argument of its own: the compiler then knows the outputs overlap no input, where
     /// slices of the scratch's vectors cost it a run-time test of each pair every row.
     #[inline(always)]
-    fn row<const BLEND: bool, const KEEP: bool>(
+    fn row<const BLEND: bool, const KEEP: bool, const INTO: bool>(
         self,
         u: &mut [f64],
         y_prev: &mut [f64],
@@ -381,7 +391,7 @@ impl Blend {
         for i in 0..len {
             let curl_curl = (head[i] - tail[i]) * il[i];
             let grad_div = (into[i] - from[i]) * id[i];
-            self.step::<BLEND, KEEP>(&mut u[i], &mut y_prev[i], curl_curl, grad_div);
+            self.step::<BLEND, KEEP, INTO>(&mut u[i], &mut y_prev[i], curl_curl, grad_div);
         }
     }
 }
@@ -787,7 +797,7 @@ mod tests {
             let (mut u, mut start) = (Vec::new(), Vec::new());
             f.rows.to_rows(&rough, &mut u);
             f.rows.to_rows(&rough, &mut start);
-            f.viscous_step(&mut u, &mut ViscousScratch::default(), nu, 0.05);
+            f.viscous_step(&mut u, &mut ViscousScratch::default(), nu, 0.05, true);
             assert_ne!(u, start, "n {n}: nothing moved");
             for e in &f.rows.seam_edges {
                 let [a, b] = e.cells.map(|(_, _, k)| k as usize);
@@ -833,7 +843,9 @@ mod tests {
         on_rows(&mut f, &mut euler_steps);
         let euler = std::mem::replace(&mut f.u_m_per_s, smooth.clone());
         let mut s = ViscousScratch::default();
-        on_rows(&mut f, &mut |f, u| f.viscous_step(u, &mut s, nu, dt));
+        on_rows(&mut f, &mut |f, u| {
+            f.viscous_step(u, &mut s, nu, dt, true);
+        });
         // The vortex's decay over the step, by each: first order in time alike, they
         // differ by about dt·λ/4 of it (λ the vortex's rate, dt·λ 0.05 here).
         let decay = |u: &[f64]| {
@@ -855,7 +867,9 @@ mod tests {
         }
         let before = energy(&f);
         let long = step_of(&f, nu, 149.5);
-        on_rows(&mut f, &mut |f, u| f.viscous_step(u, &mut s, nu, long));
+        on_rows(&mut f, &mut |f, u| {
+            f.viscous_step(u, &mut s, nu, long, true);
+        });
         let after = energy(&f);
         assert!(after < before, "energy {before:e} → {after:e}");
     }
