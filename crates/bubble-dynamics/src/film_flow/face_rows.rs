@@ -4,7 +4,8 @@
 //! arrays.
 //!
 //! The edge velocities are copied into the rows at the start of the explicit momentum
-//! step and back at its end ([`FaceRows::to_rows`], [`FaceRows::to_grid`]). An edge on a face's border is in
+//! step and back at its end ([`FaceRows::to_rows`], [`FaceRows::to_grid`]; the viscous
+//! step's last stage writes the grid's numbering itself, where it runs). An edge on a face's border is in
 //! both its faces' rows, a copy each with its own orientation; every quantity of an edge
 //! is kept in that copy's orientation, so a copy is the grid's value or its negation,
 //! exactly (IEEE negation commutes with every rounding the passes do), and the two copies
@@ -246,13 +247,7 @@ impl FaceRows {
     /// edge's two copies agree: its first is taken), the faces in reverse order
     /// ([`face_order`]).
     pub(crate) fn to_grid(&self, rows: &[f64], grid: &mut [f64]) {
-        self.to_grid_in(rows, grid, true);
-    }
-
-    /// [`Self::to_grid`], the faces in reverse order where `reverse` (so that it starts
-    /// on the faces the pass before ended on, [`face_order`]).
-    pub(crate) fn to_grid_in(&self, rows: &[f64], grid: &mut [f64], reverse: bool) {
-        self.for_each_inner_run(face_order(reverse), |local, at| {
+        self.for_each_inner_run(face_order(true), |local, at| {
             grid[at..at + local.len()].copy_from_slice(&rows[local]);
         });
         for e in &self.seam_edges {

@@ -456,17 +456,18 @@ impl FilmFlow {
                     self.rows.to_rows(&self.u_m_per_s, u);
                     after_face_5 = true;
                 }
-                if nu > 0.0 {
-                    let ended_on_face_0 =
-                        self.viscous_step(u, &mut s.viscous, nu, dt_s, after_face_5);
-                    // Into the viscous stage buffer, whose lines its last stage read (L2 has
-                    // many still), which then holds the grid's velocities; the grid's old
-                    // buffer is the next step's stage buffer.
-                    let out = &mut s.viscous.stage;
-                    out.truncate(self.u_m_per_s.len());
-                    self.rows.to_grid_in(u, out, !ended_on_face_0);
-                    std::mem::swap(out, &mut self.u_m_per_s);
+                // (A grid of one cell a face has no inner edges to keep in the grid's
+                // numbering.)
+                if nu > 0.0 && self.rows.n >= 2 {
+                    // Into the viscous stage buffer, in the grid's numbering, which then
+                    // holds the grid's velocities; the grid's old buffer is the next step's
+                    // stage buffer.
+                    self.viscous_step_to_grid(u, &mut s.viscous, nu, dt_s, after_face_5);
+                    std::mem::swap(&mut s.viscous.stage, &mut self.u_m_per_s);
                 } else {
+                    if nu > 0.0 {
+                        self.viscous_step(u, &mut s.viscous, nu, dt_s, after_face_5);
+                    }
                     self.rows.to_grid(u, &mut self.u_m_per_s);
                 }
             }

@@ -10,7 +10,7 @@
 
 use crate::avx2::with_avx2;
 
-use super::face_rows::{FaceRows, face_order};
+use super::face_rows::{FaceRows, SeamEdge, Side, face_order};
 use super::flow::FilmFlow;
 use super::grid::CubeSphere;
 
@@ -21,9 +21,10 @@ const EULER_RATE_LIMIT: f64 = 1.5;
 /// Buffers of the viscous step, reused across steps.
 #[derive(Clone, Debug, Default)]
 pub(super) struct ViscousScratch {
-    /// The stage before the one under way, in the face rows ([`FaceRows`]), m/s. Between
-    /// steps, a buffer of the grid's (`FilmFlow::momentum_explicit` copies the rows back
-    /// into it and swaps it with the grid's velocities' buffer).
+    /// The stage before the one under way, in the face rows ([`FaceRows`]), or in the
+    /// grid's numbering (its inner edges, [`FilmFlow::viscous_step_to_grid`], whose last
+    /// stage leaves the grid's velocities here), m/s. Between steps, a buffer of the
+    /// grid's (`FilmFlow::momentum_explicit` swaps it with the grid's velocities' buffer).
     pub(super) stage: Vec<f64>,
     /// Per local vertex: the vorticity on the unit sphere (m/s per rad), of the vertices
     /// on the faces' borders only (every copy); the inner ones are taken row by row into
@@ -35,6 +36,15 @@ pub(super) struct ViscousScratch {
     divergence: Vec<f64>,
     /// The rows of vertices and cells a face's edge rows read ([`Window`]).
     window: Window,
+    /// Per face, per border of it (its left and right X-edge columns, its bottom and top
+    /// Y-edge rows), along it: the value of the stage before last of that border's local
+    /// copies, where [`FilmFlow::viscous_step_to_grid`] keeps the inner edges' in
+    /// [`Self::stage`] in the grid's numbering (a copy's own slot: the other copy of its
+    /// edge may have moved).
+    border_prev: Vec<f64>,
+    /// Per edge on the faces' borders ([`FaceRows::seam_edges`]): its grid edge, its first
+    /// copy's slot in [`Self::border_prev`] and that copy's sign.
+    seam_slots: Vec<(u32, u32, f64)>,
 }
 
 /// The vorticity and divergence rows that one face's edge rows under way read: each
@@ -55,8 +65,7 @@ impl FilmFlow {
     /// edge velocities `u` in the face rows ([`FaceRows`]). The stages' faces go in
     /// alternate directions, the first in reverse where `first_reverse` ([`face_order`]:
     /// each stage starts on the faces the pass before ended on, so the first's reverse
-    /// where that pass ended on face 5); it gives the last's direction (`true`: reverse,
-    /// ending on face 0).
+    /// where that pass ended on face 5).
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     pub(super) fn viscous_step(
         &self,
@@ -65,32 +74,126 @@ impl FilmFlow {
         nu_m2_per_s: f64,
         dt_s: f64,
         first_reverse: bool,
-    ) -> bool {
-        let r = self.params.radius_m;
-        let rate = self.viscous_bound * nu_m2_per_s / (r * r);
-        let stages = legendre_stages((dt_s * rate / EULER_RATE_LIMIT).ceil().max(1.0));
-        let w1 = 2.0 / f64::from(stages * stages + stages);
-        // Y₁ = Y₀ + w₁ dt M(Y₀), with Y₀ = u. The first stage reads no stage before last
-        // (it only writes Y₀ there, where a stage follows), so `v.stage` needs its length,
-        // not a copy of u; a lone stage touches it not at all.
+    ) {
+        let (stages, w1) = self.legendre(nu_m2_per_s, dt_s);
+        // The first stage reads no stage before last (it only writes Y₀ there, where a
+        // stage follows), so `v.stage` needs its length, not a copy of u; a lone stage
+        // touches it not at all.
         v.stage.resize(u.len(), 0.0);
         with_avx2(
             #[inline(always)]
             || {
-                let order = (stages == 1, first_reverse);
-                self.viscous_stage(u, v, nu_m2_per_s, w1 * dt_s, (1.0, 0.0), order);
-                for j in 2..=stages {
-                    // Yⱼ = μⱼ Yⱼ₋₁ + νⱼ Yⱼ₋₂ + μⱼ w₁ dt M(Yⱼ₋₁), μⱼ = (2j − 1)/j,
-                    // νⱼ = (1 − j)/j.
-                    let order = (j == stages, (j % 2 == 1) == first_reverse);
-                    let j = f64::from(j);
-                    let mu = (2.0 * j - 1.0) / j;
-                    let weights = (mu, (1.0 - j) / j);
-                    self.viscous_stage(u, v, nu_m2_per_s, mu * w1 * dt_s, weights, order);
+                for j in 1..=stages {
+                    let (order, weights, dt) = stage_of(j, stages, (w1, dt_s), first_reverse);
+                    self.viscous_stage(u, v, nu_m2_per_s, dt, weights, order);
                 }
             },
         );
-        (stages % 2 == 1) == first_reverse
+    }
+
+    /// [`Self::viscous_step`], its result left in `v.stage` in the grid's numbering and
+    /// orientation ([`FaceRows::to_grid`] of it: the same bits), `u` then junk. The stages
+    /// keep the stage before last in `v.stage` in the grid's numbering (the copies on the
+    /// faces' borders in [`ViscousScratch::border_prev`]), and the last writes each edge
+    /// there in place of it: the pass that copied the rows back (0.4 MB read and written
+    /// at n = 64) is spared. For grids of at least 2 cells a face.
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
+    pub(super) fn viscous_step_to_grid(
+        &self,
+        u: &mut [f64],
+        v: &mut ViscousScratch,
+        nu_m2_per_s: f64,
+        dt_s: f64,
+        first_reverse: bool,
+    ) {
+        let rows = &self.rows;
+        let n = rows.n;
+        // Every entry is written (the inner edges by the faces' rows, the seams below).
+        v.stage.resize(self.grid.edges().len(), 0.0);
+        v.border_prev.resize(6 * 4 * n, 0.0);
+        if v.seam_slots.len() != rows.seam_edges.len() {
+            v.seam_slots = seam_slots(rows);
+        }
+        let (stages, w1) = self.legendre(nu_m2_per_s, dt_s);
+        with_avx2(
+            #[inline(always)]
+            || {
+                for j in 1..=stages {
+                    let (order, weights, dt) = stage_of(j, stages, (w1, dt_s), first_reverse);
+                    self.viscous_stage_grid(u, v, nu_m2_per_s, dt, weights, order);
+                }
+                for &(e, slot, sign) in &v.seam_slots {
+                    v.stage[e as usize] = v.border_prev[slot as usize] * sign;
+                }
+            },
+        );
+    }
+
+    /// The RKL1 stages for `nu_m2_per_s` over `dt_s`, and the first's weight `w₁`.
+    fn legendre(&self, nu_m2_per_s: f64, dt_s: f64) -> (u32, f64) {
+        let r = self.params.radius_m;
+        let rate = self.viscous_bound * nu_m2_per_s / (r * r);
+        let stages = legendre_stages((dt_s * rate / EULER_RATE_LIMIT).ceil().max(1.0));
+        (stages, 2.0 / f64::from(stages * stages + stages))
+    }
+
+    /// [`Self::viscous_stage`] with the stage before last in the grid's numbering
+    /// ([`Self::viscous_step_to_grid`]).
+    #[inline(always)]
+    fn viscous_stage_grid(
+        &self,
+        u: &mut [f64],
+        v: &mut ViscousScratch,
+        nu: f64,
+        dt_s: f64,
+        (mu, nu_prev): (f64, f64),
+        (last, reverse): (bool, bool),
+    ) {
+        let rows = &self.rows;
+        border_fields(&self.grid, rows, u, v);
+        let r = self.params.radius_m;
+        let blend = Blend {
+            rate: dt_s * nu / (r * r),
+            mu,
+            nu_prev,
+        };
+        let n = rows.n;
+        let (epf, vpf, cpf) = (
+            rows.edges_per_face(),
+            rows.vertices_per_face(),
+            rows.padded_cells_per_face(),
+        );
+        let ia = &self.grid.inverse_areas_per_sr()[..n * n];
+        let ViscousScratch {
+            stage,
+            vorticity,
+            divergence,
+            window,
+            border_prev,
+            ..
+        } = v;
+        window.prepare(n);
+        // The grid's inner X-edges, then its inner Y-edges, `m` a face (`FaceLayout`).
+        let m = n * (n - 1);
+        for f in face_order(reverse) {
+            let u = &mut u[f * epf..][..epf];
+            // The face's inner X-edges and the one edge after them, which its last row
+            // runs on through (`GridPrev::inner_x`), below its inner Y-edges.
+            let (x_part, y_part) = stage.split_at_mut(6 * m + f * m);
+            let prev = GridPrev {
+                inner_x: &mut x_part[f * m..][..=m],
+                inner_y: &mut y_part[..m],
+                border: &mut border_prev[f * 4 * n..][..4 * n],
+            };
+            let borders = (&vorticity[f * vpf..][..vpf], &divergence[f * cpf..][..cpf]);
+            let face = Face::new(rows, ia, borders);
+            match (nu_prev != 0.0, !last) {
+                (false, false) => blend.face_grid::<false, false, true>(face, u, prev, window),
+                (false, true) => blend.face_grid::<false, true, false>(face, u, prev, window),
+                (true, false) => blend.face_grid::<true, false, true>(face, u, prev, window),
+                (true, true) => blend.face_grid::<true, true, false>(face, u, prev, window),
+            }
+        }
     }
 
     /// One stage on the rows: `u ← mu·u + nu_prev·stage + dt_s·M(u)` with the stage
@@ -138,6 +241,7 @@ impl FilmFlow {
             vorticity,
             divergence,
             window,
+            ..
         } = v;
         window.prepare(n);
         // Each case its own loops: a test of the case per edge cost the reads and writes
@@ -267,6 +371,102 @@ impl Blend {
             (z, z_next) = (z_next, z);
             (from, into) = (into, from);
         }
+    }
+
+    /// [`Self::face`] with the stage before last in `prev` (the grid's numbering), which
+    /// the last stage (`INTO`) replaces with its values, `u` left as it is.
+    #[inline(always)]
+    fn face_grid<const BLEND: bool, const KEEP: bool, const INTO: bool>(
+        self,
+        face: Face,
+        u: &mut [f64],
+        prev: GridPrev,
+        window: &mut Window,
+    ) {
+        let rows = face.rows;
+        let (n, w, xs) = (rows.n, rows.n + 1, rows.n * (rows.n + 1));
+        let (u_x, u_y) = u.split_at_mut(xs);
+        let (left, border) = prev.border.split_at_mut(n);
+        let (right, border) = border.split_at_mut(n);
+        let (bottom, top) = border.split_at_mut(n);
+        let y_prev = std::iter::once(bottom)
+            .chain(prev.inner_y.chunks_exact_mut(n))
+            .chain(std::iter::once(top));
+        let (il_x, il_y) = rows.inverse_length.split_at(xs);
+        let (id_x, id_y) = rows.inverse_dual_length.split_at(xs);
+        let metric_y = il_y.chunks_exact(n).zip(id_y.chunks_exact(n));
+        let metric_x = il_x.chunks_exact(w).zip(id_x.chunks_exact(w));
+        let mut x_rows = left.iter_mut().zip(right.iter_mut()).zip(metric_x);
+        let inner_x = prev.inner_x;
+        let [va, vb] = &mut window.vertex;
+        let (mut z, mut z_next) = (&mut va[..w], &mut vb[..w]);
+        let [ca, cb] = &mut window.cell;
+        let (mut from, mut into) = (&mut ca[..w + 1], &mut cb[..w + 1]);
+        face.take_vertex_row(z, (u_x, u_y), 0);
+        face.take_cell_row(from, (u_x, u_y), 0);
+        for (y, (p, (il, id))) in y_prev.zip(metric_y).enumerate() {
+            if y < n {
+                face.take_vertex_row(z_next, (u_x, u_y), y + 1);
+            }
+            if y == n {
+                face.take_cell_row(into, (u_x, u_y), y + 1);
+            }
+            let (u, above) = u_y[y * n..].split_at_mut(n);
+            let (vertices, from_cells) = ([&z[1..], &*z], &from[1..]);
+            if y < n {
+                let sides = (&u_x[y * w..][..w], &above[..n]);
+                let (u, metric) = ((u, p), [il, id]);
+                self.y_row_taking_cells::<BLEND, KEEP, INTO>(
+                    face, u, vertices, from_cells, into, metric, sides, y,
+                );
+            } else {
+                let cells = [&into[1..], from_cells];
+                self.row::<BLEND, KEEP, INTO>(u, p, vertices, cells, [il, id]);
+            }
+            let Some(((l, r), (il, id))) = x_rows.next() else {
+                break;
+            };
+            let (u, p) = (&mut u_x[y * w..][..w], &mut inner_x[y * (n - 1)..][..n]);
+            self.x_row_grid::<BLEND, KEEP, INTO>(u, (l, p, r), [z, z_next], into, [il, id]);
+            (z, z_next) = (z_next, z);
+            (from, into) = (into, from);
+        }
+    }
+
+    /// [`Self::x_row`] with the stage before last of the row's left border copy, its
+    /// inner edges (the first `n − 1` of `inner`, in the grid's numbering) and its right
+    /// border copy apart. The inner edges' loop runs on through the right border copy, `n`
+    /// edges, which vectorise without the scalar tail of `n − 1`, its `inner` the grid's
+    /// next edge: that entry and the copy's `u` are put back after, and the copy is then
+    /// taken on its own.
+    #[inline(always)]
+    fn x_row_grid<const BLEND: bool, const KEEP: bool, const INTO: bool>(
+        self,
+        u: &mut [f64],
+        (left, inner, right): (&mut f64, &mut [f64], &mut f64),
+        [head, tail]: [&[f64]; 2],
+        cells: &[f64],
+        [il, id]: [&[f64]; 2],
+    ) {
+        let n = u.len() - 1;
+        let (head, tail, cells) = (&head[..=n], &tail[..=n], &cells[..n + 2]);
+        let (il, id, inner) = (&il[..=n], &id[..=n], &mut inner[..n]);
+        let [into, from] = [&cells[1..], cells];
+        let curl_curl = (head[0] - tail[0]) * il[0];
+        let grad_div = (into[0] - from[0]) * id[0];
+        self.step::<BLEND, KEEP, INTO>(&mut u[0], left, curl_curl, grad_div);
+        let kept = (u[n], inner[n - 1]);
+        self.row::<BLEND, KEEP, INTO>(
+            &mut u[1..],
+            inner,
+            [&head[1..], &tail[1..]],
+            [&into[1..=n], &from[1..=n]],
+            [&il[1..], &id[1..]],
+        );
+        (u[n], inner[n - 1]) = kept;
+        let curl_curl = (head[n] - tail[n]) * il[n];
+        let grad_div = (into[n] - from[n]) * id[n];
+        self.step::<BLEND, KEEP, INTO>(&mut u[n], right, curl_curl, grad_div);
     }
 
     /// Y-edge row `y < n` (`u` and `y_prev`) as [`Self::row`] takes it, and in the same
@@ -488,6 +688,63 @@ fn circulation_row(out: &mut [f64], u: [&[f64]; 4], d: [&[f64]; 4], scale: &[f64
         let z = 0.0 - ub[i] * db[i] + ul[i] * dl[i] - ur[i] * dr[i] + ua[i] * da[i];
         out[i] = z * scale[i];
     }
+}
+
+/// One face's stage before last, as [`FilmFlow::viscous_step_to_grid`] keeps it.
+struct GridPrev<'a> {
+    /// The grid's inner X-edges of the face, `n − 1` a row
+    /// ([`FaceLayout`](super::grid::FaceLayout)), and the grid's edge after them (the next
+    /// face's first, or the first inner Y-edge), which the last row runs on through
+    /// ([`Blend::x_row_grid`]).
+    inner_x: &'a mut [f64],
+    /// The grid's inner Y-edges of the face, rows `1..n`.
+    inner_y: &'a mut [f64],
+    /// The face's part of [`ViscousScratch::border_prev`]: its left and right X-edge
+    /// columns, its bottom and top Y-edge rows, `n` each.
+    border: &'a mut [f64],
+}
+
+/// RKL1 stage `j` of `stages` (from 1): its `(last, reverse)` (the faces' directions
+/// alternate, the first's `first_reverse`), its weights `(μⱼ, νⱼ)` and its step, from
+/// the first's weight `w₁` and the step `dt`. Y₁ = Y₀ + w₁ dt M(Y₀); Yⱼ = μⱼ Yⱼ₋₁ + νⱼ Yⱼ₋₂ + μⱼ w₁ dt M(Yⱼ₋₁),
+/// μⱼ = (2j − 1)/j, νⱼ = (1 − j)/j.
+fn stage_of(
+    j: u32,
+    stages: u32,
+    (w1, dt_s): (f64, f64),
+    first_reverse: bool,
+) -> ((bool, bool), (f64, f64), f64) {
+    let order = (j == stages, (j % 2 == 1) == first_reverse);
+    if j == 1 {
+        return (order, (1.0, 0.0), w1 * dt_s);
+    }
+    let j = f64::from(j);
+    let mu = (2.0 * j - 1.0) / j;
+    (order, (mu, (1.0 - j) / j), mu * w1 * dt_s)
+}
+
+/// [`ViscousScratch::seam_slots`] of `rows`.
+fn seam_slots(rows: &FaceRows) -> Vec<(u32, u32, f64)> {
+    let n = rows.n;
+    let slot = |c: usize, side: Side| {
+        let (f, x, y) = (c / (n * n), c % n, (c / n) % n);
+        let (border, along) = match side {
+            Side::Left => (0, y),
+            Side::Right => (1, y),
+            Side::Bottom => (2, x),
+            Side::Top => (3, x),
+        };
+        ((f * 4 + border) * n + along) as u32
+    };
+    let first = |e: &SeamEdge| {
+        let (c, side, k) = e.cells[0];
+        (
+            rows.edge[k as usize],
+            slot(c as usize, side),
+            rows.sign(k as usize),
+        )
+    };
+    rows.seam_edges.iter().map(first).collect()
 }
 
 impl Window {
@@ -781,6 +1038,45 @@ mod tests {
     /// Face 0's local Y-edge `(x, j)` of a grid of `n` cells a face, within the face.
     fn xs_y(n: usize, x: usize, j: usize) -> usize {
         n * (n + 1) + j * n + x
+    }
+
+    /// The stages that keep the stage before last in the grid's numbering, the last
+    /// writing there, give the grid's numbering of the stages on the rows, bit for bit:
+    /// 1, 2, 3 and 7 stages, the faces either way first, a rough field at n = 2, 5 and 16,
+    /// the stage buffer's entries junk from the start.
+    #[test]
+    fn the_stages_into_the_grid_are_the_stages_on_the_rows() {
+        for n in [2, 5, 16] {
+            let (f, nu) = viscous_film_of(n);
+            let edges = f.grid.edges().len();
+            let rough: Vec<f64> = (0..edges)
+                .map(|e| ((e * 7919) % 1000) as f64 * 1e-6 - 4e-4)
+                .collect();
+            let mut start = Vec::new();
+            f.rows.to_rows(&rough, &mut start);
+            for (substeps, first_reverse) in [1.0, 3.0, 6.0, 22.0]
+                .into_iter()
+                .flat_map(|s| [(s, false), (s, true)])
+            {
+                let dt = step_of(&f, nu, substeps);
+                let (mut u, mut v) = (start.clone(), ViscousScratch::default());
+                f.viscous_step(&mut u, &mut v, nu, dt, first_reverse);
+                let mut want = vec![0.0; edges];
+                f.rows.to_grid(&u, &mut want);
+                let mut v = ViscousScratch {
+                    stage: vec![f64::NAN; edges],
+                    ..ViscousScratch::default()
+                };
+                f.viscous_step_to_grid(&mut start.clone(), &mut v, nu, dt, first_reverse);
+                assert_ne!(want, rough, "n {n}: nothing moved");
+                let differ = want
+                    .iter()
+                    .zip(&v.stage)
+                    .filter(|(a, b)| a.to_bits() != b.to_bits());
+                let what = format!("n {n}, {substeps} sub-steps, first reverse {first_reverse}");
+                assert_eq!(differ.count(), 0, "{what}: edges differ");
+            }
+        }
     }
 
     /// The stages keep each edge on the faces' borders the same in both its copies (its
