@@ -40,7 +40,7 @@ use crate::avx2::{OTHERS, QUAD_WEIGHTS, coriolis_row, quad_starts, with_avx2};
 
 use super::compare::larger;
 use super::face_rows::{AxisGravity, FaceRows, SIDES, Side, face_order};
-use super::grid::{CubeSphere, FaceLayout};
+use super::grid::CubeSphere;
 
 /// Largest fraction of the narrowest dual edge the fastest cell may cross in a sub-step.
 /// SSP-RK3 damps (never amplifies) a rotation of `ω·sub_dt < √3`; the vorticity at the
@@ -501,7 +501,7 @@ enum Start<'a> {
     /// The edge's entry of these, in the face rows.
     Rows(&'a [f64]),
     /// These, in the grid's numbering and orientation ([`FaceRows::to_rows`] takes the
-    /// rows from them): an inner edge's a run of the grid's ([`FaceLayout`]), a copy on a
+    /// rows from them): an inner edge's a run of the grid's ([`FaceLayout`](super::grid::FaceLayout)), a copy on a
     /// face's border its grid edge's times its sign.
     Grid(&'a [f64]),
 }
@@ -519,16 +519,14 @@ impl<'a> Start<'a> {
         (f, y, x): (usize, usize, bool),
         k: std::ops::Range<usize>,
     ) -> Option<&'a [f64]> {
-        let n = rows.n;
         match self {
             Start::Dst => None,
             Start::Rows(u0) => Some(&u0[k]),
             Start::Grid(grid) => {
-                let layout = FaceLayout { n };
                 let at = if x {
-                    layout.x_edge_of_cell((f * n + y) * n + 1)
+                    rows.grid_x_run(f, y)
                 } else {
-                    layout.y_edge_of_cell((f * n + y) * n)
+                    rows.grid_y_run(f, y)
                 };
                 Some(&grid[at..at + k.len()])
             }

@@ -29,7 +29,7 @@ use glam::DVec3;
 use crate::avx2::with_avx2;
 
 use super::flow::FilmGradient;
-use super::grid::{CubeSphere, FACE_BASES, FaceLayout};
+use super::grid::{CubeSphere, FACE_BASES};
 
 /// Which side of a cell an edge is: bottom (`t` low), left (`s` low), right, top.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -229,7 +229,7 @@ impl FaceRows {
     }
 
     /// The grid's edge values `grid` (in the grid's orientation) into `rows` (each copy
-    /// in its own): each face's inner edges are runs of the grid's ([`FaceLayout`], checked
+    /// in its own): each face's inner edges are runs of the grid's ([`FaceLayout`](super::grid::FaceLayout), checked
     /// in [`Self::new`]), copied; the copies on the faces' borders one by one.
     pub(crate) fn to_rows(&self, grid: &[f64], rows: &mut Vec<f64>) {
         // Every entry is written: the buffer needs its length, not a fill.
@@ -259,7 +259,7 @@ impl FaceRows {
     /// `run(local, at)` for each run of inner local edges (a row of a face's X-edges, or
     /// a row of its Y-edges) and the grid edge its first is, face by face in the order
     /// `faces`: the grid numbers a face's inner edges in the same rows, unflipped
-    /// ([`FaceLayout`]). A row is under 2 KiB up to n = 256, which `memcpy` copies with
+    /// ([`FaceLayout`](super::grid::FaceLayout)). A row is under 2 KiB up to n = 256, which `memcpy` copies with
     /// vector moves (`rep movsb` above that).
     #[inline(always)]
     fn for_each_inner_run(
@@ -267,20 +267,37 @@ impl FaceRows {
         faces: impl Iterator<Item = usize>,
         mut run: impl FnMut(std::ops::Range<usize>, usize),
     ) {
-        let (n, layout) = (self.n, FaceLayout { n: self.n });
+        let n = self.n;
         if n < 2 {
             return; // no inner edges
         }
         for f in faces {
             for y in 0..n {
                 let k = self.x_edge(f, 1, y);
-                run(k..k + n - 1, layout.x_edge_of_cell(f * n * n + y * n + 1));
+                run(k..k + n - 1, self.grid_x_run(f, y));
             }
             for j in 1..n {
                 let k = self.y_edge(f, 0, j);
-                run(k..k + n, layout.y_edge_of_cell(f * n * n + j * n));
+                run(k..k + n, self.grid_y_run(f, j));
             }
         }
+    }
+
+    /// The grid's first inner X-edge of face `f`'s row `y` (`n ≥ 2`): its X-edge `(1, y)`,
+    /// [`FaceLayout::x_edge_of_cell`](super::grid::FaceLayout::x_edge_of_cell) of cell `(1, y)` without its divisions (three a
+    /// row, by a number the compiler does not know).
+    #[inline(always)]
+    pub(crate) fn grid_x_run(&self, f: usize, y: usize) -> usize {
+        let n = self.n;
+        (f * n + y) * (n - 1)
+    }
+
+    /// The grid's first Y-edge of face `f`'s inner row `j` (`1 ≤ j < n`): its Y-edge
+    /// `(0, j)`, [`FaceLayout::y_edge_of_cell`](super::grid::FaceLayout::y_edge_of_cell) of cell `(0, j)` without its divisions.
+    #[inline(always)]
+    pub(crate) fn grid_y_run(&self, f: usize, j: usize) -> usize {
+        let n = self.n;
+        (6 + f) * n * (n - 1) + (j - 1) * n
     }
 
     /// `u += dt_s·(g·c)` on every local edge, `c` its grid edge's centre gradient for
@@ -870,7 +887,28 @@ fn side_of(n: usize, c: usize, m: DVec3) -> Side {
 
 #[cfg(test)]
 mod tests {
+    use super::super::grid::FaceLayout;
     use super::*;
+
+    /// The rows' grid runs are the layout's edges of their first cells, at n = 2, 5
+    /// and 16.
+    #[test]
+    fn grid_runs_are_the_layouts_edges() {
+        for n in [2, 5, 16] {
+            let rows = FaceRows::new(&CubeSphere::new(n));
+            let layout = FaceLayout { n };
+            for f in 0..6 {
+                for y in 0..n {
+                    let want = layout.x_edge_of_cell((f * n + y) * n + 1);
+                    assert_eq!(rows.grid_x_run(f, y), want, "n {n}, face {f}, X row {y}");
+                }
+                for j in 1..n {
+                    let want = layout.y_edge_of_cell((f * n + j) * n);
+                    assert_eq!(rows.grid_y_run(f, j), want, "n {n}, face {f}, Y row {j}");
+                }
+            }
+        }
+    }
 
     /// Whether the grid numbers inner vertex `(i, j)`'s edges in the order the rows sum
     /// them.
