@@ -37,20 +37,22 @@
 //! (the weight `l/d` of a Laplacian is scale-free in 2D, while piecewise-constant
 //! Galerkin coarsening would double it and halve the coarse correction).
 
+#[cfg(test)]
 mod dense;
 mod kernels;
 mod layout;
+mod sparse;
 
 use super::grid::CubeSphere;
 use super::sides::{BOTTOM, CellSides, LEFT, RIGHT, TOP};
 use crate::avx2::with_avx2;
-use dense::{dense_cholesky, dense_solve};
 use kernels::{
     LevelField, NOT_A_CELL, Stencil, correct, dot, gather_row, operator, refresh, refresh_all,
     relax, relax_from_zero, residuals_in_place, restrict, restrict_field, rounded_level,
     scatter_row, scatter_run, update_and_norm2, update_direction, widened_dot,
 };
 use layout::Layout;
+use sparse::{Factor, Pattern};
 
 /// The two precisions the solve computes in: `f64` for the conjugate gradients, `f32`
 /// for the V-cycle that preconditions them (see [`Work`]). The loops are written once,
@@ -100,12 +102,14 @@ fn coarsest_face(mut n: usize) -> usize {
 }
 
 /// Largest number of cells solved directly on the coarsest level.
-const DENSE_CELLS: usize = 6 * 8 * 8;
-/// Face size the hierarchy coarsens down to when it can: its dense Cholesky of 6·2² cells
-/// is a few thousand flops a step where 6·4² cells' took 0.4 M instructions, and the
-/// extra level kept the iterations (over `film_profile n 0 9.81`'s 40 steps, 230 at
-/// n = 64, 209 at 32 and 250 at 128, against 227, 204 and 248 down to 6·4² cells).
-const COARSEST_FACE: usize = 2;
+const DIRECT_CELLS: usize = 6 * 8 * 8;
+/// Face size the hierarchy coarsens down to when it can. Its sparse Cholesky factor
+/// (`sparse`) of 6·4² cells takes about 4 k multiply-adds a step and its solve replaces
+/// that level's 8 sweeps a side and a level of 6·2² cells: over `film_profile 64 0
+/// 9.81`'s 40 steps 698.0 M instructions and 131 PCG iterations, against 703.4 M and 132
+/// down to 6·2² cells (solved the same way). Down to 6·8² cells took 130 iterations but
+/// 726.9 M instructions: its factor, 48 k multiply-adds a step, cost 36 M.
+const COARSEST_FACE: usize = 4;
 
 /// Gauss–Seidel sweeps a side of the V-cycle's coarse correction on a level of face size
 /// `m` in a hierarchy whose finest level's is `finest`. Where the finest level's fields
@@ -139,6 +143,8 @@ pub struct Hierarchy {
     /// RIGHT or TOP entries and the halo's (the rest of a face row's weights are a slice
     /// of the grid's edges).
     seam_weights: [Vec<[u32; 2]>; 2],
+    /// The coarsest level's elimination order and factor pattern (its direct solve).
+    coarsest: Pattern,
 }
 
 /// The numbers of one system: per level, the mass term and the edge weights.
@@ -179,11 +185,10 @@ pub struct Work {
     /// ([`LevelField`]): the system's faces are alike to the bit, as the grid's cell
     /// areas are.
     mass_per_face: bool,
-    /// The coarsest level's Cholesky factor, of the system as scaled for the V-cycle
-    /// ([`Work::scale`]), in `f64` (the level is solved in `f64`: its right-hand side
-    /// and answer converted, [`Work::coarse_rhs`] and [`Work::coarse_x`]).
-    coarse_factor: Vec<f64>,
-    coarse_rhs: Vec<f64>,
+    /// The coarsest level's sparse Cholesky factor, of the system as scaled for the
+    /// V-cycle ([`Work::scale`]), in `f64` (the level is solved in `f64`: its right-hand
+    /// side and answer converted in [`Work::coarse_x`], in the elimination order).
+    coarse_factor: Factor,
     coarse_x: Vec<f64>,
     /// The power of two the V-cycle's system is scaled by (1 where there is one level).
     scale: f64,
@@ -207,7 +212,7 @@ pub struct Work {
     r: Vec<f64>,
     p: Vec<f64>,
     q: Vec<f64>,
-    /// The preconditioned residual where the finest level is solved densely (in `f64`).
+    /// The preconditioned residual where the finest level is solved directly (in `f64`).
     z: Vec<f64>,
     /// `x` and the guess in the finest level's layout (`b` is put in [`Work::r`]).
     x: Vec<f64>,
@@ -276,16 +281,18 @@ impl Hierarchy {
             n /= 2;
         }
         let seam_weights = seam_weights(&levels[0], &sides);
+        let coarsest = Pattern::new(levels.last().expect("a level"));
         Self {
             levels,
             seam_weights,
+            coarsest,
         }
     }
 
     /// Whether a face size coarsens down to a directly solvable level.
     pub fn supports(face_size: usize) -> bool {
         let n = coarsest_face(face_size);
-        n >= 1 && 6 * n * n <= DENSE_CELLS
+        n >= 1 && 6 * n * n <= DIRECT_CELLS
     }
 
     /// Solves `(diag(alpha) + L_weight) x = b` into `x`, starting from `x`'s values, until
@@ -552,7 +559,7 @@ impl Hierarchy {
             work.correction[k].resize(level.len(), 0.0);
         }
         self.fine_numbers(work, alpha, weight);
-        // One level: the dense solve is the whole preconditioner, in `f64`, unscaled.
+        // One level: the direct solve is the whole preconditioner, in `f64`, unscaled.
         work.scale = if count == 1 {
             1.0
         } else {
@@ -579,14 +586,10 @@ impl Hierarchy {
             self.round_for_the_v_cycle(work, k);
         }
         let last = count - 1;
-        let (mass, stencil) = (&work.mass[last], &work.stencil[last]);
-        dense_cholesky(
-            &self.levels[last],
-            mass,
-            stencil,
-            work.scale,
-            &mut work.coarse_factor,
-        );
+        let system = (&work.mass[last][..], &work.stencil[last]);
+        let level = &self.levels[last];
+        let factor = &mut work.coarse_factor;
+        self.coarsest.factor(level, system, work.scale, factor);
     }
 
     /// The finest level's mass term (face 0's alone where the system's faces are
@@ -637,7 +640,7 @@ impl Hierarchy {
 
     /// Level `k`'s numbers scaled by [`Work::scale`] and rounded to `f32`, the inverse
     /// diagonal summed in `f64` from the unrounded numbers and rounded once (zero outside
-    /// the cells: [`rounded_level`]); nothing for the coarsest level, solved densely.
+    /// the cells: [`rounded_level`]); nothing for the coarsest level, solved directly.
     #[inline(always)]
     fn round_for_the_v_cycle(&self, work: &mut Work, k: usize) {
         let (scale, smoothed) = (work.scale, self.levels.len() - 1);
@@ -668,10 +671,10 @@ impl Hierarchy {
     }
 
     /// `z` = the preconditioner applied to the conjugate gradients' residual `r`, whose
-    /// norm is `norm`: one V-cycle in `f32` (see [`Work`]), or the dense solve where the
+    /// norm is `norm`: one V-cycle in `f32` (see [`Work`]), or the direct solve where the
     /// finest level is the coarsest. Returns `r·z` and the factor `back` that `z` is
     /// held scaled by: `z = back·z'`, `z'` the V-cycle's answer (in
-    /// [`Work::correction`]) or the dense solve's (in [`Work::z`], `back` 1). `z` is not
+    /// [`Work::correction`]) or the direct solve's (in [`Work::z`], `back` 1). `z` is not
     /// stored in `f64`: [`Hierarchy::next_direction`] forms it again as it reads it.
     #[inline(always)]
     fn precondition(&self, work: &mut Work, r: &[f64], norm: f64) -> (f64, f64) {
@@ -766,26 +769,20 @@ impl Hierarchy {
         )
     }
 
-    /// The coarsest level's dense solve, in `f64` (in either precision's fields: the
+    /// The coarsest level's direct solve (`sparse`), in `f64` (in either precision's fields: the
     /// V-cycle's last level, or the whole preconditioner where there is one level).
     #[inline(always)]
     fn coarsest<T: Real>(&self, work: &mut Work, r: &[T], z: &mut [T]) {
-        let level = self.levels.last().expect("a level");
-        let cells = level.position.len();
-        let (mut rc, mut zc) = (
-            std::mem::take(&mut work.coarse_rhs),
-            std::mem::take(&mut work.coarse_x),
-        );
-        rc.resize(cells, 0.0);
-        zc.resize(cells, 0.0);
-        for (v, &p) in rc.iter_mut().zip(&level.position) {
+        let pattern = &self.coarsest;
+        let x = &mut work.coarse_x;
+        x.resize(pattern.cells(), 0.0);
+        for (v, &p) in x.iter_mut().zip(pattern.positions()) {
             *v = r[p as usize].widen();
         }
-        dense_solve(&work.coarse_factor, cells, &rc, &mut zc);
-        for (v, &p) in zc.iter().zip(&level.position) {
+        pattern.solve(&work.coarse_factor, x);
+        for (v, &p) in x.iter().zip(pattern.positions()) {
             z[p as usize] = T::narrow(*v);
         }
-        (work.coarse_rhs, work.coarse_x) = (rc, zc);
     }
 }
 
@@ -995,7 +992,7 @@ mod tests {
     /// multigrid preconditioner keeps the count from growing with the grid), and the
     /// answer satisfies the system: the `f32` V-cycle does not keep the `f64` iterations
     /// from a tolerance far below `f32`'s rounding. n = 1, 3 and 5 are one level, solved
-    /// densely; 6 and 12 coarsen to an odd face (3).
+    /// directly; 6 and 12 coarsen to an odd face (3).
     #[test]
     fn stiff_system_converges_in_few_iterations() {
         for n in [1, 2, 3, 5, 6, 12, 16, 64] {
