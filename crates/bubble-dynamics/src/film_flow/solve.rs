@@ -18,8 +18,10 @@
 //!
 //! The solve is bound by memory traffic (at n = 64 a field of the finest level is
 //! 220 kB in `f64`, the L2 1 MB), so each pass is counted: an iteration of the conjugate
-//! gradients streams the weights once (the operator's product `q`), `x`, `r` and `p`
-//! once each, and writes `q` and the V-cycle's right-hand side. The preconditioned
+//! gradients streams the weights once (the operator's product `q`; the V-cycle's `f32`
+//! copy where the caller lets it take the weights as their `f32` roundings, as the
+//! Marangoni step does: [`Weights::F32`]), `x`, `r` and `p` once each, and writes `q` and
+//! the V-cycle's right-hand side. The preconditioned
 //! residual `z` is never held in `f64` (`r·z` is summed from the V-cycle's own numbers,
 //! `p = z + β·p` formed from them as it is read), and both starts' residuals come from
 //! one pass over the system.
@@ -47,9 +49,9 @@ use super::grid::CubeSphere;
 use super::sides::{BOTTOM, CellSides, LEFT, RIGHT, TOP};
 use crate::avx2::with_avx2;
 use kernels::{
-    LevelField, NOT_A_CELL, Stencil, correct, dot, gather_row, operator, refresh, refresh_all,
-    relax, relax_from_zero, residuals_in_place, restrict, restrict_field, rounded_level,
-    scatter_row, scatter_run, update_and_norm2, update_direction, widened_dot,
+    LevelField, NOT_A_CELL, Scaled, Stencil, correct, dot, gather_row, operator, refresh,
+    refresh_all, relax, relax_from_zero, residuals_in_place, restrict, restrict_field,
+    rounded_level, scatter_row, scatter_run, update_and_norm2, update_direction, widened_dot,
 };
 use layout::Layout;
 use sparse::{Factor, Pattern};
@@ -177,10 +179,16 @@ pub struct Hierarchy {
 #[derive(Clone, Debug, Default)]
 pub struct Work {
     /// Per level, the mass term ([`NOT_A_CELL`] outside the cells) and the edge weights
-    /// ([`Stencil`]) in `f64`: the finest level's the conjugate gradients' operator, the
+    /// ([`Stencil`]) in `f64`: the finest level's the conjugate gradients' operator (but
+    /// where its weights are read from their `f32` copy, [`Work::weights_f32`]), the
     /// others what the V-cycle's are rounded from.
     mass: Vec<Vec<f64>>,
     stencil: Vec<Stencil<f64>>,
+    /// Whether the conjugate gradients read the finest level's weights from the V-cycle's
+    /// `f32` copy ([`Weights::F32`], and more than one level): each weight rounded to
+    /// `f32` (scaled by [`Work::scale`], a power of two: exactly the weight's own `f32`
+    /// rounding, but where it lies more than 2¹²⁶ from the first cell's diagonal entry).
+    weights_f32: bool,
     /// Whether the finest level's mass term (in `f64` and `f32`) is held per face
     /// ([`LevelField`]): the system's faces are alike to the bit, as the grid's cell
     /// areas are.
@@ -237,6 +245,20 @@ pub(crate) enum MassTerm<'a> {
     /// Face 0's cells' values alone, every face's the same to the bit (as the grid's
     /// cell areas are): the solve need not read the other faces to find that out.
     EveryFace(&'a [f64]),
+}
+
+/// A system's edge weights as [`Hierarchy::solve_from_start_and_change`] is given them.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Weights<'a> {
+    /// Any `f64` values.
+    F64(&'a [f64]),
+    /// Weights the solve may take as their `f32` roundings (each within 6e-8 of itself;
+    /// [`Work::weights_f32`]): the system solved, and the residual the tolerance is
+    /// judged on, are then those of the rounded weights. The conjugate gradients'
+    /// operator reads the V-cycle's `f32` copy of them and streams half the bytes an
+    /// iteration; for weights that are `f32` values already, the solve is the same to the
+    /// bit as with [`Weights::F64`].
+    F32(&'a [f64]),
 }
 
 /// Where [`Hierarchy::solve_prepared_from`] starts.
@@ -370,7 +392,7 @@ impl Hierarchy {
     pub(crate) fn solve_from_start_and_change(
         &self,
         work: &mut Work,
-        (alpha, weight, b): (MassTerm, &[f64], &[f64]),
+        (alpha, weight, b): (MassTerm, Weights, &[f64]),
         (start, change): (&[f64], Option<&[f64]>),
         x: &mut [f64],
         limits: SolveLimits,
@@ -461,7 +483,6 @@ impl Hierarchy {
                 for v in [&mut r, &mut p, &mut q] {
                     v.resize(len, 0.0);
                 }
-                let stencil = &work.stencil[0];
                 refresh_all(fine, x);
                 let mut guess = guess;
                 if let Some(g) = guess.as_mut() {
@@ -470,8 +491,7 @@ impl Hierarchy {
                 // Both starts' residuals in one pass over the system: `x`'s into `r`, the
                 // guess's into `q`, from the `b` that `r` holds.
                 let starts = [Some(&x[..]), guess.as_deref().map(|g| &g[..])];
-                let mass = work.mass_term(0);
-                residuals_in_place(fine, (mass, stencil), starts, [&mut r, &mut q]);
+                self.start_residuals(work, starts, [&mut r, &mut q]);
                 // Relative to the start's residual: the step's change, not the whole field.
                 let mut start_norm = dot(&r, &r).sqrt();
                 let b_norm = if start_norm > 0.0 { start_norm } else { 1.0 };
@@ -492,9 +512,8 @@ impl Hierarchy {
                     let (mut rz, back) = self.precondition(work, &r, start_norm);
                     self.next_direction(work, back, None, &mut p);
                     while report.iterations < limits.max_iterations {
-                        let (mass, stencil) = (work.mass_term(0), &work.stencil[0]);
                         refresh_all(fine, &mut p);
-                        operator::<f64, false>(fine, mass, stencil, &r, &p, &mut q);
+                        self.apply(work, &p, &mut q);
                         let pq = dot(&p, &q);
                         if pq <= 0.0 || !pq.is_finite() {
                             break;
@@ -519,17 +538,57 @@ impl Hierarchy {
         )
     }
 
+    /// `q = M p` on the finest level, `M` read as [`Hierarchy::start_residuals`] reads it.
+    #[inline(always)]
+    fn apply(&self, work: &Work, p: &[f64], q: &mut [f64]) {
+        let (fine, mass) = (&self.levels[0], work.mass_term(0));
+        if work.weights_f32 {
+            let w = Scaled {
+                weights: &work.stencil32[0],
+                scale: work.scale,
+            };
+            operator::<f64, f32, false>(fine, mass, w, &[], p, q);
+        } else {
+            let w = Scaled::plain(&work.stencil[0]);
+            operator::<f64, f64, false>(fine, mass, w, &[], p, q);
+        }
+    }
+
+    /// The starts' residuals in place ([`residuals_in_place`]) on the finest level, its
+    /// weights read from the V-cycle's `f32` copy where they are `f32` values
+    /// ([`Work::weights_f32`]: the same numbers, half the bytes), else in `f64`.
+    #[inline(always)]
+    fn start_residuals(&self, work: &Work, starts: [Option<&[f64]>; 2], out: [&mut [f64]; 2]) {
+        let (fine, mass) = (&self.levels[0], work.mass_term(0));
+        if work.weights_f32 {
+            let w = Scaled {
+                weights: &work.stencil32[0],
+                scale: work.scale,
+            };
+            residuals_in_place(fine, (mass, w), starts, out);
+        } else {
+            let w = Scaled::plain(&work.stencil[0]);
+            residuals_in_place(fine, (mass, w), starts, out);
+        }
+    }
+
     /// [`Hierarchy::prepare_mass`] of a mass term given per cell.
     fn prepare(&self, work: &mut Work, alpha: &[f64], weight: &[f64]) {
-        self.prepare_mass(work, MassTerm::Cells(alpha), weight);
+        self.prepare_mass(work, MassTerm::Cells(alpha), Weights::F64(weight));
     }
 
     /// Restricts the system's numbers to every level, and rounds them to `f32` for the
-    /// V-cycle (see [`Work`]).
+    /// V-cycle (see [`Work`]); notes whether the conjugate gradients read the weights'
+    /// `f32` copy ([`Work::weights_f32`]).
     ///
     /// # Panics
     /// If the mass term's length does not match the finest level (its cells, or a face's).
-    fn prepare_mass(&self, work: &mut Work, alpha: MassTerm, weight: &[f64]) {
+    fn prepare_mass(&self, work: &mut Work, alpha: MassTerm, weight: Weights) {
+        let (weight, rounded) = match weight {
+            Weights::F64(w) => (w, false),
+            Weights::F32(w) => (w, true),
+        };
+        work.weights_f32 = rounded && self.levels.len() > 1;
         let m = self.levels[0].m;
         let len = match alpha {
             MassTerm::Cells(a) => a.len() / 6,
@@ -749,7 +808,7 @@ impl Hierarchy {
                     values: &work.mass32[k],
                     per_face: k == 0 && work.mass_per_face,
                 };
-                operator::<f32, true>(level, mass, w, r, z, &mut d);
+                operator::<f32, f32, true>(level, mass, Scaled::plain(w), r, z, &mut d);
                 let mut rc = std::mem::take(&mut work.residual[k + 1]);
                 restrict(level, &d, coarse, &mut rc, &mut work.row);
                 work.operator = d;
@@ -1102,8 +1161,10 @@ mod tests {
     /// [`Hierarchy::solve_from_start_and_change`] is [`Hierarchy::solve_with_guess`] from
     /// the start with the guess `start + change` (summed in the grid's numbering), to the
     /// bit: with a change that is taken, one that is not (worse than the start) and none;
-    /// the mass term given per cell or as face 0's (every face's the same), at n = 16 (the
-    /// mass term then held per face) and 3 (one level, where it cannot be).
+    /// the mass term given per cell or as face 0's (every face's the same); the weights
+    /// (`f32` values) given as any `f64`s or as `f32` values (the conjugate gradients then
+    /// reading the V-cycle's `f32` copy); at n = 16 (the mass term then held per face)
+    /// and 3 (one level, where it cannot be, nor the weights read in `f32`).
     #[test]
     fn a_start_and_change_solve_as_the_start_and_its_guess() {
         for n in [16, 3] {
@@ -1114,6 +1175,8 @@ mod tests {
     /// [`a_start_and_change_solve_as_the_start_and_its_guess`] at `n` cells a face.
     fn start_and_change_solve_alike(n: usize) {
         let (grid, h, alpha, weight, b) = stiff_system(n, |c| (2.0 * c.x - c.y * c.z).sin());
+        // `f32` values, so that they can be given as such too.
+        let weight: Vec<f64> = weight.iter().map(|&w| f64::from(w as f32)).collect();
         let limits = SolveLimits {
             tolerance: 1e-9,
             max_iterations: 50,
@@ -1137,15 +1200,17 @@ mod tests {
         let far: Vec<f64> = near.iter().map(|v| 1e3 * v).collect();
         let face = MassTerm::EveryFace(&alpha[..n * n]);
         let changes = [Some(&near), Some(&far), None];
-        for (mass, change) in [MassTerm::Cells(&alpha), face]
+        let weights = [Weights::F64(&weight), Weights::F32(&weight)];
+        for ((mass, change), weights) in [MassTerm::Cells(&alpha), face]
             .into_iter()
             .flat_map(|m| changes.map(|c| (m, c)))
+            .flat_map(|mc| weights.map(|w| (mc, w)))
         {
             let mut work = Work::default();
             let guess: Option<Vec<f64>> =
                 change.map(|c| start.iter().zip(c).map(|(s, c)| s + c).collect());
             let mut plain = start.clone();
-            let system = (mass, &weight[..], &b[..]);
+            let system = (mass, weights, &b[..]);
             let expected = h.solve_with_guess(
                 &mut work,
                 &alpha,
@@ -1165,13 +1230,18 @@ mod tests {
                 limits,
             );
             let face = matches!(mass, MassTerm::EveryFace(_));
-            assert_eq!(report, expected, "n {n}, face 0's mass term: {face}");
+            let f32s = matches!(weights, Weights::F32(_));
+            assert_eq!(
+                report, expected,
+                "n {n}, face 0's mass term: {face}, f32: {f32s}"
+            );
             assert!(report.iterations >= 1, "{report:?}");
             let differ = x
                 .iter()
                 .zip(&plain)
                 .filter(|(a, b)| a.to_bits() != b.to_bits());
-            assert_eq!(differ.count(), 0, "change {:?}", change.map(|c| c[0]));
+            let change = change.map(|c| c[0]);
+            assert_eq!(differ.count(), 0, "change {change:?}, f32: {f32s}");
         }
     }
 
@@ -1324,7 +1394,7 @@ mod tests {
             let none = vec![0.0; fine.len()];
             let mut out = vec![f64::NAN; fine.len()];
             let (mass, w) = (work.mass_term(0), &work.stencil[0]);
-            operator::<f64, false>(fine, mass, w, &none, &xs, &mut out);
+            operator::<f64, f64, false>(fine, mass, Scaled::plain(w), &none, &xs, &mut out);
             let expected = grid_apply(&grid, &alpha, &weight, &x);
             for (c, &p) in fine.position.iter().enumerate() {
                 let err = (out[p as usize] - expected[c]).abs();
@@ -1363,13 +1433,14 @@ mod tests {
             let (mass, w) = (work.mass_term(0), &work.stencil[0]);
             let plain = |start: &[f64]| {
                 let mut out = vec![f64::NAN; fine.len()];
-                operator::<f64, true>(fine, mass, w, &b, start, &mut out);
+                operator::<f64, f64, true>(fine, mass, Scaled::plain(w), &b, start, &mut out);
                 out
             };
             let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
             for guess in [Some(&g[..]), None] {
                 let (mut r, mut q) = (b.clone(), vec![f64::NAN; fine.len()]);
-                residuals_in_place(fine, (mass, w), [Some(&x[..]), guess], [&mut r, &mut q]);
+                let system = (mass, Scaled::plain(w));
+                residuals_in_place(fine, system, [Some(&x[..]), guess], [&mut r, &mut q]);
                 assert_eq!(bits(&r), bits(&plain(&x)), "n {n}");
                 if let Some(g) = guess {
                     assert_eq!(bits(&q), bits(&plain(g)), "n {n}");
