@@ -192,6 +192,10 @@ pub struct Work {
     /// `f32` (scaled by [`Work::scale`], a power of two: exactly the weight's own `f32`
     /// rounding, but where it lies more than 2¹²⁶ from the first cell's diagonal entry).
     weights_f32: bool,
+    /// Where [`Work::weights_f32`], the finest level's mass term times [`Work::scale`]
+    /// (exactly), as [`Work::mass`] holds it: the conjugate gradients' operator's, in the
+    /// weights' scaled system ([`Scaled`]).
+    mass_scaled: Vec<f64>,
     /// Whether the finest level's mass term (in `f64` and `f32`) is held per face
     /// ([`LevelField`]): the system's faces are alike to the bit, as the grid's cell
     /// areas are.
@@ -236,6 +240,14 @@ impl Work {
         LevelField {
             values: &self.mass[k],
             per_face: k == 0 && self.mass_per_face,
+        }
+    }
+
+    /// [`Work::mass_scaled`] as the kernels read it.
+    fn scaled_mass(&self) -> LevelField<'_, f64> {
+        LevelField {
+            values: &self.mass_scaled,
+            per_face: self.mass_per_face,
         }
     }
 }
@@ -516,13 +528,15 @@ impl Hierarchy {
                     self.next_direction(work, back, None, &mut p);
                     while report.iterations < limits.max_iterations {
                         refresh_all(fine, &mut p);
-                        self.apply(work, &p, &mut q);
-                        let pq = dot(&p, &q);
+                        // `q` is `M p` times `held` ([`Hierarchy::apply`]), a power of two:
+                        // each product with it scaled back exactly.
+                        let held = self.apply(work, &p, &mut q);
+                        let pq = dot(&p, &q) / held;
                         if pq <= 0.0 || !pq.is_finite() {
                             break;
                         }
                         let step = rz / pq;
-                        let rr = update_and_norm2(step, &p, &q, x, &mut r);
+                        let rr = update_and_norm2((step, step / held), &p, &q, x, &mut r);
                         report.iterations += 1;
                         report.relative_residual = rr.sqrt() / b_norm;
                         let done = report.relative_residual <= limits.tolerance;
@@ -541,19 +555,23 @@ impl Hierarchy {
         )
     }
 
-    /// `q = M p` on the finest level, `M` read as [`Hierarchy::start_residuals`] reads it.
+    /// `q = held·M p` on the finest level, `M` read as [`Hierarchy::start_residuals`]
+    /// reads it, in its weights' scaled system ([`Scaled`]); returns `held`, a power of
+    /// two ([`Work::scale`], or 1 where the weights are read in `f64`).
     #[inline(always)]
-    fn apply(&self, work: &Work, p: &[f64], q: &mut [f64]) {
-        let (fine, mass) = (&self.levels[0], work.mass_term(0));
+    fn apply(&self, work: &Work, p: &[f64], q: &mut [f64]) -> f64 {
+        let fine = &self.levels[0];
         if work.weights_f32 {
             let w = Scaled {
                 weights: &work.stencil32[0],
                 scale: work.scale,
             };
-            operator::<f64, f32, false>(fine, mass, w, &[], p, q);
+            operator::<f64, f32, false>(fine, work.scaled_mass(), w, &[], p, q);
+            work.scale
         } else {
             let w = Scaled::plain(&work.stencil[0]);
-            operator::<f64, f64, false>(fine, mass, w, &[], p, q);
+            operator::<f64, f64, false>(fine, work.mass_term(0), w, &[], p, q);
+            1.0
         }
     }
 
@@ -568,7 +586,7 @@ impl Hierarchy {
                 weights: &work.stencil32[0],
                 scale: work.scale,
             };
-            residuals_in_place(fine, (mass, w), starts, out);
+            residuals_in_place(fine, (work.scaled_mass(), w), starts, out);
         } else {
             let w = Scaled::plain(&work.stencil[0]);
             residuals_in_place(fine, (mass, w), starts, out);
@@ -602,6 +620,23 @@ impl Hierarchy {
             #[inline(always)]
             || self.prepare_here(work, alpha, weight),
         );
+        if work.weights_f32 {
+            // Where the mass term is held per face, face 0's positions of each colour alone.
+            let (fine, mass, scale) = (&self.levels[0], &work.mass[0], work.scale);
+            sized(&mut work.mass_scaled, mass.len(), NOT_A_CELL);
+            let (held, colours) = if work.mass_per_face {
+                (fine.face_start(1), [0, fine.half])
+            } else {
+                (mass.len(), [0, mass.len()])
+            };
+            for start in colours.into_iter().filter(|&s| s < mass.len()) {
+                let range = start..start + held;
+                let to = &mut work.mass_scaled[range.clone()];
+                for (t, m) in to.iter_mut().zip(&mass[range]) {
+                    *t = m * scale;
+                }
+            }
+        }
     }
 
     /// [`Hierarchy::prepare_mass`]'s work, inlined into the AVX2 build where there is one.

@@ -193,9 +193,11 @@ pub(super) fn relax_from_zero<T: Real>(layout: &Layout, inv_diag: &[T], r: &[T],
 /// A level's edge weights as the operator reads them: held scaled by `scale`, a power of
 /// two (1 where they are held as they are), in precision `W`. The conjugate gradients'
 /// `f64` operator reads the V-cycle's `f32` weights so where the system's weights are
-/// `f32` values ([`Weights::F32`](super::Weights::F32)): each is widened exactly, and
-/// the sum taken in the scaled system and scaled back, each a power of two, is the one
-/// the weights as given make, to the bit (where no number leaves the normal range).
+/// `f32` values ([`Weights::F32`](super::Weights::F32)): each is widened exactly, the
+/// mass term given scaled alike, and the operator's product is left in the scaled
+/// system (its residual scaled back): each factor a power of two, `scale` times the
+/// product the weights as given make, to the bit (where no number leaves the normal
+/// range).
 #[derive(Clone, Copy)]
 pub(super) struct Scaled<'a, W> {
     /// The weights, times `scale`.
@@ -311,9 +313,9 @@ fn operator_blocks<T: Real, W: Real, const RESIDUAL: bool>(
 
 /// [`operator`] at the `len` positions from `start` of colour `c`, of face `face`; the
 /// residual's `b` read from `out` itself where `IN_PLACE` (`r` then unread, as it is
-/// for the product, `RESIDUAL` false). In the
-/// weights' scaled system: `mᵢxᵢ` scaled, the weights' terms added, the sum scaled back
-/// (each factor exact: with weights held as they are, factors of 1).
+/// for the product, `RESIDUAL` false). In the weights' scaled system ([`Scaled`]: the
+/// mass term given scaled alike), the residual's sum scaled back (exactly: with
+/// weights held as they are, by 1).
 #[inline(always)]
 fn operator_run<T: Real, W: Real, const RESIDUAL: bool, const IN_PLACE: bool>(
     layout: &Layout,
@@ -329,7 +331,7 @@ fn operator_run<T: Real, W: Real, const RESIDUAL: bool, const IN_PLACE: bool>(
         neighbours(layout, c, (start, len), other),
         side_weights(layout, c, (start, len), w.weights),
     );
-    let (to, back) = (T::narrow(w.scale), T::narrow(w.scale.recip()));
+    let back = T::narrow(w.scale.recip());
     let base = c * layout.half + start;
     let (m, xs, r) = (
         mass.at(layout, face, base, len),
@@ -347,12 +349,12 @@ fn operator_run<T: Real, W: Real, const RESIDUAL: bool, const IN_PLACE: bool>(
     let at = |w: &[W], i: usize| T::narrow(w[i].widen());
     for i in 0..len {
         let xi = xs[i];
-        let mut sum = m[i] * xi * to;
+        let mut sum = m[i] * xi;
         sum += at(w0, i) * (xi - n0[i]);
         sum += at(w1, i) * (xi - n1[i]);
         sum += at(w2, i) * (xi - n2[i]);
         sum += at(w3, i) * (xi - n3[i]);
-        let sum = sum * back;
+        let sum = if RESIDUAL { sum * back } else { sum };
         let b = if IN_PLACE {
             out[i]
         } else if RESIDUAL {
@@ -736,13 +738,14 @@ pub(super) fn update_direction<T: Real>(back: f64, z: &[T], beta: Option<f64>, p
     }
 }
 
-/// `x += step·p`, `r −= step·q`, and returns `r·r`, summed as [`dot`] sums: each lane's
-/// `r` squared as it is made (one pass over `r`, where the dot read it back), `x` in a
-/// pass of its own (with both updated in one loop the compiler could not tell them
-/// apart and kept it scalar).
+/// `x += step·p`, `r −= step_q·q`, and returns `r·r`, summed as [`dot`] sums: each
+/// lane's `r` squared as it is made (one pass over `r`, where the dot read it back), `x`
+/// in a pass of its own (with both updated in one loop the compiler could not tell them
+/// apart and kept it scalar). (`step_q` is `step` but where `q` is held scaled:
+/// [`Scaled`].)
 #[inline(always)]
 pub(super) fn update_and_norm2(
-    step: f64,
+    (step, step_q): (f64, f64),
     p: &[f64],
     q: &[f64],
     x: &mut [f64],
@@ -754,9 +757,9 @@ pub(super) fn update_and_norm2(
     let main = r.len() - r.len() % LANES;
     let (r, r_tail) = r.split_at_mut(main);
     let (q, q_tail) = q.split_at(main);
-    let lanes = subtract_and_square_lanes(step, &q[..main], r);
+    let lanes = subtract_and_square_lanes(step_q, &q[..main], r);
     for (ri, qi) in r_tail.iter_mut().zip(q_tail) {
-        *ri -= step * qi;
+        *ri -= step_q * qi;
     }
     let tail: f64 = r_tail.iter().zip(r_tail.iter()).map(|(x, y)| x * y).sum();
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
