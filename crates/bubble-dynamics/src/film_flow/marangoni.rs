@@ -22,7 +22,7 @@ use super::flow::{
 use super::fluxes::{EdgeValues, apply_limited, net_inflow};
 use super::grid::CubeSphere;
 use super::sides::{EdgeBlock, EdgeRun, SeamEnds, Seams};
-use super::solve::{MassTerm, SolveLimits, SolveReport};
+use super::solve::{MassTerm, SolveLimits, SolveReport, Weights};
 
 /// Most solves a step's defect correction of the cross term takes (it takes about 11 on
 /// the swirl film at n = 64: each cuts the error by about 0.35, the cross operator's
@@ -185,9 +185,11 @@ impl FilmFlow {
         // The cells' areas, alike on every face to the bit: face 0's.
         let n = self.sides.n();
         let areas = MassTerm::EveryFace(&g.areas_sr()[..n * n]);
+        // The weights taken as their `f32` roundings (6e-8 of each at most): the solve's
+        // iterations then stream half the bytes ([`Weights::F32`]).
         self.hierarchy.solve_from_start_and_change(
             &mut s.work,
-            (areas, &s.weight, &s.rhs),
+            (areas, Weights::F32(&s.weight), &s.rhs),
             (&self.gamma, change),
             &mut s.cell2,
             SolveLimits {

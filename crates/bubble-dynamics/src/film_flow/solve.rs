@@ -18,8 +18,10 @@
 //!
 //! The solve is bound by memory traffic (at n = 64 a field of the finest level is
 //! 220 kB in `f64`, the L2 1 MB), so each pass is counted: an iteration of the conjugate
-//! gradients streams the weights once (the operator's product `q`), `x`, `r` and `p`
-//! once each, and writes `q` and the V-cycle's right-hand side. The preconditioned
+//! gradients streams the weights once (the operator's product `q`; the V-cycle's `f32`
+//! copy where the caller lets it take the weights as their `f32` roundings, as the
+//! Marangoni step does: [`Weights::F32`]), `x`, `r` and `p` once each, and writes `q` and
+//! the V-cycle's right-hand side. The preconditioned
 //! residual `z` is never held in `f64` (`r·z` is summed from the V-cycle's own numbers,
 //! `p = z + β·p` formed from them as it is read), and both starts' residuals come from
 //! one pass over the system.
@@ -37,20 +39,22 @@
 //! (the weight `l/d` of a Laplacian is scale-free in 2D, while piecewise-constant
 //! Galerkin coarsening would double it and halve the coarse correction).
 
+#[cfg(test)]
 mod dense;
 mod kernels;
 mod layout;
+mod sparse;
 
 use super::grid::CubeSphere;
 use super::sides::{BOTTOM, CellSides, LEFT, RIGHT, TOP};
 use crate::avx2::with_avx2;
-use dense::{dense_cholesky, dense_solve};
 use kernels::{
-    LevelField, NOT_A_CELL, Stencil, correct, dot, gather_row, operator, refresh, refresh_all,
-    relax, relax_from_zero, residuals_in_place, restrict, restrict_field, rounded_level,
-    scatter_row, scatter_run, update_and_norm2, update_direction, widened_dot,
+    LevelField, NOT_A_CELL, Scaled, Stencil, correct, dot, gather_row, operator, refresh,
+    refresh_all, relax, relax_from_zero, residuals_in_place, restrict, restrict_field,
+    rounded_level, scatter_row, scatter_run, update_and_norm2, update_direction, widened_dot,
 };
 use layout::Layout;
+use sparse::{Factor, Pattern};
 
 /// The two precisions the solve computes in: `f64` for the conjugate gradients, `f32`
 /// for the V-cycle that preconditions them (see [`Work`]). The loops are written once,
@@ -100,12 +104,22 @@ fn coarsest_face(mut n: usize) -> usize {
 }
 
 /// Largest number of cells solved directly on the coarsest level.
-const DENSE_CELLS: usize = 6 * 8 * 8;
-/// Face size the hierarchy coarsens down to when it can: its dense Cholesky of 6·2² cells
-/// is a few thousand flops a step where 6·4² cells' took 0.4 M instructions, and the
-/// extra level kept the iterations (over `film_profile n 0 9.81`'s 40 steps, 230 at
-/// n = 64, 209 at 32 and 250 at 128, against 227, 204 and 248 down to 6·4² cells).
-const COARSEST_FACE: usize = 2;
+const DIRECT_CELLS: usize = 6 * 8 * 8;
+/// Face size the hierarchy coarsens down to when it can. Its sparse Cholesky factor
+/// (`sparse`) of 6·4² cells takes about 4 k multiply-adds a step and its solve replaces
+/// that level's 8 sweeps a side and a level of 6·2² cells: over `film_profile 64 0
+/// 9.81`'s 40 steps 698.0 M instructions and 131 PCG iterations, against 703.4 M and 132
+/// down to 6·2² cells (solved the same way). Down to 6·8² cells took 130 iterations but
+/// 726.9 M instructions: its factor, 48 k multiply-adds a step, cost 36 M.
+const COARSEST_FACE: usize = 4;
+
+/// Face size from which the conjugate gradients read weights given as [`Weights::F32`]
+/// from the V-cycle's `f32` copy: where the finest level's fields outgrow the L2, the
+/// bytes it saves are misses saved. Over `film_profile n 0 9.81`'s 40 steps, at n = 64
+/// 1.14 M fewer LL misses for 9.8 M more instructions (the widening) at the same PCG
+/// iterations, at 128 4.5 M fewer for 9 M more; at 32 the solve stays in L2 and it only
+/// took 2.5 M more instructions.
+const F32_WEIGHTS_FROM: usize = 64;
 
 /// Gauss–Seidel sweeps a side of the V-cycle's coarse correction on a level of face size
 /// `m` in a hierarchy whose finest level's is `finest`. Where the finest level's fields
@@ -118,11 +132,14 @@ const COARSEST_FACE: usize = 2;
 /// step), 747.2 M and 18.8 M; at n = 128 (3 on the finest) 2.97 G and 204 M against
 /// 2.93 G and 212 M, where 5 on it too took 2.98 G and 220 M; at n = 32 these counts
 /// took 235 M instructions against 223 M, the same misses. (Three everywhere: one took
-/// 531 iterations at n = 64, two 230, four 155.)
+/// 531 iterations at n = 64, two 230, four 155.) Since the level of 4 is solved
+/// directly ([`COARSEST_FACE`]), 6 on the level of 8 take as few iterations as 8 (125 at
+/// n = 64, 163 at 128; 4 took 128 at 64) and 2.6 M fewer instructions at n = 64.
 fn sweeps(m: usize, finest: usize) -> usize {
     match m {
         _ if finest < 64 => 3,
-        0..=16 => 8,
+        0..=8 => 6,
+        9..=16 => 8,
         17..=32 => 4,
         33..=64 => 5,
         _ => 3,
@@ -139,6 +156,8 @@ pub struct Hierarchy {
     /// RIGHT or TOP entries and the halo's (the rest of a face row's weights are a slice
     /// of the grid's edges).
     seam_weights: [Vec<[u32; 2]>; 2],
+    /// The coarsest level's elimination order and factor pattern (its direct solve).
+    coarsest: Pattern,
 }
 
 /// The numbers of one system: per level, the mass term and the edge weights.
@@ -171,19 +190,29 @@ pub struct Hierarchy {
 #[derive(Clone, Debug, Default)]
 pub struct Work {
     /// Per level, the mass term ([`NOT_A_CELL`] outside the cells) and the edge weights
-    /// ([`Stencil`]) in `f64`: the finest level's the conjugate gradients' operator, the
+    /// ([`Stencil`]) in `f64`: the finest level's the conjugate gradients' operator (but
+    /// where its weights are read from their `f32` copy, [`Work::weights_f32`]), the
     /// others what the V-cycle's are rounded from.
     mass: Vec<Vec<f64>>,
     stencil: Vec<Stencil<f64>>,
+    /// Whether the conjugate gradients read the finest level's weights from the V-cycle's
+    /// `f32` copy ([`Weights::F32`], more than one level and a face of at least
+    /// [`F32_WEIGHTS_FROM`] cells): each weight rounded to
+    /// `f32` (scaled by [`Work::scale`], a power of two: exactly the weight's own `f32`
+    /// rounding, but where it lies more than 2¹²⁶ from the first cell's diagonal entry).
+    weights_f32: bool,
+    /// Where [`Work::weights_f32`], the finest level's mass term times [`Work::scale`]
+    /// (exactly), as [`Work::mass`] holds it: the conjugate gradients' operator's, in the
+    /// weights' scaled system ([`Scaled`]).
+    mass_scaled: Vec<f64>,
     /// Whether the finest level's mass term (in `f64` and `f32`) is held per face
     /// ([`LevelField`]): the system's faces are alike to the bit, as the grid's cell
     /// areas are.
     mass_per_face: bool,
-    /// The coarsest level's Cholesky factor, of the system as scaled for the V-cycle
-    /// ([`Work::scale`]), in `f64` (the level is solved in `f64`: its right-hand side
-    /// and answer converted, [`Work::coarse_rhs`] and [`Work::coarse_x`]).
-    coarse_factor: Vec<f64>,
-    coarse_rhs: Vec<f64>,
+    /// The coarsest level's sparse Cholesky factor, of the system as scaled for the
+    /// V-cycle ([`Work::scale`]), in `f64` (the level is solved in `f64`: its right-hand
+    /// side and answer converted in [`Work::coarse_x`], in the elimination order).
+    coarse_factor: Factor,
     coarse_x: Vec<f64>,
     /// The power of two the V-cycle's system is scaled by (1 where there is one level).
     scale: f64,
@@ -207,7 +236,7 @@ pub struct Work {
     r: Vec<f64>,
     p: Vec<f64>,
     q: Vec<f64>,
-    /// The preconditioned residual where the finest level is solved densely (in `f64`).
+    /// The preconditioned residual where the finest level is solved directly (in `f64`).
     z: Vec<f64>,
     /// `x` and the guess in the finest level's layout (`b` is put in [`Work::r`]).
     x: Vec<f64>,
@@ -222,6 +251,14 @@ impl Work {
             per_face: k == 0 && self.mass_per_face,
         }
     }
+
+    /// [`Work::mass_scaled`] as the kernels read it.
+    fn scaled_mass(&self) -> LevelField<'_, f64> {
+        LevelField {
+            values: &self.mass_scaled,
+            per_face: self.mass_per_face,
+        }
+    }
 }
 
 /// A system's mass term `α` as [`Hierarchy::solve_from_start_and_change`] is given it.
@@ -232,6 +269,21 @@ pub(crate) enum MassTerm<'a> {
     /// Face 0's cells' values alone, every face's the same to the bit (as the grid's
     /// cell areas are): the solve need not read the other faces to find that out.
     EveryFace(&'a [f64]),
+}
+
+/// A system's edge weights as [`Hierarchy::solve_from_start_and_change`] is given them.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Weights<'a> {
+    /// Any `f64` values.
+    F64(&'a [f64]),
+    /// Weights the solve may take as their `f32` roundings (each within 6e-8 of itself;
+    /// [`Work::weights_f32`], from a face of [`F32_WEIGHTS_FROM`] cells): the system
+    /// solved, and the residual the tolerance is judged on, are then those of the rounded
+    /// weights. The conjugate gradients'
+    /// operator reads the V-cycle's `f32` copy of them and streams half the bytes an
+    /// iteration; for weights that are `f32` values already, the solve is the same to the
+    /// bit as with [`Weights::F64`].
+    F32(&'a [f64]),
 }
 
 /// Where [`Hierarchy::solve_prepared_from`] starts.
@@ -276,16 +328,18 @@ impl Hierarchy {
             n /= 2;
         }
         let seam_weights = seam_weights(&levels[0], &sides);
+        let coarsest = Pattern::new(levels.last().expect("a level"));
         Self {
             levels,
             seam_weights,
+            coarsest,
         }
     }
 
     /// Whether a face size coarsens down to a directly solvable level.
     pub fn supports(face_size: usize) -> bool {
         let n = coarsest_face(face_size);
-        n >= 1 && 6 * n * n <= DENSE_CELLS
+        n >= 1 && 6 * n * n <= DIRECT_CELLS
     }
 
     /// Solves `(diag(alpha) + L_weight) x = b` into `x`, starting from `x`'s values, until
@@ -363,7 +417,7 @@ impl Hierarchy {
     pub(crate) fn solve_from_start_and_change(
         &self,
         work: &mut Work,
-        (alpha, weight, b): (MassTerm, &[f64], &[f64]),
+        (alpha, weight, b): (MassTerm, Weights, &[f64]),
         (start, change): (&[f64], Option<&[f64]>),
         x: &mut [f64],
         limits: SolveLimits,
@@ -454,7 +508,6 @@ impl Hierarchy {
                 for v in [&mut r, &mut p, &mut q] {
                     v.resize(len, 0.0);
                 }
-                let stencil = &work.stencil[0];
                 refresh_all(fine, x);
                 let mut guess = guess;
                 if let Some(g) = guess.as_mut() {
@@ -463,8 +516,7 @@ impl Hierarchy {
                 // Both starts' residuals in one pass over the system: `x`'s into `r`, the
                 // guess's into `q`, from the `b` that `r` holds.
                 let starts = [Some(&x[..]), guess.as_deref().map(|g| &g[..])];
-                let mass = work.mass_term(0);
-                residuals_in_place(fine, (mass, stencil), starts, [&mut r, &mut q]);
+                self.start_residuals(work, starts, [&mut r, &mut q]);
                 // Relative to the start's residual: the step's change, not the whole field.
                 let mut start_norm = dot(&r, &r).sqrt();
                 let b_norm = if start_norm > 0.0 { start_norm } else { 1.0 };
@@ -485,15 +537,16 @@ impl Hierarchy {
                     let (mut rz, back) = self.precondition(work, &r, start_norm);
                     self.next_direction(work, back, None, &mut p);
                     while report.iterations < limits.max_iterations {
-                        let (mass, stencil) = (work.mass_term(0), &work.stencil[0]);
                         refresh_all(fine, &mut p);
-                        operator::<f64, false>(fine, mass, stencil, &r, &p, &mut q);
-                        let pq = dot(&p, &q);
+                        // `q` is `M p` times `held` ([`Hierarchy::apply`]), a power of two:
+                        // each product with it scaled back exactly.
+                        let held = self.apply(work, &p, &mut q);
+                        let pq = dot(&p, &q) / held;
                         if pq <= 0.0 || !pq.is_finite() {
                             break;
                         }
                         let step = rz / pq;
-                        let rr = update_and_norm2(step, &p, &q, x, &mut r);
+                        let rr = update_and_norm2((step, step / held), &p, &q, x, &mut r);
                         report.iterations += 1;
                         report.relative_residual = rr.sqrt() / b_norm;
                         let done = report.relative_residual <= limits.tolerance;
@@ -512,17 +565,61 @@ impl Hierarchy {
         )
     }
 
+    /// `q = held·M p` on the finest level, `M` read as [`Hierarchy::start_residuals`]
+    /// reads it, in its weights' scaled system ([`Scaled`]); returns `held`, a power of
+    /// two ([`Work::scale`], or 1 where the weights are read in `f64`).
+    #[inline(always)]
+    fn apply(&self, work: &Work, p: &[f64], q: &mut [f64]) -> f64 {
+        let fine = &self.levels[0];
+        if work.weights_f32 {
+            let w = Scaled {
+                weights: &work.stencil32[0],
+                scale: work.scale,
+            };
+            operator::<f64, f32, false>(fine, work.scaled_mass(), w, &[], p, q);
+            work.scale
+        } else {
+            let w = Scaled::plain(&work.stencil[0]);
+            operator::<f64, f64, false>(fine, work.mass_term(0), w, &[], p, q);
+            1.0
+        }
+    }
+
+    /// The starts' residuals in place ([`residuals_in_place`]) on the finest level, its
+    /// weights read from the V-cycle's `f32` copy where they are `f32` values
+    /// ([`Work::weights_f32`]: the same numbers, half the bytes), else in `f64`.
+    #[inline(always)]
+    fn start_residuals(&self, work: &Work, starts: [Option<&[f64]>; 2], out: [&mut [f64]; 2]) {
+        let (fine, mass) = (&self.levels[0], work.mass_term(0));
+        if work.weights_f32 {
+            let w = Scaled {
+                weights: &work.stencil32[0],
+                scale: work.scale,
+            };
+            residuals_in_place(fine, (work.scaled_mass(), w), starts, out);
+        } else {
+            let w = Scaled::plain(&work.stencil[0]);
+            residuals_in_place(fine, (mass, w), starts, out);
+        }
+    }
+
     /// [`Hierarchy::prepare_mass`] of a mass term given per cell.
     fn prepare(&self, work: &mut Work, alpha: &[f64], weight: &[f64]) {
-        self.prepare_mass(work, MassTerm::Cells(alpha), weight);
+        self.prepare_mass(work, MassTerm::Cells(alpha), Weights::F64(weight));
     }
 
     /// Restricts the system's numbers to every level, and rounds them to `f32` for the
-    /// V-cycle (see [`Work`]).
+    /// V-cycle (see [`Work`]); notes whether the conjugate gradients read the weights'
+    /// `f32` copy ([`Work::weights_f32`]).
     ///
     /// # Panics
     /// If the mass term's length does not match the finest level (its cells, or a face's).
-    fn prepare_mass(&self, work: &mut Work, alpha: MassTerm, weight: &[f64]) {
+    fn prepare_mass(&self, work: &mut Work, alpha: MassTerm, weight: Weights) {
+        let (weight, rounded) = match weight {
+            Weights::F64(w) => (w, false),
+            Weights::F32(w) => (w, true),
+        };
+        work.weights_f32 = rounded && self.levels.len() > 1 && self.levels[0].m >= F32_WEIGHTS_FROM;
         let m = self.levels[0].m;
         let len = match alpha {
             MassTerm::Cells(a) => a.len() / 6,
@@ -533,6 +630,23 @@ impl Hierarchy {
             #[inline(always)]
             || self.prepare_here(work, alpha, weight),
         );
+        if work.weights_f32 {
+            // Where the mass term is held per face, face 0's positions of each colour alone.
+            let (fine, mass, scale) = (&self.levels[0], &work.mass[0], work.scale);
+            sized(&mut work.mass_scaled, mass.len(), NOT_A_CELL);
+            let (held, colours) = if work.mass_per_face {
+                (fine.face_start(1), [0, fine.half])
+            } else {
+                (mass.len(), [0, mass.len()])
+            };
+            for start in colours.into_iter().filter(|&s| s < mass.len()) {
+                let range = start..start + held;
+                let to = &mut work.mass_scaled[range.clone()];
+                for (t, m) in to.iter_mut().zip(&mass[range]) {
+                    *t = m * scale;
+                }
+            }
+        }
     }
 
     /// [`Hierarchy::prepare_mass`]'s work, inlined into the AVX2 build where there is one.
@@ -552,7 +666,7 @@ impl Hierarchy {
             work.correction[k].resize(level.len(), 0.0);
         }
         self.fine_numbers(work, alpha, weight);
-        // One level: the dense solve is the whole preconditioner, in `f64`, unscaled.
+        // One level: the direct solve is the whole preconditioner, in `f64`, unscaled.
         work.scale = if count == 1 {
             1.0
         } else {
@@ -579,14 +693,10 @@ impl Hierarchy {
             self.round_for_the_v_cycle(work, k);
         }
         let last = count - 1;
-        let (mass, stencil) = (&work.mass[last], &work.stencil[last]);
-        dense_cholesky(
-            &self.levels[last],
-            mass,
-            stencil,
-            work.scale,
-            &mut work.coarse_factor,
-        );
+        let system = (&work.mass[last][..], &work.stencil[last]);
+        let level = &self.levels[last];
+        let factor = &mut work.coarse_factor;
+        self.coarsest.factor(level, system, work.scale, factor);
     }
 
     /// The finest level's mass term (face 0's alone where the system's faces are
@@ -637,7 +747,7 @@ impl Hierarchy {
 
     /// Level `k`'s numbers scaled by [`Work::scale`] and rounded to `f32`, the inverse
     /// diagonal summed in `f64` from the unrounded numbers and rounded once (zero outside
-    /// the cells: [`rounded_level`]); nothing for the coarsest level, solved densely.
+    /// the cells: [`rounded_level`]); nothing for the coarsest level, solved directly.
     #[inline(always)]
     fn round_for_the_v_cycle(&self, work: &mut Work, k: usize) {
         let (scale, smoothed) = (work.scale, self.levels.len() - 1);
@@ -668,10 +778,10 @@ impl Hierarchy {
     }
 
     /// `z` = the preconditioner applied to the conjugate gradients' residual `r`, whose
-    /// norm is `norm`: one V-cycle in `f32` (see [`Work`]), or the dense solve where the
+    /// norm is `norm`: one V-cycle in `f32` (see [`Work`]), or the direct solve where the
     /// finest level is the coarsest. Returns `r·z` and the factor `back` that `z` is
     /// held scaled by: `z = back·z'`, `z'` the V-cycle's answer (in
-    /// [`Work::correction`]) or the dense solve's (in [`Work::z`], `back` 1). `z` is not
+    /// [`Work::correction`]) or the direct solve's (in [`Work::z`], `back` 1). `z` is not
     /// stored in `f64`: [`Hierarchy::next_direction`] forms it again as it reads it.
     #[inline(always)]
     fn precondition(&self, work: &mut Work, r: &[f64], norm: f64) -> (f64, f64) {
@@ -746,7 +856,7 @@ impl Hierarchy {
                     values: &work.mass32[k],
                     per_face: k == 0 && work.mass_per_face,
                 };
-                operator::<f32, true>(level, mass, w, r, z, &mut d);
+                operator::<f32, f32, true>(level, mass, Scaled::plain(w), r, z, &mut d);
                 let mut rc = std::mem::take(&mut work.residual[k + 1]);
                 restrict(level, &d, coarse, &mut rc, &mut work.row);
                 work.operator = d;
@@ -766,26 +876,20 @@ impl Hierarchy {
         )
     }
 
-    /// The coarsest level's dense solve, in `f64` (in either precision's fields: the
+    /// The coarsest level's direct solve (`sparse`), in `f64` (in either precision's fields: the
     /// V-cycle's last level, or the whole preconditioner where there is one level).
     #[inline(always)]
     fn coarsest<T: Real>(&self, work: &mut Work, r: &[T], z: &mut [T]) {
-        let level = self.levels.last().expect("a level");
-        let cells = level.position.len();
-        let (mut rc, mut zc) = (
-            std::mem::take(&mut work.coarse_rhs),
-            std::mem::take(&mut work.coarse_x),
-        );
-        rc.resize(cells, 0.0);
-        zc.resize(cells, 0.0);
-        for (v, &p) in rc.iter_mut().zip(&level.position) {
+        let pattern = &self.coarsest;
+        let x = &mut work.coarse_x;
+        x.resize(pattern.cells(), 0.0);
+        for (v, &p) in x.iter_mut().zip(pattern.positions()) {
             *v = r[p as usize].widen();
         }
-        dense_solve(&work.coarse_factor, cells, &rc, &mut zc);
-        for (v, &p) in zc.iter().zip(&level.position) {
+        pattern.solve(&work.coarse_factor, x);
+        for (v, &p) in x.iter().zip(pattern.positions()) {
             z[p as usize] = T::narrow(*v);
         }
-        (work.coarse_rhs, work.coarse_x) = (rc, zc);
     }
 }
 
@@ -995,7 +1099,7 @@ mod tests {
     /// multigrid preconditioner keeps the count from growing with the grid), and the
     /// answer satisfies the system: the `f32` V-cycle does not keep the `f64` iterations
     /// from a tolerance far below `f32`'s rounding. n = 1, 3 and 5 are one level, solved
-    /// densely; 6 and 12 coarsen to an odd face (3).
+    /// directly; 6 and 12 coarsen to an odd face (3).
     #[test]
     fn stiff_system_converges_in_few_iterations() {
         for n in [1, 2, 3, 5, 6, 12, 16, 64] {
@@ -1105,11 +1209,13 @@ mod tests {
     /// [`Hierarchy::solve_from_start_and_change`] is [`Hierarchy::solve_with_guess`] from
     /// the start with the guess `start + change` (summed in the grid's numbering), to the
     /// bit: with a change that is taken, one that is not (worse than the start) and none;
-    /// the mass term given per cell or as face 0's (every face's the same), at n = 16 (the
-    /// mass term then held per face) and 3 (one level, where it cannot be).
+    /// the mass term given per cell or as face 0's (every face's the same); the weights
+    /// (`f32` values) given as any `f64`s or as `f32` values (the conjugate gradients then
+    /// reading the V-cycle's `f32` copy from n = [`F32_WEIGHTS_FROM`] on); at n = 64 and
+    /// 16 (the mass term then held per face) and 3 (one level, where it cannot be).
     #[test]
     fn a_start_and_change_solve_as_the_start_and_its_guess() {
-        for n in [16, 3] {
+        for n in [F32_WEIGHTS_FROM, 16, 3] {
             start_and_change_solve_alike(n);
         }
     }
@@ -1117,6 +1223,8 @@ mod tests {
     /// [`a_start_and_change_solve_as_the_start_and_its_guess`] at `n` cells a face.
     fn start_and_change_solve_alike(n: usize) {
         let (grid, h, alpha, weight, b) = stiff_system(n, |c| (2.0 * c.x - c.y * c.z).sin());
+        // `f32` values, so that they can be given as such too.
+        let weight: Vec<f64> = weight.iter().map(|&w| f64::from(w as f32)).collect();
         let limits = SolveLimits {
             tolerance: 1e-9,
             max_iterations: 50,
@@ -1140,15 +1248,17 @@ mod tests {
         let far: Vec<f64> = near.iter().map(|v| 1e3 * v).collect();
         let face = MassTerm::EveryFace(&alpha[..n * n]);
         let changes = [Some(&near), Some(&far), None];
-        for (mass, change) in [MassTerm::Cells(&alpha), face]
+        let weights = [Weights::F64(&weight), Weights::F32(&weight)];
+        for ((mass, change), weights) in [MassTerm::Cells(&alpha), face]
             .into_iter()
             .flat_map(|m| changes.map(|c| (m, c)))
+            .flat_map(|mc| weights.map(|w| (mc, w)))
         {
             let mut work = Work::default();
             let guess: Option<Vec<f64>> =
                 change.map(|c| start.iter().zip(c).map(|(s, c)| s + c).collect());
             let mut plain = start.clone();
-            let system = (mass, &weight[..], &b[..]);
+            let system = (mass, weights, &b[..]);
             let expected = h.solve_with_guess(
                 &mut work,
                 &alpha,
@@ -1168,13 +1278,18 @@ mod tests {
                 limits,
             );
             let face = matches!(mass, MassTerm::EveryFace(_));
-            assert_eq!(report, expected, "n {n}, face 0's mass term: {face}");
+            let f32s = matches!(weights, Weights::F32(_));
+            assert_eq!(
+                report, expected,
+                "n {n}, face 0's mass term: {face}, f32: {f32s}"
+            );
             assert!(report.iterations >= 1, "{report:?}");
             let differ = x
                 .iter()
                 .zip(&plain)
                 .filter(|(a, b)| a.to_bits() != b.to_bits());
-            assert_eq!(differ.count(), 0, "change {:?}", change.map(|c| c[0]));
+            let change = change.map(|c| c[0]);
+            assert_eq!(differ.count(), 0, "change {change:?}, f32: {f32s}");
         }
     }
 
@@ -1327,7 +1442,7 @@ mod tests {
             let none = vec![0.0; fine.len()];
             let mut out = vec![f64::NAN; fine.len()];
             let (mass, w) = (work.mass_term(0), &work.stencil[0]);
-            operator::<f64, false>(fine, mass, w, &none, &xs, &mut out);
+            operator::<f64, f64, false>(fine, mass, Scaled::plain(w), &none, &xs, &mut out);
             let expected = grid_apply(&grid, &alpha, &weight, &x);
             for (c, &p) in fine.position.iter().enumerate() {
                 let err = (out[p as usize] - expected[c]).abs();
@@ -1366,13 +1481,14 @@ mod tests {
             let (mass, w) = (work.mass_term(0), &work.stencil[0]);
             let plain = |start: &[f64]| {
                 let mut out = vec![f64::NAN; fine.len()];
-                operator::<f64, true>(fine, mass, w, &b, start, &mut out);
+                operator::<f64, f64, true>(fine, mass, Scaled::plain(w), &b, start, &mut out);
                 out
             };
             let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
             for guess in [Some(&g[..]), None] {
                 let (mut r, mut q) = (b.clone(), vec![f64::NAN; fine.len()]);
-                residuals_in_place(fine, (mass, w), [Some(&x[..]), guess], [&mut r, &mut q]);
+                let system = (mass, Scaled::plain(w));
+                residuals_in_place(fine, system, [Some(&x[..]), guess], [&mut r, &mut q]);
                 assert_eq!(bits(&r), bits(&plain(&x)), "n {n}");
                 if let Some(g) = guess {
                     assert_eq!(bits(&q), bits(&plain(g)), "n {n}");

@@ -1,5 +1,5 @@
-//! The coarsest level's direct solve: a dense Cholesky factor of its few hundred cells'
-//! matrix, built once a system, and its two triangular solves.
+//! A dense Cholesky factor of a level's matrix and its two triangular solves: the tests'
+//! reference for the coarsest level's sparse solve (`sparse`), which it was until then.
 
 use super::kernels::Stencil;
 use super::layout::Layout;
