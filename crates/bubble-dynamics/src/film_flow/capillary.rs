@@ -201,6 +201,7 @@ impl EdgeValues for Differences<'_> {
 
     #[inline(always)]
     fn run(&mut self, run: EdgeRun, _rows: Range<usize>, h: &[f64], out: &mut [f64]) {
+        let run = run.padded(out.len(), h.len());
         let (ha, hb) = run.ends(h);
         differences_block(run, [ha, hb], self.fg, out);
     }
@@ -255,6 +256,7 @@ impl EdgeValues for Volumes<'_> {
 
     #[inline(always)]
     fn run(&mut self, run: EdgeRun, _rows: Range<usize>, h: &[f64], out: &mut [f64]) {
+        let run = run.padded(out.len(), h.len());
         let ((ha, hb), (la, lb)) = (run.ends(h), run.ends(self.laplacian));
         volumes_block(
             (self.fg, self.mobility, self.per_length),

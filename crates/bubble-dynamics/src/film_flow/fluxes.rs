@@ -58,12 +58,15 @@ pub(crate) trait EdgeValues {
     /// transport takes their limited rises here); nothing by default.
     #[inline(always)]
     fn rows(&mut self, _face: usize, _rows: Range<usize>, _cells: &[f64]) {}
-    /// `run`'s values into `out` (`run.len` long); `rows` are the face rows of its `b`
-    /// cells.
+    /// `run`'s values into `out` (`run.len` long, or longer: an x-run's has one place
+    /// more, which a pass may fill with anything, so as to run a whole number of vectors
+    /// where `n` is a multiple of four: the window's next left pad, written after it);
+    /// `rows` are the face rows of its `b` cells.
     fn run(&mut self, run: EdgeRun, rows: Range<usize>, cells: &[f64], out: &mut [f64]);
 }
 
-/// A per-edge array's values as an [`EdgeValues`] (the tests' volumes).
+/// A per-edge array's values as an [`EdgeValues`] (the tests' volumes); NaN into any
+/// place of `out` past the run's, as a padded pass may put anything there.
 #[cfg(test)]
 pub(crate) struct FromArray<'a>(pub(crate) &'a [f64]);
 
@@ -75,7 +78,9 @@ impl EdgeValues for FromArray<'_> {
     }
     #[inline(always)]
     fn run(&mut self, run: EdgeRun, _rows: Range<usize>, _cells: &[f64], out: &mut [f64]) {
-        out.copy_from_slice(&self.0[run.edges()]);
+        let (values, extra) = out.split_at_mut(run.len);
+        values.copy_from_slice(&self.0[run.edges()]);
+        extra.fill(f64::NAN);
     }
 }
 
@@ -225,11 +230,12 @@ impl FaceWindow {
         pass.rows(face, band.clone(), cells);
         for y in band.clone() {
             let w = self.w(y);
-            let row = &mut self.left[w * n..(w + 1) * n];
             if n > 1 {
-                pass.run(sides.x_run(face, y), y..y + 1, cells, &mut row[1..]);
+                // The row's right sides, and the next row's left pad, written after.
+                let out = &mut self.left[w * n + 1..(w + 1) * n + 1];
+                pass.run(sides.x_run(face, y), y..y + 1, cells, out);
             }
-            (row[0], self.right[w]) = (left[y], right[y]);
+            (self.left[w * n], self.right[w]) = (left[y], right[y]);
         }
         let inside = band.start.max(1)..band.end;
         if band.start == 0 {

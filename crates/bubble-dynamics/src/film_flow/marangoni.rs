@@ -646,6 +646,7 @@ impl EdgeValues for UpwindFluxes<'_> {
 
     #[inline(always)]
     fn run(&mut self, run: EdgeRun, _rows: Range<usize>, gamma: &[f64], out: &mut [f64]) {
+        let run = run.padded(out.len(), gamma.len());
         let (ga, gb) = run.ends(gamma);
         upwind_fluxes_block(run, [ga, gb], (self.fg, self.u), out);
     }
