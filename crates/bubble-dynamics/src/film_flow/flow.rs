@@ -201,9 +201,6 @@ pub(super) struct Scratch {
     pub(super) gather: GatherScratch,
     /// The seam edges' end values for the edge passes ([`SeamEnds`]).
     pub(super) seam_ends: SeamEnds,
-    /// The thickness transport's gathers' buffers and seam ends where it walks with the
-    /// velocity correction ([`super::fluxes::net_inflow_then_apply_limited`]).
-    pub(super) transport_gather: (GatherScratch, SeamEnds),
     /// Per cell: the velocity on its left x-edge (the temperature's transport,
     /// [`super::fluxes::spread_x_volumes`]).
     pub(super) spread: Vec<f64>,
@@ -378,10 +375,8 @@ impl FilmFlow {
         if let Some(m) = &self.meniscus {
             m.hold(&mut self.u_m_per_s, &mut s.drag);
         }
-        // The thickness transport's first sub-step walks with the velocity correction.
-        let drain = self.drain(forcing.g_eff_m_per_s2);
-        let (report, fastest) = self.marangoni_implicit(&mut s, dt_s, drain);
-        self.finish_transport(&mut s, dt_s, drain, fastest);
+        let report = self.marangoni_implicit(&mut s, dt_s);
+        self.transport_thickness(&mut s, dt_s, forcing.g_eff_m_per_s2);
         // A uniform evaporation joins the smoothing's last apply, where it has one.
         let thin = self.uniform_evaporation(dt_s);
         if !self.capillary_smoothing(&mut s, dt_s, thin) {

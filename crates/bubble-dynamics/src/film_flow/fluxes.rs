@@ -22,7 +22,6 @@
 
 use std::ops::Range;
 
-use super::face_geometry::FaceGeometry;
 use super::flow::MAX_OUTFLOW_FRACTION;
 use super::grid::CubeSphere;
 use super::sides::{CellSides, CellSpan, EdgeRun, INFLOW, Seams};
@@ -361,35 +360,19 @@ pub(crate) fn net_inflow(
             seam_values(sides, (pass, cells), (seams, pads));
             for band in bands(n) {
                 for (face, carried) in carried.iter_mut().enumerate() {
-                    let at = (face, &band);
-                    let window = (&mut *window, carried, &pads[..]);
-                    net_inflow_band((n, sides), at, (pass, cells), window, out, &mut finish);
+                    let pads = face_pads(pads, n, face);
+                    window.start(n, &band, carried);
+                    window.fill((n, sides), (face, band.clone()), (pass, cells), pads);
+                    let rows = sided(&band, n);
+                    let first = face * n * n + rows.start * n;
+                    let o = &mut out[first..first + rows.len() * n];
+                    window.net_inflow(n, &rows, o);
+                    window.carry(n, &band, carried);
+                    finish(face, rows, o);
                 }
             }
         },
     )
-}
-
-/// [`net_inflow`]'s work on face `face`'s band `band`, in its `window` (the rows kept
-/// from its band before in `carried`, its seam sides from `pads`).
-#[inline(always)]
-fn net_inflow_band(
-    (n, sides): (usize, &CellSides),
-    (face, band): (usize, &Range<usize>),
-    (pass, cells): (&mut impl EdgeValues, &[f64]),
-    (window, carried, pads): (&mut FaceWindow, &mut Carried, &[f64]),
-    out: &mut [f64],
-    finish: &mut impl FnMut(usize, Range<usize>, &mut [f64]),
-) {
-    window.start(n, band, carried);
-    let pads = face_pads(pads, n, face);
-    window.fill((n, sides), (face, band.clone()), (pass, cells), pads);
-    let rows = sided(band, n);
-    let first = face * n * n + rows.start * n;
-    let o = &mut out[first..first + rows.len() * n];
-    window.net_inflow(n, &rows, o);
-    window.carry(n, band, carried);
-    finish(face, rows, o);
 }
 
 /// The seam edges' values from `pass` into `seams`, and as each face's pads into `pads`
@@ -562,6 +545,7 @@ pub(crate) fn apply_limited_to(
     } = scratch;
     let n = sides.n();
     let fg = grid.face_geometry();
+    let (areas, per_area) = (&fg.area_sr[..], &fg.inverse_area_per_sr[..]);
     window.resize(n);
     rim.resize(sides.rim_cells.len());
     with_avx2(
@@ -570,147 +554,24 @@ pub(crate) fn apply_limited_to(
             seam_values(sides, (pass, values.before()), (seams, pads));
             for band in bands(n) {
                 for (face, carried) in carried.iter_mut().enumerate() {
-                    let window = (&mut *window, carried, &pads[..], &mut *rim);
-                    let at = (face, &band);
-                    apply_band((n, sides, fg), at, (pass, scale), window, values);
+                    let pads = face_pads(pads, n, face);
+                    window.start(n, &band, carried);
+                    let before = values.before();
+                    window.fill((n, sides), (face, band.clone()), (pass, before), pads);
+                    let first = face * n * n;
+                    let before = &before[first..first + n * n];
+                    let rows = sided(&band, n);
+                    let cells = rows.start * n..rows.end * n;
+                    let row_cells = (&areas[cells.clone()], &before[cells]);
+                    window.outflow_ratios(n, &rows, row_cells, scale);
+                    let rows = gatherable(&band, n);
+                    rim.keep((sides, face), &rows, window, before);
+                    let rows = (first, rows);
+                    window.gather_inside(n, rows, per_area, scale, values);
+                    window.carry(n, &band, carried);
                 }
             }
             rim.apply(sides, scale, values);
-        },
-    )
-}
-
-/// [`apply_limited_to`]'s work on face `face`'s band `band`, in its `window` (the rows
-/// kept from its band before in `carried`, its seam sides from `pads`), its rim cells'
-/// values kept in `rim`.
-#[inline(always)]
-fn apply_band(
-    (n, sides, fg): (usize, &CellSides, &FaceGeometry),
-    (face, band): (usize, &Range<usize>),
-    (pass, scale): (&mut impl EdgeValues, f64),
-    (window, carried, pads, rim): (&mut FaceWindow, &mut Carried, &[f64], &mut RimValues),
-    values: &mut (impl Moved + ?Sized),
-) {
-    window.start(n, band, carried);
-    let before = values.before();
-    let pads = face_pads(pads, n, face);
-    window.fill((n, sides), (face, band.clone()), (pass, before), pads);
-    let first = face * n * n;
-    let before = &before[first..first + n * n];
-    let rows = sided(band, n);
-    let cells = rows.start * n..rows.end * n;
-    let row_cells = (&fg.area_sr[cells.clone()], &before[cells]);
-    window.outflow_ratios(n, &rows, row_cells, scale);
-    let rows = gatherable(band, n);
-    rim.keep((sides, face), &rows, window, before);
-    let per_area = &fg.inverse_area_per_sr[..];
-    window.gather_inside(n, (first, rows), per_area, scale, values);
-    window.carry(n, band, carried);
-}
-
-/// Two passes over the edges whose gathers take one walk of the bands
-/// ([`net_inflow_then_apply_limited`]): the first's values gathered as a net inflow,
-/// the second's as a limited apply; the second may read what the first writes per edge.
-pub(crate) trait TwoPasses {
-    /// The first pass's seam values ([`EdgeValues::seams`]).
-    fn first_seams(&mut self, seams: Seams, cells: &[f64], out: &mut [f64]);
-    /// The first pass's run's values ([`EdgeValues::run`]).
-    fn first_run(&mut self, run: EdgeRun, rows: Range<usize>, cells: &[f64], out: &mut [f64]);
-    /// The second pass's seam values.
-    fn second_seams(&mut self, seams: Seams, cells: &[f64], out: &mut [f64]);
-    /// The second pass's band's set-up ([`EdgeValues::rows`]).
-    fn second_rows(&mut self, face: usize, rows: Range<usize>, cells: &[f64]);
-    /// The second pass's run's values.
-    fn second_run(&mut self, run: EdgeRun, rows: Range<usize>, cells: &[f64], out: &mut [f64]);
-}
-
-/// [`TwoPasses`]' first pass as an [`EdgeValues`].
-struct First<'a, T>(&'a mut T);
-
-impl<T: TwoPasses> EdgeValues for First<'_, T> {
-    #[inline(always)]
-    fn seams(&mut self, seams: Seams, cells: &[f64], out: &mut [f64]) {
-        self.0.first_seams(seams, cells, out);
-    }
-    #[inline(always)]
-    fn run(&mut self, run: EdgeRun, rows: Range<usize>, cells: &[f64], out: &mut [f64]) {
-        self.0.first_run(run, rows, cells, out);
-    }
-}
-
-/// [`TwoPasses`]' second pass as an [`EdgeValues`].
-struct Second<'a, T>(&'a mut T);
-
-impl<T: TwoPasses> EdgeValues for Second<'_, T> {
-    #[inline(always)]
-    fn seams(&mut self, seams: Seams, cells: &[f64], out: &mut [f64]) {
-        self.0.second_seams(seams, cells, out);
-    }
-    #[inline(always)]
-    fn rows(&mut self, face: usize, rows: Range<usize>, cells: &[f64]) {
-        self.0.second_rows(face, rows, cells);
-    }
-    #[inline(always)]
-    fn run(&mut self, run: EdgeRun, rows: Range<usize>, cells: &[f64], out: &mut [f64]) {
-        self.0.second_run(run, rows, cells, out);
-    }
-}
-
-/// [`net_inflow`] of `both`'s first pass's values from `cells` into `out` (`finish` as
-/// there) and [`apply_limited_to`] of its second's (times `scale`) on `values`, in one
-/// walk: each face's band of the second right after the first's, the seams' of the
-/// second after the first's, the same bits as the two passes one after the other.
-///
-/// Why: the Marangoni step's velocity correction writes every edge's velocity and the
-/// thickness transport then read them all again (0.4 MB at n = 64), from beyond L2;
-/// walked together, the transport finds each band's velocities in cache.
-// Inlined into the caller, so the passes compile into the AVX2 closure.
-#[inline(always)]
-pub(crate) fn net_inflow_then_apply_limited(
-    (sides, grid): (&CellSides, &CubeSphere),
-    both: &mut impl TwoPasses,
-    (cells, out, mut finish): (
-        &[f64],
-        &mut Vec<f64>,
-        impl FnMut(usize, Range<usize>, &mut [f64]),
-    ),
-    (scale, values): (f64, &mut (impl Moved + ?Sized)),
-    [a, b]: [&mut GatherScratch; 2],
-) {
-    let n = sides.n();
-    let fg = grid.face_geometry();
-    // Every entry is written below: the buffer needs its length, not a fill.
-    out.resize(6 * n * n, 0.0);
-    a.window.resize(n);
-    b.window.resize(n);
-    b.rim.resize(sides.rim_cells.len());
-    with_avx2(
-        #[inline(always)]
-        || {
-            seam_values(
-                sides,
-                (&mut First(both), cells),
-                (&mut a.seams, &mut a.pads),
-            );
-            let before = values.before();
-            seam_values(
-                sides,
-                (&mut Second(both), before),
-                (&mut b.seams, &mut b.pads),
-            );
-            for band in bands(n) {
-                for face in 0..6 {
-                    let at = (face, &band);
-                    let pass = (&mut First(both), cells);
-                    let window = (&mut a.window, &mut a.carried[face], &a.pads[..]);
-                    net_inflow_band((n, sides), at, pass, window, out, &mut finish);
-                    let (carried, pads) = (&mut b.carried[face], &b.pads[..]);
-                    let window = (&mut b.window, carried, pads, &mut b.rim);
-                    let pass = (&mut Second(both), scale);
-                    apply_band((n, sides, fg), at, pass, window, values);
-                }
-            }
-            b.rim.apply(sides, scale, values);
         },
     )
 }

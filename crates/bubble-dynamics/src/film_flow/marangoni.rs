@@ -19,13 +19,10 @@ use super::face_geometry::{EdgeConstant, FaceGeometry};
 use super::flow::{
     Drag, FilmFlow, FilmGradient, H_FLOOR_M, SOLVE_MAX_ITERATIONS, SOLVE_TOLERANCE, Scratch,
 };
-use super::fluxes::{
-    EdgeValues, OutOfPlace, TwoPasses, apply_limited, net_inflow, net_inflow_then_apply_limited,
-};
+use super::fluxes::{EdgeValues, apply_limited, net_inflow};
 use super::grid::CubeSphere;
 use super::sides::{EdgeBlock, EdgeRun, SeamEnds, Seams};
 use super::solve::{MassTerm, SolveLimits, SolveReport};
-use super::transport::{Drain, Fastest, FirstSubstep};
 
 /// Most solves a step's defect correction of the cross term takes (it takes about 11 on
 /// the swirl film at n = 64: each cuts the error by about 0.35, the cross operator's
@@ -39,17 +36,9 @@ const SWEEP_TOLERANCE: f64 = 0.3;
 impl FilmFlow {
     /// Backward-Euler Marangoni step: solves for the surfactant the step ends with, sets
     /// the velocities from its gradient, and moves the surfactant with fluxes that sum to
-    /// zero (so it is conserved to rounding whatever the solver's residual); with the
-    /// velocity correction, the thickness transport's first sub-step under `drain`, out
-    /// of place into `s.cell`, whose fastest edge's speed it returns
-    /// ([`FilmFlow::finish_transport`] takes it from there).
+    /// zero (so it is conserved to rounding whatever the solver's residual).
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
-    pub(super) fn marangoni_implicit(
-        &mut self,
-        s: &mut Scratch,
-        dt_s: f64,
-        drain: Drain,
-    ) -> (SolveReport, f64) {
+    pub(super) fn marangoni_implicit(&mut self, s: &mut Scratch, dt_s: f64) -> SolveReport {
         self.transport_surfactant(s, dt_s);
         let report = match self.params.gradient {
             FilmGradient::TwoPoint => {
@@ -67,16 +56,11 @@ impl FilmFlow {
                 self.correct_the_cross_term(s, dt_s, first)
             }
         };
-        let thickness = Some(drain);
-        let fastest = match self.params.gradient {
-            FilmGradient::TwoPoint => {
-                self.correct_velocity_and_move_surfactant::<false>(s, dt_s, thickness)
-            }
-            FilmGradient::Normal => {
-                self.correct_velocity_and_move_surfactant::<true>(s, dt_s, thickness)
-            }
-        };
-        (report, fastest)
+        match self.params.gradient {
+            FilmGradient::TwoPoint => self.correct_velocity_and_move_surfactant::<false>(s, dt_s),
+            FilmGradient::Normal => self.correct_velocity_and_move_surfactant::<true>(s, dt_s),
+        }
+        report
     }
 
     /// Moves Γ upwind with the velocity the step started with, in sub-steps of per-edge
@@ -288,16 +272,12 @@ impl FilmFlow {
     /// The velocity correction `−k ∇Γ'/Γ` (with the normal gradient, `NORMAL`, its
     /// implicit part, plus the cross term) and the conservative surfactant update with
     /// the transport fluxes plus the correction's; a step that would leave Γ negative
-    /// anywhere is redone upwind and limited instead. Where `thickness`, the thickness
-    /// transport's first sub-step under that drainage walks with it (out of place into
-    /// `s.cell`, [`net_inflow_then_apply_limited`]): returns its fastest edge's speed (0
-    /// without).
+    /// anywhere is redone upwind and limited instead.
     fn correct_velocity_and_move_surfactant<const NORMAL: bool>(
         &mut self,
         s: &mut Scratch,
         dt_s: f64,
-        thickness: Option<Drain>,
-    ) -> f64 {
+    ) {
         let r = self.params.radius_m;
         let g = std::sync::Arc::clone(&self.grid);
         let sides = std::sync::Arc::clone(&self.sides);
@@ -332,49 +312,23 @@ impl FilmFlow {
         change.resize(gamma.len(), 0.0);
         let (per_area, solution) = (&fg.inverse_area_per_sr[..], &s.cell2[..]);
         let mut negative = false;
-        let finish = surfactant_after(n, (gamma, solution, per_area), change, &mut negative);
-        let mut fastest = 0.0;
-        if let Some(drain) = thickness {
-            let (gather, seam_ends) = &mut s.transport_gather;
-            let mut both = CorrectThenMove {
-                correction,
-                thickness: FirstSubstep {
-                    sides,
-                    geo: &self.transport,
-                    fg,
-                    drain,
-                    dt_per_r: scale,
-                    rises: &mut s.rises,
-                    seam_ends,
-                    fastest: Fastest {
-                        speed: std::mem::take(&mut s.edge2),
-                        fastest: 0.0,
-                    },
-                },
-            };
-            // Every cell of `after` is written: its length, not a fill.
-            s.cell.resize(self.h_m.len(), 0.0);
-            let h = &mut OutOfPlace {
-                before: &self.h_m,
-                after: &mut s.cell,
-            };
-            let first = (gamma, &mut s.rhs, finish);
-            let scratch = [&mut s.gather, gather];
-            net_inflow_then_apply_limited((sides, &g), &mut both, first, (1.0, h), scratch);
-            s.edge2 = both.thickness.fastest.speed;
-            fastest = both.thickness.fastest.fastest;
-        } else {
-            net_inflow(
-                sides,
-                (&mut correction, gamma),
-                &mut s.rhs,
-                &mut s.gather,
-                finish,
-            );
-        }
+        let pass = (&mut correction, gamma);
+        net_inflow(
+            sides,
+            pass,
+            &mut s.rhs,
+            &mut s.gather,
+            |face, rows, next| {
+                let cells = face * n * n + rows.start * n..face * n * n + rows.end * n;
+                let per_area = &per_area[rows.start * n..rows.end * n];
+                let before = (&gamma[cells.clone()], &solution[cells.clone()]);
+                let after = (next, &mut change[cells]);
+                negative |= next_surfactant(before, per_area, after);
+            },
+        );
         if !negative {
             std::mem::swap(&mut self.gamma, &mut s.rhs);
-            return fastest;
+            return;
         }
         // A violent step (a film torn near zero thickness, where the waves run at
         // hundreds of m/s) overshot: redo it with every flux upwind and each donor
@@ -386,65 +340,6 @@ impl FilmFlow {
         let mut fluxes = UpwindFluxes::new(fg, change, &mut s.seam_ends);
         let (gamma, gather) = (&mut self.gamma, &mut s.gather);
         apply_limited(sides, &g, &mut fluxes, scale, gamma, gather);
-        fastest
-    }
-}
-
-/// The gathers' `finish` of [`FilmFlow::correct_velocity_and_move_surfactant`]: a
-/// stretch of face `face`'s rows `rows`' net inflows `next` into the surfactant after the
-/// step ([`next_surfactant`], `gamma` before, the solve's `solution`, face 0's
-/// `per_area`), its change from `gamma` into `change`, `negative` set where one is.
-#[inline(always)]
-fn surfactant_after<'a>(
-    n: usize,
-    (gamma, solution, per_area): (&'a [f64], &'a [f64], &'a [f64]),
-    change: &'a mut [f64],
-    negative: &'a mut bool,
-) -> impl FnMut(usize, Range<usize>, &mut [f64]) + 'a {
-    // Inlined into the gathers' AVX2 closure (a closure of its own, it took SSE2).
-    #[inline(always)]
-    move |face, rows, next| {
-        let cells = face * n * n + rows.start * n..face * n * n + rows.end * n;
-        let per_area = &per_area[rows.start * n..rows.end * n];
-        let before = (&gamma[cells.clone()], &solution[cells.clone()]);
-        let after = (next, &mut change[cells]);
-        *negative |= next_surfactant(before, per_area, after);
-    }
-}
-
-/// The velocity correction's pass and the thickness transport's first sub-step's, in one
-/// walk ([`net_inflow_then_apply_limited`]): the transport reads each band's velocities
-/// as the correction leaves them.
-struct CorrectThenMove<'a, 'b, const NORMAL: bool> {
-    /// The correction.
-    correction: Correction<'a, NORMAL>,
-    /// The transport, which reads the correction's velocities.
-    thickness: FirstSubstep<'b>,
-}
-
-impl<const NORMAL: bool> TwoPasses for CorrectThenMove<'_, '_, NORMAL> {
-    #[inline(always)]
-    fn first_seams(&mut self, seams: Seams, cells: &[f64], out: &mut [f64]) {
-        self.correction.seams(seams, cells, out);
-    }
-    #[inline(always)]
-    fn first_run(&mut self, run: EdgeRun, rows: Range<usize>, cells: &[f64], out: &mut [f64]) {
-        self.correction.run(run, rows, cells, out);
-    }
-    #[inline(always)]
-    fn second_seams(&mut self, seams: Seams, cells: &[f64], out: &mut [f64]) {
-        let u = &*self.correction.edges.u;
-        self.thickness.volumes(u).seams(seams, cells, out);
-    }
-    #[inline(always)]
-    fn second_rows(&mut self, face: usize, rows: Range<usize>, cells: &[f64]) {
-        let u = &*self.correction.edges.u;
-        self.thickness.volumes(u).rows(face, rows, cells);
-    }
-    #[inline(always)]
-    fn second_run(&mut self, run: EdgeRun, rows: Range<usize>, cells: &[f64], out: &mut [f64]) {
-        let u = &*self.correction.edges.u;
-        self.thickness.volumes(u).run(run, rows, cells, out);
     }
 }
 
@@ -816,60 +711,15 @@ mod tests {
         f
     }
 
-    /// The velocity correction walked with the thickness transport's first sub-step
-    /// ([`net_inflow_then_apply_limited`]) against the correction, then the transport:
-    /// the same bits of velocity, surfactant and thickness, on a grid of two bands (rows
-    /// carried from band to band), the seams' values and the rim's taken apart.
-    #[test]
-    fn the_correction_walked_with_the_transport_is_the_two_in_turn() {
-        let dt_s = 1.0 / 60.0;
-        let n = crate::film_flow::fluxes::BAND + 3;
-        let grid = std::sync::Arc::new(CubeSphere::new(n));
-        let hierarchy = std::sync::Arc::new(crate::film_flow::Hierarchy::new(&grid));
-        let params = FlowParams {
-            drainage_viscosity_pa_s: 1e-6,
-            ..FlowParams::water_film(0.05)
-        };
-        let mut f = FilmFlow::new(grid, hierarchy, params, |d| {
-            600e-9 * (1.0 + 0.3 * (4.0 * d.x + d.y).sin())
-        });
-        f.set_velocity(|d| DVec3::Y.cross(d) * 0.05);
-        f.set_surfactant(|d| 1.0 + 0.1 * d.z);
-        let mut s = Scratch::default();
-        s.u_start.clone_from(&f.u_m_per_s);
-        for (e, u) in f.u_m_per_s.iter_mut().enumerate() {
-            *u = 1.1 * *u + 1e-3 * ((e % 5) as f64 - 2.0);
-        }
-        f.fluxes_weights_and_right_hand_side::<false>(&mut s, dt_s);
-        f.solve_surfactant(&mut s);
-        let drain = f.drain(DVec3::new(0.3, -9.8, 0.5));
-        let (mut apart, mut s_apart) = (f.clone(), s.clone());
-        apart.correct_velocity_and_move_surfactant::<false>(&mut s_apart, dt_s, None);
-        let fastest = apart.upwind_substep(&mut s_apart, dt_s, drain, true);
-        apart.finish_transport(&mut s_apart, dt_s, drain, fastest);
-        let walked = f.correct_velocity_and_move_surfactant::<false>(&mut s, dt_s, Some(drain));
-        assert_eq!(walked.to_bits(), fastest.to_bits(), "the fastest edge");
-        f.finish_transport(&mut s, dt_s, drain, walked);
-        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-        assert_eq!(bits(&f.u_m_per_s), bits(&apart.u_m_per_s), "velocities");
-        assert_eq!(bits(&f.gamma), bits(&apart.gamma), "surfactant");
-        assert_eq!(bits(&f.h_m), bits(&apart.h_m), "thickness");
-        assert_ne!(
-            bits(&f.h_m),
-            bits(&s.cell),
-            "the thickness stayed: the test is idle"
-        );
-    }
-
     /// The central pass's weights against the plain `dt² E l/(ρ h d R²)` times the drag's
     /// factor, to rounding (face 0's constants), and the velocities untouched with the
-    /// factors kept: on a grid of two bands, whose x-runs run padded, each row's extra
+    /// factors kept: on a grid of three bands, whose x-runs run padded, each row's extra
     /// edge put back (a face's last row's is the next face's first x-edge, whose band
     /// came before).
     #[test]
     fn the_central_weights_are_the_plain_ones_on_every_edge() {
         let dt_s = 1.0 / 60.0;
-        let n = crate::film_flow::fluxes::BAND + 3;
+        let n = 2 * crate::film_flow::fluxes::BAND + 3;
         let grid = std::sync::Arc::new(CubeSphere::new(n));
         let hierarchy = std::sync::Arc::new(crate::film_flow::Hierarchy::new(&grid));
         let params = FlowParams::water_film(0.05);
@@ -926,7 +776,7 @@ mod tests {
         f.fluxes_weights_and_right_hand_side::<false>(&mut s, dt_s);
         f.solve_surfactant(&mut s);
         let (u_before, gamma_before) = (f.u_m_per_s.clone(), f.gamma.clone());
-        f.correct_velocity_and_move_surfactant::<false>(&mut s, dt_s, None);
+        f.correct_velocity_and_move_surfactant::<false>(&mut s, dt_s);
 
         let (p, g) = (f.params, std::sync::Arc::clone(&f.grid));
         let (ea, r) = (g.edge_arrays(), p.radius_m);

@@ -492,8 +492,8 @@ impl EdgeRun {
 
     /// An x-run of `n − 1` edges taken as `n`, where its values' place (`out` long) has
     /// room and its last `b` cell is not the field's last (`cells` long), for a pass that
-    /// writes only its values ([`super::fluxes::EdgeValues::run`]), or puts back what it
-    /// writes of the extra edge's per-edge arrays: a whole number of vectors where `n` is a
+    /// reads per-edge arrays and writes only its values
+    /// ([`super::fluxes::EdgeValues::run`]): a whole number of vectors where `n` is a
     /// multiple of four (the `n − 1` left a scalar remainder of three edges, about 190
     /// instructions a row in the thickness transport at n = 64). The extra edge reads the
     /// next row's first x-edge's values and end cells (the y-edges' first after a face's

@@ -7,10 +7,7 @@
 //! ([`super::upwind`], [`super::fluxes`]): each cell's limited rises to its sides, the
 //! volume across each edge, each donor's outflow factor and each cell's gathered volumes,
 //! the band's scratch never leaving the cache. Inside a face each stretch reads slices
-//! and vectorises. The first sub-step takes the Courant number too ([`Fastest`]); in the
-//! step it walks the bands with the Marangoni step's velocity correction
-//! ([`FirstSubstep`], [`super::fluxes::net_inflow_then_apply_limited`]), which writes the
-//! velocities it reads.
+//! and vectorises. The first sub-step takes the Courant number too ([`Fastest`]).
 
 use glam::DVec3;
 
@@ -19,8 +16,8 @@ use super::face_geometry::FaceGeometry;
 use super::flow::{FilmFlow, Scratch};
 use super::fluxes::{OutOfPlace, apply_limited, apply_limited_to};
 use super::grid::dot_at;
-use super::sides::{CellSides, EdgeBlock, SeamEnds};
-use super::upwind::{self, Rises, UpwindGeometry};
+use super::sides::EdgeBlock;
+use super::upwind;
 
 /// Most sub-steps one thickness transport takes.
 const MAX_SUBSTEPS: u32 = 64;
@@ -36,40 +33,16 @@ impl FilmFlow {
     /// Courant number read the velocities, thicknesses and normals again (14 k cache lines
     /// a step at n = 64) for the one sub-step a film in the optics' range takes; and the
     /// thickness copied aside in case (0.2 MB a step) cost as much.
-    ///
-    /// The step takes the first sub-step with the Marangoni step's velocity correction
-    /// ([`FilmFlow::marangoni_implicit`]) and the rest by [`Self::finish_transport`]; the
-    /// tests take it here.
-    #[cfg(test)]
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     pub(super) fn transport_thickness(&mut self, s: &mut Scratch, dt_s: f64, g_eff: DVec3) {
-        let drain = self.drain(g_eff);
-        let fastest = self.upwind_substep(s, dt_s, drain, true);
-        self.finish_transport(s, dt_s, drain, fastest);
-    }
-
-    /// The drainage under `g_eff` ([`Drain`]).
-    pub(super) fn drain(&self, g_eff: DVec3) -> Drain {
-        let p = &self.params;
+        let p = self.params;
         let drain = if p.drainage_viscosity_pa_s.is_finite() && p.drainage_viscosity_pa_s > 0.0 {
             p.density_kg_per_m3 / (3.0 * p.drainage_viscosity_pa_s)
         } else {
             0.0
         };
-        Drain { drain, g_eff }
-    }
-
-    /// The thickness transport after its first sub-step over `dt_s`, taken out of place
-    /// into `s.cell` with its fastest edge's speed `fastest` ([`Fastest`]): swapped in
-    /// where one sub-step does, else the sub-steps the Courant number asks for, from the
-    /// thickness untouched.
-    pub(super) fn finish_transport(
-        &mut self,
-        s: &mut Scratch,
-        dt_s: f64,
-        drain: Drain,
-        fastest: f64,
-    ) {
-        let courant = fastest * dt_s / self.params.radius_m;
+        let drain = Drain { drain, g_eff };
+        let courant = self.upwind_substep(s, dt_s, drain, true) * dt_s / p.radius_m;
         // A cell drains through at most two edges of a smooth flow: 2·courant per step, kept
         // within one sub-step's content; the outflow limit guards the rest.
         let substeps = (2.0 * courant).ceil().clamp(1.0, f64::from(MAX_SUBSTEPS)) as u32;
@@ -90,13 +63,7 @@ impl FilmFlow {
     /// `s.cell` (`h_m` unchanged), returning the fastest edge's characteristic speed over
     /// its smaller cell's width ([`Fastest`]); else in place, returning 0.
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
-    pub(super) fn upwind_substep(
-        &mut self,
-        s: &mut Scratch,
-        dt_s: f64,
-        drain: Drain,
-        courant: bool,
-    ) -> f64 {
+    fn upwind_substep(&mut self, s: &mut Scratch, dt_s: f64, drain: Drain, courant: bool) -> f64 {
         let mut fastest = Fastest {
             speed: std::mem::take(&mut s.edge2),
             fastest: 0.0,
@@ -129,47 +96,6 @@ impl FilmFlow {
         }
         s.edge2 = fastest.speed;
         fastest.fastest
-    }
-}
-
-/// The thickness transport's first sub-step's pass ([`upwind::Volumes`]) but the
-/// velocities, which the walk it joins writes first ([`super::fluxes::TwoPasses`]).
-pub(crate) struct FirstSubstep<'a> {
-    /// The cells' sides.
-    pub(crate) sides: &'a CellSides,
-    /// The rises' weights.
-    pub(crate) geo: &'a UpwindGeometry,
-    /// The grid's constants.
-    pub(crate) fg: &'a FaceGeometry,
-    /// The drainage.
-    pub(crate) drain: Drain,
-    /// The step over the sphere's radius, s/m.
-    pub(crate) dt_per_r: f64,
-    /// The limited rises.
-    pub(crate) rises: &'a mut Rises,
-    /// The seams' ends.
-    pub(crate) seam_ends: &'a mut SeamEnds,
-    /// The fastest edge so far.
-    pub(crate) fastest: Fastest,
-}
-
-impl FirstSubstep<'_> {
-    /// The pass with the velocities `u`.
-    #[inline(always)]
-    pub(crate) fn volumes<'b>(&'b mut self, u: &'b [f64]) -> upwind::Volumes<'b> {
-        upwind::Volumes {
-            sides: self.sides,
-            geo: self.geo,
-            fg: self.fg,
-            speeds: upwind::EdgeSpeeds {
-                u,
-                drain: self.drain,
-                dt_per_r: self.dt_per_r,
-            },
-            rises: self.rises,
-            seam_ends: self.seam_ends,
-            fastest: Some(&mut self.fastest),
-        }
     }
 }
 
