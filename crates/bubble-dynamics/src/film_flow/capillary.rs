@@ -17,7 +17,9 @@ use std::ops::Range;
 
 use super::compare::{largest, pick, smaller};
 use super::face_geometry::FaceGeometry;
-use super::fluxes::{EdgeValues, GatherScratch, apply_limited, net_inflow};
+use super::fluxes::{
+    EdgeValues, GatherScratch, Thinned, apply_limited, apply_limited_to, net_inflow,
+};
 use super::grid::CubeSphere;
 use super::sides::{CellSides, EdgeBlock, EdgeRun, SeamEnds, Seams};
 
@@ -56,15 +58,17 @@ pub(crate) struct CapillaryScratch {
     seam_ends: SeamEnds,
 }
 
-/// Moves liquid by the capillary pressure over `dt_s`; `h_m` per cell.
+/// Moves liquid by the capillary pressure over `dt_s`; `h_m` per cell. Where `thin`
+/// and a sub-step is taken, the last one's apply also thins every cell by it, kept ≥ 0
+/// ([`Thinned`]: the evaporation): returns whether it did.
 pub(crate) fn smooth_thickness(
     grid: &CubeSphere,
     sides: &CellSides,
     c: Capillary,
-    dt_s: f64,
+    (dt_s, thin): (f64, Option<f64>),
     h_m: &mut [f64],
     s: &mut CapillaryScratch,
-) {
+) -> bool {
     // h³/(3μ_d) times σ/2 (the pressure's factor), per m³ of h³.
     let per_cubed = 0.5 * c.sigma_n_per_m / (3.0 * c.drainage_viscosity_pa_s);
     // Gershgorin: |∇·(M∇)| ≤ max M · |∇²| and |∇²| ≤ 2 max Σ l/(d A R²).
@@ -80,7 +84,7 @@ pub(crate) fn smooth_thickness(
     let max_mobility = per_cubed * thickest * thickest * thickest;
     let rate = max_mobility * (norm / (c.radius_m * c.radius_m)).powi(2);
     if rate * dt_s < 1e-3 {
-        return; // a smoothing the step cannot see (every film of the optics' range)
+        return false; // a smoothing the step cannot see (every film of the optics' range)
     }
     let substeps = (rate * dt_s / STABLE_RATE_DT)
         .ceil()
@@ -89,9 +93,12 @@ pub(crate) fn smooth_thickness(
     // Cap the mobility where the sub-steps cannot resolve the rate.
     let cap = max_mobility * (STABLE_RATE_DT / (rate * sub_dt)).min(1.0);
     let mobility = Mobility { per_cubed, cap };
-    for _ in 0..substeps as u32 {
-        substep((grid, sides), c.radius_m, mobility, sub_dt, h_m, s);
+    let substeps = substeps as u32;
+    for k in 0..substeps {
+        let thin = thin.filter(|_| k + 1 == substeps);
+        substep((grid, sides), c.radius_m, mobility, (sub_dt, thin), h_m, s);
     }
+    thin.is_some()
 }
 
 /// The ∞-norm of the grid's Laplacian on the unit sphere, `2 max_c Σ l/(d A)`.
@@ -119,12 +126,12 @@ struct Mobility {
 
 /// One forward-Euler sub-step of `∂h/∂t = −∇·(M ∇(−∇²h))`: two gathers by bands
 /// ([`super::fluxes`]), of the thickness's differences into the Laplacian, then of the
-/// volumes into the thickness.
+/// volumes into the thickness, each cell then thinned by `thin` where given.
 fn substep(
     (grid, sides): (&CubeSphere, &CellSides),
     radius_m: f64,
     mobility: Mobility,
-    dt_s: f64,
+    (dt_s, thin): (f64, Option<f64>),
     h_m: &mut [f64],
     s: &mut CapillaryScratch,
 ) {
@@ -168,7 +175,13 @@ fn substep(
         seam_ends: &mut s.seam_ends,
     };
     // Each donor gives at most half its content: h stays ≥ 0.
-    apply_limited(sides, grid, &mut volumes, 1.0, h_m, &mut s.gather);
+    match thin {
+        None => apply_limited(sides, grid, &mut volumes, 1.0, h_m, &mut s.gather),
+        Some(by) => {
+            let h = &mut Thinned { values: h_m, by };
+            apply_limited_to(sides, grid, &mut volumes, 1.0, h, &mut s.gather);
+        }
+    }
 }
 
 /// The Laplacian's differences across every edge, from the thickness ([`EdgeValues`]).
@@ -188,6 +201,7 @@ impl EdgeValues for Differences<'_> {
 
     #[inline(always)]
     fn run(&mut self, run: EdgeRun, _rows: Range<usize>, h: &[f64], out: &mut [f64]) {
+        let run = run.padded(out.len(), h.len());
         let (ha, hb) = run.ends(h);
         differences_block(run, [ha, hb], self.fg, out);
     }
@@ -242,6 +256,7 @@ impl EdgeValues for Volumes<'_> {
 
     #[inline(always)]
     fn run(&mut self, run: EdgeRun, _rows: Range<usize>, h: &[f64], out: &mut [f64]) {
+        let run = run.padded(out.len(), h.len());
         let ((ha, hb), (la, lb)) = (run.ends(h), run.ends(self.laplacian));
         volumes_block(
             (self.fg, self.mobility, self.per_length),

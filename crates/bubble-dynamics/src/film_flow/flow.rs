@@ -377,8 +377,11 @@ impl FilmFlow {
         }
         let report = self.marangoni_implicit(&mut s, dt_s);
         self.transport_thickness(&mut s, dt_s, forcing.g_eff_m_per_s2);
-        self.capillary_smoothing(&mut s, dt_s);
-        self.evaporate(dt_s);
+        // A uniform evaporation joins the smoothing's last apply, where it has one.
+        let thin = self.uniform_evaporation(dt_s);
+        if !self.capillary_smoothing(&mut s, dt_s, thin) {
+            self.evaporate(dt_s);
+        }
         self.feed_meniscus(dt_s);
         if let Some(mut burst) = self.burst.take() {
             burst.step(self, dt_s);
@@ -386,6 +389,13 @@ impl FilmFlow {
         }
         self.scratch = s;
         report
+    }
+
+    /// What the step's evaporation takes from every cell where it is the same for all
+    /// (the film has no temperature), m; `None` where it takes nothing or varies.
+    fn uniform_evaporation(&self, dt_s: f64) -> Option<f64> {
+        let evaporated = self.params.evaporation_nm_per_s * 1e-9 * dt_s;
+        (evaporated > 0.0 && self.temperature_k.is_empty()).then_some(evaporated)
     }
 
     /// Thins every cell by the evaporation rate, scaled by its temperature's vapour
@@ -559,13 +569,15 @@ impl FilmFlow {
     }
 
     /// The capillary pressure's flow relative to the surfaces (module `capillary`); none
-    /// without drainage (immobile liquid between the surfaces).
+    /// without drainage (immobile liquid between the surfaces). Where `thin`, its last
+    /// apply thins every cell by it too (kept ≥ 0, as [`Self::evaporate`]): returns
+    /// whether it did.
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
-    fn capillary_smoothing(&mut self, s: &mut Scratch, dt_s: f64) {
+    fn capillary_smoothing(&mut self, s: &mut Scratch, dt_s: f64, thin: Option<f64>) -> bool {
         let p = &self.params;
         let mu = p.drainage_viscosity_pa_s;
         if !(mu.is_finite() && mu > 0.0 && p.burst.sigma_n_per_m > 0.0) {
-            return;
+            return false;
         }
         let c = Capillary {
             sigma_n_per_m: p.burst.sigma_n_per_m,
@@ -573,7 +585,8 @@ impl FilmFlow {
             radius_m: p.radius_m,
         };
         let sides = &self.sides;
-        smooth_thickness(&self.grid, sides, c, dt_s, &mut self.h_m, &mut s.capillary);
+        let h = &mut self.h_m;
+        smooth_thickness(&self.grid, sides, c, (dt_s, thin), h, &mut s.capillary)
     }
 }
 

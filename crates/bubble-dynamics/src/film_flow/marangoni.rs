@@ -392,8 +392,17 @@ impl<const NORMAL: bool> EdgeValues for CentralFluxes<'_, NORMAL> {
 
     #[inline(always)]
     fn run(&mut self, run: EdgeRun, _rows: Range<usize>, gamma: &[f64], out: &mut [f64]) {
-        let ((ga, gb), (ha, hb)) = (run.ends(gamma), run.ends(self.h));
-        self.edges.block(run, [ga, gb, ha, hb], out);
+        // With the two-point gradient an x-run runs padded ([`EdgeRun::padded`]), the
+        // extra edge's velocity and weight, which it writes, put back after: they are
+        // the next x-edge's, taken by its own run (the cross term's arrays are more).
+        let padded = run.padded(if NORMAL { 0 } else { out.len() }, gamma.len());
+        let ((ga, gb), (ha, hb)) = (padded.ends(gamma), padded.ends(self.h));
+        let extra = padded.first() + run.len;
+        let kept = (padded.len > run.len).then(|| (self.edges.u[extra], self.edges.weight[extra]));
+        self.edges.block(padded, [ga, gb, ha, hb], out);
+        if let Some(kept) = kept {
+            (self.edges.u[extra], self.edges.weight[extra]) = kept;
+        }
     }
 }
 
@@ -535,8 +544,17 @@ impl<const NORMAL: bool> EdgeValues for Correction<'_, NORMAL> {
 
     #[inline(always)]
     fn run(&mut self, run: EdgeRun, _rows: Range<usize>, gamma: &[f64], out: &mut [f64]) {
-        let ((ga, gb), (xa, xb)) = (run.ends(gamma), run.ends(self.solution));
-        self.edges.block(run, [ga, gb, xa, xb], out);
+        // An x-run runs padded ([`EdgeRun::padded`]), the extra edge's velocity, which
+        // it corrects in place, put back after: it is the next x-edge's, corrected by its
+        // own run.
+        let padded = run.padded(out.len(), gamma.len());
+        let ((ga, gb), (xa, xb)) = (padded.ends(gamma), padded.ends(self.solution));
+        let extra = padded.first() + run.len;
+        let kept = (padded.len > run.len).then(|| self.edges.u[extra]);
+        self.edges.block(padded, [ga, gb, xa, xb], out);
+        if let Some(kept) = kept {
+            self.edges.u[extra] = kept;
+        }
     }
 }
 
@@ -648,6 +666,7 @@ impl EdgeValues for UpwindFluxes<'_> {
 
     #[inline(always)]
     fn run(&mut self, run: EdgeRun, _rows: Range<usize>, gamma: &[f64], out: &mut [f64]) {
+        let run = run.padded(out.len(), gamma.len());
         let (ga, gb) = run.ends(gamma);
         upwind_fluxes_block(run, [ga, gb], (self.fg, self.u), out);
     }
@@ -692,6 +711,48 @@ mod tests {
             f.step(1.0 / 60.0, &forcing);
         }
         f
+    }
+
+    /// The central pass's weights against the plain `dt² E l/(ρ h d R²)` times the drag's
+    /// factor, to rounding (face 0's constants), and the velocities untouched with the
+    /// factors kept: on a grid of three bands, whose x-runs run padded, each row's extra
+    /// edge put back (a face's last row's is the next face's first x-edge, whose band
+    /// came before).
+    #[test]
+    fn the_central_weights_are_the_plain_ones_on_every_edge() {
+        let dt_s = 1.0 / 60.0;
+        let n = 2 * crate::film_flow::fluxes::BAND + 3;
+        let grid = std::sync::Arc::new(CubeSphere::new(n));
+        let hierarchy = std::sync::Arc::new(crate::film_flow::Hierarchy::new(&grid));
+        let params = FlowParams::water_film(0.05);
+        let mut f = FilmFlow::new(grid, hierarchy, params, |d| {
+            20e-6 * (1.0 + 0.3 * (4.0 * d.x + d.y).sin())
+        });
+        f.set_velocity(|d| DVec3::Y.cross(d) * 0.05);
+        f.set_surfactant(|d| 1.0 + 0.1 * d.z);
+        let mut s = Scratch::default();
+        s.u_start.clone_from(&f.u_m_per_s);
+        let edges = f.u_m_per_s.len();
+        s.drag = (0..edges)
+            .map(|e| 1.0 / (1.0 + 0.1 * (e % 7) as f64))
+            .collect();
+        s.drag_by = Drag::Stored;
+        let u_before = f.u_m_per_s.clone();
+        f.fluxes_weights_and_right_hand_side::<false>(&mut s, dt_s);
+        assert_eq!(f.u_m_per_s, u_before, "velocities written");
+        let (p, ea, h) = (f.params, f.grid.edge_arrays(), &f.h_m);
+        let per_r2 = 1.0 / (p.radius_m * p.radius_m);
+        for (e, &[a, b]) in ea.cells.iter().enumerate() {
+            let h_edge = (0.5 * (h[a as usize] + h[b as usize])).max(H_FLOOR_M);
+            let k = dt_s * p.elasticity_n_per_m / p.density_kg_per_m3 / h_edge * s.drag[e];
+            let plain = dt_s * per_r2 * k * ea.length[e] * ea.inverse_dual_length[e];
+            let off = (s.weight[e] - plain).abs();
+            assert!(
+                off <= 1e-12 * plain,
+                "edge {e}: {} against {plain}",
+                s.weight[e]
+            );
+        }
     }
 
     /// The two-point gradient's velocity correction, taken from the system's weights,

@@ -490,6 +490,24 @@ impl EdgeRun {
         (&cells[self.a_cells()], &cells[self.b_cells()])
     }
 
+    /// An x-run of `n − 1` edges taken as `n`, where its values' place (`out` long) has
+    /// room and its last `b` cell is not the field's last (`cells` long), for a pass that
+    /// reads per-edge arrays and writes only its values
+    /// ([`super::fluxes::EdgeValues::run`]): a whole number of vectors where `n` is a
+    /// multiple of four (the `n − 1` left a scalar remainder of three edges, about 190
+    /// instructions a row in the thickness transport at n = 64). The extra edge reads the
+    /// next row's first x-edge's values and end cells (the y-edges' first after a face's
+    /// last row), and its value lands in the window's next pad, written after it.
+    #[inline(always)]
+    pub(crate) fn padded(self, out: usize, cells: usize) -> Self {
+        let len = self.len + 1;
+        if self.sides[0] == RIGHT && out >= len && self.b + len <= cells {
+            Self { len, ..self }
+        } else {
+            self
+        }
+    }
+
     /// A per-edge array's values along the run, to write.
     #[inline(always)]
     pub(crate) fn along_mut<'a>(&self, per_edge: &'a mut [f64]) -> &'a mut [f64] {
@@ -836,6 +854,35 @@ fn side_towards(grid: &CubeSphere, c: usize, towards: glam::DVec3) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A padded x-run is one edge longer, its first `n − 1` edges and ends the run's,
+    /// the extra one the next x-edge between the row's last cell and the next one; not
+    /// on the field's last row, nor a y-run, nor where its values' place has no room.
+    #[test]
+    fn a_padded_x_run_takes_the_next_edge_where_it_can() {
+        let n = 5;
+        let sides = CellSides::new(&CubeSphere::new(n));
+        let cells = 6 * n * n;
+        for (face, y) in [(0, 0), (2, 3), (5, n - 2)] {
+            let run = sides.x_run(face, y);
+            let padded = run.padded(n, cells);
+            assert_eq!(padded.len, n, "face {face} row {y}");
+            assert_eq!(
+                (padded.start, padded.a, padded.b),
+                (run.start, run.a, run.b)
+            );
+            assert_eq!(
+                padded.b + n - 1,
+                face * n * n + (y + 1) * n,
+                "the next row's first"
+            );
+        }
+        let last = sides.x_run(5, n - 1);
+        assert_eq!(last.padded(n, cells).len, n - 1, "the field's last row");
+        assert_eq!(sides.x_run(1, 2).padded(n - 1, cells).len, n - 1, "no room");
+        let below = sides.y_run(1, 1..3);
+        assert_eq!(below.padded(4 * n, cells).len, below.len, "a y-run");
+    }
 
     #[test]
     fn inside_a_face_the_sides_sit_at_the_layouts_offsets() {

@@ -392,6 +392,7 @@ impl EdgeValues for Volumes<'_> {
         rim_rises(self.sides, self.geo, h, rim);
         let [h_ends, rises] = self.seam_ends.gather_with_rim_sides(seams, h, &rim.rise);
         let fastest = self.fastest.as_deref_mut();
+        let fastest = fastest.map(|f| (f, seams.len));
         volumes_block(seams, h_ends, rises, (self.fg, self.speeds), (out, fastest));
     }
 
@@ -412,6 +413,8 @@ impl EdgeValues for Volumes<'_> {
             (r.at(n, ka, rows.start - 1), r.at(n, kb, rows.start))
         };
         let (ra, rb) = (&r.rows[a..], &r.rows[b..]);
+        let edges = run.len;
+        let run = run.padded(out.len(), h.len());
         let (ha, hb) = run.ends(h);
         let fastest = self.fastest.as_deref_mut();
         volumes_block(
@@ -419,13 +422,15 @@ impl EdgeValues for Volumes<'_> {
             [ha, hb],
             [ra, rb],
             (self.fg, self.speeds),
-            (out, fastest),
+            (out, fastest.map(|f| (f, edges))),
         );
     }
 }
 
 /// [`Volumes`] over a block of edges, with their ends' thicknesses and rises, into
-/// `out`, and their characteristic speeds into `fastest` where it is taken.
+/// `out`, and their characteristic speeds into `fastest` where it is taken, the first
+/// `edges` of them (an [`EdgeRun::padded`] run's extra one's zeroed: the speeds are ≥ 0 and the
+/// fastest starts at 0, so it changes no maximum).
 ///
 /// Why the speeds here: a loop of their own read the velocities, thicknesses and normals
 /// again and took each edge's drainage coefficient a second time (0.12 M instructions a
@@ -436,15 +441,22 @@ fn volumes_block(
     ends: [&[f64]; 2],
     rises: [&[f64]; 2],
     (fg, speeds): (&FaceGeometry, EdgeSpeeds),
-    (out, fastest): (&mut [f64], Option<&mut Fastest>),
+    (out, fastest): (&mut [f64], Option<(&mut Fastest, usize)>),
 ) {
-    let edges = (block, ends, rises);
+    let all = (block, ends, rises);
     match fastest {
-        None => volumes_loop::<false>(edges, (fg, speeds), out, &mut []),
-        Some(fastest) => fastest.take(
+        None => volumes_loop::<false>(all, (fg, speeds), out, &mut []),
+        Some((fastest, edges)) => fastest.take(
             block.count(),
             #[inline(always)]
-            |speed| volumes_loop::<true>(edges, (fg, speeds), out, speed),
+            |speed| {
+                volumes_loop::<true>(all, (fg, speeds), out, speed);
+                // One at most ([`EdgeRun::padded`]); as a store, not a fill (a call to memset).
+                debug_assert!(speed.len() <= edges + 1);
+                if let Some(extra) = speed.get_mut(edges) {
+                    *extra = 0.0;
+                }
+            },
         ),
     }
 }
@@ -509,7 +521,7 @@ mod tests {
         }
         fn run(&mut self, run: EdgeRun, rows: Range<usize>, cells: &[f64], out: &mut [f64]) {
             self.pass.run(run, rows, cells, out);
-            self.values[run.edges()].copy_from_slice(out);
+            self.values[run.edges()].copy_from_slice(&out[..run.len]);
         }
     }
 
