@@ -447,14 +447,17 @@ pub(super) fn refresh_all<T: Real>(layout: &Layout, field: &mut [T]) {
 }
 
 /// Each copy of colour `c`'s halo runs: `set(field, halo, source)` on the field's
-/// pointer and the copy's positions, every one inside `field`.
+/// pointer and the copy's positions, every one inside `field`; from the level's flat
+/// list of the copies where it holds one ([`Layout::flat_halo_copies`]: the small
+/// levels, whose runs' set-up would cost more than their copies).
 ///
 /// Why raw positions: a run walks two constant strides through one array, which safe
 /// slices can only do with a check a copy (the index pairs did two) or a division a run
 /// (`chunks_exact`), and at the coarse levels, where a run is one to eight copies, the
 /// latter costs more than the copies. The layout checked when it was built that every
 /// run stays inside its `len()` ([`Layout::halo_runs`]), so checking `field` against
-/// that length once makes every position of every run valid.
+/// that length once makes every position of every run (and of the flat list, the same
+/// copies) valid.
 #[inline(always)]
 fn for_each_copy<T: Copy>(
     layout: &Layout,
@@ -464,6 +467,13 @@ fn for_each_copy<T: Copy>(
 ) {
     let field = &mut field[..layout.len()];
     let base = field.as_mut_ptr();
+    let flat = layout.flat_halo_copies(c);
+    if !flat.is_empty() {
+        for &[halo, source] in flat {
+            set(base, halo as usize, source as usize);
+        }
+        return;
+    }
     for run in layout.halo_runs(c) {
         let (mut halo, mut source) = (run.halo as usize, run.source as usize);
         let (halo_step, source_step) = (run.halo_step as usize, run.source_step as isize);
