@@ -43,7 +43,13 @@ fn neighbours<'a, T>(
     other: &'a [T],
 ) -> [&'a [T]; 4] {
     let o = layout.neighbour_offsets(c);
-    [0, 1, 2, 3].map(|k| shifted(other, start, o[k], len))
+    // Spelt out: `[0, 1, 2, 3].map(…)` was left a call of its own.
+    [
+        shifted(other, start, o[0], len),
+        shifted(other, start, o[1], len),
+        shifted(other, start, o[2], len),
+        shifted(other, start, o[3], len),
+    ]
 }
 
 /// The four side-weight slices (LEFT, RIGHT, BOTTOM, TOP) of the `len` cells from
