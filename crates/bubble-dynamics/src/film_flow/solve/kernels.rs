@@ -187,7 +187,7 @@ pub(super) fn relax_from_zero<T: Real>(layout: &Layout, inv_diag: &[T], r: &[T],
     }
     let half = layout.half;
     // SAFETY: as in `refresh`.
-    for_each_copy(layout, 0, z, |base, halo, source| unsafe {
+    for_each_copy(layout, (0, false), z, |base, halo, source| unsafe {
         *base.add(halo) = if source < half {
             *base.add(source)
         } else {
@@ -440,7 +440,18 @@ fn round_run(scale: f64, range: std::ops::Range<usize>, values: &[f64], out: &mu
 pub(super) fn refresh<T: Real>(layout: &Layout, c: usize, field: &mut [T]) {
     // SAFETY: `for_each_copy` passes positions inside the field; a halo cell is never a
     // source, so the read and the write do not overlap.
-    for_each_copy(layout, c, field, |base, halo, source| unsafe {
+    for_each_copy(layout, (c, false), field, |base, halo, source| unsafe {
+        *base.add(halo) = *base.add(source);
+    });
+}
+
+/// Copies into the halo cells of colour `c` whose sources are cells of the other colour
+/// their sources' values: after a half-sweep of that other colour, the only ones of
+/// colour `c` that changed, where colour `c`'s halo was refreshed before it.
+#[inline(always)]
+pub(super) fn refresh_from_other<T: Real>(layout: &Layout, c: usize, field: &mut [T]) {
+    // SAFETY: as in `refresh`.
+    for_each_copy(layout, (c, true), field, |base, halo, source| unsafe {
         *base.add(halo) = *base.add(source);
     });
 }
@@ -452,8 +463,9 @@ pub(super) fn refresh_all<T: Real>(layout: &Layout, field: &mut [T]) {
     refresh(layout, 1, field);
 }
 
-/// Each copy of colour `c`'s halo runs: `set(field, halo, source)` on the field's
-/// pointer and the copy's positions, every one inside `field`; from the level's flat
+/// Each copy of colour `c`'s halo runs (`from_other`: only those whose sources are of the
+/// other colour): `set(field, halo, source)` on the field's pointer and the copy's
+/// positions, every one inside `field`; from the level's flat
 /// list of the copies where it holds one ([`Layout::flat_halo_copies`]: the small
 /// levels, whose runs' set-up would cost more than their copies).
 ///
@@ -467,20 +479,29 @@ pub(super) fn refresh_all<T: Real>(layout: &Layout, field: &mut [T]) {
 #[inline(always)]
 fn for_each_copy<T: Copy>(
     layout: &Layout,
-    c: usize,
+    (c, from_other): (usize, bool),
     field: &mut [T],
     set: impl Fn(*mut T, usize, usize),
 ) {
     let field = &mut field[..layout.len()];
     let base = field.as_mut_ptr();
-    let flat = layout.flat_halo_copies(c);
-    if !flat.is_empty() {
+    if !layout.flat_halo_copies(c).is_empty() {
+        let flat = if from_other {
+            layout.flat_halo_copies_from_other(c)
+        } else {
+            layout.flat_halo_copies(c)
+        };
         for &[halo, source] in flat {
             set(base, halo as usize, source as usize);
         }
         return;
     }
-    for run in layout.halo_runs(c) {
+    let runs = if from_other {
+        layout.halo_runs_from_other(c)
+    } else {
+        layout.halo_runs(c)
+    };
+    for run in runs {
         let (mut halo, mut source) = (run.halo as usize, run.source as usize);
         let (halo_step, source_step) = (run.halo_step as usize, run.source_step as isize);
         for _ in 0..run.count {

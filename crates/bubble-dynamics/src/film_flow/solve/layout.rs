@@ -106,6 +106,11 @@ pub(super) struct Layout {
     /// positions (empty elsewhere): a copy then costs a pair's load, where a run's set-up
     /// costs as much as several copies. Private, as [`Layout::halos`] is.
     flat_halos: [Vec<[u32; 2]>; 2],
+    /// Per colour, how many of its [`Layout::halos`] (they come first) and of its copies
+    /// (in [`Layout::flat_halos`], first too) take their values from the other colour's
+    /// cells: after a half-sweep of that other colour, the only stale ones of this colour.
+    from_other: [usize; 2],
+    flat_from_other: [usize; 2],
     /// Per cell in the grid's numbering, the cell across each side.
     pub(super) neighbour: Vec<[u32; 4]>,
 }
@@ -143,6 +148,8 @@ impl Layout {
             position: Vec::with_capacity(6 * m * m),
             halos: [Vec::new(), Vec::new()],
             flat_halos: [Vec::new(), Vec::new()],
+            from_other: [0, 0],
+            flat_from_other: [0, 0],
             neighbour,
         };
         for c in 0..6 * m * m {
@@ -150,6 +157,14 @@ impl Layout {
             layout.position.push(p as u32);
         }
         layout.halos = layout.runs_of_halo_copies();
+        // Each colour's runs from the other colour's cells first (a run's sources have
+        // one colour; the order of the copies is free, as no halo cell is a source).
+        for c in 0..2 {
+            let half = layout.half as u32;
+            let from_other = |run: &HaloRun| (run.source >= half) != (c == 1);
+            layout.halos[c].sort_by_key(|run| !from_other(run));
+            layout.from_other[c] = layout.halos[c].iter().filter(|r| from_other(r)).count();
+        }
         let len = layout.len() as i64;
         for run in layout.halos.iter().flatten() {
             let last = i64::from(run.count) - 1;
@@ -166,6 +181,10 @@ impl Layout {
                 .each_ref()
                 .map(|runs| runs.iter().flat_map(HaloRun::copies).collect());
         }
+        layout.flat_from_other = [0, 1].map(|c| {
+            let runs = &layout.halos[c][..layout.from_other[c]];
+            runs.iter().map(|run| run.count as usize).sum()
+        });
         layout
     }
 
@@ -177,6 +196,19 @@ impl Layout {
     /// a source.
     pub(super) fn halo_runs(&self, c: usize) -> &[HaloRun] {
         &self.halos[c]
+    }
+
+    /// The first of [`Layout::halo_runs`]`(c)`, those whose sources are cells of the other
+    /// colour (as [`Layout::halo_runs`]).
+    pub(super) fn halo_runs_from_other(&self, c: usize) -> &[HaloRun] {
+        &self.halos[c][..self.from_other[c]]
+    }
+
+    /// The first of [`Layout::flat_halo_copies`]`(c)`, those whose sources are cells of
+    /// the other colour (as [`Layout::flat_halo_copies`]).
+    pub(super) fn flat_halo_copies_from_other(&self, c: usize) -> &[[u32; 2]] {
+        let copies = &self.flat_halos[c];
+        &copies[..self.flat_from_other[c].min(copies.len())]
     }
 
     /// The copies of [`Layout::halo_runs`] one by one, `[halo, source]`, where the level
@@ -445,7 +477,8 @@ mod tests {
 
     /// A refresh of either colour, whether copy by copy ([`Layout::flat_halo_copies`], on
     /// a face of at most [`FLAT_HALO_UP_TO`] cells) or by runs, leaves each halo cell of
-    /// that colour its source's value and every other position as it was, on every
+    /// that colour its source's value and every other position as it was (a refresh
+    /// from the other colour: each whose source is of the other colour), on every
     /// level of the hierarchy's sizes; and the levels up to that size hold their copies
     /// one by one, the others not.
     #[test]
@@ -462,8 +495,17 @@ mod tests {
                     for [halo, source] in &level.halo_copies()[colour] {
                         expected[*halo as usize] = expected[*source as usize];
                     }
+                    let mut from_other = field.clone();
                     super::super::kernels::refresh(&level, colour, &mut field);
                     assert_eq!(field, expected, "n {n} m {} colour {colour}", level.m);
+                    let mut expected = from_other.clone();
+                    for [halo, source] in &level.halo_copies()[colour] {
+                        if (*source as usize >= level.half) != (colour == 1) {
+                            expected[*halo as usize] = expected[*source as usize];
+                        }
+                    }
+                    super::super::kernels::refresh_from_other(&level, colour, &mut from_other);
+                    assert_eq!(from_other, expected, "n {n} m {} colour {colour}", level.m);
                 }
                 if level.m % 2 == 1 || level.m <= 1 {
                     break;
