@@ -50,8 +50,9 @@ use super::sides::{BOTTOM, CellSides, LEFT, RIGHT, TOP};
 use crate::avx2::with_avx2;
 use kernels::{
     LevelField, NOT_A_CELL, Scaled, Stencil, correct, dot, gather_row, operator, refresh,
-    refresh_all, relax, relax_from_zero, residuals_in_place, restrict, restrict_field,
-    rounded_level, scatter_row, scatter_run, update_and_norm2, update_direction, widened_dot,
+    refresh_all, refresh_from_other, relax, relax_from_zero, residuals_in_place, restrict,
+    restrict_field, rounded_level, scatter_row, scatter_run, update_and_norm2, update_direction,
+    widened_dot,
 };
 use layout::Layout;
 use sparse::{Factor, Pattern};
@@ -827,7 +828,8 @@ impl Hierarchy {
     /// One symmetric V-cycle on level `k` for residual `r`, result in `z`, in `f32`:
     /// [`sweeps`] forward sweeps (colour 0 then 1, the first from zero), the coarse
     /// correction, as many backward sweeps (colour 1 then 0). Before each half-sweep the
-    /// halo cells it reads are refreshed.
+    /// halo cells it reads are refreshed, and before the residual the stale ones of both
+    /// colours.
     fn v_cycle(&self, work: &mut Work, k: usize, r: &[f32], z: &mut [f32]) {
         with_avx2(
             #[inline(always)]
@@ -846,7 +848,11 @@ impl Hierarchy {
                         relax(level, c, inv_diag, w, r, z);
                     }
                 }
-                refresh_all(level, z);
+                // The operator reads both colours' halos: colour 0's was refreshed before
+                // the last half-sweep (of colour 1), so only its cells copied from colour 1
+                // are stale.
+                refresh(level, 1, z);
+                refresh_from_other(level, 0, z);
                 let coarse = &self.levels[k + 1];
                 let mut d = std::mem::take(&mut work.operator);
                 // Kept at the finest level's length and sliced: resized to each level's in

@@ -43,7 +43,13 @@ fn neighbours<'a, T>(
     other: &'a [T],
 ) -> [&'a [T]; 4] {
     let o = layout.neighbour_offsets(c);
-    [0, 1, 2, 3].map(|k| shifted(other, start, o[k], len))
+    // Spelt out: `[0, 1, 2, 3].map(…)` was left a call of its own.
+    [
+        shifted(other, start, o[0], len),
+        shifted(other, start, o[1], len),
+        shifted(other, start, o[2], len),
+        shifted(other, start, o[3], len),
+    ]
 }
 
 /// The four side-weight slices (LEFT, RIGHT, BOTTOM, TOP) of the `len` cells from
@@ -181,7 +187,7 @@ pub(super) fn relax_from_zero<T: Real>(layout: &Layout, inv_diag: &[T], r: &[T],
     }
     let half = layout.half;
     // SAFETY: as in `refresh`.
-    for_each_copy(layout, 0, z, |base, halo, source| unsafe {
+    for_each_copy(layout, (0, false), z, |base, halo, source| unsafe {
         *base.add(halo) = if source < half {
             *base.add(source)
         } else {
@@ -434,7 +440,18 @@ fn round_run(scale: f64, range: std::ops::Range<usize>, values: &[f64], out: &mu
 pub(super) fn refresh<T: Real>(layout: &Layout, c: usize, field: &mut [T]) {
     // SAFETY: `for_each_copy` passes positions inside the field; a halo cell is never a
     // source, so the read and the write do not overlap.
-    for_each_copy(layout, c, field, |base, halo, source| unsafe {
+    for_each_copy(layout, (c, false), field, |base, halo, source| unsafe {
+        *base.add(halo) = *base.add(source);
+    });
+}
+
+/// Copies into the halo cells of colour `c` whose sources are cells of the other colour
+/// their sources' values: after a half-sweep of that other colour, the only ones of
+/// colour `c` that changed, where colour `c`'s halo was refreshed before it.
+#[inline(always)]
+pub(super) fn refresh_from_other<T: Real>(layout: &Layout, c: usize, field: &mut [T]) {
+    // SAFETY: as in `refresh`.
+    for_each_copy(layout, (c, true), field, |base, halo, source| unsafe {
         *base.add(halo) = *base.add(source);
     });
 }
@@ -446,25 +463,45 @@ pub(super) fn refresh_all<T: Real>(layout: &Layout, field: &mut [T]) {
     refresh(layout, 1, field);
 }
 
-/// Each copy of colour `c`'s halo runs: `set(field, halo, source)` on the field's
-/// pointer and the copy's positions, every one inside `field`.
+/// Each copy of colour `c`'s halo runs (`from_other`: only those whose sources are of the
+/// other colour): `set(field, halo, source)` on the field's pointer and the copy's
+/// positions, every one inside `field`; from the level's flat
+/// list of the copies where it holds one ([`Layout::flat_halo_copies`]: the small
+/// levels, whose runs' set-up would cost more than their copies).
 ///
 /// Why raw positions: a run walks two constant strides through one array, which safe
 /// slices can only do with a check a copy (the index pairs did two) or a division a run
 /// (`chunks_exact`), and at the coarse levels, where a run is one to eight copies, the
 /// latter costs more than the copies. The layout checked when it was built that every
 /// run stays inside its `len()` ([`Layout::halo_runs`]), so checking `field` against
-/// that length once makes every position of every run valid.
+/// that length once makes every position of every run (and of the flat list, the same
+/// copies) valid.
 #[inline(always)]
 fn for_each_copy<T: Copy>(
     layout: &Layout,
-    c: usize,
+    (c, from_other): (usize, bool),
     field: &mut [T],
     set: impl Fn(*mut T, usize, usize),
 ) {
     let field = &mut field[..layout.len()];
     let base = field.as_mut_ptr();
-    for run in layout.halo_runs(c) {
+    if !layout.flat_halo_copies(c).is_empty() {
+        let flat = if from_other {
+            layout.flat_halo_copies_from_other(c)
+        } else {
+            layout.flat_halo_copies(c)
+        };
+        for &[halo, source] in flat {
+            set(base, halo as usize, source as usize);
+        }
+        return;
+    }
+    let runs = if from_other {
+        layout.halo_runs_from_other(c)
+    } else {
+        layout.halo_runs(c)
+    };
+    for run in runs {
         let (mut halo, mut source) = (run.halo as usize, run.source as usize);
         let (halo_step, source_step) = (run.halo_step as usize, run.source_step as isize);
         for _ in 0..run.count {
