@@ -744,8 +744,8 @@ impl RimValues {
     /// Face `face`'s rows `rows`' rim cells' volumes, factors and values, and their
     /// neighbours' factors on the face (those across a seam wait for [`Self::apply`]),
     /// from the face's `window` (the rows and those either side have their factors) and
-    /// `values`: the whole of the first and last rows, the ends of the others
-    /// ([`CellSides::rim_of_row`]).
+    /// `values`: the whole of the first and last rows ([`Self::keep_row`]), the ends of
+    /// the others ([`Self::keep_ends`]).
     #[inline(always)]
     fn keep(
         &mut self,
@@ -755,57 +755,97 @@ impl RimValues {
         values: &[f64],
     ) {
         let n = sides.n();
-        let m = sides.rim_per_face();
-        for y in rows.clone() {
-            let place = face * m + sides.rim_of_row(y).start;
-            let w = window.w(y);
-            let [l, r, b, t] = window_sides(&window.left, &window.bottom, n, (w, w + 1));
-            let ratio = &window.ratio[w * n..];
-            // A side on a seam takes its row's factors here and its neighbour's in
-            // `apply`.
-            let below = if y > 0 {
-                &window.ratio[(w - 1) * n..]
-            } else {
-                ratio
-            };
-            let above = if y + 1 < n { &ratio[n..] } else { ratio };
-            let value = &values[y * n..(y + 1) * n];
-            // Cell `x`'s volumes, its neighbours' factors, its own and its value.
-            let v = [l, r, b, t];
-            let across = [
-                &ratio[..n],
-                &ratio[2..n + 2],
-                &below[1..n + 1],
-                &above[1..n + 1],
-            ];
-            let own = &ratio[1..n + 1];
-            if y == 0 || y + 1 == n {
-                let at = place..place + n;
-                for k in 0..4 {
-                    self.volume[k][at.clone()].copy_from_slice(v[k]);
-                    self.across[k][at.clone()].copy_from_slice(across[k]);
-                }
-                self.volume[1][place + n - 1] = window.right[w];
-                self.ratio[at.clone()].copy_from_slice(own);
-                self.value[at].copy_from_slice(value);
-                continue;
-            }
-            // The row's two ends, each place's slices taken once (element by element
-            // through the vectors, their bounds checks cost 145 instructions a row).
-            let ends = place..place + 2;
-            let last = n - 1;
-            for k in 0..4 {
-                let volume = &mut self.volume[k][ends.clone()];
-                (volume[0], volume[1]) = (v[k][0], v[k][last]);
-                let kept = &mut self.across[k][ends.clone()];
-                (kept[0], kept[1]) = (across[k][0], across[k][last]);
-            }
-            let (ratio, kept) = (&mut self.ratio[ends.clone()], &mut self.value[ends]);
-            (ratio[0], ratio[1], kept[0], kept[1]) = (own[0], own[last], value[0], value[last]);
-            self.volume[1][place + 1] = window.right[w];
+        let ends = rows.start.max(1)..rows.end.min(n.saturating_sub(1));
+        if !ends.is_empty() {
+            let place = face * sides.rim_per_face() + sides.rim_of_row(ends.start).start;
+            self.keep_ends(n, (place, ends), window, values);
+        }
+        if rows.contains(&0) {
+            self.keep_row((sides, face), 0, window, values);
+        }
+        if n > 1 && rows.contains(&(n - 1)) {
+            self.keep_row((sides, face), n - 1, window, values);
         }
     }
 
+    /// [`Self::keep`] for face row `y`, the first or the last: all its cells are on the
+    /// rim.
+    #[inline(always)]
+    fn keep_row(
+        &mut self,
+        (sides, face): (&CellSides, usize),
+        y: usize,
+        window: &FaceWindow,
+        values: &[f64],
+    ) {
+        let n = sides.n();
+        let place = face * sides.rim_per_face() + sides.rim_of_row(y).start;
+        let w = window.w(y);
+        let [l, r, b, t] = window_sides(&window.left, &window.bottom, n, (w, w + 1));
+        let ratio = &window.ratio[w * n..];
+        // A side on a seam takes its row's factors here and its neighbour's in `apply`.
+        let below = if y > 0 {
+            &window.ratio[(w - 1) * n..]
+        } else {
+            ratio
+        };
+        let above = if y + 1 < n { &ratio[n..] } else { ratio };
+        let value = &values[y * n..(y + 1) * n];
+        // Cell `x`'s volumes, its neighbours' factors, its own and its value.
+        let v = [l, r, b, t];
+        let across = [
+            &ratio[..n],
+            &ratio[2..n + 2],
+            &below[1..n + 1],
+            &above[1..n + 1],
+        ];
+        let at = place..place + n;
+        for k in 0..4 {
+            self.volume[k][at.clone()].copy_from_slice(v[k]);
+            self.across[k][at.clone()].copy_from_slice(across[k]);
+        }
+        self.volume[1][place + n - 1] = window.right[w];
+        self.ratio[at.clone()].copy_from_slice(&ratio[1..n + 1]);
+        self.value[at].copy_from_slice(value);
+    }
+
+    /// [`Self::keep`] for face rows `rows`, off the first and last (`n ≥ 3`), whose two
+    /// end cells are the rim's places from `place` on, two a row: each kept value a loop
+    /// over the rows, from its window array shifted to the row's first cell's: about 45
+    /// instructions a row, where each row's slices and places set up one by one cost
+    /// about 190.
+    #[inline(always)]
+    fn keep_ends(
+        &mut self,
+        n: usize,
+        (place, rows): (usize, Range<usize>),
+        window: &FaceWindow,
+        values: &[f64],
+    ) {
+        let len = rows.len();
+        let kept = place..place + 2 * len;
+        let first = window.w(rows.start);
+        let w = first * n;
+        let (left, bottom, ratio) = (&window.left, &window.bottom, &window.ratio);
+        let [v0, v1, v2, v3] = self.volume.each_mut().map(|v| &mut v[kept.clone()]);
+        row_ends(v0, &left[w..], n, len);
+        row_ends(v2, &bottom[w..], n, len);
+        row_ends(v3, &bottom[w + n..], n, len);
+        // Right sides: the first cell's is its neighbour's left, the last cell's its
+        // window row's right pad.
+        let right = &window.right[first..first + len];
+        let left = left[w + 1..w + 1 + len * n].chunks_exact(n);
+        for ((v, row), &pad) in v1.chunks_exact_mut(2).zip(left).zip(right) {
+            (v[0], v[1]) = (row[0], pad);
+        }
+        let [a0, a1, a2, a3] = self.across.each_mut().map(|a| &mut a[kept.clone()]);
+        row_ends(a0, &ratio[w..], n, len);
+        row_ends(a1, &ratio[w + 2..], n, len);
+        row_ends(a2, &ratio[w + 1 - n..], n, len);
+        row_ends(a3, &ratio[w + 1 + n..], n, len);
+        row_ends(&mut self.ratio[kept.clone()], &ratio[w + 1..], n, len);
+        row_ends(&mut self.value[kept], &values[rows.start * n..], n, len);
+    }
     /// The rim cells' neighbours' factors across the seams, then their gathers into
     /// `values`, from their values before.
     #[inline(always)]
@@ -824,6 +864,16 @@ impl RimValues {
             let gain = scale * gained(v, INFLOW, across, own[i]) * pa[i];
             values.set(c as usize, value[i] + gain);
         }
+    }
+}
+
+/// Each of the first `rows` rows of `n` values in `from`: its first and last value into
+/// `to`, two a row.
+#[inline(always)]
+fn row_ends(to: &mut [f64], from: &[f64], n: usize, rows: usize) {
+    // Exact chunks: each row `n` long, its ends' bounds checks gone.
+    for (to, row) in to.chunks_exact_mut(2).zip(from[..rows * n].chunks_exact(n)) {
+        (to[0], to[1]) = (row[0], row[n - 1]);
     }
 }
 
