@@ -391,8 +391,9 @@ fn seam_values(
     // Side by side (flattened, the four sides' iterator took 38 instructions a pad).
     for (face, out) in pads.chunks_exact_mut(4 * n).enumerate() {
         for (out, side) in out.chunks_exact_mut(n).zip(sides.face_pads(face)) {
-            for (o, pad) in out.iter_mut().zip(side) {
-                *o = seams[pad.seam as usize] * pad.sign;
+            let sign = side.sign;
+            for (o, &seam) in out.iter_mut().zip(side.seams) {
+                *o = seams[seam as usize] * sign;
             }
         }
     }
