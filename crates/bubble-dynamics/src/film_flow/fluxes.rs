@@ -724,8 +724,10 @@ impl FaceWindow {
 struct RimValues {
     /// Per side: the volume, positive towards the face's +x or +y (as [`FaceWindow`]).
     volume: [Vec<f64>; 4],
-    /// Per side: the neighbour's factor as a donor.
-    across: [Vec<f64>; 4],
+    /// Per side, side `k`'s from `k·m` on (`m` the rim's cells): the neighbour's factor
+    /// as a donor; one table, so the seams' sides are filled by flat places
+    /// ([`CellSides::rim_seam_copies`]).
+    across: Vec<f64>,
     /// The cells' own factors as donors.
     ratio: Vec<f64>,
     /// The cells' values before the apply.
@@ -735,9 +737,10 @@ struct RimValues {
 impl RimValues {
     /// Sized for `m` rim cells.
     fn resize(&mut self, m: usize) {
-        for v in self.volume.iter_mut().chain(&mut self.across) {
+        for v in &mut self.volume {
             v.resize(m, 0.0);
         }
+        self.across.resize(4 * m, 0.0);
         self.ratio.resize(m, 0.0);
         self.value.resize(m, 0.0);
     }
@@ -800,10 +803,11 @@ impl RimValues {
             &below[1..n + 1],
             &above[1..n + 1],
         ];
-        let at = place..place + n;
+        let (at, m) = (place..place + n, self.ratio.len());
         for k in 0..4 {
             self.volume[k][at.clone()].copy_from_slice(v[k]);
-            self.across[k][at.clone()].copy_from_slice(across[k]);
+            let at = k * m + at.start..k * m + at.end;
+            self.across[at].copy_from_slice(across[k]);
         }
         self.volume[1][place + n - 1] = window.right[w];
         self.ratio[at.clone()].copy_from_slice(&ratio[1..n + 1]);
@@ -839,7 +843,13 @@ impl RimValues {
         for ((v, row), &pad) in v1.chunks_exact_mut(2).zip(left).zip(right) {
             (v[0], v[1]) = (row[0], pad);
         }
-        let [a0, a1, a2, a3] = self.across.each_mut().map(|a| &mut a[kept.clone()]);
+        let m = self.ratio.len();
+        let mut across = self
+            .across
+            .chunks_exact_mut(m)
+            .map(|a| &mut a[kept.clone()]);
+        let mut next = || across.next().expect("four sides");
+        let [a0, a1, a2, a3] = [next(), next(), next(), next()];
         row_ends(a0, &ratio[w..], n, len);
         row_ends(a1, &ratio[w + 2..], n, len);
         row_ends(a2, &ratio[w + 1 - n..], n, len);
@@ -847,17 +857,21 @@ impl RimValues {
         row_ends(&mut self.ratio[kept.clone()], &ratio[w + 1..], n, len);
         row_ends(&mut self.value[kept], &values[rows.start * n..], n, len);
     }
+
     /// The rim cells' neighbours' factors across the seams, then their gathers into
     /// `values`, from their values before.
     #[inline(always)]
     fn apply(&mut self, sides: &CellSides, scale: f64, values: &mut (impl Moved + ?Sized)) {
-        for s in sides.rim_seam_sides() {
-            self.across[usize::from(s.side)][s.rim as usize] = self.ratio[s.across as usize];
+        for &[to, from] in sides.rim_seam_copies() {
+            self.across[to as usize] = self.ratio[from as usize];
         }
         let rim = sides.rim();
         let m = rim.cells.len();
         let [v0, v1, v2, v3] = self.volume.each_ref().map(|v| &v[..m]);
-        let [a0, a1, a2, a3] = self.across.each_ref().map(|a| &a[..m]);
+        let (a0, rest) = self.across.split_at(m);
+        let (a1, rest) = rest.split_at(m);
+        let (a2, a3) = rest.split_at(m);
+        let [a0, a1, a2, a3] = [a0, a1, a2, a3].map(|a| &a[..m]);
         let (own, pa, value) = (&self.ratio[..m], &rim.inverse_area[..m], &self.value[..m]);
         for (i, &c) in rim.cells.iter().enumerate() {
             let v = [v0[i], v1[i], v2[i], v3[i]];

@@ -66,6 +66,8 @@ pub(crate) struct CellSides {
     pad_signs: Vec<f64>,
     /// Every rim cell's sides on a seam ([`RimSeamSide`]).
     rim_seam_sides: Vec<RimSeamSide>,
+    /// The same as flat places ([`Self::rim_seam_copies`]).
+    rim_seam_copies: Vec<[u32; 2]>,
     /// Where each face row's rim cells start among a face's ([`Self::rim_of_row`]),
     /// and the face's count after the last.
     rim_rows: Vec<u32>,
@@ -561,6 +563,7 @@ impl CellSides {
             pads: Vec::new(),
             pad_signs: Vec::new(),
             rim_seam_sides: Vec::new(),
+            rim_seam_copies: Vec::new(),
             rim_rows: Vec::new(),
         };
         (sides.cell_runs, sides.rim_cells) = sides.find_cell_runs();
@@ -629,6 +632,10 @@ impl CellSides {
                 }
             }
         }
+        let m = self.rim_cells.len() as u32;
+        self.rim_seam_copies = (self.rim_seam_sides.iter())
+            .map(|s| [u32::from(s.side) * m + s.rim, s.across])
+            .collect();
     }
 
     /// The cells inside the faces as [`CellRun`]s, one a face row, and the rim's cells.
@@ -761,9 +768,19 @@ impl CellSides {
         self.rim_cells.len() / 6
     }
 
-    /// Every rim cell's sides on a seam ([`RimSeamSide`]).
+    /// Every rim cell's sides on a seam ([`RimSeamSide`]): the tests' (the passes take
+    /// [`Self::rim_seam_copies`]).
+    #[cfg(test)]
     pub(crate) fn rim_seam_sides(&self) -> &[RimSeamSide] {
         &self.rim_seam_sides
+    }
+
+    /// [`Self::rim_seam_sides`] as flat places `[to, from]`: `to` the side's in a table
+    /// of the rim's values side by side (`side·M + rim`, `M` the rim's cells), `from`
+    /// the cell across's in the rim's order; a copy of a factor a side is then a load and
+    /// a store (through the side's table first, 10 instructions a side).
+    pub(crate) fn rim_seam_copies(&self) -> &[[u32; 2]] {
+        &self.rim_seam_copies
     }
 
     /// The sign of each side's volume in cell `c`'s inflow (as [`INFLOW`] inside a face).
@@ -997,6 +1014,14 @@ mod tests {
                 let across = sides.rim_cells[s.across as usize];
                 assert_eq!(sides.neighbour[c][k], across, "n = {n}, cell {c} side {k}");
             }
+            let m = sides.rim_cells.len();
+            let copies = sides.rim_seam_sides().iter().map(|s| {
+                [usize::from(s.side) * m + s.rim as usize, s.across as usize].map(|p| p as u32)
+            });
+            assert!(
+                copies.eq(sides.rim_seam_copies().iter().copied()),
+                "n = {n}"
+            );
         }
     }
 
