@@ -730,7 +730,7 @@ struct RimValues {
     across: Vec<f64>,
     /// The cells' own factors as donors.
     ratio: Vec<f64>,
-    /// The cells' values before the apply.
+    /// The cells' values before the apply (after it, in [`Self::apply`]).
     value: Vec<f64>,
 }
 
@@ -859,7 +859,10 @@ impl RimValues {
     }
 
     /// The rim cells' neighbours' factors across the seams, then their gathers into
-    /// `values`, from their values before.
+    /// `values`, from their values before: the new values taken in the rim's order in a
+    /// loop that vectorises (in place of the values before), then set cell by cell (in
+    /// one scalar loop with the sets, the gathers took about 21 instructions a cell
+    /// more).
     #[inline(always)]
     fn apply(&mut self, sides: &CellSides, scale: f64, values: &mut (impl Moved + ?Sized)) {
         for &[to, from] in sides.rim_seam_copies() {
@@ -872,12 +875,18 @@ impl RimValues {
         let (a1, rest) = rest.split_at(m);
         let (a2, a3) = rest.split_at(m);
         let [a0, a1, a2, a3] = [a0, a1, a2, a3].map(|a| &a[..m]);
-        let (own, pa, value) = (&self.ratio[..m], &rim.inverse_area[..m], &self.value[..m]);
-        for (i, &c) in rim.cells.iter().enumerate() {
+        let (own, pa, value) = (
+            &self.ratio[..m],
+            &rim.inverse_area[..m],
+            &mut self.value[..m],
+        );
+        for i in 0..m {
             let v = [v0[i], v1[i], v2[i], v3[i]];
             let across = [a0[i], a1[i], a2[i], a3[i]];
-            let gain = scale * gained(v, INFLOW, across, own[i]) * pa[i];
-            values.set(c as usize, value[i] + gain);
+            value[i] += scale * gained(v, INFLOW, across, own[i]) * pa[i];
+        }
+        for (&c, &value) in rim.cells.iter().zip(&*value) {
+            values.set(c as usize, value);
         }
     }
 }
