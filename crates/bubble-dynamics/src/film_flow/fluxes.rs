@@ -228,15 +228,21 @@ impl FaceWindow {
         [left, right, bottom, top]: [&[f64]; 4],
     ) {
         pass.rows(face, band.clone(), cells);
-        for y in band.clone() {
-            let w = self.w(y);
-            if n > 1 {
-                // The row's right sides, and the next row's left pad, written after.
-                let out = &mut self.left[w * n + 1..(w + 1) * n + 1];
+        let (w0, w1) = (self.w(band.start), self.w(band.end));
+        if n > 1 {
+            // Each row's right sides, and the next row's left pad, written after.
+            let outs = self.left[w0 * n + 1..w1 * n + 1].chunks_exact_mut(n);
+            for (y, out) in band.clone().zip(outs) {
                 pass.run(sides.x_run(face, y), y..y + 1, cells, out);
             }
-            (self.left[w * n], self.right[w]) = (left[y], right[y]);
         }
+        // The pads after the runs, a side at a time (row by row between the runs, with
+        // each row's places, about 13 instructions a row).
+        let pads = self.left[w0 * n..w1 * n].iter_mut().step_by(n);
+        for (pad, &value) in pads.zip(&left[band.clone()]) {
+            *pad = value;
+        }
+        self.right[w0..w1].copy_from_slice(&right[band.clone()]);
         let inside = band.start.max(1)..band.end;
         if band.start == 0 {
             let w = self.w(0);
