@@ -237,7 +237,7 @@ impl FaceWindow {
             }
         }
         // The pads after the runs, a side at a time (row by row between the runs, with
-        // each row's places, about 13 instructions a row).
+        // each row's places, they took about 20 instructions a row more).
         let pads = self.left[w0 * n..w1 * n].iter_mut().step_by(n);
         for (pad, &value) in pads.zip(&left[band.clone()]) {
             *pad = value;
@@ -659,7 +659,7 @@ impl FaceWindow {
             o[i] = outflow_factor(v, INFLOW, scale, a[i], x[i]);
         }
         // Each row's last cell again, its right side from `right`: the rows as exact
-        // chunks (row by row through the window's places, about 15 instructions a row
+        // chunks (row by row through the window's places, about 20 instructions a row
         // more).
         let sides = v0
             .chunks_exact(n)

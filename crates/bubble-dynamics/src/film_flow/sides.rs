@@ -77,8 +77,8 @@ pub(crate) struct CellSides {
 /// (from the first), and the sign that turns their values, positive from an edge's `a`
 /// cell to its `b`, into ones positive towards the face's +x or +y, as the face's own
 /// edges' are: one for the side (a seam's edges all run one way), so a pass copies a
-/// side's pads in a loop of a load, a multiplication and a store (a sign a pad took 12
-/// instructions a pad).
+/// side's pads in a loop of a load, a multiplication and a store: about 3 instructions
+/// a pad, where a sign a pad took 12.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Pads<'a> {
     /// The seam edges, counted from [`FaceLayout::first_seam_edge`].
@@ -778,7 +778,7 @@ impl CellSides {
     /// [`Self::rim_seam_sides`] as flat places `[to, from]`: `to` the side's in a table
     /// of the rim's values side by side (`side·M + rim`, `M` the rim's cells), `from`
     /// the cell across's in the rim's order; a copy of a factor a side is then a load and
-    /// a store (through the side's table first, 10 instructions a side).
+    /// a store, about 4 instructions (through the side's table first, 10).
     pub(crate) fn rim_seam_copies(&self) -> &[[u32; 2]] {
         &self.rim_seam_copies
     }

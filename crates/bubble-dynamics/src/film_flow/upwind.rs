@@ -252,7 +252,7 @@ fn band_rises(
     // are the whole row or its two ends ([`CellSides::rim_of_row`]), copied as such
     // (cell by cell through the rim's table, they took 30 instructions a cell), the
     // inside rows' ends a side at a time in one loop over the rows (row by row, each
-    // row's slices set up four times: about 60 instructions a row).
+    // row's slices set up four times, about 17 instructions a row more).
     let m = sides.rim_per_face();
     let outs = [&mut *o0, &mut *o1, &mut *o2, &mut *o3];
     if !inside.is_empty() {
