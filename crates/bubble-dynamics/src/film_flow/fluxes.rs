@@ -228,15 +228,21 @@ impl FaceWindow {
         [left, right, bottom, top]: [&[f64]; 4],
     ) {
         pass.rows(face, band.clone(), cells);
-        for y in band.clone() {
-            let w = self.w(y);
-            if n > 1 {
-                // The row's right sides, and the next row's left pad, written after.
-                let out = &mut self.left[w * n + 1..(w + 1) * n + 1];
+        let (w0, w1) = (self.w(band.start), self.w(band.end));
+        if n > 1 {
+            // Each row's right sides, and the next row's left pad, written after.
+            let outs = self.left[w0 * n + 1..w1 * n + 1].chunks_exact_mut(n);
+            for (y, out) in band.clone().zip(outs) {
                 pass.run(sides.x_run(face, y), y..y + 1, cells, out);
             }
-            (self.left[w * n], self.right[w]) = (left[y], right[y]);
         }
+        // The pads after the runs, a side at a time (row by row between the runs, with
+        // each row's places, they took about 20 instructions a row more).
+        let pads = self.left[w0 * n..w1 * n].iter_mut().step_by(n);
+        for (pad, &value) in pads.zip(&left[band.clone()]) {
+            *pad = value;
+        }
+        self.right[w0..w1].copy_from_slice(&right[band.clone()]);
         let inside = band.start.max(1)..band.end;
         if band.start == 0 {
             let w = self.w(0);
@@ -251,19 +257,6 @@ impl FaceWindow {
             let w = self.w(n);
             self.bottom[w * n..(w + 1) * n].copy_from_slice(top);
         }
-    }
-
-    /// The four sides of the last cell of face row `y`.
-    #[inline(always)]
-    fn last_sides(&self, n: usize, y: usize) -> [f64; 4] {
-        let w = self.w(y);
-        let i = w * n + n - 1;
-        [
-            self.left[i],
-            self.right[w],
-            self.bottom[i],
-            self.bottom[i + n],
-        ]
     }
 }
 
@@ -391,8 +384,9 @@ fn seam_values(
     // Side by side (flattened, the four sides' iterator took 38 instructions a pad).
     for (face, out) in pads.chunks_exact_mut(4 * n).enumerate() {
         for (out, side) in out.chunks_exact_mut(n).zip(sides.face_pads(face)) {
-            for (o, pad) in out.iter_mut().zip(side) {
-                *o = seams[pad.seam as usize] * pad.sign;
+            let sign = side.sign;
+            for (o, &seam) in out.iter_mut().zip(side.seams) {
+                *o = seams[seam as usize] * sign;
             }
         }
     }
@@ -635,8 +629,14 @@ impl FaceWindow {
         for i in 0..o.len() {
             o[i] = net([v0[i], v1[i], v2[i], v3[i]], INFLOW);
         }
-        for (y, o) in rows.clone().zip(o.chunks_exact_mut(n)) {
-            o[n - 1] = net(self.last_sides(n, y), INFLOW);
+        // Each row's last cell again, its right side from `right` (as in
+        // `outflow_ratios`).
+        let sides = v0
+            .chunks_exact(n)
+            .zip(v2.chunks_exact(n))
+            .zip(v3.chunks_exact(n));
+        for ((o, ((l, b), t)), &r) in o.chunks_exact_mut(n).zip(sides).zip(&self.right[w0..w1]) {
+            o[n - 1] = net([l[n - 1], r, b[n - 1], t[n - 1]], INFLOW);
         }
     }
 
@@ -658,17 +658,20 @@ impl FaceWindow {
             let v = [v0[i], v1[i], v2[i], v3[i]];
             o[i] = outflow_factor(v, INFLOW, scale, a[i], x[i]);
         }
-        for (j, y) in rows.clone().enumerate() {
-            let i = j * n + n - 1;
-            let w = y + BEHIND - self.first;
-            let last = w * n + n - 1;
-            let v = [
-                self.left[last],
-                self.right[w],
-                self.bottom[last],
-                self.bottom[last + n],
-            ];
-            o[i] = outflow_factor(v, INFLOW, scale, a[i], x[i]);
+        // Each row's last cell again, its right side from `right`: the rows as exact
+        // chunks (row by row through the window's places, about 20 instructions a row
+        // more).
+        let sides = v0
+            .chunks_exact(n)
+            .zip(v2.chunks_exact(n))
+            .zip(v3.chunks_exact(n));
+        let cells = o
+            .chunks_exact_mut(n)
+            .zip(a.chunks_exact(n))
+            .zip(x.chunks_exact(n));
+        for ((((o, a), x), ((l, b), t)), &r) in cells.zip(sides).zip(&self.right[w0..w1]) {
+            let v = [l[n - 1], r, b[n - 1], t[n - 1]];
+            o[n - 1] = outflow_factor(v, INFLOW, scale, a[n - 1], x[n - 1]);
         }
     }
 
@@ -723,20 +726,23 @@ impl FaceWindow {
 struct RimValues {
     /// Per side: the volume, positive towards the face's +x or +y (as [`FaceWindow`]).
     volume: [Vec<f64>; 4],
-    /// Per side: the neighbour's factor as a donor.
-    across: [Vec<f64>; 4],
+    /// Per side, side `k`'s from `k·m` on (`m` the rim's cells): the neighbour's factor
+    /// as a donor; one table, so the seams' sides are filled by flat places
+    /// ([`CellSides::rim_seam_copies`]).
+    across: Vec<f64>,
     /// The cells' own factors as donors.
     ratio: Vec<f64>,
-    /// The cells' values before the apply.
+    /// The cells' values before the apply (after it, in [`Self::apply`]).
     value: Vec<f64>,
 }
 
 impl RimValues {
     /// Sized for `m` rim cells.
     fn resize(&mut self, m: usize) {
-        for v in self.volume.iter_mut().chain(&mut self.across) {
+        for v in &mut self.volume {
             v.resize(m, 0.0);
         }
+        self.across.resize(4 * m, 0.0);
         self.ratio.resize(m, 0.0);
         self.value.resize(m, 0.0);
     }
@@ -744,8 +750,8 @@ impl RimValues {
     /// Face `face`'s rows `rows`' rim cells' volumes, factors and values, and their
     /// neighbours' factors on the face (those across a seam wait for [`Self::apply`]),
     /// from the face's `window` (the rows and those either side have their factors) and
-    /// `values`: the whole of the first and last rows, the ends of the others
-    /// ([`CellSides::rim_of_row`]).
+    /// `values`: the whole of the first and last rows ([`Self::keep_row`]), the ends of
+    /// the others ([`Self::keep_ends`]).
     #[inline(always)]
     fn keep(
         &mut self,
@@ -755,75 +761,145 @@ impl RimValues {
         values: &[f64],
     ) {
         let n = sides.n();
-        let m = sides.rim_per_face();
-        for y in rows.clone() {
-            let place = face * m + sides.rim_of_row(y).start;
-            let w = window.w(y);
-            let [l, r, b, t] = window_sides(&window.left, &window.bottom, n, (w, w + 1));
-            let ratio = &window.ratio[w * n..];
-            // A side on a seam takes its row's factors here and its neighbour's in
-            // `apply`.
-            let below = if y > 0 {
-                &window.ratio[(w - 1) * n..]
-            } else {
-                ratio
-            };
-            let above = if y + 1 < n { &ratio[n..] } else { ratio };
-            let value = &values[y * n..(y + 1) * n];
-            // Cell `x`'s volumes, its neighbours' factors, its own and its value.
-            let v = [l, r, b, t];
-            let across = [
-                &ratio[..n],
-                &ratio[2..n + 2],
-                &below[1..n + 1],
-                &above[1..n + 1],
-            ];
-            let own = &ratio[1..n + 1];
-            if y == 0 || y + 1 == n {
-                let at = place..place + n;
-                for k in 0..4 {
-                    self.volume[k][at.clone()].copy_from_slice(v[k]);
-                    self.across[k][at.clone()].copy_from_slice(across[k]);
-                }
-                self.volume[1][place + n - 1] = window.right[w];
-                self.ratio[at.clone()].copy_from_slice(own);
-                self.value[at].copy_from_slice(value);
-                continue;
-            }
-            // The row's two ends, each place's slices taken once (element by element
-            // through the vectors, their bounds checks cost 145 instructions a row).
-            let ends = place..place + 2;
-            let last = n - 1;
-            for k in 0..4 {
-                let volume = &mut self.volume[k][ends.clone()];
-                (volume[0], volume[1]) = (v[k][0], v[k][last]);
-                let kept = &mut self.across[k][ends.clone()];
-                (kept[0], kept[1]) = (across[k][0], across[k][last]);
-            }
-            let (ratio, kept) = (&mut self.ratio[ends.clone()], &mut self.value[ends]);
-            (ratio[0], ratio[1], kept[0], kept[1]) = (own[0], own[last], value[0], value[last]);
-            self.volume[1][place + 1] = window.right[w];
+        let ends = rows.start.max(1)..rows.end.min(n.saturating_sub(1));
+        if !ends.is_empty() {
+            let place = face * sides.rim_per_face() + sides.rim_of_row(ends.start).start;
+            self.keep_ends(n, (place, ends), window, values);
+        }
+        if rows.contains(&0) {
+            self.keep_row((sides, face), 0, window, values);
+        }
+        if n > 1 && rows.contains(&(n - 1)) {
+            self.keep_row((sides, face), n - 1, window, values);
         }
     }
 
+    /// [`Self::keep`] for face row `y`, the first or the last: all its cells are on the
+    /// rim.
+    #[inline(always)]
+    fn keep_row(
+        &mut self,
+        (sides, face): (&CellSides, usize),
+        y: usize,
+        window: &FaceWindow,
+        values: &[f64],
+    ) {
+        let n = sides.n();
+        let place = face * sides.rim_per_face() + sides.rim_of_row(y).start;
+        let w = window.w(y);
+        let [l, r, b, t] = window_sides(&window.left, &window.bottom, n, (w, w + 1));
+        let ratio = &window.ratio[w * n..];
+        // A side on a seam takes its row's factors here and its neighbour's in `apply`.
+        let below = if y > 0 {
+            &window.ratio[(w - 1) * n..]
+        } else {
+            ratio
+        };
+        let above = if y + 1 < n { &ratio[n..] } else { ratio };
+        let value = &values[y * n..(y + 1) * n];
+        // Cell `x`'s volumes, its neighbours' factors, its own and its value.
+        let v = [l, r, b, t];
+        let across = [
+            &ratio[..n],
+            &ratio[2..n + 2],
+            &below[1..n + 1],
+            &above[1..n + 1],
+        ];
+        let (at, m) = (place..place + n, self.ratio.len());
+        for k in 0..4 {
+            self.volume[k][at.clone()].copy_from_slice(v[k]);
+            let at = k * m + at.start..k * m + at.end;
+            self.across[at].copy_from_slice(across[k]);
+        }
+        self.volume[1][place + n - 1] = window.right[w];
+        self.ratio[at.clone()].copy_from_slice(&ratio[1..n + 1]);
+        self.value[at].copy_from_slice(value);
+    }
+
+    /// [`Self::keep`] for face rows `rows`, off the first and last (`n ≥ 3`), whose two
+    /// end cells are the rim's places from `place` on, two a row: each kept value a loop
+    /// over the rows, from its window array shifted to the row's first cell's: about 45
+    /// instructions a row, where each row's slices and places set up one by one cost
+    /// about 190.
+    #[inline(always)]
+    fn keep_ends(
+        &mut self,
+        n: usize,
+        (place, rows): (usize, Range<usize>),
+        window: &FaceWindow,
+        values: &[f64],
+    ) {
+        let len = rows.len();
+        let kept = place..place + 2 * len;
+        let first = window.w(rows.start);
+        let w = first * n;
+        let (left, bottom, ratio) = (&window.left, &window.bottom, &window.ratio);
+        let [v0, v1, v2, v3] = self.volume.each_mut().map(|v| &mut v[kept.clone()]);
+        row_ends(v0, &left[w..], n, len);
+        row_ends(v2, &bottom[w..], n, len);
+        row_ends(v3, &bottom[w + n..], n, len);
+        // Right sides: the first cell's is its neighbour's left, the last cell's its
+        // window row's right pad.
+        let right = &window.right[first..first + len];
+        let left = left[w + 1..w + 1 + len * n].chunks_exact(n);
+        for ((v, row), &pad) in v1.chunks_exact_mut(2).zip(left).zip(right) {
+            (v[0], v[1]) = (row[0], pad);
+        }
+        let m = self.ratio.len();
+        let mut across = self
+            .across
+            .chunks_exact_mut(m)
+            .map(|a| &mut a[kept.clone()]);
+        let mut next = || across.next().expect("four sides");
+        let [a0, a1, a2, a3] = [next(), next(), next(), next()];
+        row_ends(a0, &ratio[w..], n, len);
+        row_ends(a1, &ratio[w + 2..], n, len);
+        row_ends(a2, &ratio[w + 1 - n..], n, len);
+        row_ends(a3, &ratio[w + 1 + n..], n, len);
+        row_ends(&mut self.ratio[kept.clone()], &ratio[w + 1..], n, len);
+        row_ends(&mut self.value[kept], &values[rows.start * n..], n, len);
+    }
+
     /// The rim cells' neighbours' factors across the seams, then their gathers into
-    /// `values`, from their values before.
+    /// `values`, from their values before: the new values taken in the rim's order in a
+    /// loop that vectorises (in place of the values before), then set cell by cell (in
+    /// one scalar loop with the sets, the gathers took about 21 instructions a cell
+    /// more).
     #[inline(always)]
     fn apply(&mut self, sides: &CellSides, scale: f64, values: &mut (impl Moved + ?Sized)) {
-        for s in sides.rim_seam_sides() {
-            self.across[usize::from(s.side)][s.rim as usize] = self.ratio[s.across as usize];
+        for &[to, from] in sides.rim_seam_copies() {
+            self.across[to as usize] = self.ratio[from as usize];
         }
         let rim = sides.rim();
         let m = rim.cells.len();
         let [v0, v1, v2, v3] = self.volume.each_ref().map(|v| &v[..m]);
-        let [a0, a1, a2, a3] = self.across.each_ref().map(|a| &a[..m]);
-        let (own, pa, value) = (&self.ratio[..m], &rim.inverse_area[..m], &self.value[..m]);
-        for (i, &c) in rim.cells.iter().enumerate() {
+        let (a0, rest) = self.across.split_at(m);
+        let (a1, rest) = rest.split_at(m);
+        let (a2, a3) = rest.split_at(m);
+        let [a0, a1, a2, a3] = [a0, a1, a2, a3].map(|a| &a[..m]);
+        let (own, pa, value) = (
+            &self.ratio[..m],
+            &rim.inverse_area[..m],
+            &mut self.value[..m],
+        );
+        for i in 0..m {
             let v = [v0[i], v1[i], v2[i], v3[i]];
             let across = [a0[i], a1[i], a2[i], a3[i]];
-            let gain = scale * gained(v, INFLOW, across, own[i]) * pa[i];
-            values.set(c as usize, value[i] + gain);
+            value[i] += scale * gained(v, INFLOW, across, own[i]) * pa[i];
         }
+        for (&c, &value) in rim.cells.iter().zip(&*value) {
+            values.set(c as usize, value);
+        }
+    }
+}
+
+/// Each of the first `rows` rows of `n` values in `from`: its first and last value into
+/// `to`, two a row.
+#[inline(always)]
+fn row_ends(to: &mut [f64], from: &[f64], n: usize, rows: usize) {
+    // Exact chunks: each row `n` long, its ends' bounds checks gone.
+    for (to, row) in to.chunks_exact_mut(2).zip(from[..rows * n].chunks_exact(n)) {
+        (to[0], to[1]) = (row[0], row[n - 1]);
     }
 }
 

@@ -58,23 +58,31 @@ pub(crate) struct CellSides {
     pub(crate) edge_runs: Vec<EdgeRun>,
     /// The seam edges' cells and sides ([`Seams`]).
     seam_tables: SeamTables,
-    /// Per face, the seam edges around it ([`Pad`]): on its cells' left sides (by row),
-    /// their right sides, their bottom sides (by column), their top sides, `n` each.
-    pads: Vec<Pad>,
+    /// Per face, the seam edges around it, counted from the first ([`Pads`]): on its
+    /// cells' left sides (by row), their right sides, their bottom sides (by column),
+    /// their top sides, `n` each.
+    pads: Vec<u32>,
+    /// Per face and side, its pads' sign ([`Pads`]).
+    pad_signs: Vec<f64>,
     /// Every rim cell's sides on a seam ([`RimSeamSide`]).
     rim_seam_sides: Vec<RimSeamSide>,
+    /// The same as flat places ([`Self::rim_seam_copies`]).
+    rim_seam_copies: Vec<[u32; 2]>,
     /// Where each face row's rim cells start among a face's ([`Self::rim_of_row`]),
     /// and the face's count after the last.
     rim_rows: Vec<u32>,
 }
 
-/// A seam edge as it borders a face ([`CellSides::face_pads`]): which seam edge (from
-/// the first), and the sign that turns its value, positive from its `a` cell to its `b`,
-/// into one positive towards the face's +x or +y, as the face's own edges' are.
+/// The seam edges along one side of a face ([`CellSides::face_pads`]): which seam edges
+/// (from the first), and the sign that turns their values, positive from an edge's `a`
+/// cell to its `b`, into ones positive towards the face's +x or +y, as the face's own
+/// edges' are: one for the side (a seam's edges all run one way), so a pass copies a
+/// side's pads in a loop of a load, a multiplication and a store: about 3 instructions
+/// a pad, where a sign a pad took 12.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Pad {
-    /// The seam edge, counted from [`FaceLayout::first_seam_edge`].
-    pub(crate) seam: u32,
+pub(crate) struct Pads<'a> {
+    /// The seam edges, counted from [`FaceLayout::first_seam_edge`].
+    pub(crate) seams: &'a [u32],
     /// ±1.
     pub(crate) sign: f64,
 }
@@ -553,7 +561,9 @@ impl CellSides {
             edge_runs: Vec::new(),
             seam_tables: seams,
             pads: Vec::new(),
+            pad_signs: Vec::new(),
             rim_seam_sides: Vec::new(),
+            rim_seam_copies: Vec::new(),
             rim_rows: Vec::new(),
         };
         (sides.cell_runs, sides.rim_cells) = sides.find_cell_runs();
@@ -564,11 +574,12 @@ impl CellSides {
     }
 
     /// The tables that place the seam edges among the rim's cells: each seam's ends'
-    /// places in the rim's order, each face's [`Pad`]s, the rim's [`RimSeamSide`]s; and
+    /// places in the rim's order, each face's [`Pads`], the rim's [`RimSeamSide`]s; and
     /// where each face row's rim cells are.
     ///
     /// # Panics
-    /// If a face's outer side is not on a seam, or a seam's cell not on the rim.
+    /// If a face's outer side is not on a seam, or its seam's edges do not all run the
+    /// same way, or a seam's cell is not on the rim.
     fn seams_on_the_rim(&mut self) {
         let (n, first_seam) = (self.n(), self.layout.first_seam_edge());
         let mut place = vec![u32::MAX; self.neighbour.len()];
@@ -585,6 +596,7 @@ impl CellSides {
             t.rim.iter().flatten().all(|&r| r != u32::MAX),
             "a seam off the rim"
         );
+        let mut pads = Vec::with_capacity(24 * n);
         for face in 0..6 {
             let outer = |side: usize, i: usize| match side {
                 LEFT => i * n,
@@ -593,16 +605,19 @@ impl CellSides {
                 _ => (n - 1) * n + i,
             };
             for side in [LEFT, RIGHT, BOTTOM, TOP] {
+                let sign_of = |c: usize| self.inflow(c)[side] * INFLOW[side];
+                let sign = sign_of(face * n * n + outer(side, 0));
                 for i in 0..n {
                     let c = face * n * n + outer(side, i);
                     let e = self.edge[c][side] as usize;
                     assert!(e >= first_seam, "cell {c}: side {side} is not on a seam");
-                    let sign = self.inflow(c)[side] * INFLOW[side];
-                    let seam = (e - first_seam) as u32;
-                    self.pads.push(Pad { seam, sign });
+                    assert_eq!(sign_of(c), sign, "cell {c}: side {side} runs the other way");
+                    pads.push((e - first_seam) as u32);
                 }
+                self.pad_signs.push(sign);
             }
         }
+        self.pads = pads;
         let face_rim = &self.rim_cells[..self.rim_cells.len() / 6];
         self.rim_rows = (0..=n)
             .map(|y| face_rim.partition_point(|&c| (c as usize) < y * n) as u32)
@@ -617,6 +632,10 @@ impl CellSides {
                 }
             }
         }
+        let m = self.rim_cells.len() as u32;
+        self.rim_seam_copies = (self.rim_seam_sides.iter())
+            .map(|s| [u32::from(s.side) * m + s.rim, s.across])
+            .collect();
     }
 
     /// The cells inside the faces as [`CellRun`]s, one a face row, and the rim's cells.
@@ -730,13 +749,16 @@ impl CellSides {
         self.rim_rows[y] as usize..self.rim_rows[y + 1] as usize
     }
 
-    /// The seam edges around face `face` ([`Pad`]): on its cells' left sides (by row),
+    /// The seam edges around face `face` ([`Pads`]): on its cells' left sides (by row),
     /// right sides, bottom sides (by column) and top sides, `n` each.
     #[inline(always)]
-    pub(crate) fn face_pads(&self, face: usize) -> [&[Pad]; 4] {
+    pub(crate) fn face_pads(&self, face: usize) -> [Pads<'_>; 4] {
         let n = self.n();
         let pads = &self.pads[4 * n * face..4 * n * (face + 1)];
-        [0, 1, 2, 3].map(|k| &pads[k * n..(k + 1) * n])
+        [0, 1, 2, 3].map(|k| Pads {
+            seams: &pads[k * n..(k + 1) * n],
+            sign: self.pad_signs[4 * face + k],
+        })
     }
 
     /// How many rim cells each face has, `m`: face `f`'s are the places `f·m..(f + 1)·m`
@@ -746,9 +768,19 @@ impl CellSides {
         self.rim_cells.len() / 6
     }
 
-    /// Every rim cell's sides on a seam ([`RimSeamSide`]).
+    /// Every rim cell's sides on a seam ([`RimSeamSide`]): the tests' (the passes take
+    /// [`Self::rim_seam_copies`]).
+    #[cfg(test)]
     pub(crate) fn rim_seam_sides(&self) -> &[RimSeamSide] {
         &self.rim_seam_sides
+    }
+
+    /// [`Self::rim_seam_sides`] as flat places `[to, from]`: `to` the side's in a table
+    /// of the rim's values side by side (`side·M + rim`, `M` the rim's cells), `from`
+    /// the cell across's in the rim's order; a copy of a factor a side is then a load and
+    /// a store, about 4 instructions (through the side's table first, 10).
+    pub(crate) fn rim_seam_copies(&self) -> &[[u32; 2]] {
+        &self.rim_seam_copies
     }
 
     /// The sign of each side's volume in cell `c`'s inflow (as [`INFLOW`] inside a face).
@@ -947,15 +979,16 @@ mod tests {
                 let [left, right, bottom, top] = sides.face_pads(face);
                 for i in 0..n {
                     let outer = [
-                        (left[i], i * n, LEFT),
-                        (right[i], i * n + n - 1, RIGHT),
-                        (bottom[i], i, BOTTOM),
-                        (top[i], (n - 1) * n + i, TOP),
+                        (left, i * n, LEFT),
+                        (right, i * n + n - 1, RIGHT),
+                        (bottom, i, BOTTOM),
+                        (top, (n - 1) * n + i, TOP),
                     ];
-                    for (pad, c, k) in outer {
+                    for (pads, c, k) in outer {
                         let c = face * n * n + c;
-                        assert_eq!(pad.seam as usize + first_seam, sides.edge[c][k] as usize);
-                        assert_eq!(pad.sign, sides.inflow(c)[k] * INFLOW[k], "cell {c}");
+                        let seam = pads.seams[i] as usize;
+                        assert_eq!(seam + first_seam, sides.edge[c][k] as usize);
+                        assert_eq!(pads.sign, sides.inflow(c)[k] * INFLOW[k], "cell {c}");
                     }
                 }
             }
@@ -981,6 +1014,14 @@ mod tests {
                 let across = sides.rim_cells[s.across as usize];
                 assert_eq!(sides.neighbour[c][k], across, "n = {n}, cell {c} side {k}");
             }
+            let m = sides.rim_cells.len();
+            let copies = sides.rim_seam_sides().iter().map(|s| {
+                [usize::from(s.side) * m + s.rim as usize, s.across as usize].map(|p| p as u32)
+            });
+            assert!(
+                copies.eq(sides.rim_seam_copies().iter().copied()),
+                "n = {n}"
+            );
         }
     }
 

@@ -250,22 +250,31 @@ fn band_rises(
     }
     // Face 0's rim cells are every face's places ([`CellSides::rim_per_face`]): a row's
     // are the whole row or its two ends ([`CellSides::rim_of_row`]), copied as such
-    // (cell by cell through the rim's table, they took 30 instructions a cell).
+    // (cell by cell through the rim's table, they took 30 instructions a cell), the
+    // inside rows' ends a side at a time in one loop over the rows (row by row, each
+    // row's slices set up four times, about 17 instructions a row more).
     let m = sides.rim_per_face();
-    for y in band.clone() {
-        let on_row = sides.rim_of_row(y);
-        let (at, x) = (face * m + on_row.start, w(y));
+    let outs = [&mut *o0, &mut *o1, &mut *o2, &mut *o3];
+    if !inside.is_empty() {
+        let (at, x) = (
+            face * m + sides.rim_of_row(inside.start).start,
+            w(inside.start),
+        );
+        let len = inside.len();
+        for (o, r) in outs.into_iter().zip(&rim.rise) {
+            let rows = o[x..x + len * n].chunks_exact_mut(n);
+            for (o, r) in rows.zip(r[at..at + 2 * len].chunks_exact(2)) {
+                (o[0], o[n - 1]) = (r[0], r[1]);
+            }
+        }
+    }
+    for y in band.clone().filter(|&y| y == 0 || y + 1 >= n) {
+        let (at, x) = (face * m + sides.rim_of_row(y).start, w(y));
         for (o, r) in [&mut *o0, &mut *o1, &mut *o2, &mut *o3]
             .into_iter()
             .zip(&rim.rise)
         {
-            let o = &mut o[x..x + n];
-            if on_row.len() == n {
-                o.copy_from_slice(&r[at..at + n]);
-            } else {
-                let r = &r[at..at + 2];
-                (o[0], o[n - 1]) = (r[0], r[1]);
-            }
+            o[x..x + n].copy_from_slice(&r[at..at + n]);
         }
     }
     if band.end < n {
