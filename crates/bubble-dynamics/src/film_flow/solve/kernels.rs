@@ -704,28 +704,82 @@ pub(super) fn gather_row<T: Real>(
     }
 }
 
-/// `z += zc` at every fine cell from its coarse parent: the coarse correction.
+/// Values a chunk of [`correct_row`] takes: one AVX2 vector of `f32`, formed from two
+/// half vectors by shuffles.
+const CHUNK: usize = 8;
+
+/// `z += zc` at every fine cell from its coarse parent: the coarse correction, a face
+/// at a time: a coarse row's fine child rows lie [`Layout::stride`] further than the
+/// last row's in each colour, and its cells start at the next padded row, so a row
+/// costs a few adds of set-up ([`correct_row`]).
 #[inline(always)]
-pub(super) fn correct(
-    fine: &Layout,
-    coarse: &Layout,
-    zc: &mut [f32],
-    z: &mut [f32],
-    row: &mut Vec<f32>,
-) {
-    let m = coarse.m;
-    row.resize(m, 0.0);
+pub(super) fn correct(fine: &Layout, coarse: &Layout, zc: &[f32], z: &mut [f32]) {
+    let (m, fine_step, coarse_step) = (coarse.m, fine.stride(), coarse.stride());
+    let (c_lo, c_hi) = zc[..coarse.len()].split_at(coarse.half);
+    let half = fine.half;
+    let (lo, hi) = z[..fine.len()].split_at_mut(half);
     for face in 0..6 {
+        // Children a0 and b1 lie in one colour, b1 after a0's run; b0 and a1 in the
+        // other, a1 after b0's: their runs are cut apart by a split at the later one.
+        let [a0, b0] = fine.children_of_row(face, 0, 0);
+        let [a1, b1] = fine.children_of_row(face, 0, 1);
+        let (first, second) = if a0 < half {
+            (&mut *lo, &mut *hi)
+        } else {
+            (&mut *hi, &mut *lo)
+        };
+        let (a0, b1) = (a0 % half, b1 % half);
+        let (b0, a1) = (b0 % half, a1 % half);
+        let coarse_first = coarse.padded_at(face, 1, 1);
         for y in 0..m {
-            gather_row(coarse, face, y, zc, row);
-            for j in 0..2 {
-                for start in fine.children_of_row(face, y, j) {
-                    for (zi, v) in z[start..][..m].iter_mut().zip(row.iter()) {
-                        *zi += *v;
-                    }
-                }
-            }
+            let s = y * fine_step;
+            let (x0, x3) = first[a0 + s..].split_at_mut(b1 - a0);
+            let (x1, x2) = second[b0 + s..].split_at_mut(a1 - b0);
+            let f = coarse_first + y * coarse_step;
+            let (even, odd) = if f & 1 == 0 {
+                (c_lo, c_hi)
+            } else {
+                (c_hi, c_lo)
+            };
+            let (even, odd) = (
+                &even[f >> 1..][..m.div_ceil(2)],
+                &odd[(f + 1) >> 1..][..m / 2],
+            );
+            let children = [&mut x0[..m], &mut x1[..m], &mut x2[..m], &mut x3[..m]];
+            correct_row(even, odd, children);
         }
+    }
+}
+
+/// A coarse row's values, its even cells' `even` and its odd cells' `odd`, added to
+/// each of its cells' fine children (`children`, each in order along the row).
+#[inline(always)]
+fn correct_row(even: &[f32], odd: &[f32], children: [&mut [f32]; 4]) {
+    let [a0, b0, a1, b1] = children;
+    let m = a0.len();
+    let halves = even
+        .chunks_exact(CHUNK / 2)
+        .zip(odd.chunks_exact(CHUNK / 2));
+    let chunks = a0.chunks_exact_mut(CHUNK).zip(b0.chunks_exact_mut(CHUNK));
+    let chunks = chunks.zip(a1.chunks_exact_mut(CHUNK).zip(b1.chunks_exact_mut(CHUNK)));
+    for ((e, o), ((a0, b0), (a1, b1))) in halves.zip(chunks) {
+        let mut v = [0.0; CHUNK];
+        for i in 0..CHUNK / 2 {
+            (v[2 * i], v[2 * i + 1]) = (e[i], o[i]);
+        }
+        for i in 0..CHUNK {
+            a0[i] += v[i];
+            b0[i] += v[i];
+            a1[i] += v[i];
+            b1[i] += v[i];
+        }
+    }
+    for x in m - m % CHUNK..m {
+        let v = if x % 2 == 0 { even[x / 2] } else { odd[x / 2] };
+        a0[x] += v;
+        b0[x] += v;
+        a1[x] += v;
+        b1[x] += v;
     }
 }
 
