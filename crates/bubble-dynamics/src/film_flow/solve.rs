@@ -1635,6 +1635,59 @@ mod tests {
         }
     }
 
+    /// The restriction a face at a time gives the bits of its plain form: each coarse
+    /// row's sums formed from its fine child runs ([`Layout::children_of_row`]) and
+    /// scattered ([`scatter_row`]); in `f32` and `f64`, of a field held whole and per
+    /// face, at coarse faces of odd sizes, of sizes below and above a chunk, and of 32.
+    #[test]
+    fn the_restriction_by_faces_is_the_restriction_by_rows() {
+        fn by_rows<T: Real>(fine: &Layout, values: &[T], from: usize, coarse: &Layout) -> Vec<T> {
+            let (m, mut out) = (coarse.m, vec![T::ZERO; coarse.len()]);
+            for face in 0..6 {
+                let f = if from == 6 { face } else { from };
+                for y in 0..m {
+                    let [a0, b0] = fine.children_of_row(f, y, 0);
+                    let [a1, b1] = fine.children_of_row(f, y, 1);
+                    let row: Vec<T> = (0..m)
+                        .map(|x| {
+                            (values[a0 + x] + values[b0 + x]) + (values[a1 + x] + values[b1 + x])
+                        })
+                        .collect();
+                    scatter_row(coarse, face, y, &row, &mut out);
+                }
+            }
+            out
+        }
+        for n in [2, 6, 8, 10, 24, 64] {
+            let fine = Layout::of_grid(&CellSides::new(&CubeSphere::new(n)));
+            let coarse = fine.coarser();
+            let values: Vec<f64> = (0..fine.len())
+                .map(|i| (((i * 7919) % 1000) as f64 - 500.0) / 37.0)
+                .collect();
+            let narrow: Vec<f32> = values.iter().map(|v| *v as f32).collect();
+            let (mut out32, mut out, mut row32, mut row) = (
+                vec![0.0f32; coarse.len()],
+                vec![0.0; coarse.len()],
+                Vec::new(),
+                Vec::new(),
+            );
+            restrict(&fine, &narrow, &coarse, &mut out32, &mut row32);
+            let bits32 = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            let expected = by_rows(&fine, &narrow, 6, &coarse);
+            assert_eq!(bits32(&out32), bits32(&expected), "n {n} f32");
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            for (per_face, from) in [(false, 6), (true, 0)] {
+                let field = LevelField {
+                    values: &values,
+                    per_face,
+                };
+                restrict_field(&fine, field, &coarse, &mut out, &mut row);
+                let expected = by_rows(&fine, &values, from, &coarse);
+                assert_eq!(bits(&out), bits(&expected), "n {n} per face {per_face}");
+            }
+        }
+    }
+
     #[test]
     fn supported_face_sizes_coarsen_to_a_small_level() {
         for n in [1, 2, 4, 5, 8, 16, 24, 64, 128, 256, 512] {
