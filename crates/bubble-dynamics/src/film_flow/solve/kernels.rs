@@ -519,7 +519,8 @@ fn for_each_copy<T: Copy>(
 ///
 /// A function of its own (built for AVX2 where the processor has it): inlined into the
 /// V-cycle's, it left the V-cycle's other loops slower, 682.5 M instructions over
-/// `film_profile 64 0 9.81`'s 40 steps against 662.1 M.
+/// `film_profile 64 0 9.81`'s 40 steps against 662.1 M (before [`split_row`] and
+/// [`add_chunk`] read their chunks whole).
 #[inline(never)]
 pub(super) fn restrict<T: Real>(
     fine: &Layout,
@@ -599,9 +600,14 @@ fn split_row<T: Real>(row: &[T], even: &mut [T], odd: &mut [T]) {
         .chunks_exact_mut(CHUNK / 2)
         .zip(odd.chunks_exact_mut(CHUNK / 2));
     for (v, (e, o)) in row.chunks_exact(CHUNK).zip(halves) {
+        // Read whole first, as in `add_chunk`.
+        let v: [T; CHUNK] = v.try_into().expect("a chunk");
+        let (mut even, mut odd) = ([T::ZERO; CHUNK / 2], [T::ZERO; CHUNK / 2]);
         for i in 0..CHUNK / 2 {
-            (e[i], o[i]) = (v[2 * i], v[2 * i + 1]);
+            (even[i], odd[i]) = (v[2 * i], v[2 * i + 1]);
         }
+        e.copy_from_slice(&even);
+        o.copy_from_slice(&odd);
     }
     for x in m - m % CHUNK..m {
         if x % 2 == 0 {
@@ -802,6 +808,19 @@ fn correct_faces(fine: &Layout, coarse: &Layout, zc: &[f32], z: &mut [f32]) {
     }
 }
 
+/// `child += v`, read whole before it is written: the compiler cannot tell a chunk
+/// from the row's other children (they are cut from one field), so element by element
+/// each store might change the next load, and the adds were left one at a time.
+#[inline(always)]
+fn add_chunk(child: &mut [f32], v: &[f32; CHUNK]) {
+    let child: &mut [f32; CHUNK] = child.try_into().expect("a chunk");
+    let mut sum = *child;
+    for (s, v) in sum.iter_mut().zip(v) {
+        *s += *v;
+    }
+    *child = sum;
+}
+
 /// A coarse row's values, its even cells' `even` and its odd cells' `odd`, added to
 /// each of its cells' fine children (`children`, each in order along the row).
 #[inline(always)]
@@ -818,11 +837,8 @@ fn correct_row(even: &[f32], odd: &[f32], children: [&mut [f32]; 4]) {
         for i in 0..CHUNK / 2 {
             (v[2 * i], v[2 * i + 1]) = (e[i], o[i]);
         }
-        for i in 0..CHUNK {
-            a0[i] += v[i];
-            b0[i] += v[i];
-            a1[i] += v[i];
-            b1[i] += v[i];
+        for child in [a0, b0, a1, b1] {
+            add_chunk(child, &v);
         }
     }
     for x in m - m % CHUNK..m {
