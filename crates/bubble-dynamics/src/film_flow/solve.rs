@@ -228,7 +228,7 @@ pub struct Work {
     correction: Vec<Vec<f32>>,
     /// A level's residual `r − M z` before it is restricted (the finest level's length).
     operator: Vec<f32>,
-    /// One coarse row of the coarse correction.
+    /// One coarse row of the restriction.
     row: Vec<f32>,
     /// One face row of the finest level's numbers.
     row64: Vec<f64>,
@@ -868,9 +868,8 @@ impl Hierarchy {
                 work.operator = d;
                 let mut zc = std::mem::take(&mut work.correction[k + 1]);
                 self.v_cycle(work, k + 1, &rc, &mut zc);
-                let mut row = std::mem::take(&mut work.row);
-                correct(level, coarse, &mut zc, z, &mut row);
-                (work.residual[k + 1], work.correction[k + 1], work.row) = (rc, zc, row);
+                correct(level, coarse, &zc, z);
+                (work.residual[k + 1], work.correction[k + 1]) = (rc, zc);
                 let (inv_diag, w) = (&work.inv_diag[k], &work.stencil32[k]);
                 for _ in 0..sweeps(level.m, self.levels[0].m) {
                     for c in [1, 0] {
@@ -1582,7 +1581,7 @@ mod tests {
                 let mut zc = vec![0.0; coarse.len()];
                 zc[coarse.position[c] as usize] = 1.0;
                 let mut z = vec![0.0; fine.len()];
-                correct(&fine, &coarse, &mut zc, &mut z, &mut row);
+                correct(&fine, &coarse, &zc, &mut z);
                 for (f, p) in fine.position.iter().enumerate() {
                     prolong[f][c] = z[*p as usize];
                 }
@@ -1598,6 +1597,93 @@ mod tests {
                     assert_eq!(prolong[f][c], parent, "n {n} fine {f} coarse {c}");
                     assert_eq!(given.to_bits(), prolong[f][c].to_bits(), "n {n} {f} {c}");
                 }
+            }
+        }
+    }
+
+    /// The coarse correction a face at a time gives the bits of its plain form: each
+    /// coarse row gathered ([`gather_row`]) and added to its four fine child runs in
+    /// turn; at coarse faces of odd sizes, of sizes below and above a chunk, and of 32.
+    #[test]
+    fn the_correction_by_faces_is_the_correction_by_rows() {
+        for n in [2, 6, 8, 10, 24, 64] {
+            let fine = Layout::of_grid(&CellSides::new(&CubeSphere::new(n)));
+            let coarse = fine.coarser();
+            let noise = |len: usize, seed: usize| -> Vec<f32> {
+                (0..len)
+                    .map(|i| (((i * 7919 + seed * 104_729) % 1000) as f32 - 500.0) / 37.0)
+                    .collect()
+            };
+            let (mut zc, z) = (noise(coarse.len(), 1), noise(fine.len(), 2));
+            let mut by_faces = z.clone();
+            correct(&fine, &coarse, &zc, &mut by_faces);
+            let (mut by_rows, mut row) = (z, vec![0.0; coarse.m]);
+            for face in 0..6 {
+                for y in 0..coarse.m {
+                    gather_row(&coarse, face, y, &mut zc, &mut row);
+                    for j in 0..2 {
+                        for start in fine.children_of_row(face, y, j) {
+                            for (zi, v) in by_rows[start..][..coarse.m].iter_mut().zip(&row) {
+                                *zi += *v;
+                            }
+                        }
+                    }
+                }
+            }
+            let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&by_faces), bits(&by_rows), "n {n}");
+        }
+    }
+
+    /// The restriction a face at a time gives the bits of its plain form: each coarse
+    /// row's sums formed from its fine child runs ([`Layout::children_of_row`]) and
+    /// scattered ([`scatter_row`]); in `f32` and `f64`, of a field held whole and per
+    /// face, at coarse faces of odd sizes, of sizes below and above a chunk, and of 32.
+    #[test]
+    fn the_restriction_by_faces_is_the_restriction_by_rows() {
+        fn by_rows<T: Real>(fine: &Layout, values: &[T], from: usize, coarse: &Layout) -> Vec<T> {
+            let (m, mut out) = (coarse.m, vec![T::ZERO; coarse.len()]);
+            for face in 0..6 {
+                let f = if from == 6 { face } else { from };
+                for y in 0..m {
+                    let [a0, b0] = fine.children_of_row(f, y, 0);
+                    let [a1, b1] = fine.children_of_row(f, y, 1);
+                    let row: Vec<T> = (0..m)
+                        .map(|x| {
+                            (values[a0 + x] + values[b0 + x]) + (values[a1 + x] + values[b1 + x])
+                        })
+                        .collect();
+                    scatter_row(coarse, face, y, &row, &mut out);
+                }
+            }
+            out
+        }
+        for n in [2, 6, 8, 10, 24, 64] {
+            let fine = Layout::of_grid(&CellSides::new(&CubeSphere::new(n)));
+            let coarse = fine.coarser();
+            let values: Vec<f64> = (0..fine.len())
+                .map(|i| (((i * 7919) % 1000) as f64 - 500.0) / 37.0)
+                .collect();
+            let narrow: Vec<f32> = values.iter().map(|v| *v as f32).collect();
+            let (mut out32, mut out, mut row32, mut row) = (
+                vec![0.0f32; coarse.len()],
+                vec![0.0; coarse.len()],
+                Vec::new(),
+                Vec::new(),
+            );
+            restrict(&fine, &narrow, &coarse, &mut out32, &mut row32);
+            let bits32 = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            let expected = by_rows(&fine, &narrow, 6, &coarse);
+            assert_eq!(bits32(&out32), bits32(&expected), "n {n} f32");
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            for (per_face, from) in [(false, 6), (true, 0)] {
+                let field = LevelField {
+                    values: &values,
+                    per_face,
+                };
+                restrict_field(&fine, field, &coarse, &mut out, &mut row);
+                let expected = by_rows(&fine, &values, from, &coarse);
+                assert_eq!(bits(&out), bits(&expected), "n {n} per face {per_face}");
             }
         }
     }

@@ -260,6 +260,12 @@ impl Layout {
         face * self.face_len + (rest / m + 1) * self.stride + rest % m + 1
     }
 
+    /// Padded row length, odd: a face row's step in padded indices, and two rows' step in
+    /// each colour's array.
+    pub(super) fn stride(&self) -> usize {
+        self.stride
+    }
+
     /// Position in the split arrays of padded index `f`.
     pub(super) fn index(&self, f: usize) -> usize {
         (f & 1) * self.half + (f >> 1)
