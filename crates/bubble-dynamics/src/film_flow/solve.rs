@@ -106,13 +106,15 @@ fn coarsest_face(mut n: usize) -> usize {
 
 /// Largest number of cells solved directly on the coarsest level.
 const DIRECT_CELLS: usize = 6 * 8 * 8;
-/// Face size the hierarchy coarsens down to when it can. Its sparse Cholesky factor
-/// (`sparse`) of 6·4² cells takes about 4 k multiply-adds a step and its solve replaces
-/// that level's 8 sweeps a side and a level of 6·2² cells: over `film_profile 64 0
-/// 9.81`'s 40 steps 698.0 M instructions and 131 PCG iterations, against 703.4 M and 132
-/// down to 6·2² cells (solved the same way). Down to 6·8² cells took 130 iterations but
-/// 726.9 M instructions: its factor, 48 k multiply-adds a step, cost 36 M.
-const COARSEST_FACE: usize = 4;
+/// Face size the hierarchy coarsens down to when it can, solved by a sparse Cholesky
+/// factor (`sparse`). Down to 6·4² cells took as many instructions over `film_profile n
+/// 0 9.81`'s 40 steps (642.4 M at n = 64, 183.2 M at 32; 125 and 158 PCG iterations,
+/// against 126 and 164 here) but more time: its triangular solves are chains of
+/// dependent multiply-adds, about 20 k instructions a V-cycle at a fraction of the
+/// sweeps' rate, and criterion's n = 32 step took 311 µs against 280–290 µs down to
+/// 6·2² (n = 64 alike, 1.21–1.24 ms). Down to 6·8² cells took 130 iterations but
+/// 726.9 M instructions at n = 64: its factor, 48 k multiply-adds a step, cost 36 M.
+const COARSEST_FACE: usize = 2;
 
 /// Face size from which the conjugate gradients read weights given as [`Weights::F32`]
 /// from the V-cycle's `f32` copy: where the finest level's fields outgrow the L2, the
@@ -133,9 +135,10 @@ const F32_WEIGHTS_FROM: usize = 64;
 /// step), 747.2 M and 18.8 M; at n = 128 (3 on the finest) 2.97 G and 204 M against
 /// 2.93 G and 212 M, where 5 on it too took 2.98 G and 220 M; at n = 32 these counts
 /// took 235 M instructions against 223 M, the same misses. (Three everywhere: one took
-/// 531 iterations at n = 64, two 230, four 155.) Since the level of 4 is solved
-/// directly ([`COARSEST_FACE`]), 6 on the level of 8 take as few iterations as 8 (125 at
-/// n = 64, 163 at 128; 4 took 128 at 64) and 2.6 M fewer instructions at n = 64.
+/// 531 iterations at n = 64, two 230, four 155.) On the levels of 8 and 4, 6
+/// took as few iterations as 8 where the level of 4 was solved directly (125 at n = 64,
+/// 163 at 128; 4 took 128 at 64) and 2.6 M fewer instructions at n = 64; with the level
+/// of 4 swept too, 126 at n = 64 ([`COARSEST_FACE`]).
 fn sweeps(m: usize, finest: usize) -> usize {
     match m {
         _ if finest < 64 => 3,

@@ -5,9 +5,10 @@
 //!
 //! Why sparse: a level's matrix has four neighbours a row, and in a minimum-degree order
 //! its factor stays sparse: at 6·4² = 96 cells it holds 712 entries below the diagonal
-//! (a dense one 4560) and takes about 4 k multiply-adds to make (a dense one 147 k), so
-//! the hierarchy can stop at 4 cells a face ([`COARSEST_FACE`](super::COARSEST_FACE)),
-//! where the level of 4 took 8 sweeps a side and one of 2 below it.
+//! (a dense one 4560) and takes about 4 k multiply-adds to make (a dense one 147 k). The
+//! hierarchy still stops at 2 cells a face ([`COARSEST_FACE`](super::COARSEST_FACE)):
+//! stopping at 4 took as many instructions but more time, the triangular solves being
+//! chains of dependent operations.
 
 use super::kernels::Stencil;
 use super::layout::Layout;
