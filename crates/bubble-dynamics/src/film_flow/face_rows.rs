@@ -183,6 +183,15 @@ impl FaceRows {
         (self.n + 2) * (self.n + 2)
     }
 
+    /// A face's edges, vertices and padded cells: each stage's strides between faces.
+    pub(crate) fn per_face(&self) -> (usize, usize, usize) {
+        (
+            self.edges_per_face(),
+            self.vertices_per_face(),
+            self.padded_cells_per_face(),
+        )
+    }
+
     /// The padded layout's slot `(px, py)` of face `f`: cell `(px − 1, py − 1)`, or the
     /// halo where `px` or `py` is 0 or `n + 1`.
     pub(crate) fn padded_cell(&self, f: usize, px: usize, py: usize) -> usize {

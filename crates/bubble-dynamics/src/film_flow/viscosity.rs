@@ -137,6 +137,32 @@ impl FilmFlow {
         (stages, 2.0 / f64::from(stages * stages + stages))
     }
 
+    /// A stage's set-up, the same for both of its passes: the border cells' vorticity
+    /// and divergence from `u`, the stage's [`Blend`], and face 0's cells' inverse areas,
+    /// which every face reads ([`FaceRows`] says why).
+    #[inline(always)]
+    fn stage_set_up(
+        &self,
+        u: &[f64],
+        v: &mut ViscousScratch,
+        nu: f64,
+        dt_s: f64,
+        (mu, nu_prev): (f64, f64),
+    ) -> (Blend, &[f64]) {
+        let n = self.rows.n;
+        border_fields(&self.grid, &self.rows, u, v);
+        v.window.prepare(n);
+        // Vorticity and divergence per R (of the unit sphere's), and each difference of
+        // them per R again: every term of the stress carries 1/R², taken once here.
+        let r = self.params.radius_m;
+        let blend = Blend {
+            rate: dt_s * nu / (r * r),
+            mu,
+            nu_prev,
+        };
+        (blend, &self.grid.inverse_areas_per_sr()[..n * n])
+    }
+
     /// [`Self::viscous_stage`] with the stage before last in the grid's numbering
     /// ([`Self::viscous_step_to_grid`]).
     #[inline(always)]
@@ -150,20 +176,9 @@ impl FilmFlow {
         (last, reverse): (bool, bool),
     ) {
         let rows = &self.rows;
-        border_fields(&self.grid, rows, u, v);
-        let r = self.params.radius_m;
-        let blend = Blend {
-            rate: dt_s * nu / (r * r),
-            mu,
-            nu_prev,
-        };
+        let (blend, ia) = self.stage_set_up(u, v, nu, dt_s, (mu, nu_prev));
         let n = rows.n;
-        let (epf, vpf, cpf) = (
-            rows.edges_per_face(),
-            rows.vertices_per_face(),
-            rows.padded_cells_per_face(),
-        );
-        let ia = &self.grid.inverse_areas_per_sr()[..n * n];
+        let (epf, vpf, cpf) = rows.per_face();
         let ViscousScratch {
             stage,
             vorticity,
@@ -172,7 +187,6 @@ impl FilmFlow {
             border_prev,
             ..
         } = v;
-        window.prepare(n);
         // The grid's inner X-edges, then its inner Y-edges, `m` a face (`FaceLayout`).
         let m = n * (n - 1);
         for f in face_order(reverse) {
@@ -219,23 +233,8 @@ impl FilmFlow {
         (last, reverse): (bool, bool),
     ) {
         let rows = &self.rows;
-        border_fields(&self.grid, rows, u, v);
-        // Vorticity and divergence per R (of the unit sphere's), and each difference of
-        // them per R again: every term of the stress carries 1/R², taken once here.
-        let r = self.params.radius_m;
-        let blend = Blend {
-            rate: dt_s * nu / (r * r),
-            mu,
-            nu_prev,
-        };
-        let n = rows.n;
-        let (epf, vpf, cpf) = (
-            rows.edges_per_face(),
-            rows.vertices_per_face(),
-            rows.padded_cells_per_face(),
-        );
-        // Face 0's cells' inverse areas, which every face reads ([`FaceRows`] says why).
-        let ia = &self.grid.inverse_areas_per_sr()[..n * n];
+        let (blend, ia) = self.stage_set_up(u, v, nu, dt_s, (mu, nu_prev));
+        let (epf, vpf, cpf) = rows.per_face();
         let ViscousScratch {
             stage,
             vorticity,
@@ -243,7 +242,6 @@ impl FilmFlow {
             window,
             ..
         } = v;
-        window.prepare(n);
         // Each case its own loops: a test of the case per edge cost the reads and writes
         // it was to spare.
         for f in face_order(reverse) {
