@@ -17,7 +17,8 @@ use std::ops::Range;
 use super::compare::{larger, pick};
 use super::face_geometry::{EdgeConstant, FaceGeometry};
 use super::flow::{
-    Drag, FilmFlow, FilmGradient, H_FLOOR_M, SOLVE_MAX_ITERATIONS, SOLVE_TOLERANCE, Scratch,
+    Drag, FilmFlow, FilmGradient, GUESS_REST, H_FLOOR_M, SOLVE_MAX_ITERATIONS, SOLVE_TOLERANCE,
+    Scratch,
 };
 use super::fluxes::{EdgeValues, apply_limited, net_inflow};
 use super::grid::CubeSphere;
@@ -178,16 +179,19 @@ impl FilmFlow {
     /// Solves for the surfactant the step ends with into `s.cell2`, from the last step's
     /// change again as the first guess (a film in steady motion changes alike from step
     /// to step; the tolerance stays relative to Γⁿ's residual).
-    fn solve_surfactant(&self, s: &mut Scratch) -> SolveReport {
+    fn solve_surfactant(&mut self, s: &mut Scratch) -> SolveReport {
         let g = &self.grid;
-        let change = Some(&self.surfactant_change[..]).filter(|c| !c.is_empty());
+        // The guess offered only where the last ones paid ([`GUESS_REST`]).
+        let offer = self.guess_wait == 0 && !self.surfactant_change.is_empty();
+        self.guess_wait = self.guess_wait.saturating_sub(1);
+        let change = offer.then_some(&self.surfactant_change[..]);
         s.cell2.resize(self.gamma.len(), 0.0);
         // The cells' areas, alike on every face to the bit: face 0's.
         let n = self.sides.n();
         let areas = MassTerm::EveryFace(&g.areas_sr()[..n * n]);
         // The weights taken as their `f32` roundings (6e-8 of each at most): the solve's
         // iterations then stream half the bytes ([`Weights::F32`]).
-        self.hierarchy.solve_from_start_and_change(
+        let report = self.hierarchy.solve_from_start_and_change(
             &mut s.work,
             (areas, Weights::F32(&s.weight), &s.rhs),
             (&self.gamma, change),
@@ -196,7 +200,11 @@ impl FilmFlow {
                 tolerance: SOLVE_TOLERANCE,
                 max_iterations: SOLVE_MAX_ITERATIONS,
             },
-        )
+        );
+        if offer && !report.from_guess {
+            self.guess_wait = GUESS_REST;
+        }
+        report
     }
 
     /// Defect correction: the cross term again from the solution, and the system solved
@@ -309,6 +317,8 @@ impl FilmFlow {
         // step from it while the band is in cache; each face's cells with face 0's
         // inverse areas (the same on every face).
         let (gamma, n) = (&self.gamma[..], sides.n());
+        // The change recorded only where the next solve takes it as its guess.
+        let record = self.guess_wait == 0;
         let change = &mut self.surfactant_change;
         // Every entry is written below: the buffer needs its length, not a fill.
         change.resize(gamma.len(), 0.0);
@@ -324,7 +334,7 @@ impl FilmFlow {
                 let cells = face * n * n + rows.start * n..face * n * n + rows.end * n;
                 let per_area = &per_area[rows.start * n..rows.end * n];
                 let before = (&gamma[cells.clone()], &solution[cells.clone()]);
-                let after = (next, &mut change[cells]);
+                let after = (next, record.then(|| &mut change[cells]));
                 negative |= next_surfactant(before, per_area, after);
             },
         );
@@ -607,21 +617,25 @@ impl<const NORMAL: bool> CorrectionEdges<'_, NORMAL> {
 }
 
 /// A stretch of cells' surfactant after the step, `Γ + inflow/area` (`next` holds the
-/// inflows and takes the result; `per_area` the cells' inverse areas), and the step's
-/// change of the solve, `solution − Γ` (the next step's first guess), in one pass;
-/// returns whether any cell went negative.
+/// inflows and takes the result; `per_area` the cells' inverse areas), and, where
+/// `change` is given, the step's change of the solve, `solution − Γ` (the next step's
+/// first guess), while the stretch is in cache; returns whether any cell went negative.
 #[inline(always)]
 fn next_surfactant(
     (gamma, solution): (&[f64], &[f64]),
     per_area: &[f64],
-    (next, change): (&mut [f64], &mut [f64]),
+    (next, change): (&mut [f64], Option<&mut [f64]>),
 ) -> bool {
     let m = next.len();
-    let (gamma, solution, per_area) = (&gamma[..m], &solution[..m], &per_area[..m]);
-    let change = &mut change[..m];
+    let (gamma, per_area) = (&gamma[..m], &per_area[..m]);
+    if let Some(change) = change {
+        let (solution, change) = (&solution[..m], &mut change[..m]);
+        for i in 0..m {
+            change[i] = solution[i] - gamma[i];
+        }
+    }
     let mut negative = false;
     for i in 0..m {
-        change[i] = solution[i] - gamma[i];
         next[i] = gamma[i] + next[i] * per_area[i];
         negative |= next[i] < 0.0;
     }
@@ -711,6 +725,41 @@ mod tests {
             f.step(1.0 / 60.0, &forcing);
         }
         f
+    }
+
+    /// A guess that does not beat its start rests the guess for [`GUESS_REST`] solves, and
+    /// the change is recorded again in time for the solve that offers it next: a wild
+    /// change put in its place is gone by then. Where the guess pays (on this film, at
+    /// n = 12, in some steps), it is taken.
+    #[test]
+    fn a_guess_that_does_not_pay_rests_and_comes_back_recorded_anew() {
+        let forcing = Forcing {
+            g_eff_m_per_s2: DVec3::new(0.0, -9.81, 0.0),
+            air_m_per_s: DVec3::new(0.3, 0.0, 0.1),
+        };
+        let mut f = film();
+        let paid = (0..30).any(|_| f.step(1.0 / 60.0, &forcing).from_guess);
+        assert!(paid, "the guess never paid");
+        assert_eq!(f.guess_wait, 0);
+        f.surfactant_change.iter_mut().for_each(|c| *c = 1e3);
+        assert!(!f.step(1.0 / 60.0, &forcing).from_guess);
+        for wait in (0..GUESS_REST).rev() {
+            assert_eq!(f.guess_wait, wait + 1);
+            assert!(!f.step(1.0 / 60.0, &forcing).from_guess, "rested");
+        }
+        assert_eq!(f.guess_wait, 0);
+        let largest = f
+            .surfactant_change
+            .iter()
+            .fold(0.0f64, |m, c| m.max(c.abs()));
+        assert!(
+            largest < 1.0,
+            "a stale change of {largest} would be offered"
+        );
+        assert!(
+            f.step(1.0 / 60.0, &forcing).from_guess,
+            "the guess pays again"
+        );
     }
 
     /// The central pass's weights against the plain `dt² E l/(ρ h d R²)` times the drag's
