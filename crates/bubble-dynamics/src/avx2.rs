@@ -184,13 +184,15 @@ fn widened_dot_lanes_avx2(a: &[f32], b: &[f32]) -> [f64; 4] {
     lanes
 }
 
-/// For each of a cell's four sides, the other three, in the order of the four.
-pub(crate) const OTHERS: [[usize; 3]; 4] = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]];
+/// The pairs `[i, o]` of a cell's four sides (`i < o`), in the order of their weights in
+/// [`coriolis_row`]: the term of side `o` in side `i`'s rate and that of side `i` in side
+/// `o`'s are one weight of opposite signs.
+pub(crate) const PAIRS: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
 
-/// The weights of a group of four cells in [`coriolis_row`]: per other side `k`, per
-/// side `i`, per cell (index `(4k + i)·4 + cell`), so that a group's twelve weight
-/// vectors are read from one base.
-pub(crate) const QUAD_WEIGHTS: usize = 48;
+/// The weights of a group of four cells in [`coriolis_row`]: per pair of sides `p`
+/// ([`PAIRS`]), per cell (index `4p + cell`), so that a group's six weight vectors are
+/// read from one base.
+pub(crate) const QUAD_WEIGHTS: usize = 24;
 
 /// The first cells of a row of `n` cells' groups of four in [`coriolis_row`]: every
 /// fourth, then the last four again where `n` is not a multiple of four (the cells taken
@@ -202,13 +204,17 @@ pub(crate) fn quad_starts(n: usize) -> impl Iterator<Item = usize> {
 }
 
 /// A row of `n` cells' terms of their sides' rates into `out` (per side: bottom, left,
-/// right, top): side `i`'s `Σ_k w[k][i] (ζ_i + ζ_o) u_o` over the other sides
-/// `o = OTHERS[i][k]`, summed in `k` order, each side's `ζ` the sum of its two corners'
-/// (from `z`, the row's bottom and top vertices, `n + 1` each), `u` the bottom sides'
-/// velocities, the left and right sides' (`n + 1`: cell `x`'s left is `x`, its right
-/// `x + 1`) and the top sides', `w` the groups' weights as [`QUAD_WEIGHTS`] lays them
-/// out. The same bits with AVX2 (explicit, from five input bases: the compiler's loop
-/// over twelve weight arrays and eight shifted slices ran out of registers) as without.
+/// right, top), each times its side's weight in the energy norm: with `P_io = w_io (ζ_i +
+/// ζ_o)` for each pair `[i, o]` of [`PAIRS`] (`w` its weight, each side's `ζ` the sum of
+/// its two corners' from `z`, the row's bottom and top vertices, `n + 1` each) and `u_s`
+/// side `s`'s velocity (`u`: the bottom sides', the left and right sides' (`n + 1`: cell
+/// `x`'s left is `x`, its right `x + 1`) and the top sides'), the bottom's
+/// `(P₀₁u₁ + P₀₂u₂) + P₀₃u₃`, the left's `(P₁₂u₂ − P₀₁u₀) + P₁₃u₃`, the right's
+/// `(P₂₃u₃ − P₀₂u₀) − P₁₂u₁` and the top's `((0 − P₀₃u₀) − P₁₃u₁) − P₂₃u₂`: an
+/// antisymmetric form, six weights where twelve were read. `w` holds the groups' weights
+/// as [`QUAD_WEIGHTS`] lays them out. The same bits with AVX2 (explicit, from five input
+/// bases: the compiler's loop over the weight arrays and eight shifted slices ran out of
+/// registers) as without.
 ///
 /// # Panics
 /// If the slices' lengths do not fit `n`, or `w` is short of the groups' weights.
@@ -233,15 +239,15 @@ pub(crate) fn coriolis_row(w: &[f64], z: [&[f64]; 2], u: [&[f64]; 3], out: [&mut
             let c = [zb[x], zb[x + 1], zt[x], zt[x + 1]];
             let z = [c[0] + c[1], c[0] + c[2], c[1] + c[3], c[2] + c[3]];
             let v = [ub[x], ux[x], ux[x + 1], ut[x]];
-            let wk = |k: usize, i: usize| wq[(4 * k + i) * 4 + x - start];
-            let rate = |i: usize| {
-                let [a, b, c] = OTHERS[i];
-                let t0 = wk(0, i) * (z[i] + z[a]) * v[a];
-                let t1 = wk(1, i) * (z[i] + z[b]) * v[b];
-                let t2 = wk(2, i) * (z[i] + z[c]) * v[c];
-                t0 + t1 + t2
-            };
-            (ob[x], ol[x], or[x], ot[x]) = (rate(0), rate(1), rate(2), rate(3));
+            let p: [f64; 6] = std::array::from_fn(|q| {
+                let [i, o] = PAIRS[q];
+                wq[4 * q + x - start] * (z[i] + z[o])
+            });
+            let t = |q: usize, side: usize| p[q] * v[side];
+            ob[x] = (t(0, 1) + t(1, 2)) + t(2, 3);
+            ol[x] = (t(3, 2) - t(0, 0)) + t(4, 3);
+            or[x] = (t(5, 3) - t(1, 0)) - t(3, 1);
+            ot[x] = ((0.0 - t(2, 0)) - t(4, 1)) - t(5, 2);
         }
     }
 }
@@ -250,14 +256,17 @@ pub(crate) fn coriolis_row(w: &[f64], z: [&[f64]; 2], u: [&[f64]; 3], out: [&mut
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn coriolis_row_avx2(w: &[f64], z: [&[f64]; 2], u: [&[f64]; 3], out: [&mut [f64]; 4]) {
-    use std::arch::x86_64::{_mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_storeu_pd};
+    use std::arch::x86_64::{
+        _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_setzero_pd, _mm256_storeu_pd,
+        _mm256_sub_pd,
+    };
     let n = u[0].len();
     let ([zb, zt], [ub, ux, ut]) = (z.map(<[f64]>::as_ptr), u.map(<[f64]>::as_ptr));
-    let out = out.map(<[f64]>::as_mut_ptr);
-    let quad = |wq: &[f64], x: usize| {
+    let [ob, ol, or, ot] = out.map(<[f64]>::as_mut_ptr);
+    let quad = |wq: *const f64, x: usize| {
         // SAFETY: `x + 4 ≤ n` (`n ≥ 4`), the slices are as long as `coriolis_row` checked
-        // (`n + 1` where read at `x + 1`) and `wq` holds `QUAD_WEIGHTS`: every load and
-        // store is in bounds.
+        // (`n + 1` where read at `x + 1`) and `wq` starts a group's `QUAD_WEIGHTS` within
+        // `w` (the caller's): every load and store is in bounds.
         unsafe {
             let ld = |p: *const f64, at: usize| _mm256_loadu_pd(p.wrapping_add(at));
             let (c0, c1, c2, c3) = (ld(zb, x), ld(zb, x + 1), ld(zt, x), ld(zt, x + 1));
@@ -268,22 +277,117 @@ fn coriolis_row_avx2(w: &[f64], z: [&[f64]; 2], u: [&[f64]; 3], out: [&mut [f64]
                 _mm256_add_pd(c2, c3),
             ];
             let v = [ld(ub, x), ld(ux, x), ld(ux, x + 1), ld(ut, x)];
-            let wk = |k: usize, i: usize| ld(wq.as_ptr(), (4 * k + i) * 4);
-            for (i, o) in out.iter().enumerate() {
-                let [a, b, d] = OTHERS[i];
-                let t0 = _mm256_mul_pd(_mm256_mul_pd(wk(0, i), _mm256_add_pd(z[i], z[a])), v[a]);
-                let t1 = _mm256_mul_pd(_mm256_mul_pd(wk(1, i), _mm256_add_pd(z[i], z[b])), v[b]);
-                let t2 = _mm256_mul_pd(_mm256_mul_pd(wk(2, i), _mm256_add_pd(z[i], z[d])), v[d]);
-                let rate = _mm256_add_pd(_mm256_add_pd(t0, t1), t2);
-                _mm256_storeu_pd(o.wrapping_add(x), rate);
-            }
+            let p: [_; 6] = std::array::from_fn(|q| {
+                let [i, o] = PAIRS[q];
+                _mm256_mul_pd(ld(wq, 4 * q), _mm256_add_pd(z[i], z[o]))
+            });
+            let t = |q: usize, side: usize| _mm256_mul_pd(p[q], v[side]);
+            let (add, sub) = (_mm256_add_pd, _mm256_sub_pd);
+            let st = |o: *mut f64, r| _mm256_storeu_pd(o.wrapping_add(x), r);
+            st(ob, add(add(t(0, 1), t(1, 2)), t(2, 3)));
+            st(ol, add(sub(t(3, 2), t(0, 0)), t(4, 3)));
+            st(or, sub(sub(t(5, 3), t(1, 0)), t(3, 1)));
+            st(
+                ot,
+                sub(sub(sub(_mm256_setzero_pd(), t(2, 0)), t(4, 1)), t(5, 2)),
+            );
         }
     };
-    let mut quads = w.chunks_exact(QUAD_WEIGHTS);
-    for (x, wq) in (0..n / 4).map(|g| 4 * g).zip(&mut quads) {
-        quad(wq, x);
+    // Each group's weights from the row's base: `w` holds `⌈n/4⌉` groups' (checked by
+    // `coriolis_row`).
+    let groups = n / 4;
+    for g in 0..groups {
+        quad(w.as_ptr().wrapping_add(g * QUAD_WEIGHTS), 4 * g);
     }
     if n % 4 != 0 {
-        quad(quads.next().expect("the last group's weights"), n - 4);
+        quad(w.as_ptr().wrapping_add(groups * QUAD_WEIGHTS), n - 4);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A repeatable number in `[-0.5, 0.5)` for `i`.
+    fn rough(i: usize) -> f64 {
+        ((i * 7919 + 13) % 1000) as f64 * 1e-3 - 0.5
+    }
+
+    /// A row of `n` cells' inputs to [`coriolis_row`] from `seed`: weights, vertices and
+    /// velocities.
+    fn row_inputs(n: usize, seed: usize) -> (Vec<f64>, [Vec<f64>; 2], [Vec<f64>; 3]) {
+        let v = |len: usize, k: usize| (0..len).map(|i| rough(seed + 1000 * k + i)).collect();
+        let w = v(n.div_ceil(4) * QUAD_WEIGHTS, 0);
+        (
+            w,
+            [v(n + 1, 1), v(n + 1, 2)],
+            [v(n, 3), v(n + 1, 4), v(n, 5)],
+        )
+    }
+
+    /// [`coriolis_row`] of the inputs, portable or not.
+    fn run_row(w: &[f64], z: &[Vec<f64>; 2], u: &[Vec<f64>; 3], portable: bool) -> Vec<f64> {
+        let n = u[0].len();
+        let mut out = vec![vec![0.0; n]; 4];
+        let [ob, ol, or, ot] = &mut out[..] else {
+            unreachable!()
+        };
+        set_portable_only(portable);
+        coriolis_row(w, [&z[0], &z[1]], [&u[0], &u[1], &u[2]], [ob, ol, or, ot]);
+        set_portable_only(false);
+        out.concat()
+    }
+
+    /// The AVX2 row gives the portable row's bits: rows of 4 to 64 cells, whole groups of
+    /// four and not.
+    #[test]
+    fn the_avx2_coriolis_row_gives_the_portable_bits() {
+        for n in [4, 5, 7, 8, 13, 64] {
+            let (w, z, u) = row_inputs(n, n);
+            let (fast, plain) = (run_row(&w, &z, &u, false), run_row(&w, &z, &u, true));
+            assert!(plain.iter().any(|&r| r != 0.0), "n {n}: no terms");
+            let differ = fast
+                .iter()
+                .zip(&plain)
+                .filter(|(a, b)| a.to_bits() != b.to_bits());
+            assert_eq!(differ.count(), 0, "n {n}: terms differ");
+        }
+    }
+
+    /// The antisymmetric row is, to rounding, each side's sum over the other three of
+    /// `w[i][o] (ζ_i + ζ_o) u_o` with twelve weights, `w[o][i]` minus `w[i][o]` for each
+    /// pair (what the weights were before the energy norm's weights were taken out of
+    /// them): rows of 1 to 13 cells.
+    #[test]
+    fn the_coriolis_row_is_the_twelve_weight_sum() {
+        for n in [1, 3, 5, 13] {
+            let (w, z, u) = row_inputs(n, 3 * n);
+            let got = run_row(&w, &z, &u, false);
+            let quads: Vec<usize> = quad_starts(n).collect();
+            for x in 0..n {
+                // The last group that holds cell `x`, as the row takes it.
+                let g = quads.iter().rposition(|&s| s <= x).expect("a group");
+                let lane = x - quads[g];
+                let c = [z[0][x], z[0][x + 1], z[1][x], z[1][x + 1]];
+                let zeta = [c[0] + c[1], c[0] + c[2], c[1] + c[3], c[2] + c[3]];
+                let v = [u[0][x], u[1][x], u[1][x + 1], u[2][x]];
+                let mut weight = [[0.0; 4]; 4];
+                for (q, [i, o]) in PAIRS.into_iter().enumerate() {
+                    weight[i][o] = w[g * QUAD_WEIGHTS + 4 * q + lane];
+                    weight[o][i] = -weight[i][o];
+                }
+                for i in 0..4 {
+                    let want: f64 = (0..4)
+                        .filter(|&o| o != i)
+                        .map(|o| weight[i][o] * (zeta[i] + zeta[o]) * v[o])
+                        .sum();
+                    let got = got[i * n + x];
+                    assert!(
+                        (got - want).abs() <= 1e-14,
+                        "n {n}, cell {x}, side {i}: {got} against {want}"
+                    );
+                }
+            }
+        }
     }
 }

@@ -36,7 +36,7 @@
 
 use glam::DVec3;
 
-use crate::avx2::{OTHERS, QUAD_WEIGHTS, coriolis_row, quad_starts, with_avx2};
+use crate::avx2::{PAIRS, QUAD_WEIGHTS, coriolis_row, quad_starts, with_avx2};
 
 use super::compare::larger;
 use super::face_rows::{AxisGravity, FaceRows, SIDES, Side, face_order};
@@ -60,20 +60,23 @@ pub(crate) struct AdvectionGeometry {
     to_cell: [[Vec<f64>; 3]; 4],
     /// Per component, per cell: the cell's centre.
     centre: [Vec<f64>; 3],
-    /// Per cell, per side `i` of it (in [`SIDES`] order): the weights of the cell's three
-    /// other sides (in [`OTHERS`] order) in side `i`'s `ζ k×u` term, times ¼: the term
-    /// takes the sum of the two edges' vorticities, each the sum of its two vertices'
-    /// (the ½ of the mean and the ½ of each edge's mean, exact powers of two, folded
-    /// into the weight, for the same bits as halving each sum in the loop).
-    /// An edge's term sums over the other edges of its two cells; the weights are the
-    /// reconstruction's `½ t·w` made antisymmetric under the energy norm `Σ l d u²`, so
-    /// the term does no work, as `ζ k×u ⊥ u` in the continuum (with the reconstruction's
-    /// own weights the advection alone lost 3.3e-4 of a rotating film's energy in 0.25 s:
-    /// `tests::the_rotation_term_does_no_work`). Taken cell by cell, each cell's four
-    /// edges are read once for the twelve terms among them. Stored by rows of cells, in
-    /// each row its groups of four cells ([`quad_starts`]) laid out as [`QUAD_WEIGHTS`]
-    /// says ([`coriolis_row`]): twelve separate arrays a row left the compiler's loop
-    /// short of registers for their bases. Every cell sums its terms in this order, the
+    /// Per cell, per pair `[i, o]` of its sides ([`PAIRS`], in [`SIDES`] order): the
+    /// weight of side `o` in side `i`'s `ζ k×u` term times side `i`'s weight `l d` in the
+    /// energy norm, times ¼: the term takes the sum of the two edges' vorticities, each
+    /// the sum of its two vertices' (the ½ of the mean and the ½ of each edge's mean,
+    /// exact powers of two, folded into the weight, for the same bits as halving each sum
+    /// in the loop). An edge's term sums over the other edges of its two cells; the
+    /// weights are the reconstruction's `½ t·w` made antisymmetric under the energy norm
+    /// `Σ l d u²`, so the term does no work, as `ζ k×u ⊥ u` in the continuum (with the
+    /// reconstruction's own weights the advection alone lost 3.3e-4 of a rotating film's
+    /// energy in 0.25 s: `tests::the_rotation_term_does_no_work`). Times `l d`, side
+    /// `o`'s weight in side `i`'s term is minus side `i`'s in side `o`'s: one weight a
+    /// pair, six a cell where twelve were read, each edge's rate then divided by its own
+    /// `l d` ([`Self::inverse_norm`]). Taken cell by cell, each cell's four edges are read
+    /// once for the twelve terms among them. Stored by rows of cells, in each row its
+    /// groups of four cells ([`quad_starts`]) laid out as [`QUAD_WEIGHTS`] says
+    /// ([`coriolis_row`]): separate arrays a row left the compiler's loop short of
+    /// registers for their bases. Every cell sums its terms in this order, the
     /// faces' border cells whose edges the grid numbers otherwise too
     /// ([`FaceRows::irregular_cells`]): taken apart in the grid's order, those cost a
     /// fifth of the advection's instructions, for sums that differ only in rounding.
@@ -81,10 +84,16 @@ pub(crate) struct AdvectionGeometry {
     /// Face 0's only, which every face reads: the grid is symmetric under the cube's
     /// rotations and each face's rows are in its own frame, so every face's weights are
     /// face 0's to rounding (within 1e-14 of the largest at n = 64:
-    /// `tests::every_faces_coriolis_weights_are_face_0s`). Six faces' weights were 2.4 MB
-    /// at n = 64, streamed from beyond the core's 1 MB L2 in each of a step's three
-    /// stages; one face's are 0.4 MB.
+    /// `tests::every_faces_coriolis_weights_are_face_0s`). Six faces' weights (twelve a
+    /// cell) were 2.4 MB at n = 64, streamed from beyond the core's 1 MB L2 in each of a
+    /// step's three stages; one face's twelve were 0.4 MB, its six are 0.2 MB.
     coriolis: Vec<f64>,
+    /// Per local edge of face 0, which every face reads as it reads [`Self::coriolis`]
+    /// (every face's within 1e-14 of face 0's:
+    /// `tests::every_faces_coriolis_weights_are_face_0s`): `1/(l d)`, the inverse of the
+    /// edge's weight in the energy norm, by which the sum of its two cells' terms becomes
+    /// its rate.
+    inverse_norm: Vec<f64>,
     /// [`Self::to_cell`] for the [`FaceRows::irregular_cells`], in the order the grid
     /// numbers their edges.
     irregular: Vec<IrregularWeights>,
@@ -112,6 +121,8 @@ struct SeamTerms {
     /// The grid's edge (both copies'), for the starting velocities in the grid's
     /// numbering ([`Start::Grid`]).
     grid_edge: u32,
+    /// [`AdvectionGeometry::inverse_norm`] of the grid's edge.
+    inverse_norm: f64,
 }
 
 /// An irregular cell's reconstruction weights, its sides in the grid's order.
@@ -152,8 +163,9 @@ impl AdvectionGeometry {
             let w = to_cells[e][usize::from(edges[e].a as usize != c)];
             (e, rows.sign(k), w)
         };
-        // The weight of side `o`'s velocity in side `i`'s term, in the rows' orientation.
-        let coriolis = |c: usize, i: usize, o: usize| {
+        // The weight of side `o`'s velocity in side `i`'s term times side `i`'s `l d`, in
+        // the rows' orientation.
+        let coriolis = |c: usize, [i, o]: [usize; 2]| {
             let ((e, si, _), (other, so, _)) = (side(c, i), side(c, o));
             let half = if edges[e].a as usize == c { 0 } else { 3 };
             let (_, w) = stencil[e][half..half + 3]
@@ -172,13 +184,7 @@ impl AdvectionGeometry {
             })
         });
         let face_cells = faces * rows.n * rows.n;
-        let weights = std::array::from_fn(|k| {
-            std::array::from_fn(|i| {
-                (0..face_cells)
-                    .map(|c| coriolis(c, i, OTHERS[i][k]))
-                    .collect()
-            })
-        });
+        let weights = PAIRS.map(|pair| (0..face_cells).map(|c| coriolis(c, pair)).collect());
         let irregular = rows
             .irregular_cells
             .iter()
@@ -204,6 +210,7 @@ impl AdvectionGeometry {
                     edges: e.cells.map(|(_, _, k)| k),
                     signs: e.cells.map(|(_, _, k)| rows.sign(k as usize)),
                     grid_edge: rows.edge[e.cells[0].2 as usize],
+                    inverse_norm: inverse_norm(&edges[rows.edge[e.cells[0].2 as usize] as usize]),
                 }
             })
             .collect();
@@ -213,6 +220,9 @@ impl AdvectionGeometry {
             to_cell,
             centre: std::array::from_fn(|a| centres.iter().map(|c| c[a]).collect()),
             coriolis: interleave_quads(&weights, rows.n, faces),
+            inverse_norm: (0..rows.edges_per_face())
+                .map(|k| inverse_norm(&edges[rows.edge[k] as usize]))
+                .collect(),
             irregular,
             min_dual_length: edges
                 .iter()
@@ -222,15 +232,20 @@ impl AdvectionGeometry {
     }
 }
 
-/// The Coriolis weights `w[k][i][cell]` of the first `faces` faces laid out by rows of
+/// `1/(l d)` of `edge`: the inverse of its weight in the energy norm.
+fn inverse_norm(edge: &super::grid::GridEdge) -> f64 {
+    1.0 / (edge.length * edge.dual_length)
+}
+
+/// The Coriolis weights `w[pair][cell]` of the first `faces` faces laid out by rows of
 /// `n` cells, each row by its groups of four ([`AdvectionGeometry::coriolis`]); zero past
 /// a row of fewer than four.
-fn interleave_quads(w: &[[Vec<f64>; 4]; 3], n: usize, faces: usize) -> Vec<f64> {
+fn interleave_quads(w: &[Vec<f64>; 6], n: usize, faces: usize) -> Vec<f64> {
     let mut out = Vec::with_capacity(faces * n * n.div_ceil(4) * QUAD_WEIGHTS);
     for row in 0..faces * n {
         for start in quad_starts(n) {
             let cell = |lane: usize| row * n + start + lane;
-            for side in w.iter().flatten() {
+            for side in w {
                 out.extend((0..4).map(|l| if l < n { side[cell(l)] } else { 0.0 }));
             }
         }
@@ -254,8 +269,9 @@ fn cell_edges(grid: &CubeSphere) -> Vec<[u32; 4]> {
     lists.into_iter().enumerate().map(four).collect()
 }
 
-/// The antisymmetric `ζ k×u` stencil (see [`AdvectionGeometry::coriolis`]): per edge,
-/// cell `a`'s other edges, then cell `b`'s, each in increasing order.
+/// The antisymmetric `ζ k×u` stencil (see [`AdvectionGeometry::coriolis`]) times each
+/// edge's `l d`: per edge, cell `a`'s other edges, then cell `b`'s, each in increasing
+/// order (so that an edge's weight of another is minus the other's of it).
 fn coriolis_stencil(
     grid: &CubeSphere,
     cell_edges: &[[u32; 4]],
@@ -286,7 +302,7 @@ fn coriolis_stencil(
                     .filter(|&o| o != e)
                 {
                     let a = 0.5 * (m(e, other, c) - m(other, e, c));
-                    out[k] = (other as u32, a / (ed.length * ed.dual_length));
+                    out[k] = (other as u32, a);
                     k += 1;
                 }
             }
@@ -614,8 +630,8 @@ impl Stage<'_> {
                 let border_copy = dst[k.end - 1];
                 let u0x = u0.run(rows, (f, y, true), k.clone());
                 let srcx = src.map(|s| &s[k.clone()]);
-                let rates = (&right[..], &left[1..]);
                 let at = (f, k.start - f * epf);
+                let rates = (&right[..], &left[1..], &self.geo.inverse_norm[at.1..]);
                 move_edges(&mut dst[k.clone()], srcx, u0x, rates, &step, gravity, at);
                 dst[k.end - 1] = border_copy;
                 if y == 0 {
@@ -627,7 +643,8 @@ impl Stage<'_> {
                 let u0y = u0.run(rows, (f, y, false), k.clone());
                 let srcy = src.map(|s| &s[k.clone()]);
                 let at = (f, k.start - f * epf);
-                move_edges(&mut dst[k], srcy, u0y, (top, bottom), &step, gravity, at);
+                let rates = (&top[..], &bottom[..], &self.geo.inverse_norm[at.1..]);
+                move_edges(&mut dst[k], srcy, u0y, rates, &step, gravity, at);
             }
         }
         self.move_seam_edges(src, dst, u0, &w.border_rate, &step);
@@ -693,7 +710,7 @@ impl Stage<'_> {
     ) {
         for e in &self.geo.seams {
             let ([ia, ib], [sa, sb]) = (e.slots.map(|i| i as usize), e.signs);
-            let r = (0.0 + sa * border[ia]) + sb * border[ib];
+            let r = ((0.0 + sa * border[ia]) + sb * border[ib]) * e.inverse_norm;
             for (k, sign) in [(e.edges[0] as usize, sa), (e.edges[1] as usize, sb)] {
                 let start = u0.at(dst, k, (e.grid_edge as usize, sign));
                 let from = src.map_or(dst[k], |s| s[k]);
@@ -732,8 +749,10 @@ fn border_slot(n: usize, c: usize, side: Side) -> u32 {
     ((f * 4 + side as usize) * n + along) as u32
 }
 
-/// `dst ← step(src, u0, (0 + ra) + rb)` edge by edge over `dst`, `src` and `u0` the
-/// edge's entries of them, or of `dst` before it is written where `None`; plus
+/// `dst ← step(src, u0, ((0 + ra) + rb)·s)` edge by edge, each of `dst`, `src`, `u0` and
+/// `rates = (ra, rb, s)` the edge's entry (`s` its
+/// [`inverse_norm`](AdvectionGeometry::inverse_norm)), `src` and `u0` that of `dst`
+/// before it is written where `None`; plus
 /// `dt·(g·c)` where `gravity` is given (`dst` face `f`'s local edges from `from`), as
 /// [`FaceRows::add_gravity`] adds it.
 #[inline(always)]
@@ -741,7 +760,7 @@ fn move_edges(
     dst: &mut [f64],
     src: Option<&[f64]>,
     u0: Option<&[f64]>,
-    rates: (&[f64], &[f64]),
+    rates: (&[f64], &[f64], &[f64]),
     step: &impl Fn(f64, f64, f64) -> f64,
     gravity: Option<&AxisGravity>,
     (f, from): (usize, usize),
@@ -762,33 +781,33 @@ fn move_edges_by(
     dst: &mut [f64],
     src: Option<&[f64]>,
     u0: Option<&[f64]>,
-    (ra, rb): (&[f64], &[f64]),
+    (ra, rb, inv): (&[f64], &[f64], &[f64]),
     step: impl Fn(usize, f64, f64, f64) -> f64,
 ) {
     let len = dst.len();
-    let (ra, rb) = (&ra[..len], &rb[..len]);
+    let (ra, rb, inv) = (&ra[..len], &rb[..len], &inv[..len]);
     match (src, u0) {
         (Some(src), Some(u0)) => {
             let (src, u0) = (&src[..len], &u0[..len]);
             for i in 0..len {
-                dst[i] = step(i, src[i], u0[i], (0.0 + ra[i]) + rb[i]);
+                dst[i] = step(i, src[i], u0[i], ((0.0 + ra[i]) + rb[i]) * inv[i]);
             }
         }
         (Some(src), None) => {
             let src = &src[..len];
             for i in 0..len {
-                dst[i] = step(i, src[i], dst[i], (0.0 + ra[i]) + rb[i]);
+                dst[i] = step(i, src[i], dst[i], ((0.0 + ra[i]) + rb[i]) * inv[i]);
             }
         }
         (None, Some(u0)) => {
             let u0 = &u0[..len];
             for i in 0..len {
-                dst[i] = step(i, dst[i], u0[i], (0.0 + ra[i]) + rb[i]);
+                dst[i] = step(i, dst[i], u0[i], ((0.0 + ra[i]) + rb[i]) * inv[i]);
             }
         }
         (None, None) => {
             for i in 0..len {
-                dst[i] = step(i, dst[i], dst[i], (0.0 + ra[i]) + rb[i]);
+                dst[i] = step(i, dst[i], dst[i], ((0.0 + ra[i]) + rb[i]) * inv[i]);
             }
         }
     }
@@ -1068,11 +1087,20 @@ mod tests {
         u
     }
 
+    /// Every face's Coriolis weights are face 0's to rounding, and so is every face's
+    /// local edges' inverse norm.
     #[test]
     fn every_faces_coriolis_weights_are_face_0s() {
         for n in [1, 5, 16, 64] {
             let grid = CubeSphere::new(n);
             let rows = FaceRows::new(&grid);
+            let face_0 = AdvectionGeometry::new(&grid, &rows).inverse_norm;
+            let epf = rows.edges_per_face();
+            for (k, &e) in rows.edge.iter().enumerate() {
+                let (got, want) = (inverse_norm(&grid.edges()[e as usize]), face_0[k % epf]);
+                let off = (got - want).abs() / want;
+                assert!(off <= 1e-14, "n = {n}, local edge {k}: off by {off:e}");
+            }
             let w = AdvectionGeometry::with_coriolis_faces(&grid, &rows, 6).coriolis;
             let face = w.len() / 6;
             let (first, rest) = w.split_at(face);
