@@ -300,21 +300,8 @@ impl Blend {
         }
     }
 
-    /// One face's edges (`u` and `y_prev` its local edges), row by row: Y-edge row `y`
-    /// reads vertex row `y` and padded cell rows `y` and `y + 1`, X-edge row `y` vertex
-    /// rows `y` (heads) and `y + 1` (tails) and padded cell row `y + 1`. Vertex row
-    /// `y + 1` and padded cell row `y + 1` are taken into `window` from edges that have
-    /// not moved yet: vertex row `j` reads X-edge rows `j − 1` and `j` and Y-edge row `j`
-    /// (taken before Y-edge row `y` moves), padded cell row `p` X-edge row `p − 1` and
-    /// Y-edge rows `p − 1` and `p` (taken in Y-edge row `y`'s loop, each cell just before
-    /// its bottom edge moves). Every row of edges whole, the faces' borders' too: their cells across
-    /// the border are in the divergence's halo. Every face reads face 0's metric
-    /// `[1/length, 1/dual length]` ([`FaceRows`] says why).
-    ///
-    /// The face's arrays are split into their X- and Y-edge halves once, the rows of the
-    /// metric and of `y_prev` come from iterators, and the window's two rows of each kind
-    /// swap places: each a bounds check or several a row less, where a row's set-up was
-    /// a third of the stage's instructions.
+    /// One face's edges (`u` and `y_prev` its local edges), row by row ([`Self::walk`]),
+    /// the stage before last kept in the face's rows.
     #[inline(always)]
     fn face<const BLEND: bool, const KEEP: bool>(
         self,
@@ -323,52 +310,18 @@ impl Blend {
         y_prev: &mut [f64],
         window: &mut Window,
     ) {
-        let rows = face.rows;
-        let (n, w, xs) = (rows.n, rows.n + 1, rows.n * (rows.n + 1));
-        let (u_x, u_y) = u.split_at_mut(xs);
-        let (p_x, p_y) = y_prev.split_at_mut(xs);
-        let (il_x, il_y) = rows.inverse_length.split_at(xs);
-        let (id_x, id_y) = rows.inverse_dual_length.split_at(xs);
-        let metric_y = il_y.chunks_exact(n).zip(id_y.chunks_exact(n));
-        let metric_x = il_x.chunks_exact(w).zip(id_x.chunks_exact(w));
-        let mut x_rows = p_x.chunks_exact_mut(w).zip(metric_x);
-        let [va, vb] = &mut window.vertex;
-        let (mut z, mut z_next) = (&mut va[..w], &mut vb[..w]);
-        let [ca, cb] = &mut window.cell;
-        let (mut from, mut into) = (&mut ca[..w + 1], &mut cb[..w + 1]);
-        face.take_vertex_row(z, (u_x, u_y), 0);
-        face.take_cell_row(from, (u_x, u_y), 0);
-        for (y, (p, (il, id))) in p_y.chunks_exact_mut(n).zip(metric_y).enumerate() {
-            if y < n {
-                face.take_vertex_row(z_next, (u_x, u_y), y + 1);
-            }
-            // Y-edge (x, y): tail the vertex (x, y), head (x + 1, y); from cell (x, y − 1)
-            // (padded row y) into (x, y) (padded row y + 1: the halo row, or taken in the
-            // edges' loop).
-            if y == n {
-                face.take_cell_row(into, (u_x, u_y), y + 1);
-            }
-            let (u, above) = u_y[y * n..].split_at_mut(n);
-            let (vertices, from_cells) = ([&z[1..], &*z], &from[1..]);
-            if y < n {
-                let sides = (&u_x[y * w..][..w], &above[..n]);
-                let (u, metric) = ((u, p), [il, id]);
-                self.y_row_taking_cells::<BLEND, KEEP, false>(
-                    face, u, vertices, from_cells, into, metric, sides, y,
-                );
-            } else {
-                self.row::<BLEND, KEEP, false>(u, p, vertices, [&into[1..], from_cells], [il, id]);
-            }
-            let Some((p, (il, id))) = x_rows.next() else {
-                break;
-            };
-            // X-edge (i, y): tail the vertex (i, y + 1), head (i, y); from cell (i − 1, y)
-            // into (i, y) (padded row y + 1).
-            let u = &mut u_x[y * w..][..w];
-            self.x_row::<BLEND, KEEP>(u, p, [z, z_next], into, [il, id]);
-            (z, z_next) = (z_next, z);
-            (from, into) = (into, from);
-        }
+        let (n, w) = (face.rows.n, face.rows.n + 1);
+        let (p_x, p_y) = y_prev.split_at_mut(n * w);
+        let rows = (p_x.chunks_exact_mut(w), p_y.chunks_exact_mut(n));
+        self.walk::<BLEND, KEEP, false, _>(
+            face,
+            u,
+            rows,
+            window,
+            |_, u, p, heads, cells, metric| {
+                self.x_row::<BLEND, KEEP>(u, p, heads, cells, metric);
+            },
+        );
     }
 
     /// [`Self::face`] with the stage before last in `prev` (the grid's numbering), which
@@ -381,21 +334,61 @@ impl Blend {
         prev: GridPrev,
         window: &mut Window,
     ) {
-        let rows = face.rows;
-        let (n, w, xs) = (rows.n, rows.n + 1, rows.n * (rows.n + 1));
-        let (u_x, u_y) = u.split_at_mut(xs);
+        let n = face.rows.n;
         let (left, border) = prev.border.split_at_mut(n);
         let (right, border) = border.split_at_mut(n);
         let (bottom, top) = border.split_at_mut(n);
         let y_prev = std::iter::once(bottom)
             .chain(prev.inner_y.chunks_exact_mut(n))
             .chain(std::iter::once(top));
+        let (x_prev, inner_x) = (left.iter_mut().zip(right.iter_mut()), prev.inner_x);
+        let rows = (x_prev, y_prev);
+        self.walk::<BLEND, KEEP, INTO, _>(
+            face,
+            u,
+            rows,
+            window,
+            move |y, u, (l, r), heads, cells, metric| {
+                let p = &mut inner_x[y * (n - 1)..][..n];
+                self.x_row_grid::<BLEND, KEEP, INTO>(u, (l, p, r), heads, cells, metric);
+            },
+        );
+    }
+
+    /// One face's edges (`u` its local edges), row by row, the stage before last of its
+    /// rows from `prev`: per X-edge row (`n`), what `x_row` takes of it, and per Y-edge
+    /// row (`n + 1`), its `n` edges'. X-edge row `y` moves by `x_row(y, u, prev, [heads,
+    /// tails], cells, metric)`: Y-edge row `y` reads vertex row `y`
+    /// and padded cell rows `y` and `y + 1`, X-edge row `y` vertex rows `y` (heads) and
+    /// `y + 1` (tails) and padded cell row `y + 1`. Vertex row `y + 1` and padded cell row
+    /// `y + 1` are taken into `window` from edges that have not moved yet: vertex row `j`
+    /// reads X-edge rows `j − 1` and `j` and Y-edge row `j` (taken before Y-edge row `y`
+    /// moves), padded cell row `p` X-edge row `p − 1` and Y-edge rows `p − 1` and `p`
+    /// (taken in Y-edge row `y`'s loop, each cell just before its bottom edge moves).
+    /// Every row of edges whole, the faces' borders' too: their cells across the border
+    /// are in the divergence's halo. Every face reads face 0's metric `[1/length, 1/dual
+    /// length]` ([`FaceRows`] says why).
+    ///
+    /// The face's arrays are split into their X- and Y-edge halves once, the rows of the
+    /// metric and of the stage before last come from iterators, and the window's two rows
+    /// of each kind swap places: each a bounds check or several a row less, where a row's
+    /// set-up was a third of the stage's instructions.
+    #[inline(always)]
+    fn walk<'p, const BLEND: bool, const KEEP: bool, const INTO: bool, P>(
+        self,
+        face: Face,
+        u: &mut [f64],
+        (x_prev, y_prev): (impl Iterator<Item = P>, impl Iterator<Item = &'p mut [f64]>),
+        window: &mut Window,
+        mut x_row: impl FnMut(usize, &mut [f64], P, [&[f64]; 2], &[f64], [&[f64]; 2]),
+    ) {
+        let rows = face.rows;
+        let (n, w, xs) = (rows.n, rows.n + 1, rows.n * (rows.n + 1));
+        let (u_x, u_y) = u.split_at_mut(xs);
         let (il_x, il_y) = rows.inverse_length.split_at(xs);
         let (id_x, id_y) = rows.inverse_dual_length.split_at(xs);
         let metric_y = il_y.chunks_exact(n).zip(id_y.chunks_exact(n));
-        let metric_x = il_x.chunks_exact(w).zip(id_x.chunks_exact(w));
-        let mut x_rows = left.iter_mut().zip(right.iter_mut()).zip(metric_x);
-        let inner_x = prev.inner_x;
+        let mut x_rows = x_prev.zip(il_x.chunks_exact(w).zip(id_x.chunks_exact(w)));
         let [va, vb] = &mut window.vertex;
         let (mut z, mut z_next) = (&mut va[..w], &mut vb[..w]);
         let [ca, cb] = &mut window.cell;
@@ -406,6 +399,9 @@ impl Blend {
             if y < n {
                 face.take_vertex_row(z_next, (u_x, u_y), y + 1);
             }
+            // Y-edge (x, y): tail the vertex (x, y), head (x + 1, y); from cell (x, y − 1)
+            // (padded row y) into (x, y) (padded row y + 1: the halo row, or taken in the
+            // edges' loop).
             if y == n {
                 face.take_cell_row(into, (u_x, u_y), y + 1);
             }
@@ -421,11 +417,12 @@ impl Blend {
                 let cells = [&into[1..], from_cells];
                 self.row::<BLEND, KEEP, INTO>(u, p, vertices, cells, [il, id]);
             }
-            let Some(((l, r), (il, id))) = x_rows.next() else {
+            // X-edge (i, y): tail the vertex (i, y + 1), head (i, y); from cell (i − 1, y)
+            // into (i, y) (padded row y + 1).
+            let Some((p, (il, id))) = x_rows.next() else {
                 break;
             };
-            let (u, p) = (&mut u_x[y * w..][..w], &mut inner_x[y * (n - 1)..][..n]);
-            self.x_row_grid::<BLEND, KEEP, INTO>(u, (l, p, r), [z, z_next], into, [il, id]);
+            x_row(y, &mut u_x[y * w..][..w], p, [z, z_next], into, [il, id]);
             (z, z_next) = (z_next, z);
             (from, into) = (into, from);
         }
