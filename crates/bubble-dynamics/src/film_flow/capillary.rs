@@ -146,18 +146,17 @@ fn substep(
         seam_ends: &mut s.seam_ends,
     };
     let pass = (&mut differences, &h_m[..]);
-    net_inflow(
-        sides,
-        pass,
-        &mut s.laplacian,
-        &mut s.gather,
-        |_, rows, lap| {
-            let per_area = &per_area[rows.start * n..rows.end * n];
-            for (lap, per_area) in lap.iter_mut().zip(per_area) {
-                *lap *= per_area * per_r2;
-            }
-        },
-    );
+    // Every entry is written below: the buffer needs its length, not a fill.
+    let laplacian = &mut s.laplacian;
+    laplacian.resize(h_m.len(), 0.0);
+    net_inflow(sides, pass, &mut s.gather, |_, face, rows, inflow| {
+        let cells = rows.start * n..rows.end * n;
+        let (per_area, first) = (&per_area[cells.clone()], face * n * n + cells.start);
+        let lap = &mut laplacian[first..first + cells.len()];
+        for ((lap, inflow), per_area) in lap.iter_mut().zip(inflow).zip(per_area) {
+            *lap = inflow * (per_area * per_r2);
+        }
+    });
     // Volume from a to b over the sub-step, per R² (m·sr): the flux runs down the
     // pressure −(σ/2)∇²h, i.e. up the gradient of ∇²h (the ½σ is in the mobility), so
     // out of a bump, whose top has the lowest ∇²h.

@@ -615,9 +615,8 @@ mod tests {
                 pass: volumes,
                 values: &mut got,
             };
-            let mut out = Vec::new();
             let scratch = &mut GatherScratch::default();
-            net_inflow(&sides, (&mut kept, &h), &mut out, scratch, |_, _, _| {});
+            net_inflow(&sides, (&mut kept, &h), scratch, |_, _, _, _| {});
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&got), bits(&want), "n = {n}");
             let fastest = fastest.fastest;
