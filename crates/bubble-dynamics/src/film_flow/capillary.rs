@@ -52,10 +52,19 @@ pub(crate) struct CapillaryScratch {
     laplacian_norm: Option<(usize, f64)>,
     /// The thickness's Laplacian per cell, per m.
     laplacian: Vec<f64>,
+}
+
+/// Buffers the smoothing shares with the step's other band passes: the gathers' and the
+/// seams' ends.
+///
+/// Why shared: the thickness transport, which runs just before, leaves them in cache,
+/// where buffers of the smoothing's own were written cold at each step's first band
+/// (the window and the rows carried between bands, about 60 KB).
+pub(crate) struct Shared<'a> {
     /// The gathers' buffers.
-    gather: GatherScratch,
+    pub(crate) gather: &'a mut GatherScratch,
     /// The seam edges' end values.
-    seam_ends: SeamEnds,
+    pub(crate) seam_ends: &'a mut SeamEnds,
 }
 
 /// Moves liquid by the capillary pressure over `dt_s`; `h_m` per cell. Where `thin`
@@ -67,7 +76,7 @@ pub(crate) fn smooth_thickness(
     c: Capillary,
     (dt_s, thin): (f64, Option<f64>),
     h_m: &mut [f64],
-    s: &mut CapillaryScratch,
+    (s, shared): (&mut CapillaryScratch, Shared),
 ) -> bool {
     // h³/(3μ_d) times σ/2 (the pressure's factor), per m³ of h³.
     let per_cubed = 0.5 * c.sigma_n_per_m / (3.0 * c.drainage_viscosity_pa_s);
@@ -96,7 +105,18 @@ pub(crate) fn smooth_thickness(
     let substeps = substeps as u32;
     for k in 0..substeps {
         let thin = thin.filter(|_| k + 1 == substeps);
-        substep((grid, sides), c.radius_m, mobility, (sub_dt, thin), h_m, s);
+        let shared = Shared {
+            gather: &mut *shared.gather,
+            seam_ends: &mut *shared.seam_ends,
+        };
+        substep(
+            (grid, sides),
+            c.radius_m,
+            mobility,
+            (sub_dt, thin),
+            h_m,
+            (s, shared),
+        );
     }
     thin.is_some()
 }
@@ -133,7 +153,7 @@ fn substep(
     mobility: Mobility,
     (dt_s, thin): (f64, Option<f64>),
     h_m: &mut [f64],
-    s: &mut CapillaryScratch,
+    (s, shared): (&mut CapillaryScratch, Shared),
 ) {
     let fg = grid.face_geometry();
     // ∇²h as the net inflow of the differences `(h_b − h_a) l/d` (their sum out of a
@@ -143,13 +163,13 @@ fn substep(
     let per_area = &fg.inverse_area_per_sr;
     let mut differences = Differences {
         fg,
-        seam_ends: &mut s.seam_ends,
+        seam_ends: &mut *shared.seam_ends,
     };
     let pass = (&mut differences, &h_m[..]);
     // Every entry is written below: the buffer needs its length, not a fill.
     let laplacian = &mut s.laplacian;
     laplacian.resize(h_m.len(), 0.0);
-    net_inflow(sides, pass, &mut s.gather, |_, face, rows, inflow| {
+    net_inflow(sides, pass, shared.gather, |_, face, rows, inflow| {
         let cells = rows.start * n..rows.end * n;
         let (per_area, first) = (&per_area[cells.clone()], face * n * n + cells.start);
         let lap = &mut laplacian[first..first + cells.len()];
@@ -171,14 +191,14 @@ fn substep(
         mobility,
         per_length: dt_s / (radius_m * radius_m),
         laplacian: &s.laplacian,
-        seam_ends: &mut s.seam_ends,
+        seam_ends: shared.seam_ends,
     };
     // Each donor gives at most half its content: h stays ≥ 0.
     match thin {
-        None => apply_limited(sides, grid, &mut volumes, 1.0, h_m, &mut s.gather),
+        None => apply_limited(sides, grid, &mut volumes, 1.0, h_m, shared.gather),
         Some(by) => {
             let h = &mut Thinned { values: h_m, by };
-            apply_limited_to(sides, grid, &mut volumes, 1.0, h, &mut s.gather);
+            apply_limited_to(sides, grid, &mut volumes, 1.0, h, shared.gather);
         }
     }
 }
