@@ -814,5 +814,12 @@ mod tests {
                 f.gamma[c]
             );
         }
+        // The step's change of the solve, taken from the solution before the surfactant
+        // after the step replaced it: the same bits as the plain difference.
+        let change: Vec<u64> = (solution.iter().zip(&gamma_before))
+            .map(|(x, g)| (x - g).to_bits())
+            .collect();
+        let got: Vec<u64> = f.surfactant_change.iter().map(|d| d.to_bits()).collect();
+        assert_eq!(got, change, "the solve's change");
     }
 }
