@@ -334,8 +334,9 @@ fn net(v: [f64; 4], inflow: [f64; 4]) -> f64 {
 /// Why a stretch's buffer, not a field's: the field was written cold every pass (3072
 /// lines at n = 64, a write miss each), where `finish` can write its result into a field
 /// the pass has just read (the Marangoni correction's surfactant after the step, in place
-/// of the solution it read: [`EdgeValues`] passes read no cell of the rows a band's
-/// `finish` took again).
+/// of the solution it read): the bands ask the pass for no value from a cell of rows
+/// `finish` has taken, but a padded x-run's extra edge's (a face's last row's reads the
+/// next face's first cell), whose value is dropped ([`EdgeRun::padded`]).
 // Inlined into the callers, so `pass` and `finish` compile into the AVX2 closure.
 #[inline(always)]
 pub(crate) fn net_inflow<P: EdgeValues>(
