@@ -17,7 +17,7 @@ use glam::DVec3;
 
 use super::advect::{AdvectionGeometry, AdvectionScratch, advect_momentum};
 use super::burst::{BurstParams, BurstState, Hole};
-use super::capillary::{Capillary, CapillaryScratch, smooth_thickness};
+use super::capillary::{Capillary, CapillaryScratch, Shared, smooth_thickness};
 use super::compare::larger;
 use super::face_geometry::{EdgeVector, FaceGeometry};
 use super::face_rows::FaceRows;
@@ -598,7 +598,12 @@ impl FilmFlow {
         };
         let sides = &self.sides;
         let h = &mut self.h_m;
-        smooth_thickness(&self.grid, sides, c, (dt_s, thin), h, &mut s.capillary)
+        let shared = Shared {
+            gather: &mut s.gather,
+            seam_ends: &mut s.seam_ends,
+        };
+        let scratch = (&mut s.capillary, shared);
+        smooth_thickness(&self.grid, sides, c, (dt_s, thin), h, scratch)
     }
 }
 

@@ -100,6 +100,8 @@ pub(crate) struct GatherScratch {
     /// The rim's values in its order, kept until every face's factors are in
     /// ([`RimValues`]).
     rim: RimValues,
+    /// A stretch of a face's rows' net inflows ([`net_inflow`]), `(BAND + 1)·n`.
+    inflow: Vec<f64>,
 }
 
 /// The bands of rows of a face of `n` rows, in order.
@@ -325,28 +327,37 @@ fn net(v: [f64; 4], inflow: [f64; 4]) -> f64 {
 
 /// Each cell's net inflow of the values `pass` gives the edges from `cells` (positive
 /// from an edge's `a` cell to its `b` cell): `Σ value` over the edges it is `b` of, less
-/// over those it is `a` of, into `out`; `finish(face, rows, out)` then runs on each
-/// stretch of a face's rows' cells (`rows.len()·n` of `out`) while they are in cache.
+/// over those it is `a` of, a stretch of a face's rows at a time into a buffer of the
+/// stretch's, which `finish(pass, face, rows, inflow)` then takes (`rows.len()·n` of
+/// them, the rows' cells in order) while it is in L1.
+///
+/// Why a stretch's buffer, not a field's: the field was written cold every pass (3072
+/// lines at n = 64, a write miss each), where `finish` can write its result into a field
+/// the pass has just read (the Marangoni correction's surfactant after the step, in place
+/// of the solution it read): the bands ask the pass for no value from a cell of rows
+/// `finish` has taken, but a padded x-run's extra edge's (a face's last row's reads the
+/// next face's first cell), whose value is dropped ([`EdgeRun::padded`]).
 // Inlined into the callers, so `pass` and `finish` compile into the AVX2 closure.
 #[inline(always)]
-pub(crate) fn net_inflow(
+pub(crate) fn net_inflow<P: EdgeValues>(
     sides: &CellSides,
-    (pass, cells): (&mut impl EdgeValues, &[f64]),
-    out: &mut Vec<f64>,
+    (pass, cells): (&mut P, &[f64]),
     scratch: &mut GatherScratch,
-    mut finish: impl FnMut(usize, Range<usize>, &mut [f64]),
+    mut finish: impl FnMut(&mut P, usize, Range<usize>, &[f64]),
 ) {
     let n = sides.n();
-    // Every entry is written below: the buffer needs its length, not a fill.
-    out.resize(6 * n * n, 0.0);
     let GatherScratch {
         window,
         carried,
         seams,
         pads,
+        inflow,
         ..
     } = scratch;
     window.resize(n);
+    // Every entry a stretch takes is written before `finish` reads it: the buffer needs
+    // its length, not a fill.
+    inflow.resize((BAND + 1) * n, 0.0);
     with_avx2(
         #[inline(always)]
         || {
@@ -357,11 +368,10 @@ pub(crate) fn net_inflow(
                     window.start(n, &band, carried);
                     window.fill((n, sides), (face, band.clone()), (pass, cells), pads);
                     let rows = sided(&band, n);
-                    let first = face * n * n + rows.start * n;
-                    let o = &mut out[first..first + rows.len() * n];
+                    let o = &mut inflow[..rows.len() * n];
                     window.net_inflow(n, &rows, o);
                     window.carry(n, &band, carried);
-                    finish(face, rows, o);
+                    finish(pass, face, rows, o);
                 }
             }
         },
@@ -536,6 +546,7 @@ pub(crate) fn apply_limited_to(
         seams,
         pads,
         rim,
+        ..
     } = scratch;
     let n = sides.n();
     let fg = grid.face_geometry();
@@ -935,12 +946,14 @@ mod tests {
                 }
             }
             let want: Vec<f64> = sum.iter().map(|s| (s[0] + s[1]) + (s[2] + s[3])).collect();
-            let mut got = vec![f64::NAN; 3];
+            let mut got = vec![f64::NAN; grid.cells()];
             let mut finished = Vec::new();
             let pass = (&mut FromArray(&volume), &[][..]);
             let scratch = &mut GatherScratch::default();
-            net_inflow(&sides, pass, &mut got, scratch, |f, rows, out| {
-                assert_eq!(out.len(), rows.len() * n, "n = {n}: a stretch's cells");
+            net_inflow(&sides, pass, scratch, |_, f, rows, inflow| {
+                assert_eq!(inflow.len(), rows.len() * n, "n = {n}: a stretch's cells");
+                let first = f * n * n + rows.start * n;
+                got[first..first + inflow.len()].copy_from_slice(inflow);
                 finished.extend(rows.map(|y| (f, y)));
             });
             assert_eq!(got, want, "n = {n}");

@@ -160,20 +160,18 @@ impl FilmFlow {
         let dt_per_r = dt_s / p.radius_m;
         let (areas, gamma, n) = (&g.face_geometry().area_sr[..], &self.gamma, self.sides.n());
         let pass = (&mut fluxes, &gamma[..]);
-        net_inflow(
-            &self.sides,
-            pass,
-            &mut s.rhs,
-            &mut s.gather,
-            |face, rows, rhs| {
-                let cells = rows.start * n..rows.end * n;
-                let gamma = &gamma[face * n * n + cells.start..face * n * n + cells.end];
-                let (areas, gamma) = (&areas[cells], &gamma[..rhs.len()]);
-                for i in 0..rhs.len() {
-                    rhs[i] = areas[i] * gamma[i] + dt_per_r * rhs[i];
-                }
-            },
-        );
+        // Every entry is written below: the buffer needs its length, not a fill.
+        let rhs = &mut s.rhs;
+        rhs.resize(gamma.len(), 0.0);
+        net_inflow(&self.sides, pass, &mut s.gather, |_, face, rows, inflow| {
+            let cells = rows.start * n..rows.end * n;
+            let at = face * n * n + cells.start..face * n * n + cells.end;
+            let (areas, gamma, rhs) = (&areas[cells], &gamma[at.clone()], &mut rhs[at]);
+            let (gamma, inflow) = (&gamma[..rhs.len()], &inflow[..rhs.len()]);
+            for i in 0..rhs.len() {
+                rhs[i] = areas[i] * gamma[i] + dt_per_r * inflow[i];
+            }
+        });
     }
 
     /// Solves for the surfactant the step ends with into `s.cell2`, from the last step's
@@ -310,36 +308,32 @@ impl FilmFlow {
                 per_r: 1.0 / r,
                 scale,
             },
-            solution: &s.cell2,
+            solution: &mut s.cell2,
             seam_ends: &mut s.seam_ends,
         };
         // Each cell's net inflow gathered band by band, and the surfactant after the
-        // step from it while the band is in cache; each face's cells with face 0's
-        // inverse areas (the same on every face).
+        // step from it while the band is in cache, in place of the solution (the band
+        // has just read it: written into a field of its own, every line of it missed);
+        // each face's cells with face 0's inverse areas (the same on every face).
         let (gamma, n) = (&self.gamma[..], sides.n());
         // The change recorded only where the next solve takes it as its guess.
         let record = self.guess_wait == 0;
         let change = &mut self.surfactant_change;
         // Every entry is written below: the buffer needs its length, not a fill.
         change.resize(gamma.len(), 0.0);
-        let (per_area, solution) = (&fg.inverse_area_per_sr[..], &s.cell2[..]);
+        let per_area = &fg.inverse_area_per_sr[..];
         let mut negative = false;
         let pass = (&mut correction, gamma);
-        net_inflow(
-            sides,
-            pass,
-            &mut s.rhs,
-            &mut s.gather,
-            |face, rows, next| {
-                let cells = face * n * n + rows.start * n..face * n * n + rows.end * n;
-                let per_area = &per_area[rows.start * n..rows.end * n];
-                let before = (&gamma[cells.clone()], &solution[cells.clone()]);
-                let after = (next, record.then(|| &mut change[cells]));
-                negative |= next_surfactant(before, per_area, after);
-            },
-        );
+        net_inflow(sides, pass, &mut s.gather, |pass, face, rows, inflow| {
+            let cells = face * n * n + rows.start * n..face * n * n + rows.end * n;
+            let per_area = &per_area[rows.start * n..rows.end * n];
+            let before = (&gamma[cells.clone()], inflow);
+            let change = record.then(|| &mut change[cells.clone()]);
+            let after = (&mut pass.solution[cells], change);
+            negative |= next_surfactant(before, per_area, after);
+        });
         if !negative {
-            std::mem::swap(&mut self.gamma, &mut s.rhs);
+            std::mem::swap(&mut self.gamma, &mut s.cell2);
             return;
         }
         // A violent step (a film torn near zero thickness, where the waves run at
@@ -514,8 +508,10 @@ impl<const NORMAL: bool> CentralEdges<'_, NORMAL> {
 struct Correction<'a, const NORMAL: bool> {
     /// What it reads and writes per edge.
     edges: CorrectionEdges<'a, NORMAL>,
-    /// The surfactant the step ends with.
-    solution: &'a [f64],
+    /// The surfactant the step ends with (the solve's solution), which the gather
+    /// replaces, a stretch of rows at a time once the pass has read them, by the
+    /// surfactant after the step.
+    solution: &'a mut [f64],
     /// The seams' ends.
     seam_ends: &'a mut SeamEnds,
 }
@@ -548,7 +544,7 @@ struct CorrectionEdges<'a, const NORMAL: bool> {
 impl<const NORMAL: bool> EdgeValues for Correction<'_, NORMAL> {
     #[inline(always)]
     fn seams(&mut self, seams: Seams, gamma: &[f64], out: &mut [f64]) {
-        let [[ga, gb], [xa, xb]] = self.seam_ends.gather_many(seams, [gamma, self.solution]);
+        let [[ga, gb], [xa, xb]] = self.seam_ends.gather_many(seams, [gamma, &*self.solution]);
         self.edges.block(seams, [ga, gb, xa, xb], out);
     }
 
@@ -558,7 +554,7 @@ impl<const NORMAL: bool> EdgeValues for Correction<'_, NORMAL> {
         // it corrects in place, put back after: it is the next x-edge's, corrected by its
         // own run.
         let padded = run.padded(out.len(), gamma.len());
-        let ((ga, gb), (xa, xb)) = (padded.ends(gamma), padded.ends(self.solution));
+        let ((ga, gb), (xa, xb)) = (padded.ends(gamma), padded.ends(&*self.solution));
         let extra = padded.first() + run.len;
         let kept = (padded.len > run.len).then(|| self.edges.u[extra]);
         self.edges.block(padded, [ga, gb, xa, xb], out);
@@ -616,27 +612,28 @@ impl<const NORMAL: bool> CorrectionEdges<'_, NORMAL> {
     }
 }
 
-/// A stretch of cells' surfactant after the step, `Γ + inflow/area` (`next` holds the
-/// inflows and takes the result; `per_area` the cells' inverse areas), and, where
-/// `change` is given, the step's change of the solve, `solution − Γ` (the next step's
-/// first guess), while the stretch is in cache; returns whether any cell went negative.
+/// A stretch of cells' surfactant after the step, `Γ + inflow/area` (`per_area` the
+/// cells' inverse areas), into `next`, which holds the solve's solution before, and,
+/// where `change` is given, the step's change of the solve, `solution − Γ` (the next
+/// step's first guess), while the stretch is in cache; returns whether any cell went
+/// negative.
 #[inline(always)]
 fn next_surfactant(
-    (gamma, solution): (&[f64], &[f64]),
+    (gamma, inflow): (&[f64], &[f64]),
     per_area: &[f64],
     (next, change): (&mut [f64], Option<&mut [f64]>),
 ) -> bool {
     let m = next.len();
-    let (gamma, per_area) = (&gamma[..m], &per_area[..m]);
+    let (gamma, inflow, per_area) = (&gamma[..m], &inflow[..m], &per_area[..m]);
     if let Some(change) = change {
-        let (solution, change) = (&solution[..m], &mut change[..m]);
+        let change = &mut change[..m];
         for i in 0..m {
-            change[i] = solution[i] - gamma[i];
+            change[i] = next[i] - gamma[i];
         }
     }
     let mut negative = false;
     for i in 0..m {
-        next[i] = gamma[i] + next[i] * per_area[i];
+        next[i] = gamma[i] + inflow[i] * per_area[i];
         negative |= next[i] < 0.0;
     }
     negative
@@ -827,11 +824,15 @@ mod tests {
         f.fluxes_weights_and_right_hand_side::<false>(&mut s, dt_s);
         f.solve_surfactant(&mut s);
         let (u_before, gamma_before) = (f.u_m_per_s.clone(), f.gamma.clone());
+        // The solution, which the correction replaces by the surfactant after the step.
+        let solution = s.cell2.clone();
+        // The next solve offers the guess, so the change is recorded ([`GUESS_REST`]).
+        f.guess_wait = 0;
         f.correct_velocity_and_move_surfactant::<false>(&mut s, dt_s);
 
         let (p, g) = (f.params, std::sync::Arc::clone(&f.grid));
         let (ea, r) = (g.edge_arrays(), p.radius_m);
-        let (x, h) = (&s.cell2, &f.h_m);
+        let (x, h) = (&solution, &f.h_m);
         let mut du_plain = vec![0.0; edges];
         let mut inflow = vec![0.0; gamma_before.len()];
         for (e, &[a, b]) in ea.cells.iter().enumerate() {
@@ -866,5 +867,12 @@ mod tests {
                 f.gamma[c]
             );
         }
+        // The step's change of the solve, taken from the solution before the surfactant
+        // after the step replaced it: the same bits as the plain difference.
+        let change: Vec<u64> = (solution.iter().zip(&gamma_before))
+            .map(|(x, g)| (x - g).to_bits())
+            .collect();
+        let got: Vec<u64> = f.surfactant_change.iter().map(|d| d.to_bits()).collect();
+        assert_eq!(got, change, "the solve's change");
     }
 }

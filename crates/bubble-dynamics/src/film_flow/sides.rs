@@ -6,6 +6,8 @@
 //! Why cell by cell: an edge-by-edge pass scatters into both cells through index arrays,
 //! which no compiler vectorises; a cell that gathers its four sides from slices does.
 
+use std::ops::Range;
+
 use glam::DVec3;
 
 use super::face_geometry::{EdgeConstant, EdgeVector, to_face_frame};
@@ -351,19 +353,25 @@ impl Rim<'_> {
         [s[0][i], s[1][i], s[2][i], s[3][i]]
     }
 
-    /// A cell field's values at the rim cells' neighbours, in the rim's order, into
-    /// `out[k]`.
+    /// A cell field's values at the neighbours of the rim cells at places `at`, in the
+    /// rim's order, into `out[k]`.
     #[inline(always)]
-    pub(crate) fn gather_neighbours(&self, per_cell: &[f64], out: &mut [Vec<f64>; 4]) {
+    pub(crate) fn gather_neighbours(
+        &self,
+        per_cell: &[f64],
+        at: Range<usize>,
+        out: &mut [Vec<f64>; 4],
+    ) {
         for (o, cells) in out.iter_mut().zip(self.neighbour) {
-            gather(per_cell, cells, o);
+            gather(per_cell, &cells[at.clone()], o);
         }
     }
 
-    /// A cell field's values at the rim cells, in the rim's order, into `out`.
+    /// A cell field's values at the rim cells at places `at`, in the rim's order, into
+    /// `out`.
     #[inline(always)]
-    pub(crate) fn gather_cells(&self, per_cell: &[f64], out: &mut Vec<f64>) {
-        gather(per_cell, self.cells, out);
+    pub(crate) fn gather_cells(&self, per_cell: &[f64], at: Range<usize>, out: &mut Vec<f64>) {
+        gather(per_cell, &self.cells[at], out);
     }
 }
 
