@@ -184,6 +184,111 @@ fn widened_dot_lanes_avx2(a: &[f32], b: &[f32]) -> [f64; 4] {
     lanes
 }
 
+/// Values [`deinterleave_f64`] and [`interleave_f64`] take a chunk: two AVX2 vectors
+/// of `f64`.
+const PAIRS_CHUNK: usize = 8;
+
+/// `even[k] = values[2k]` and `odd[k] = values[2k + 1]` over the first chunks of
+/// [`PAIRS_CHUNK`] values that all three slices hold; returns how many values that was.
+/// With AVX2 two loads, two unpacks, two lane permutes and two stores a chunk, where the
+/// compiler left the `f64` copies one at a time (the split layout's scatters: each
+/// face row's cells to its two colours); copies, so the same bits either way.
+#[inline(always)]
+pub(crate) fn deinterleave_f64(values: &[f64], even: &mut [f64], odd: &mut [f64]) -> usize {
+    let half = PAIRS_CHUNK / 2;
+    let chunks = (values.len() / PAIRS_CHUNK)
+        .min(even.len() / half)
+        .min(odd.len() / half);
+    let done = chunks * PAIRS_CHUNK;
+    let (values, even, odd) = (&values[..done], &mut even[..done / 2], &mut odd[..done / 2]);
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && !portable_only() {
+        // SAFETY: the processor supports AVX2, checked just above.
+        unsafe { deinterleave_f64_avx2(values, even, odd) };
+        return done;
+    }
+    let halves = even.chunks_exact_mut(half).zip(odd.chunks_exact_mut(half));
+    for (v, (e, o)) in values.chunks_exact(PAIRS_CHUNK).zip(halves) {
+        for k in 0..half {
+            (e[k], o[k]) = (v[2 * k], v[2 * k + 1]);
+        }
+    }
+    done
+}
+
+/// [`deinterleave_f64`]'s chunks in AVX2 registers (the slices cut to whole chunks).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn deinterleave_f64_avx2(values: &[f64], even: &mut [f64], odd: &mut [f64]) {
+    use std::arch::x86_64::{
+        _mm256_loadu_pd, _mm256_permute4x64_pd, _mm256_storeu_pd, _mm256_unpackhi_pd,
+        _mm256_unpacklo_pd,
+    };
+    let half = PAIRS_CHUNK / 2;
+    let halves = even.chunks_exact_mut(half).zip(odd.chunks_exact_mut(half));
+    for (v, (e, o)) in values.chunks_exact(PAIRS_CHUNK).zip(halves) {
+        // SAFETY: each chunk holds eight values and each half four, the loads' and
+        // stores' widths.
+        unsafe {
+            let a = _mm256_loadu_pd(v.as_ptr());
+            let b = _mm256_loadu_pd(v.as_ptr().add(half));
+            // [v0 v4 v2 v6] and [v1 v5 v3 v7], their middle lanes swapped.
+            let (lo, hi) = (_mm256_unpacklo_pd(a, b), _mm256_unpackhi_pd(a, b));
+            _mm256_storeu_pd(e.as_mut_ptr(), _mm256_permute4x64_pd(lo, 0b11_01_10_00));
+            _mm256_storeu_pd(o.as_mut_ptr(), _mm256_permute4x64_pd(hi, 0b11_01_10_00));
+        }
+    }
+}
+
+/// `out[2k] = even[k]` and `out[2k + 1] = odd[k]` over the first chunks of
+/// [`PAIRS_CHUNK`] values that all three slices hold; returns how many values that was:
+/// [`deinterleave_f64`]'s inverse (the split layout's gathers).
+#[inline(always)]
+pub(crate) fn interleave_f64(even: &[f64], odd: &[f64], out: &mut [f64]) -> usize {
+    let half = PAIRS_CHUNK / 2;
+    let chunks = (out.len() / PAIRS_CHUNK)
+        .min(even.len() / half)
+        .min(odd.len() / half);
+    let done = chunks * PAIRS_CHUNK;
+    let (even, odd, out) = (&even[..done / 2], &odd[..done / 2], &mut out[..done]);
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && !portable_only() {
+        // SAFETY: the processor supports AVX2, checked just above.
+        unsafe { interleave_f64_avx2(even, odd, out) };
+        return done;
+    }
+    let halves = even.chunks_exact(half).zip(odd.chunks_exact(half));
+    for (v, (e, o)) in out.chunks_exact_mut(PAIRS_CHUNK).zip(halves) {
+        for k in 0..half {
+            (v[2 * k], v[2 * k + 1]) = (e[k], o[k]);
+        }
+    }
+    done
+}
+
+/// [`interleave_f64`]'s chunks in AVX2 registers (the slices cut to whole chunks).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn interleave_f64_avx2(even: &[f64], odd: &[f64], out: &mut [f64]) {
+    use std::arch::x86_64::{
+        _mm256_loadu_pd, _mm256_permute4x64_pd, _mm256_storeu_pd, _mm256_unpackhi_pd,
+        _mm256_unpacklo_pd,
+    };
+    let half = PAIRS_CHUNK / 2;
+    let halves = even.chunks_exact(half).zip(odd.chunks_exact(half));
+    for (v, (e, o)) in out.chunks_exact_mut(PAIRS_CHUNK).zip(halves) {
+        // SAFETY: each chunk holds eight values and each half four, the loads' and
+        // stores' widths.
+        unsafe {
+            // [e0 e2 e1 e3] and [o0 o2 o1 o3]: their unpacks are the pairs in order.
+            let e = _mm256_permute4x64_pd(_mm256_loadu_pd(e.as_ptr()), 0b11_01_10_00);
+            let o = _mm256_permute4x64_pd(_mm256_loadu_pd(o.as_ptr()), 0b11_01_10_00);
+            _mm256_storeu_pd(v.as_mut_ptr(), _mm256_unpacklo_pd(e, o));
+            _mm256_storeu_pd(v.as_mut_ptr().add(half), _mm256_unpackhi_pd(e, o));
+        }
+    }
+}
+
 /// For each of a cell's four sides, the other three, in the order of the four.
 pub(crate) const OTHERS: [[usize; 3]; 4] = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]];
 

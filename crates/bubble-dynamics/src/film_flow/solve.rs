@@ -73,6 +73,20 @@ trait Real:
     fn widen(self) -> f64;
     /// `x` rounded to this precision.
     fn narrow(x: f64) -> Self;
+    /// `even[k] = values[2k]` and `odd[k] = values[2k + 1]` over a leading run of the
+    /// values, where this precision has a vectorised copy for it
+    /// ([`deinterleave_f64`](crate::avx2::deinterleave_f64)); returns how many values
+    /// that was (none by default: the caller's own loop takes them all).
+    #[inline(always)]
+    fn deinterleave(_values: &[Self], _even: &mut [Self], _odd: &mut [Self]) -> usize {
+        0
+    }
+    /// [`Real::deinterleave`]'s inverse, `out[2k] = even[k]` and `out[2k + 1] = odd[k]`
+    /// ([`interleave_f64`](crate::avx2::interleave_f64)).
+    #[inline(always)]
+    fn interleave(_even: &[Self], _odd: &[Self], _out: &mut [Self]) -> usize {
+        0
+    }
 }
 
 impl Real for f64 {
@@ -82,6 +96,14 @@ impl Real for f64 {
     }
     fn narrow(x: f64) -> Self {
         x
+    }
+    #[inline(always)]
+    fn deinterleave(values: &[Self], even: &mut [Self], odd: &mut [Self]) -> usize {
+        crate::avx2::deinterleave_f64(values, even, odd)
+    }
+    #[inline(always)]
+    fn interleave(even: &[Self], odd: &[Self], out: &mut [Self]) -> usize {
+        crate::avx2::interleave_f64(even, odd, out)
     }
 }
 
@@ -1424,6 +1446,44 @@ mod tests {
         let mut areas = CubeSphere::new(16).areas_sr().to_vec();
         areas[5 * 256 + 17] *= 1.0 + f64::EPSILON;
         assert!(!faces_alike(&areas));
+    }
+
+    /// The split layout's scatters and gathers (their `f64` chunks copied by AVX2
+    /// shuffles where the processor has it, [`Real::deinterleave`]) put each value at its
+    /// padded index's position and read it back, with and without AVX2: runs of every
+    /// length from 0 to 40 from both colours' first cells, and whole fields at face sizes
+    /// with odd and even rows.
+    #[test]
+    fn scatters_and_gathers_put_each_value_at_its_position() {
+        for portable in [false, true] {
+            crate::avx2::set_portable_only(portable);
+            for n in [3, 8, 13, 64] {
+                let layout = &Hierarchy::new(&CubeSphere::new(n)).levels[0];
+                for first in [layout.padded_at(1, 2, 0), layout.padded_at(1, 2, 1)] {
+                    for len in 0..=40.min(layout.stride() - 1) {
+                        let values: Vec<f64> = (0..len).map(|j| j as f64 + 0.5).collect();
+                        let mut out = vec![-1.0; layout.len()];
+                        scatter_run(layout, first, &values, &mut out);
+                        let mut expected = vec![-1.0; layout.len()];
+                        for (j, v) in values.iter().enumerate() {
+                            expected[layout.index(first + j)] = *v;
+                        }
+                        assert_eq!(out, expected, "n {n} first {first} len {len}");
+                    }
+                }
+                let cells = 6 * n * n;
+                let values: Vec<f64> = (0..cells).map(|c| c as f64 * 0.25 - 7.0).collect();
+                let mut field = vec![-1.0; layout.len()];
+                to_split(layout, &values, &mut field);
+                for (c, &p) in layout.position.iter().enumerate() {
+                    assert_eq!(field[p as usize], values[c], "n {n} cell {c}");
+                }
+                let mut back = vec![0.0; cells];
+                from_split(layout, &mut field, &mut back);
+                assert_eq!(back, values, "n {n}");
+            }
+            crate::avx2::set_portable_only(false);
+        }
     }
 
     /// The operator applies the grid's system at every cell, through the halo, the

@@ -694,8 +694,12 @@ fn run_halves<'a, T>(
 /// Writes `values[j]` to padded index `first + j`, for each `j`.
 #[inline(always)]
 pub(super) fn scatter_run<T: Real>(layout: &Layout, first: usize, values: &[T], out: &mut [T]) {
+    let (even, odd) = run_halves(layout, first, values.len(), out);
+    // A leading run of whole chunks by the precision's own vectorised copy where it has
+    // one (`f64`'s: the compiler's were one value at a time), the rest below.
+    let done = T::deinterleave(values, even, odd);
+    let (values, even, odd) = (&values[done..], &mut even[done / 2..], &mut odd[done / 2..]);
     let len = values.len();
-    let (even, odd) = run_halves(layout, first, len, out);
     // Eight pairs at a time in chunks of constant length, so the compiler splits them
     // with shuffles (zipped two-value chunks were left a value at a time), then the
     // rest a pair at a time.
@@ -742,8 +746,11 @@ pub(super) fn gather_row<T: Real>(
 ) {
     let m = layout.m;
     let (even, odd) = run_halves(layout, layout.padded_at(face, y + 1, 1), m, field);
-    let pairs = row[..m].chunks_exact_mut(2);
-    for ((pair, e), o) in pairs.zip(even.iter()).zip(odd.iter()) {
+    // As in `scatter_run`: a leading run by the precision's vectorised copy.
+    let done = T::interleave(even, odd, &mut row[..m]);
+    let pairs = row[done..m].chunks_exact_mut(2);
+    let (rest_even, rest_odd) = (&even[done / 2..], &odd[done / 2..]);
+    for ((pair, e), o) in pairs.zip(rest_even.iter()).zip(rest_odd.iter()) {
         (pair[0], pair[1]) = (*e, *o);
     }
     if m % 2 == 1 {
