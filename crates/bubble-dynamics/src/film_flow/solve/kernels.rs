@@ -929,3 +929,40 @@ pub(super) fn update_and_norm2(
     let tail: f64 = r_tail.iter().zip(r_tail.iter()).map(|(x, y)| x * y).sum();
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
 }
+
+/// The `f32` iterations' first direction `p' = z' + c·p` rounded to `f32` (`z'` the
+/// V-cycle's answer, `p` the last `f64` direction, `c = β/back`).
+#[inline(always)]
+pub(super) fn direction_from_f64(z: &[f32], c: f64, p: &[f64], out: &mut [f32]) {
+    let (z, p) = (&z[..out.len()], &p[..out.len()]);
+    for ((o, zi), pi) in out.iter_mut().zip(z).zip(p) {
+        *o = (f64::from(*zi) + c * pi) as f32;
+    }
+}
+
+/// The `f32` iterations' next direction `p' = z' + β·p'`.
+#[inline(always)]
+pub(super) fn update_direction_f32(beta: f32, z: &[f32], p: &mut [f32]) {
+    let z = &z[..p.len()];
+    for (pi, zi) in p.iter_mut().zip(z) {
+        *pi = *zi + beta * *pi;
+    }
+}
+
+/// `x += a·p`, each `p` widened to `f64` (exactly).
+#[inline(always)]
+pub(super) fn add_widened(a: f64, p: &[f32], x: &mut [f64]) {
+    let p = &p[..x.len()];
+    for (xi, pi) in x.iter_mut().zip(p) {
+        *xi += a * f64::from(*pi);
+    }
+}
+
+/// `r −= a·q` in `f32`.
+#[inline(always)]
+pub(super) fn subtract_scaled(a: f32, q: &[f32], r: &mut [f32]) {
+    let q = &q[..r.len()];
+    for (ri, qi) in r.iter_mut().zip(q) {
+        *ri -= a * *qi;
+    }
+}
