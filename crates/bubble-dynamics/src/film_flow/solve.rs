@@ -54,9 +54,10 @@ use super::sides::{BOTTOM, CellSides, LEFT, RIGHT, TOP};
 use crate::avx2::with_avx2;
 use kernels::{
     LevelField, NOT_A_CELL, Scaled, Stencil, add_widened, correct, direction_from_f64, dot,
-    gather_row, operator, refresh, refresh_all, refresh_from_other, relax, relax_from_zero,
-    residuals_in_place, restrict, restrict_field, rounded_level, scatter_row, scatter_run,
-    subtract_scaled, update_and_norm2, update_direction, update_direction_f32, widened_dot,
+    dot_f32, gather_row, operator, refresh, refresh_all, refresh_from_other, relax,
+    relax_from_zero, residuals_in_place, restrict, restrict_field, rounded_level, scatter_row,
+    scatter_run, subtract_scaled, update_and_norm2, update_direction, update_direction_f32,
+    widened_dot,
 };
 use layout::Layout;
 use sparse::{Factor, Pattern};
@@ -159,12 +160,14 @@ const F32_WEIGHTS_FROM: usize = 64;
 /// residual 7e-7 of the start's from the true one), so the residual the iterations
 /// track falls from the true one by about `c·ε·2¹⁶ ≈ 0.01` tolerances at most. Measured
 /// against the true residual formed afresh in `f64` over `film_profile`'s 20 first
-/// steps: at most 1e-9 of the start's residual (a thousandth of the 1e-6 tolerance) at
-/// n = 64 and 128, 1.4e-8 at 32 (where the system is the `f64` weights' and the `f32`
-/// iterations apply their roundings), 3.7e-8 in the normal gradient's defect
-/// corrections at 32. Over the 40 steps, at the same 126 PCG iterations (164 at 32):
-/// 640.2 → 630.4 M instructions and 14.16 → 13.47 M LL misses at n = 64, 183.4 →
-/// 180.4 M and 1.95 → 2.00 M misses at 32.
+/// steps: at most 2.8e-9 of the start's residual (3 thousandths of the 1e-6 tolerance)
+/// at n = 64, 4.3e-10 at 128, 1.3e-8 at 32 (where the system is the `f64` weights' and
+/// the `f32` iterations apply their roundings); driven through the normal gradient, 5e-4
+/// of each solve's tolerance (its defect corrections' included). Over the 40 steps, at
+/// the same 126 PCG iterations (164 at 32): 640.2 → 625.5 M instructions and 14.16 →
+/// 13.48 M LL misses at n = 64, 183.4 → 178.5 M and 1.95 → 2.00 M misses at 32 (with
+/// [`dot_f32`]; its products widened to `f64` as [`widened_dot`] sums them, 630.4 M and
+/// 180.4 M).
 const F32_FROM_TOLERANCES: f64 = 65536.0;
 
 /// Gauss–Seidel sweeps a side of the V-cycle's coarse correction on a level of face size
@@ -648,8 +651,10 @@ impl Hierarchy {
     /// `f32` operator ([`Work::q32`]); `x` is updated in `f64` by `α·back·p'`, each
     /// `p'` widened exactly, so `x − x₀` is the sum of the `f32` directions and `r'`
     /// falls from the true residual only by each iteration's `f32` rounding of `α M p`.
-    /// Given `(rz, back, beta)` of the last preconditioning and `p`, the last `f64`
-    /// direction.
+    /// The dot products are summed in `f32` lanes ([`dot_f32`]: they weigh the steps and
+    /// measure the residual to a few millionths, where `x` and `r'` take each step
+    /// alike). Given `(rz, back, beta)` of the last preconditioning and `p`, the last
+    /// `f64` direction.
     #[inline(always)]
     fn iterate_in_f32(
         &self,
@@ -679,7 +684,7 @@ impl Hierarchy {
             let w = Scaled::plain(&work.stencil32[0]);
             operator::<f32, f32, false>(fine, mass, w, &[], &p32, &mut q32);
             // `p·M p = back²/scale · p'·q'`.
-            let pq = widened_dot(&p32, &q32) * back * (back / scale);
+            let pq = dot_f32(&p32, &q32) * back * (back / scale);
             if pq <= 0.0 || !pq.is_finite() {
                 break;
             }
@@ -687,7 +692,7 @@ impl Hierarchy {
             add_widened(step * back, &p32, x);
             // `r' −= t·step·M p = (t·step·back/scale)·q'`.
             subtract_scaled(((t * step) * (back / scale)) as f32, &q32, &mut r32);
-            let rr = widened_dot(&r32, &r32) / (t * t);
+            let rr = dot_f32(&r32, &r32) / (t * t);
             report.iterations += 1;
             report.relative_residual = rr.sqrt() / b_norm;
             let done = report.relative_residual <= limits.tolerance;
@@ -697,7 +702,7 @@ impl Hierarchy {
             let mut z32 = std::mem::take(&mut work.correction[0]);
             self.v_cycle(work, 0, &r32, &mut z32);
             // `r·z = (r'/t)·(back·z')`.
-            let rz_next = widened_dot(&r32, &z32) * (back / t);
+            let rz_next = dot_f32(&r32, &z32) * (back / t);
             let beta = rz_next / rz;
             rz = rz_next;
             update_direction_f32(beta as f32, &z32, &mut p32);
@@ -1618,6 +1623,43 @@ mod tests {
                 assert!(
                     bits(&answers[0].0) == bits(&answers[1].0),
                     "n {n}: AVX2 differs"
+                );
+            }
+        }
+    }
+
+    /// [`dot_f32`] sums lane `k` over the `i ≡ k (mod 32)` in order in `f32`, then the
+    /// lanes and the tail's widened products in order in `f64`: to the bit, with AVX2 and
+    /// without, at lengths with and without a tail and shorter than a lane chunk.
+    #[test]
+    fn the_f32_dot_sums_its_lanes_in_order() {
+        for len in [0, 5, 32, 100, 1000, 26136] {
+            let a: Vec<f32> = (0..len)
+                .map(|i| ((i * 37) % 101) as f32 * 0.37 - 9.0)
+                .collect();
+            let b: Vec<f32> = (0..len)
+                .map(|i| ((i * 11) % 13) as f32 * 1.3 + 0.1)
+                .collect();
+            let main = len - len % 32;
+            let mut lanes = [0.0f32; 32];
+            for i in 0..main {
+                lanes[i % 32] += a[i] * b[i];
+            }
+            let mut expected = 0.0;
+            for lane in lanes {
+                expected += f64::from(lane);
+            }
+            for i in main..len {
+                expected += f64::from(a[i]) * f64::from(b[i]);
+            }
+            for portable in [false, true] {
+                crate::avx2::set_portable_only(portable);
+                let got = with_avx2(|| dot_f32(&a, &b));
+                crate::avx2::set_portable_only(false);
+                assert_eq!(
+                    got.to_bits(),
+                    expected.to_bits(),
+                    "len {len}, portable {portable}"
                 );
             }
         }

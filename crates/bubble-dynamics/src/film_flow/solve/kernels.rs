@@ -8,7 +8,9 @@
 
 use super::Real;
 use super::layout::{Layout, RIGHT_W, TOP_W};
-use crate::avx2::{dot_lanes, subtract_and_square_lanes, widened_dot_lanes, with_avx2};
+use crate::avx2::{
+    F32_LANES, dot_lanes, dot_lanes_f32, subtract_and_square_lanes, widened_dot_lanes, with_avx2,
+};
 
 /// A level's edge weights once an edge: per cell its RIGHT side's weight
 /// ([`RIGHT_W`]) and its TOP side's ([`TOP_W`]), the left halo column and the bottom
@@ -965,4 +967,21 @@ pub(super) fn subtract_scaled(a: f32, q: &[f32], r: &mut [f32]) {
     for (ri, qi) in r.iter_mut().zip(q) {
         *ri -= a * *qi;
     }
+}
+
+/// `a·b` of the `f32` iterations' fields, summed in `f32` in [`F32_LANES`] lanes
+/// ([`dot_lanes_f32`]), then the lanes widened and summed in `f64` in order, the tail's
+/// products (widened, exact) last.
+#[inline(always)]
+pub(super) fn dot_f32(a: &[f32], b: &[f32]) -> f64 {
+    let main = a.len() - a.len() % F32_LANES;
+    let lanes = dot_lanes_f32(&a[..main], &b[..main]);
+    let mut sum = 0.0;
+    for lane in lanes {
+        sum += f64::from(lane);
+    }
+    for (x, y) in a[main..].iter().zip(&b[main..a.len()]) {
+        sum += f64::from(*x) * f64::from(*y);
+    }
+    sum
 }
