@@ -165,9 +165,10 @@ const F32_WEIGHTS_FROM: usize = 64;
 /// the `f32` iterations apply their roundings); driven through the normal gradient, 5e-4
 /// of each solve's tolerance (its defect corrections' included). Over the 40 steps, at
 /// the same 126 PCG iterations (164 at 32): 640.2 → 625.5 M instructions and 14.16 →
-/// 13.48 M LL misses at n = 64, 183.4 → 178.5 M and 1.95 → 2.00 M misses at 32 (with
+/// 13.08 M LL misses at n = 64, 183.4 → 178.5 M and 1.95 → 1.82 M misses at 32 (with
 /// [`dot_f32`]; its products widened to `f64` as [`widened_dot`] sums them, 630.4 M and
-/// 180.4 M).
+/// 180.4 M; with the product in a field of its own, not the V-cycle's scratch
+/// [`Work::operator`], 13.48 M and 2.00 M misses).
 const F32_FROM_TOLERANCES: f64 = 65536.0;
 
 /// Gauss–Seidel sweeps a side of the V-cycle's coarse correction on a level of face size
@@ -293,10 +294,10 @@ pub struct Work {
     q: Vec<f64>,
     /// The preconditioned residual where the finest level is solved directly (in `f64`).
     z: Vec<f64>,
-    /// The direction and its product in the `f32` iterations
-    /// ([`Hierarchy::iterate_in_f32`]).
+    /// The direction in the `f32` iterations ([`Hierarchy::iterate_in_f32`]; its
+    /// product with `M` is held in [`Work::operator`], which the V-cycle only uses
+    /// within itself: one field fewer to keep in cache).
     p32: Vec<f32>,
-    q32: Vec<f32>,
     /// `x` and the guess in the finest level's layout (`b` is put in [`Work::r`]).
     x: Vec<f64>,
     guess: Vec<f64>,
@@ -648,7 +649,7 @@ impl Hierarchy {
     /// `t` the power of two [`Hierarchy::precondition`] scaled it by, and the direction
     /// is held as `p' = p/back` ([`Work::p32`]; `back = scale/t` is `z`'s factor, fixed
     /// from here, so `p' = z' + β·p'`), its product `q' = scale·M p'` by the V-cycle's
-    /// `f32` operator ([`Work::q32`]); `x` is updated in `f64` by `α·back·p'`, each
+    /// `f32` operator (in [`Work::operator`]); `x` is updated in `f64` by `α·back·p'`, each
     /// `p'` widened exactly, so `x − x₀` is the sum of the `f32` directions and `r'`
     /// falls from the true residual only by each iteration's `f32` rounding of `α M p`.
     /// The dot products are summed in `f32` lanes ([`dot_f32`]: they weigh the steps and
@@ -669,14 +670,16 @@ impl Hierarchy {
         let b_norm = report.start_residual;
         let r32 = std::mem::take(&mut work.residual[0]);
         let mut p32 = std::mem::take(&mut work.p32);
-        let mut q32 = std::mem::take(&mut work.q32);
         p32.resize(fine.len(), 0.0);
-        q32.resize(fine.len(), 0.0);
         // `p' = (back·z' + β·p)/back`.
         direction_from_f64(&work.correction[0], beta / back, p, &mut p32);
         let mut r32 = r32;
         while report.iterations < limits.max_iterations {
             refresh_all(fine, &mut p32);
+            // `q'` in the V-cycle's scratch field, free until the V-cycle runs (kept at the
+            // finest level's length; the operator writes all of it).
+            let mut q32 = std::mem::take(&mut work.operator);
+            q32.resize(fine.len(), 0.0);
             let mass = LevelField {
                 values: &work.mass32[0],
                 per_face: work.mass_per_face,
@@ -685,13 +688,17 @@ impl Hierarchy {
             operator::<f32, f32, false>(fine, mass, w, &[], &p32, &mut q32);
             // `p·M p = back²/scale · p'·q'`.
             let pq = dot_f32(&p32, &q32) * back * (back / scale);
-            if pq <= 0.0 || !pq.is_finite() {
+            let usable = pq > 0.0 && pq.is_finite();
+            if usable {
+                let step = rz / pq;
+                add_widened(step * back, &p32, x);
+                // `r' −= t·step·M p = (t·step·back/scale)·q'`.
+                subtract_scaled(((t * step) * (back / scale)) as f32, &q32, &mut r32);
+            }
+            work.operator = q32;
+            if !usable {
                 break;
             }
-            let step = rz / pq;
-            add_widened(step * back, &p32, x);
-            // `r' −= t·step·M p = (t·step·back/scale)·q'`.
-            subtract_scaled(((t * step) * (back / scale)) as f32, &q32, &mut r32);
             let rr = dot_f32(&r32, &r32) / (t * t);
             report.iterations += 1;
             report.relative_residual = rr.sqrt() / b_norm;
@@ -709,7 +716,7 @@ impl Hierarchy {
             work.correction[0] = z32;
         }
         work.residual[0] = r32;
-        (work.p32, work.q32) = (p32, q32);
+        work.p32 = p32;
     }
 
     /// `q = held·M p` on the finest level, `M` read as [`Hierarchy::start_residuals`]
