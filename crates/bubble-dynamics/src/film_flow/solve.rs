@@ -5,9 +5,9 @@
 //! The conjugate gradients run in `f64`, the V-cycle in `f32` (see [`Work`]: a
 //! preconditioner need only be a fixed map near `M⁻¹`, and the V-cycle's `f32` rounding
 //! is far below its own error as an inverse). Where the weights are given as their
-//! `f32` roundings ([`Weights::F32`]), the conjugate gradients' last iterations, once
-//! the residual is within [`F32_FROM_TOLERANCES`] tolerances of the goal, run in `f32`
-//! but for `x` ([`Hierarchy::iterate_in_f32`]).
+//! `f32` roundings (`Weights::F32`), the conjugate gradients' last iterations, once
+//! the residual is within `F32_FROM_TOLERANCES` tolerances of the goal, run in `f32`
+//! but for `x` (`Hierarchy::iterate_in_f32`).
 //!
 //! Every level is held in a padded, colour-split layout (`layout`): each face ringed by
 //! halo copies of its neighbours' cells, and the cells split by parity into two arrays,
@@ -228,7 +228,7 @@ pub struct Hierarchy {
 /// answer's accuracy does not depend on the preconditioner's; `r·z`, which only weighs
 /// the directions, is summed in `f64` from the V-cycle's `f32` right-hand side and
 /// answer (`Hierarchy::precondition`). (The last iterations, where the weights are
-/// given as `f32` roundings, run in `f32` but for `x`: [`Hierarchy::iterate_in_f32`]
+/// given as `f32` roundings, run in `f32` but for `x`: `Hierarchy::iterate_in_f32`
 /// says why the residual they track stays the true one to a few hundredths of the
 /// tolerance.) `f32`'s narrower range is
 /// kept away from: the system enters the V-cycle scaled by a power of two that brings
