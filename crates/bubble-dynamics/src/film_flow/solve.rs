@@ -565,9 +565,9 @@ impl Hierarchy {
                 let fine = &self.levels[0];
                 let len = fine.len();
                 let mut r = std::mem::take(&mut work.r);
-                let mut p = std::mem::take(&mut work.p);
+                let mut own_p = std::mem::take(&mut work.p);
                 let mut q = std::mem::take(&mut work.q);
-                for v in [&mut r, &mut p, &mut q] {
+                for v in [&mut r, &mut q] {
                     v.resize(len, 0.0);
                 }
                 refresh_all(fine, x);
@@ -582,7 +582,7 @@ impl Hierarchy {
                 // Relative to the start's residual: the step's change, not the whole field.
                 let mut start_norm = dot(&r, &r).sqrt();
                 let b_norm = if start_norm > 0.0 { start_norm } else { 1.0 };
-                if let Some(guess) = guess.filter(|_| start_norm > 0.0) {
+                if let Some(guess) = guess.as_mut().filter(|_| start_norm > 0.0) {
                     let guess_norm = dot(&q, &q).sqrt();
                     if guess_norm < start_norm {
                         std::mem::swap(x, guess);
@@ -590,6 +590,15 @@ impl Hierarchy {
                         start_norm = guess_norm;
                     }
                 }
+                // The start not taken is not read again: its field holds the direction
+                // (one field fewer to keep in cache), else `Work::p`.
+                let p = match guess {
+                    Some(spare) => spare,
+                    None => {
+                        own_p.resize(len, 0.0);
+                        &mut own_p
+                    }
+                };
                 let mut report = SolveReport {
                     iterations: 0,
                     relative_residual: start_norm / b_norm,
@@ -597,18 +606,18 @@ impl Hierarchy {
                 };
                 if report.relative_residual > limits.tolerance {
                     let (mut rz, back) = self.precondition(work, &r, start_norm);
-                    self.next_direction(work, back, None, &mut p);
+                    self.next_direction(work, back, None, p);
                     while report.iterations < limits.max_iterations {
-                        refresh_all(fine, &mut p);
+                        refresh_all(fine, p);
                         // `q` is `M p` times `held` ([`Hierarchy::apply`]), a power of two:
                         // each product with it scaled back exactly.
-                        let held = self.apply(work, &p, &mut q);
-                        let pq = dot(&p, &q) / held;
+                        let held = self.apply(work, p, &mut q);
+                        let pq = dot(p, &q) / held;
                         if pq <= 0.0 || !pq.is_finite() {
                             break;
                         }
                         let step = rz / pq;
-                        let rr = update_and_norm2((step, step / held), &p, &q, x, &mut r);
+                        let rr = update_and_norm2((step, step / held), p, &q, x, &mut r);
                         report.iterations += 1;
                         report.relative_residual = rr.sqrt() / b_norm;
                         let done = report.relative_residual <= limits.tolerance;
@@ -620,13 +629,13 @@ impl Hierarchy {
                         rz = rz_next;
                         if self.continues_in_f32(work, report.relative_residual, limits) {
                             let state = (rz, back, beta);
-                            self.iterate_in_f32(work, state, (&p, x), limits, &mut report);
+                            self.iterate_in_f32(work, state, (p, x), limits, &mut report);
                             break;
                         }
-                        self.next_direction(work, back, Some(beta), &mut p);
+                        self.next_direction(work, back, Some(beta), p);
                     }
                 }
-                (work.r, work.p, work.q) = (r, p, q);
+                (work.r, work.p, work.q) = (r, own_p, q);
                 report
             },
         )
