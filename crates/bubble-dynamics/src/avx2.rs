@@ -189,6 +189,169 @@ fn widened_dot_lanes_avx2(a: &[f32], b: &[f32]) -> [f64; 4] {
 /// `o`'s are one weight of opposite signs.
 pub(crate) const PAIRS: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
 
+/// Lanes of [`dot_lanes_f32`]: four AVX2 vectors of eight `f32`s, four independent
+/// chains of adds (one vector's chain waits four cycles an add).
+pub(crate) const F32_LANES: usize = 32;
+
+/// [`F32_LANES`] running sums of `a[i]·b[i]` in `f32`, lane `k` over the
+/// `i ≡ k (mod 32)` in increasing order, over the first `32⌊len/32⌋` elements: the
+/// conjugate gradients' `f32` iterations' dot products (a lane sums about 800 terms at
+/// n = 64, each rounding within 6e-8 of the lane, far below what the products weigh: the
+/// directions' steps and the residual's norm to a few millionths). The same bits with
+/// AVX2 as without.
+///
+/// # Panics
+/// If the slices differ in length.
+#[inline(always)]
+pub(crate) fn dot_lanes_f32(a: &[f32], b: &[f32]) -> [f32; F32_LANES] {
+    assert_eq!(a.len(), b.len(), "dot of slices of different lengths");
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && !portable_only() {
+        // SAFETY: the processor supports AVX2, checked just above.
+        return unsafe { dot_lanes_f32_avx2(a, b) };
+    }
+    let mut lanes = [0.0; F32_LANES];
+    for (x, y) in a.chunks_exact(F32_LANES).zip(b.chunks_exact(F32_LANES)) {
+        for k in 0..F32_LANES {
+            lanes[k] += x[k] * y[k];
+        }
+    }
+    lanes
+}
+
+/// [`dot_lanes_f32`] in AVX2 registers.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn dot_lanes_f32_avx2(a: &[f32], b: &[f32]) -> [f32; F32_LANES] {
+    use std::arch::x86_64::{
+        __m256, _mm256_add_ps, _mm256_loadu_ps, _mm256_mul_ps, _mm256_setzero_ps, _mm256_storeu_ps,
+    };
+    let mut sums: [__m256; 4] = [_mm256_setzero_ps(); 4];
+    for (x, y) in a.chunks_exact(F32_LANES).zip(b.chunks_exact(F32_LANES)) {
+        for (j, sum) in sums.iter_mut().enumerate() {
+            // SAFETY: each chunk holds 32 numbers, four loads of eight each.
+            let (x, y) = unsafe {
+                (
+                    _mm256_loadu_ps(x.as_ptr().add(8 * j)),
+                    _mm256_loadu_ps(y.as_ptr().add(8 * j)),
+                )
+            };
+            *sum = _mm256_add_ps(*sum, _mm256_mul_ps(x, y));
+        }
+    }
+    let mut lanes = [0.0; F32_LANES];
+    for (j, sum) in sums.iter().enumerate() {
+        // SAFETY: `lanes` holds 32 numbers, four stores of eight each.
+        unsafe { _mm256_storeu_ps(lanes.as_mut_ptr().add(8 * j), *sum) };
+    }
+    lanes
+}
+
+/// Values [`deinterleave_f64`] and [`interleave_f64`] take a chunk: two AVX2 vectors
+/// of `f64`.
+const PAIRS_CHUNK: usize = 8;
+
+/// `even[k] = values[2k]` and `odd[k] = values[2k + 1]` over the first chunks of
+/// [`PAIRS_CHUNK`] values that all three slices hold; returns how many values that was.
+/// With AVX2 two loads, two unpacks, two lane permutes and two stores a chunk, where the
+/// compiler left the `f64` copies one at a time (the split layout's scatters: each
+/// face row's cells to its two colours); copies, so the same bits either way.
+#[inline(always)]
+pub(crate) fn deinterleave_f64(values: &[f64], even: &mut [f64], odd: &mut [f64]) -> usize {
+    let half = PAIRS_CHUNK / 2;
+    let chunks = (values.len() / PAIRS_CHUNK)
+        .min(even.len() / half)
+        .min(odd.len() / half);
+    let done = chunks * PAIRS_CHUNK;
+    let (values, even, odd) = (&values[..done], &mut even[..done / 2], &mut odd[..done / 2]);
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && !portable_only() {
+        // SAFETY: the processor supports AVX2, checked just above.
+        unsafe { deinterleave_f64_avx2(values, even, odd) };
+        return done;
+    }
+    let halves = even.chunks_exact_mut(half).zip(odd.chunks_exact_mut(half));
+    for (v, (e, o)) in values.chunks_exact(PAIRS_CHUNK).zip(halves) {
+        for k in 0..half {
+            (e[k], o[k]) = (v[2 * k], v[2 * k + 1]);
+        }
+    }
+    done
+}
+
+/// [`deinterleave_f64`]'s chunks in AVX2 registers (the slices cut to whole chunks).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn deinterleave_f64_avx2(values: &[f64], even: &mut [f64], odd: &mut [f64]) {
+    use std::arch::x86_64::{
+        _mm256_loadu_pd, _mm256_permute4x64_pd, _mm256_storeu_pd, _mm256_unpackhi_pd,
+        _mm256_unpacklo_pd,
+    };
+    let half = PAIRS_CHUNK / 2;
+    let halves = even.chunks_exact_mut(half).zip(odd.chunks_exact_mut(half));
+    for (v, (e, o)) in values.chunks_exact(PAIRS_CHUNK).zip(halves) {
+        // SAFETY: each chunk holds eight values and each half four, the loads' and
+        // stores' widths.
+        unsafe {
+            let a = _mm256_loadu_pd(v.as_ptr());
+            let b = _mm256_loadu_pd(v.as_ptr().add(half));
+            // [v0 v4 v2 v6] and [v1 v5 v3 v7], their middle lanes swapped.
+            let (lo, hi) = (_mm256_unpacklo_pd(a, b), _mm256_unpackhi_pd(a, b));
+            _mm256_storeu_pd(e.as_mut_ptr(), _mm256_permute4x64_pd(lo, 0b11_01_10_00));
+            _mm256_storeu_pd(o.as_mut_ptr(), _mm256_permute4x64_pd(hi, 0b11_01_10_00));
+        }
+    }
+}
+
+/// `out[2k] = even[k]` and `out[2k + 1] = odd[k]` over the first chunks of
+/// [`PAIRS_CHUNK`] values that all three slices hold; returns how many values that was:
+/// [`deinterleave_f64`]'s inverse (the split layout's gathers).
+#[inline(always)]
+pub(crate) fn interleave_f64(even: &[f64], odd: &[f64], out: &mut [f64]) -> usize {
+    let half = PAIRS_CHUNK / 2;
+    let chunks = (out.len() / PAIRS_CHUNK)
+        .min(even.len() / half)
+        .min(odd.len() / half);
+    let done = chunks * PAIRS_CHUNK;
+    let (even, odd, out) = (&even[..done / 2], &odd[..done / 2], &mut out[..done]);
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && !portable_only() {
+        // SAFETY: the processor supports AVX2, checked just above.
+        unsafe { interleave_f64_avx2(even, odd, out) };
+        return done;
+    }
+    let halves = even.chunks_exact(half).zip(odd.chunks_exact(half));
+    for (v, (e, o)) in out.chunks_exact_mut(PAIRS_CHUNK).zip(halves) {
+        for k in 0..half {
+            (v[2 * k], v[2 * k + 1]) = (e[k], o[k]);
+        }
+    }
+    done
+}
+
+/// [`interleave_f64`]'s chunks in AVX2 registers (the slices cut to whole chunks).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn interleave_f64_avx2(even: &[f64], odd: &[f64], out: &mut [f64]) {
+    use std::arch::x86_64::{
+        _mm256_loadu_pd, _mm256_permute4x64_pd, _mm256_storeu_pd, _mm256_unpackhi_pd,
+        _mm256_unpacklo_pd,
+    };
+    let half = PAIRS_CHUNK / 2;
+    let halves = even.chunks_exact(half).zip(odd.chunks_exact(half));
+    for (v, (e, o)) in out.chunks_exact_mut(PAIRS_CHUNK).zip(halves) {
+        // SAFETY: each chunk holds eight values and each half four, the loads' and
+        // stores' widths.
+        unsafe {
+            // [e0 e2 e1 e3] and [o0 o2 o1 o3]: their unpacks are the pairs in order.
+            let e = _mm256_permute4x64_pd(_mm256_loadu_pd(e.as_ptr()), 0b11_01_10_00);
+            let o = _mm256_permute4x64_pd(_mm256_loadu_pd(o.as_ptr()), 0b11_01_10_00);
+            _mm256_storeu_pd(v.as_mut_ptr(), _mm256_unpacklo_pd(e, o));
+            _mm256_storeu_pd(v.as_mut_ptr().add(half), _mm256_unpackhi_pd(e, o));
+        }
+    }
+}
+
 /// The weights of a group of four cells in [`coriolis_row`]: per pair of sides `p`
 /// ([`PAIRS`]), per cell (index `4p + cell`), so that a group's six weight vectors are
 /// read from one base.

@@ -4,7 +4,10 @@
 //!
 //! The conjugate gradients run in `f64`, the V-cycle in `f32` (see [`Work`]: a
 //! preconditioner need only be a fixed map near `M⁻¹`, and the V-cycle's `f32` rounding
-//! is far below its own error as an inverse).
+//! is far below its own error as an inverse). Where the weights are given as their
+//! `f32` roundings (`Weights::F32`), the conjugate gradients' last iterations, once
+//! the residual is within `F32_FROM_TOLERANCES` tolerances of the goal, run in `f32`
+//! but for `x` (`Hierarchy::iterate_in_f32`).
 //!
 //! Every level is held in a padded, colour-split layout (`layout`): each face ringed by
 //! halo copies of its neighbours' cells, and the cells split by parity into two arrays,
@@ -21,7 +24,8 @@
 //! gradients streams the weights once (the operator's product `q`; the V-cycle's `f32`
 //! copy where the caller lets it take the weights as their `f32` roundings, as the
 //! Marangoni step does: [`Weights::F32`]), `x`, `r` and `p` once each, and writes `q` and
-//! the V-cycle's right-hand side. The preconditioned
+//! the V-cycle's right-hand side (an `f32` iteration streams `x` in `f64` and the rest in
+//! `f32`, its residual the V-cycle's right-hand side itself). The preconditioned
 //! residual `z` is never held in `f64` (`r·z` is summed from the V-cycle's own numbers,
 //! `p = z + β·p` formed from them as it is read), and both starts' residuals come from
 //! one pass over the system.
@@ -49,9 +53,10 @@ use super::grid::CubeSphere;
 use super::sides::{BOTTOM, CellSides, LEFT, RIGHT, TOP};
 use crate::avx2::with_avx2;
 use kernels::{
-    LevelField, NOT_A_CELL, Scaled, Stencil, correct, dot, gather_row, operator, refresh,
-    refresh_all, refresh_from_other, relax, relax_from_zero, residuals_in_place, restrict,
-    restrict_field, rounded_level, scatter_row, scatter_run, update_and_norm2, update_direction,
+    LevelField, NOT_A_CELL, Scaled, Stencil, add_widened, correct, direction_from_f64, dot,
+    dot_f32, gather_row, operator, refresh, refresh_all, refresh_from_other, relax,
+    relax_from_zero, residuals_in_place, restrict, restrict_field, rounded_level, scatter_row,
+    scatter_run, subtract_scaled, update_and_norm2, update_direction, update_direction_f32,
     widened_dot,
 };
 use layout::Layout;
@@ -73,6 +78,20 @@ trait Real:
     fn widen(self) -> f64;
     /// `x` rounded to this precision.
     fn narrow(x: f64) -> Self;
+    /// `even[k] = values[2k]` and `odd[k] = values[2k + 1]` over a leading run of the
+    /// values, where this precision has a vectorised copy for it
+    /// ([`deinterleave_f64`](crate::avx2::deinterleave_f64)); returns how many values
+    /// that was (none by default: the caller's own loop takes them all).
+    #[inline(always)]
+    fn deinterleave(_values: &[Self], _even: &mut [Self], _odd: &mut [Self]) -> usize {
+        0
+    }
+    /// [`Real::deinterleave`]'s inverse, `out[2k] = even[k]` and `out[2k + 1] = odd[k]`
+    /// ([`interleave_f64`](crate::avx2::interleave_f64)).
+    #[inline(always)]
+    fn interleave(_even: &[Self], _odd: &[Self], _out: &mut [Self]) -> usize {
+        0
+    }
 }
 
 impl Real for f64 {
@@ -82,6 +101,14 @@ impl Real for f64 {
     }
     fn narrow(x: f64) -> Self {
         x
+    }
+    #[inline(always)]
+    fn deinterleave(values: &[Self], even: &mut [Self], odd: &mut [Self]) -> usize {
+        crate::avx2::deinterleave_f64(values, even, odd)
+    }
+    #[inline(always)]
+    fn interleave(even: &[Self], odd: &[Self], out: &mut [Self]) -> usize {
+        crate::avx2::interleave_f64(even, odd, out)
     }
 }
 
@@ -123,6 +150,26 @@ const COARSEST_FACE: usize = 2;
 /// iterations, at 128 4.5 M fewer for 9 M more; at 32 the solve stays in L2 and it only
 /// took 2.5 M more instructions.
 const F32_WEIGHTS_FROM: usize = 64;
+
+/// How many tolerances above the goal the conjugate gradients' residual may be when they
+/// go on in `f32` ([`Hierarchy::iterate_in_f32`], where the weights are given as `f32`
+/// roundings). Each `f32` iteration's product `α M p` is rounded, the operator's sums of
+/// differences to about `c·ε` of the residual it removes (`ε` = 6e-8; `c` measured about
+/// 3 over `film_profile 64 0 9.81`'s steps, but 12 for the first iteration from a start,
+/// which therefore stays in `f64`: its product in `f32` would have left the tracked
+/// residual 7e-7 of the start's from the true one), so the residual the iterations
+/// track falls from the true one by about `c·ε·2¹⁶ ≈ 0.01` tolerances at most. Measured
+/// against the true residual formed afresh in `f64` over `film_profile`'s 20 first
+/// steps: at most 2.8e-9 of the start's residual (3 thousandths of the 1e-6 tolerance)
+/// at n = 64, 4.3e-10 at 128, 1.3e-8 at 32 (where the system is the `f64` weights' and
+/// the `f32` iterations apply their roundings); driven through the normal gradient, 5e-4
+/// of each solve's tolerance (its defect corrections' included). Over the 40 steps, at
+/// the same 126 PCG iterations (164 at 32): 640.2 → 625.5 M instructions and 14.16 →
+/// 13.08 M LL misses at n = 64, 183.4 → 178.5 M and 1.95 → 1.82 M misses at 32 (with
+/// [`dot_f32`]; its products widened to `f64` as [`widened_dot`] sums them, 630.4 M and
+/// 180.4 M; with the product in a field of its own, not the V-cycle's scratch
+/// [`Work::operator`], 13.48 M and 2.00 M misses).
+const F32_FROM_TOLERANCES: f64 = 65536.0;
 
 /// Gauss–Seidel sweeps a side of the V-cycle's coarse correction on a level of face size
 /// `m` in a hierarchy whose finest level's is `finest`. Where the finest level's fields
@@ -184,7 +231,10 @@ pub struct Hierarchy {
 /// in `f64` from the same `f64` direction and its `f64` product with `M`, so the
 /// answer's accuracy does not depend on the preconditioner's; `r·z`, which only weighs
 /// the directions, is summed in `f64` from the V-cycle's `f32` right-hand side and
-/// answer (`Hierarchy::precondition`). `f32`'s narrower range is
+/// answer (`Hierarchy::precondition`). (The last iterations, where the weights are
+/// given as `f32` roundings, run in `f32` but for `x`: `Hierarchy::iterate_in_f32`
+/// says why the residual they track stays the true one to a few hundredths of the
+/// tolerance.) `f32`'s narrower range is
 /// kept away from: the system enters the V-cycle scaled by a power of two that brings
 /// the first cell's diagonal entry to `[1, 2)`, and each right-hand side by one that
 /// brings its norm there (a power of two changes the exponent, not the bits of the rest,
@@ -213,6 +263,8 @@ pub struct Work {
     /// (exactly), as [`Work::mass`] holds it: the conjugate gradients' operator's, in the
     /// weights' scaled system ([`Scaled`]).
     mass_scaled: Vec<f64>,
+    /// Whether the weights were given as [`Weights::F32`].
+    weights_rounded: bool,
     /// Whether the finest level's mass term (in `f64` and `f32`) is held per face
     /// ([`LevelField`]): the system's faces are alike to the bit, as the grid's cell
     /// areas are.
@@ -246,6 +298,10 @@ pub struct Work {
     q: Vec<f64>,
     /// The preconditioned residual where the finest level is solved directly (in `f64`).
     z: Vec<f64>,
+    /// The direction in the `f32` iterations ([`Hierarchy::iterate_in_f32`]; its
+    /// product with `M` is held in [`Work::operator`], which the V-cycle only uses
+    /// within itself: one field fewer to keep in cache).
+    p32: Vec<f32>,
     /// `x` and the guess in the finest level's layout (`b` is put in [`Work::r`]).
     x: Vec<f64>,
     guess: Vec<f64>,
@@ -289,8 +345,10 @@ pub(crate) enum Weights<'a> {
     /// solved, and the residual the tolerance is judged on, are then those of the rounded
     /// weights. The conjugate gradients'
     /// operator reads the V-cycle's `f32` copy of them and streams half the bytes an
-    /// iteration; for weights that are `f32` values already, the solve is the same to the
-    /// bit as with [`Weights::F64`].
+    /// iteration, and their last iterations run in `f32` ([`Hierarchy::iterate_in_f32`],
+    /// at any face size: below [`F32_WEIGHTS_FROM`] the residual they track is then the
+    /// rounded weights' system's, within a few hundredths of the tolerance of the
+    /// `f64` one's).
     F32(&'a [f64]),
 }
 
@@ -513,9 +571,9 @@ impl Hierarchy {
                 let fine = &self.levels[0];
                 let len = fine.len();
                 let mut r = std::mem::take(&mut work.r);
-                let mut p = std::mem::take(&mut work.p);
+                let mut own_p = std::mem::take(&mut work.p);
                 let mut q = std::mem::take(&mut work.q);
-                for v in [&mut r, &mut p, &mut q] {
+                for v in [&mut r, &mut q] {
                     v.resize(len, 0.0);
                 }
                 refresh_all(fine, x);
@@ -531,7 +589,7 @@ impl Hierarchy {
                 let mut start_norm = dot(&r, &r).sqrt();
                 let b_norm = if start_norm > 0.0 { start_norm } else { 1.0 };
                 let mut from_guess = false;
-                if let Some(guess) = guess.filter(|_| start_norm > 0.0) {
+                if let Some(guess) = guess.as_mut().filter(|_| start_norm > 0.0) {
                     let guess_norm = dot(&q, &q).sqrt();
                     if guess_norm < start_norm {
                         std::mem::swap(x, guess);
@@ -540,6 +598,15 @@ impl Hierarchy {
                         from_guess = true;
                     }
                 }
+                // The start not taken is not read again: its field holds the direction
+                // (one field fewer to keep in cache), else `Work::p`.
+                let p = match guess {
+                    Some(spare) => spare,
+                    None => {
+                        own_p.resize(len, 0.0);
+                        &mut own_p
+                    }
+                };
                 let mut report = SolveReport {
                     iterations: 0,
                     relative_residual: start_norm / b_norm,
@@ -548,18 +615,18 @@ impl Hierarchy {
                 };
                 if report.relative_residual > limits.tolerance {
                     let (mut rz, back) = self.precondition(work, &r, start_norm);
-                    self.next_direction(work, back, None, &mut p);
+                    self.next_direction(work, back, None, p);
                     while report.iterations < limits.max_iterations {
-                        refresh_all(fine, &mut p);
+                        refresh_all(fine, p);
                         // `q` is `M p` times `held` ([`Hierarchy::apply`]), a power of two:
                         // each product with it scaled back exactly.
-                        let held = self.apply(work, &p, &mut q);
-                        let pq = dot(&p, &q) / held;
+                        let held = self.apply(work, p, &mut q);
+                        let pq = dot(p, &q) / held;
                         if pq <= 0.0 || !pq.is_finite() {
                             break;
                         }
                         let step = rz / pq;
-                        let rr = update_and_norm2((step, step / held), &p, &q, x, &mut r);
+                        let rr = update_and_norm2((step, step / held), p, &q, x, &mut r);
                         report.iterations += 1;
                         report.relative_residual = rr.sqrt() / b_norm;
                         let done = report.relative_residual <= limits.tolerance;
@@ -569,13 +636,105 @@ impl Hierarchy {
                         let (rz_next, back) = self.precondition(work, &r, rr.sqrt());
                         let beta = rz_next / rz;
                         rz = rz_next;
-                        self.next_direction(work, back, Some(beta), &mut p);
+                        if self.continues_in_f32(work, report.relative_residual, limits) {
+                            let state = (rz, back, beta);
+                            self.iterate_in_f32(work, state, (p, x), limits, &mut report);
+                            break;
+                        }
+                        self.next_direction(work, back, Some(beta), p);
                     }
                 }
-                (work.r, work.p, work.q) = (r, p, q);
+                (work.r, work.p, work.q) = (r, own_p, q);
                 report
             },
         )
+    }
+
+    /// Whether the conjugate gradients, at a residual `relative` to the start's, go on
+    /// in `f32` ([`Hierarchy::iterate_in_f32`]): where they read the V-cycle's `f32`
+    /// weights ([`Work::weights_f32`]) and the residual is within [`F32_FROM_TOLERANCES`]
+    /// tolerances of the goal.
+    #[inline(always)]
+    fn continues_in_f32(&self, work: &Work, relative: f64, limits: SolveLimits) -> bool {
+        work.weights_rounded
+            && self.levels.len() > 1
+            && relative <= F32_FROM_TOLERANCES * limits.tolerance
+    }
+
+    /// The conjugate gradients' iterations from the one whose preconditioned residual
+    /// the V-cycle just made, in `f32` but for `x` (see [`F32_FROM_TOLERANCES`]): the
+    /// residual `r' = t·r` is the V-cycle's own right-hand side ([`Work::residual`]),
+    /// `t` the power of two [`Hierarchy::precondition`] scaled it by, and the direction
+    /// is held as `p' = p/back` ([`Work::p32`]; `back = scale/t` is `z`'s factor, fixed
+    /// from here, so `p' = z' + β·p'`), its product `q' = scale·M p'` by the V-cycle's
+    /// `f32` operator (in [`Work::operator`]); `x` is updated in `f64` by `α·back·p'`, each
+    /// `p'` widened exactly, so `x − x₀` is the sum of the `f32` directions and `r'`
+    /// falls from the true residual only by each iteration's `f32` rounding of `α M p`.
+    /// The dot products are summed in `f32` lanes ([`dot_f32`]: they weigh the steps and
+    /// measure the residual to a few millionths, where `x` and `r'` take each step
+    /// alike). Given `(rz, back, beta)` of the last preconditioning and `p`, the last
+    /// `f64` direction.
+    #[inline(always)]
+    fn iterate_in_f32(
+        &self,
+        work: &mut Work,
+        (mut rz, back, beta): (f64, f64, f64),
+        (p, x): (&[f64], &mut [f64]),
+        limits: SolveLimits,
+        report: &mut SolveReport,
+    ) {
+        let fine = &self.levels[0];
+        let (scale, t) = (work.scale, work.scale / back);
+        let b_norm = report.start_residual;
+        let r32 = std::mem::take(&mut work.residual[0]);
+        let mut p32 = std::mem::take(&mut work.p32);
+        p32.resize(fine.len(), 0.0);
+        // `p' = (back·z' + β·p)/back`.
+        direction_from_f64(&work.correction[0], beta / back, p, &mut p32);
+        let mut r32 = r32;
+        while report.iterations < limits.max_iterations {
+            refresh_all(fine, &mut p32);
+            // `q'` in the V-cycle's scratch field, free until the V-cycle runs (kept at the
+            // finest level's length; the operator writes all of it).
+            let mut q32 = std::mem::take(&mut work.operator);
+            q32.resize(fine.len(), 0.0);
+            let mass = LevelField {
+                values: &work.mass32[0],
+                per_face: work.mass_per_face,
+            };
+            let w = Scaled::plain(&work.stencil32[0]);
+            operator::<f32, f32, false>(fine, mass, w, &[], &p32, &mut q32);
+            // `p·M p = back²/scale · p'·q'`.
+            let pq = dot_f32(&p32, &q32) * back * (back / scale);
+            let usable = pq > 0.0 && pq.is_finite();
+            if usable {
+                let step = rz / pq;
+                add_widened(step * back, &p32, x);
+                // `r' −= t·step·M p = (t·step·back/scale)·q'`.
+                subtract_scaled(((t * step) * (back / scale)) as f32, &q32, &mut r32);
+            }
+            work.operator = q32;
+            if !usable {
+                break;
+            }
+            let rr = dot_f32(&r32, &r32) / (t * t);
+            report.iterations += 1;
+            report.relative_residual = rr.sqrt() / b_norm;
+            let done = report.relative_residual <= limits.tolerance;
+            if done || report.iterations == limits.max_iterations {
+                break;
+            }
+            let mut z32 = std::mem::take(&mut work.correction[0]);
+            self.v_cycle(work, 0, &r32, &mut z32);
+            // `r·z = (r'/t)·(back·z')`.
+            let rz_next = dot_f32(&r32, &z32) * (back / t);
+            let beta = rz_next / rz;
+            rz = rz_next;
+            update_direction_f32(beta as f32, &z32, &mut p32);
+            work.correction[0] = z32;
+        }
+        work.residual[0] = r32;
+        work.p32 = p32;
     }
 
     /// `q = held·M p` on the finest level, `M` read as [`Hierarchy::start_residuals`]
@@ -633,6 +792,7 @@ impl Hierarchy {
             Weights::F32(w) => (w, true),
         };
         work.weights_f32 = rounded && self.levels.len() > 1 && self.levels[0].m >= F32_WEIGHTS_FROM;
+        work.weights_rounded = rounded;
         let m = self.levels[0].m;
         let len = match alpha {
             MassTerm::Cells(a) => a.len() / 6,
@@ -1228,7 +1388,8 @@ mod tests {
     /// bit: with a change that is taken, one that is not (worse than the start) and none;
     /// the mass term given per cell or as face 0's (every face's the same); the weights
     /// (`f32` values) given as any `f64`s or as `f32` values (the conjugate gradients then
-    /// reading the V-cycle's `f32` copy from n = [`F32_WEIGHTS_FROM`] on); at n = 64 and
+    /// reading the V-cycle's `f32` copy from n = [`F32_WEIGHTS_FROM`] on, and ending in
+    /// `f32`: [`Hierarchy::iterate_in_f32`]); at n = 64 and
     /// 16 (the mass term then held per face) and 3 (one level, where it cannot be).
     #[test]
     fn a_start_and_change_solve_as_the_start_and_its_guess() {
@@ -1276,15 +1437,10 @@ mod tests {
                 change.map(|c| start.iter().zip(c).map(|(s, c)| s + c).collect());
             let mut plain = start.clone();
             let system = (mass, weights, &b[..]);
-            let expected = h.solve_with_guess(
-                &mut work,
-                &alpha,
-                &weight,
-                &b,
-                &mut plain,
-                guess.as_deref(),
-                limits,
-            );
+            // The weights given alike: given as `f32` values, the conjugate gradients end
+            // in `f32` ([`Hierarchy::iterate_in_f32`]).
+            h.prepare_mass(&mut work, MassTerm::Cells(&alpha), weights);
+            let expected = h.solve_prepared(&mut work, &b, &mut plain, guess.as_deref(), limits);
             let mut x = vec![f64::NAN; grid.cells()];
             let change = change.map(|c| &c[..]);
             let report = h.solve_from_start_and_change(
@@ -1433,6 +1589,143 @@ mod tests {
         let mut areas = CubeSphere::new(16).areas_sr().to_vec();
         areas[5 * 256 + 17] *= 1.0 + f64::EPSILON;
         assert!(!faces_alike(&areas));
+    }
+
+    /// The conjugate gradients' `f32` iterations ([`Hierarchy::iterate_in_f32`], for
+    /// weights given as [`Weights::F32`]) end where the true residual, formed afresh in
+    /// `f64` from the answer, meets the tolerance: it differs from the residual the
+    /// iterations tracked (and report) by a twentieth of the tolerance at most; at n = 64
+    /// (the system the `f32` weights') and 32 (the `f64` weights'), from a start that
+    /// reaches the `f32` iterations after one iteration and from one that reaches them
+    /// later; and with AVX2 as without, to the bit.
+    #[test]
+    fn the_f32_iterations_meet_the_tolerance_on_the_true_residual() {
+        for n in [64, 32] {
+            let (grid, h, alpha, weight, b) = stiff_system(n, |c| (2.0 * c.x - c.y * c.z).sin());
+            let rounded: Vec<f64> = weight.iter().map(|&w| f64::from(w as f32)).collect();
+            let system_weights = if n >= F32_WEIGHTS_FROM {
+                &rounded
+            } else {
+                &weight
+            };
+            let limits = SolveLimits {
+                tolerance: 1e-6,
+                max_iterations: 50,
+            };
+            for start in [
+                vec![0.0; grid.cells()],
+                grid.centres().iter().map(|c| 1e3 * c.y).collect(),
+            ] {
+                let mut answers = Vec::new();
+                for portable in [false, true] {
+                    crate::avx2::set_portable_only(portable);
+                    let mut work = Work::default();
+                    let mut x = vec![f64::NAN; grid.cells()];
+                    let system = (MassTerm::Cells(&alpha), Weights::F32(&weight), &b[..]);
+                    let report = h.solve_from_start_and_change(
+                        &mut work,
+                        system,
+                        (&start, None),
+                        &mut x,
+                        limits,
+                    );
+                    crate::avx2::set_portable_only(false);
+                    assert!(!work.p32.is_empty(), "n {n}: no f32 iterations, {report:?}");
+                    let mx = grid_apply(&grid, &alpha, system_weights, &x);
+                    let left: f64 = b.iter().zip(&mx).map(|(b, m)| (b - m) * (b - m)).sum();
+                    let relative = left.sqrt() / report.start_residual;
+                    let tolerance = limits.tolerance;
+                    assert!(
+                        relative <= 1.05 * tolerance,
+                        "n {n}: {relative:e}, {report:?}"
+                    );
+                    let apart = (relative - report.relative_residual).abs();
+                    assert!(apart <= 0.05 * tolerance, "n {n}: {relative:e}, {report:?}");
+                    answers.push((x, report));
+                }
+                let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+                assert_eq!(answers[0].1, answers[1].1, "n {n}");
+                assert!(
+                    bits(&answers[0].0) == bits(&answers[1].0),
+                    "n {n}: AVX2 differs"
+                );
+            }
+        }
+    }
+
+    /// [`dot_f32`] sums lane `k` over the `i ≡ k (mod 32)` in order in `f32`, then the
+    /// lanes and the tail's widened products in order in `f64`: to the bit, with AVX2 and
+    /// without, at lengths with and without a tail and shorter than a lane chunk.
+    #[test]
+    fn the_f32_dot_sums_its_lanes_in_order() {
+        for len in [0, 5, 32, 100, 1000, 26136] {
+            let a: Vec<f32> = (0..len)
+                .map(|i| ((i * 37) % 101) as f32 * 0.37 - 9.0)
+                .collect();
+            let b: Vec<f32> = (0..len)
+                .map(|i| ((i * 11) % 13) as f32 * 1.3 + 0.1)
+                .collect();
+            let main = len - len % 32;
+            let mut lanes = [0.0f32; 32];
+            for i in 0..main {
+                lanes[i % 32] += a[i] * b[i];
+            }
+            let mut expected = 0.0;
+            for lane in lanes {
+                expected += f64::from(lane);
+            }
+            for i in main..len {
+                expected += f64::from(a[i]) * f64::from(b[i]);
+            }
+            for portable in [false, true] {
+                crate::avx2::set_portable_only(portable);
+                let got = with_avx2(|| dot_f32(&a, &b));
+                crate::avx2::set_portable_only(false);
+                assert_eq!(
+                    got.to_bits(),
+                    expected.to_bits(),
+                    "len {len}, portable {portable}"
+                );
+            }
+        }
+    }
+
+    /// The split layout's scatters and gathers (their `f64` chunks copied by AVX2
+    /// shuffles where the processor has it, [`Real::deinterleave`]) put each value at its
+    /// padded index's position and read it back, with and without AVX2: runs of every
+    /// length from 0 to 40 from both colours' first cells, and whole fields at face sizes
+    /// with odd and even rows.
+    #[test]
+    fn scatters_and_gathers_put_each_value_at_its_position() {
+        for portable in [false, true] {
+            crate::avx2::set_portable_only(portable);
+            for n in [3, 8, 13, 64] {
+                let layout = &Hierarchy::new(&CubeSphere::new(n)).levels[0];
+                for first in [layout.padded_at(1, 2, 0), layout.padded_at(1, 2, 1)] {
+                    for len in 0..=40.min(layout.stride() - 1) {
+                        let values: Vec<f64> = (0..len).map(|j| j as f64 + 0.5).collect();
+                        let mut out = vec![-1.0; layout.len()];
+                        scatter_run(layout, first, &values, &mut out);
+                        let mut expected = vec![-1.0; layout.len()];
+                        for (j, v) in values.iter().enumerate() {
+                            expected[layout.index(first + j)] = *v;
+                        }
+                        assert_eq!(out, expected, "n {n} first {first} len {len}");
+                    }
+                }
+                let cells = 6 * n * n;
+                let values: Vec<f64> = (0..cells).map(|c| c as f64 * 0.25 - 7.0).collect();
+                let mut field = vec![-1.0; layout.len()];
+                to_split(layout, &values, &mut field);
+                for (c, &p) in layout.position.iter().enumerate() {
+                    assert_eq!(field[p as usize], values[c], "n {n} cell {c}");
+                }
+                let mut back = vec![0.0; cells];
+                from_split(layout, &mut field, &mut back);
+                assert_eq!(back, values, "n {n}");
+            }
+            crate::avx2::set_portable_only(false);
+        }
     }
 
     /// The operator applies the grid's system at every cell, through the halo, the

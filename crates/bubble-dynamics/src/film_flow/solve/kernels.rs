@@ -8,7 +8,9 @@
 
 use super::Real;
 use super::layout::{Layout, RIGHT_W, TOP_W};
-use crate::avx2::{dot_lanes, subtract_and_square_lanes, widened_dot_lanes, with_avx2};
+use crate::avx2::{
+    F32_LANES, dot_lanes, dot_lanes_f32, subtract_and_square_lanes, widened_dot_lanes, with_avx2,
+};
 
 /// A level's edge weights once an edge: per cell its RIGHT side's weight
 /// ([`RIGHT_W`]) and its TOP side's ([`TOP_W`]), the left halo column and the bottom
@@ -694,8 +696,12 @@ fn run_halves<'a, T>(
 /// Writes `values[j]` to padded index `first + j`, for each `j`.
 #[inline(always)]
 pub(super) fn scatter_run<T: Real>(layout: &Layout, first: usize, values: &[T], out: &mut [T]) {
+    let (even, odd) = run_halves(layout, first, values.len(), out);
+    // A leading run of whole chunks by the precision's own vectorised copy where it has
+    // one (`f64`'s: the compiler's were one value at a time), the rest below.
+    let done = T::deinterleave(values, even, odd);
+    let (values, even, odd) = (&values[done..], &mut even[done / 2..], &mut odd[done / 2..]);
     let len = values.len();
-    let (even, odd) = run_halves(layout, first, len, out);
     // Eight pairs at a time in chunks of constant length, so the compiler splits them
     // with shuffles (zipped two-value chunks were left a value at a time), then the
     // rest a pair at a time.
@@ -742,8 +748,11 @@ pub(super) fn gather_row<T: Real>(
 ) {
     let m = layout.m;
     let (even, odd) = run_halves(layout, layout.padded_at(face, y + 1, 1), m, field);
-    let pairs = row[..m].chunks_exact_mut(2);
-    for ((pair, e), o) in pairs.zip(even.iter()).zip(odd.iter()) {
+    // As in `scatter_run`: a leading run by the precision's vectorised copy.
+    let done = T::interleave(even, odd, &mut row[..m]);
+    let pairs = row[done..m].chunks_exact_mut(2);
+    let (rest_even, rest_odd) = (&even[done / 2..], &odd[done / 2..]);
+    for ((pair, e), o) in pairs.zip(rest_even.iter()).zip(rest_odd.iter()) {
         (pair[0], pair[1]) = (*e, *o);
     }
     if m % 2 == 1 {
@@ -921,4 +930,58 @@ pub(super) fn update_and_norm2(
     }
     let tail: f64 = r_tail.iter().zip(r_tail.iter()).map(|(x, y)| x * y).sum();
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
+}
+
+/// The `f32` iterations' first direction `p' = z' + c·p` rounded to `f32` (`z'` the
+/// V-cycle's answer, `p` the last `f64` direction, `c = β/back`).
+#[inline(always)]
+pub(super) fn direction_from_f64(z: &[f32], c: f64, p: &[f64], out: &mut [f32]) {
+    let (z, p) = (&z[..out.len()], &p[..out.len()]);
+    for ((o, zi), pi) in out.iter_mut().zip(z).zip(p) {
+        *o = (f64::from(*zi) + c * pi) as f32;
+    }
+}
+
+/// The `f32` iterations' next direction `p' = z' + β·p'`.
+#[inline(always)]
+pub(super) fn update_direction_f32(beta: f32, z: &[f32], p: &mut [f32]) {
+    let z = &z[..p.len()];
+    for (pi, zi) in p.iter_mut().zip(z) {
+        *pi = *zi + beta * *pi;
+    }
+}
+
+/// `x += a·p`, each `p` widened to `f64` (exactly).
+#[inline(always)]
+pub(super) fn add_widened(a: f64, p: &[f32], x: &mut [f64]) {
+    let p = &p[..x.len()];
+    for (xi, pi) in x.iter_mut().zip(p) {
+        *xi += a * f64::from(*pi);
+    }
+}
+
+/// `r −= a·q` in `f32`.
+#[inline(always)]
+pub(super) fn subtract_scaled(a: f32, q: &[f32], r: &mut [f32]) {
+    let q = &q[..r.len()];
+    for (ri, qi) in r.iter_mut().zip(q) {
+        *ri -= a * *qi;
+    }
+}
+
+/// `a·b` of the `f32` iterations' fields, summed in `f32` in [`F32_LANES`] lanes
+/// ([`dot_lanes_f32`]), then the lanes widened and summed in `f64` in order, the tail's
+/// products (widened, exact) last.
+#[inline(always)]
+pub(super) fn dot_f32(a: &[f32], b: &[f32]) -> f64 {
+    let main = a.len() - a.len() % F32_LANES;
+    let lanes = dot_lanes_f32(&a[..main], &b[..main]);
+    let mut sum = 0.0;
+    for lane in lanes {
+        sum += f64::from(lane);
+    }
+    for (x, y) in a[main..].iter().zip(&b[main..a.len()]) {
+        sum += f64::from(*x) * f64::from(*y);
+    }
+    sum
 }
