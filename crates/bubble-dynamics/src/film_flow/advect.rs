@@ -621,8 +621,8 @@ impl Stage<'_> {
         let [z_even, z_odd] = &mut w.vertex_rows;
         for f in face_order(reverse) {
             // The face's own parts, sliced once (a row's offsets are then the face's rows',
-            // from 0): each row sliced the whole arrays again, a fifth of a row's
-            // instructions in bounds checks and offsets.
+            // from 0), where each row sliced the whole arrays again: 2.7 M of the
+            // advection's 99 M instructions over film_profile 64 0 9.81's 40 steps.
             let face = f * epf..(f + 1) * epf;
             let (dst, src) = (&mut dst[face.clone()], src.map(|s| &s[face.clone()]));
             let vorticity = &vorticity[f * vpf..][..vpf];
