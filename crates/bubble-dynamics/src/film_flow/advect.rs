@@ -728,7 +728,7 @@ impl Stage<'_> {
     ) {
         for e in &self.geo.seams {
             let ([ia, ib], [sa, sb]) = (e.slots.map(|i| i as usize), e.signs);
-            let r = ((0.0 + sa * border[ia]) + sb * border[ib]) * e.inverse_norm;
+            let r = (sa * border[ia] + sb * border[ib]) * e.inverse_norm;
             for (k, sign) in [(e.edges[0] as usize, sa), (e.edges[1] as usize, sb)] {
                 let start = u0.at(dst, k, (e.grid_edge as usize, sign));
                 let from = src.map_or(dst[k], |s| s[k]);
@@ -767,10 +767,12 @@ fn border_slot(n: usize, c: usize, side: Side) -> u32 {
     ((f * 4 + side as usize) * n + along) as u32
 }
 
-/// `dst ← step(src, u0, ((0 + ra) + rb)·s)` edge by edge, each of `dst`, `src`, `u0` and
+/// `dst ← step(src, u0, (ra + rb)·s)` edge by edge, each of `dst`, `src`, `u0` and
 /// `rates = (ra, rb, s)` the edge's entry (`s` its
 /// [`inverse_norm`](AdvectionGeometry::inverse_norm)), `src` and `u0` that of `dst`
-/// before it is written where `None`; plus
+/// before it is written where `None` (the two terms added directly: summed from zero, as
+/// they were, the rate differed only in a zero's sign where both terms are −0, for one
+/// addition more each four edges); plus
 /// `dt·(g·c)` where `gravity` is given (`dst` face `f`'s local edges from `from`), as
 /// [`FaceRows::add_gravity`] adds it.
 #[inline(always)]
@@ -808,24 +810,24 @@ fn move_edges_by(
         (Some(src), Some(u0)) => {
             let (src, u0) = (&src[..len], &u0[..len]);
             for i in 0..len {
-                dst[i] = step(i, src[i], u0[i], ((0.0 + ra[i]) + rb[i]) * inv[i]);
+                dst[i] = step(i, src[i], u0[i], (ra[i] + rb[i]) * inv[i]);
             }
         }
         (Some(src), None) => {
             let src = &src[..len];
             for i in 0..len {
-                dst[i] = step(i, src[i], dst[i], ((0.0 + ra[i]) + rb[i]) * inv[i]);
+                dst[i] = step(i, src[i], dst[i], (ra[i] + rb[i]) * inv[i]);
             }
         }
         (None, Some(u0)) => {
             let u0 = &u0[..len];
             for i in 0..len {
-                dst[i] = step(i, dst[i], u0[i], ((0.0 + ra[i]) + rb[i]) * inv[i]);
+                dst[i] = step(i, dst[i], u0[i], (ra[i] + rb[i]) * inv[i]);
             }
         }
         (None, None) => {
             for i in 0..len {
-                dst[i] = step(i, dst[i], dst[i], ((0.0 + ra[i]) + rb[i]) * inv[i]);
+                dst[i] = step(i, dst[i], dst[i], (ra[i] + rb[i]) * inv[i]);
             }
         }
     }
