@@ -44,8 +44,9 @@ pub(super) const SOLVE_TOLERANCE: f64 = 1e-6;
 /// Marangoni solves that go without the guess after one whose guess did not beat its
 /// start. Why: where the film's change does not persist from step to step the guess
 /// only costs its residual's pass and the change's record (on the bench's swirl film at
-/// n = 64 its residual was 1.6× the start's in the median step, at n = 128 too; at
-/// n = 32 0.38×, at n = 16 0.29×).
+/// n = 32 its residual was 0.38× the start's in the median step, at n = 16 0.29×; at
+/// n = 64 and 128 1.6× while the solve took its start's residual with the weights
+/// rounded to `f32`, whose error made each step's change alternate).
 pub(super) const GUESS_REST: u32 = 7;
 /// Iteration cap of the Marangoni solve (it takes 3–8).
 pub(super) const SOLVE_MAX_ITERATIONS: u32 = 40;
