@@ -5,6 +5,7 @@
 //! CPU fallback.
 #![cfg(feature = "view")]
 
+use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::thread::sleep;
@@ -174,6 +175,28 @@ fn view_without_a_display_exits_2(args: &[&str]) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
+/// A fresh Xvfb on a display it picks itself (`-displayfd`: the first free number, its
+/// lock and socket checked, written back once it listens), and that display. A number
+/// chosen here from the process id met stale locks and sockets that earlier runs had
+/// left on a long-lived machine, and the viewer could not open the display.
+fn start_xvfb() -> (Reap, String) {
+    let mut xvfb = Reap(
+        Command::new("Xvfb")
+            .args(["-displayfd", "1", "-screen", "0", "640x480x24"])
+            .args(["-nolisten", "tcp"])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap(),
+    );
+    let mut number = String::new();
+    let stdout = xvfb.0.stdout.take().expect("Xvfb's stdout");
+    BufReader::new(stdout).read_line(&mut number).unwrap();
+    let number = number.trim();
+    assert!(!number.is_empty(), "Xvfb wrote no display number");
+    (xvfb, format!(":{number}"))
+}
+
 /// Runs `bubbles view paper` with `args` and `env` under a fresh Xvfb, drives it with real
 /// X input (a drag, then the keys F, S and Escape), checks the window shows the scene,
 /// turns on the drag, shows the overlay on F, saves a screenshot on S and exits 0 on Escape, and returns the viewer's stderr; `None` where the tools are missing
@@ -191,23 +214,7 @@ fn drive_viewer(args: &[&str], env: &[(&str, &str)]) -> Option<String> {
         return None;
     }
     let dir = tempfile::tempdir().unwrap();
-    // One display per test (tests run in parallel threads of one process).
-    let offset = 1 + args.len() as u32 + env.len() as u32 * 3;
-    let display = format!(":{}", 100 + (std::process::id() * 4 + offset) % 3000);
-    let _xvfb = Reap(
-        Command::new("Xvfb")
-            .args([
-                display.as_str(),
-                "-screen",
-                "0",
-                "640x480x24",
-                "-nolisten",
-                "tcp",
-            ])
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap(),
-    );
+    let (_xvfb, display) = start_xvfb();
     let deadline = Instant::now() + Duration::from_secs(20);
     while !run_ok(&display, "xdotool", &["getmouselocation"]) {
         assert!(Instant::now() < deadline, "Xvfb {display} did not start");
