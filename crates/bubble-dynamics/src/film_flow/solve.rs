@@ -53,11 +53,10 @@ use super::grid::CubeSphere;
 use super::sides::{BOTTOM, CellSides, LEFT, RIGHT, TOP};
 use crate::avx2::with_avx2;
 use kernels::{
-    LevelField, NOT_A_CELL, Scaled, Stencil, add_widened, correct, direction_from_f64, dot,
-    dot_f32, gather_row, operator, refresh, refresh_all, refresh_from_other, relax,
-    relax_from_zero, residuals_in_place, restrict, restrict_field, rounded_level, scatter_row,
-    scatter_run, subtract_scaled, update_and_norm2, update_direction, update_direction_f32,
-    widened_dot,
+    LevelField, NOT_A_CELL, Stencil, add_widened, correct, direction_from_f64, dot, dot_f32,
+    gather_row, operator, refresh, refresh_all, refresh_from_other, relax, relax_from_zero,
+    residuals_in_place, restrict, restrict_field, rounded_level, scatter_row, scatter_run,
+    subtract_scaled, update_and_norm2, update_direction, update_direction_f32, widened_dot,
 };
 use layout::Layout;
 use sparse::{Factor, Pattern};
@@ -595,7 +594,7 @@ impl Hierarchy {
                             break;
                         }
                         let step = rz / pq;
-                        let rr = update_and_norm2((step, step), p, &q, x, &mut r);
+                        let rr = update_and_norm2(step, p, &q, x, &mut r);
                         report.iterations += 1;
                         report.relative_residual = rr.sqrt() / b_norm;
                         let done = report.relative_residual <= limits.tolerance;
@@ -671,8 +670,7 @@ impl Hierarchy {
                 values: &work.mass32[0],
                 per_face: work.mass_per_face,
             };
-            let w = Scaled::plain(&work.stencil32[0]);
-            operator::<f32, f32, false>(fine, mass, w, &[], &p32, &mut q32);
+            operator::<f32, false>(fine, mass, &work.stencil32[0], &[], &p32, &mut q32);
             // `p·M p = back²/scale · p'·q'`.
             let pq = dot_f32(&p32, &q32) * back * (back / scale);
             let usable = pq > 0.0 && pq.is_finite();
@@ -710,8 +708,8 @@ impl Hierarchy {
     /// [`Hierarchy::start_residuals`]).
     #[inline(always)]
     fn apply(&self, work: &Work, p: &[f64], q: &mut [f64]) {
-        let w = Scaled::plain(&work.stencil[0]);
-        operator::<f64, f64, false>(&self.levels[0], work.mass_term(0), w, &[], p, q);
+        let w = &work.stencil[0];
+        operator::<f64, false>(&self.levels[0], work.mass_term(0), w, &[], p, q);
     }
 
     /// The starts' residuals in place ([`residuals_in_place`]) on the finest level, with
@@ -733,8 +731,7 @@ impl Hierarchy {
     #[inline(always)]
     fn start_residuals(&self, work: &Work, starts: [Option<&[f64]>; 2], out: [&mut [f64]; 2]) {
         let (fine, mass) = (&self.levels[0], work.mass_term(0));
-        let w = Scaled::plain(&work.stencil[0]);
-        residuals_in_place(fine, (mass, w), starts, out);
+        residuals_in_place(fine, (mass, &work.stencil[0]), starts, out);
     }
 
     /// [`Hierarchy::prepare_mass`] of a mass term given per cell.
@@ -978,7 +975,7 @@ impl Hierarchy {
                     values: &work.mass32[k],
                     per_face: k == 0 && work.mass_per_face,
                 };
-                operator::<f32, f32, true>(level, mass, Scaled::plain(w), r, z, &mut d);
+                operator::<f32, true>(level, mass, w, r, z, &mut d);
                 let mut rc = std::mem::take(&mut work.residual[k + 1]);
                 restrict(level, &d, coarse, &mut rc, &mut work.row);
                 work.operator = d;
@@ -1715,7 +1712,7 @@ mod tests {
             let none = vec![0.0; fine.len()];
             let mut out = vec![f64::NAN; fine.len()];
             let (mass, w) = (work.mass_term(0), &work.stencil[0]);
-            operator::<f64, f64, false>(fine, mass, Scaled::plain(w), &none, &xs, &mut out);
+            operator::<f64, false>(fine, mass, w, &none, &xs, &mut out);
             let expected = grid_apply(&grid, &alpha, &weight, &x);
             for (c, &p) in fine.position.iter().enumerate() {
                 let err = (out[p as usize] - expected[c]).abs();
@@ -1754,13 +1751,13 @@ mod tests {
             let (mass, w) = (work.mass_term(0), &work.stencil[0]);
             let plain = |start: &[f64]| {
                 let mut out = vec![f64::NAN; fine.len()];
-                operator::<f64, f64, true>(fine, mass, Scaled::plain(w), &b, start, &mut out);
+                operator::<f64, true>(fine, mass, w, &b, start, &mut out);
                 out
             };
             let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
             for guess in [Some(&g[..]), None] {
                 let (mut r, mut q) = (b.clone(), vec![f64::NAN; fine.len()]);
-                let system = (mass, Scaled::plain(w));
+                let system = (mass, w);
                 residuals_in_place(fine, system, [Some(&x[..]), guess], [&mut r, &mut q]);
                 assert_eq!(bits(&r), bits(&plain(&x)), "n {n}");
                 if let Some(g) = guess {

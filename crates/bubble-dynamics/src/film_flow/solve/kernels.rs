@@ -198,32 +198,6 @@ pub(super) fn relax_from_zero<T: Real>(layout: &Layout, inv_diag: &[T], r: &[T],
     });
 }
 
-/// A level's edge weights as the operator reads them: held scaled by `scale`, a power of
-/// two (1 where they are held as they are), in precision `W`. The conjugate gradients'
-/// `f64` operator reads the V-cycle's `f32` weights so where the system's weights are
-/// `f32` values ([`Weights::F32`](super::Weights::F32)): each is widened exactly, the
-/// mass term given scaled alike, and the operator's product is left in the scaled
-/// system (its residual scaled back): each factor a power of two, `scale` times the
-/// product the weights as given make, to the bit (where no number leaves the normal
-/// range).
-#[derive(Clone, Copy)]
-pub(super) struct Scaled<'a, W> {
-    /// The weights, times `scale`.
-    pub(super) weights: &'a Stencil<W>,
-    /// The power of two they are held scaled by.
-    pub(super) scale: f64,
-}
-
-impl<'a, W> Scaled<'a, W> {
-    /// The weights as they are (scaled by 1).
-    pub(super) fn plain(weights: &'a Stencil<W>) -> Self {
-        Self {
-            weights,
-            scale: 1.0,
-        }
-    }
-}
-
 /// `out = (diag(mass) + L_w) x` (`RESIDUAL` false) or `r − (diag(mass) + L_w) x`
 /// (true), as `mᵢxᵢ + Σ wᵢⱼ (xᵢ − xⱼ)`: the differences keep the result accurate where
 /// the weights dwarf the mass term and `x` is nearly uniform (a stiff step's
@@ -232,15 +206,15 @@ impl<'a, W> Scaled<'a, W> {
 /// a block at a time ([`BLOCK`]): each weight entry is read once, by its cell and by the
 /// neighbour across the edge, while it is in L2.
 #[inline(always)]
-pub(super) fn operator<T: Real, W: Real, const RESIDUAL: bool>(
+pub(super) fn operator<T: Real, const RESIDUAL: bool>(
     layout: &Layout,
     mass: LevelField<T>,
-    w: Scaled<W>,
+    w: &Stencil<T>,
     r: &[T],
     x: &[T],
     out: &mut [T],
 ) {
-    operator_blocks::<T, W, RESIDUAL>(layout, (mass, w, r), &mut [(Some(x), out)]);
+    operator_blocks::<T, RESIDUAL>(layout, (mass, w, r), &mut [(Some(x), out)]);
 }
 
 /// `out = b − (diag(mass) + L_w) x` for each start `x` given ([`operator`]'s residual),
@@ -249,9 +223,9 @@ pub(super) fn operator<T: Real, W: Real, const RESIDUAL: bool>(
 /// own is written), in one pass over the system: each block's numbers are read once for
 /// every start, and `b` needs no field of its own.
 #[inline(always)]
-pub(super) fn residuals_in_place<T: Real, W: Real>(
+pub(super) fn residuals_in_place<T: Real>(
     layout: &Layout,
-    (mass, w): (LevelField<T>, Scaled<W>),
+    (mass, w): (LevelField<T>, &Stencil<T>),
     [x_a, x_b]: [Option<&[T]>; 2],
     [a, b_out]: [&mut [T]; 2],
 ) {
@@ -268,12 +242,12 @@ pub(super) fn residuals_in_place<T: Real, W: Real>(
             let at = (face, start, len);
             if let Some(x) = x_b {
                 for c in 0..2 {
-                    operator_run::<T, W, true, false>(layout, c, at, (mass, w, &*a), x, b_out);
+                    operator_run::<T, true, false>(layout, c, at, (mass, w, &*a), x, b_out);
                 }
             }
             if let Some(x) = x_a {
                 for c in 0..2 {
-                    operator_run::<T, W, true, true>(layout, c, at, (mass, w, &[]), x, a);
+                    operator_run::<T, true, true>(layout, c, at, (mass, w, &[]), x, a);
                 }
             }
         },
@@ -293,9 +267,9 @@ fn zero_outside<T: Real>(layout: &Layout, range: std::ops::Range<usize>, out: &m
 /// zeroed outside the cells), both colours a block at a time: each block's numbers are
 /// read once for every start.
 #[inline(always)]
-fn operator_blocks<T: Real, W: Real, const RESIDUAL: bool>(
+fn operator_blocks<T: Real, const RESIDUAL: bool>(
     layout: &Layout,
-    (mass, w, r): (LevelField<T>, Scaled<W>, &[T]),
+    (mass, w, r): (LevelField<T>, &Stencil<T>, &[T]),
     pairs: &mut [(Option<&[T]>, &mut [T])],
 ) {
     let range = both_sweeps(layout);
@@ -312,7 +286,7 @@ fn operator_blocks<T: Real, W: Real, const RESIDUAL: bool>(
                 let Some(x) = x else { continue };
                 for c in 0..2 {
                     let at = (face, start, len);
-                    operator_run::<T, W, RESIDUAL, false>(layout, c, at, (mass, w, r), x, out);
+                    operator_run::<T, RESIDUAL, false>(layout, c, at, (mass, w, r), x, out);
                 }
             }
         },
@@ -321,15 +295,13 @@ fn operator_blocks<T: Real, W: Real, const RESIDUAL: bool>(
 
 /// [`operator`] at the `len` positions from `start` of colour `c`, of face `face`; the
 /// residual's `b` read from `out` itself where `IN_PLACE` (`r` then unread, as it is
-/// for the product, `RESIDUAL` false). In the weights' scaled system ([`Scaled`]: the
-/// mass term given scaled alike), the residual's sum scaled back (exactly: with
-/// weights held as they are, by 1).
+/// for the product, `RESIDUAL` false).
 #[inline(always)]
-fn operator_run<T: Real, W: Real, const RESIDUAL: bool, const IN_PLACE: bool>(
+fn operator_run<T: Real, const RESIDUAL: bool, const IN_PLACE: bool>(
     layout: &Layout,
     c: usize,
     (face, start, len): (usize, usize, usize),
-    (mass, w, r): (LevelField<T>, Scaled<W>, &[T]),
+    (mass, w, r): (LevelField<T>, &Stencil<T>, &[T]),
     x: &[T],
     out: &mut [T],
 ) {
@@ -337,9 +309,8 @@ fn operator_run<T: Real, W: Real, const RESIDUAL: bool, const IN_PLACE: bool>(
     let (own, other) = if c == 0 { (own, other) } else { (other, own) };
     let (near, weights) = (
         neighbours(layout, c, (start, len), other),
-        side_weights(layout, c, (start, len), w.weights),
+        side_weights(layout, c, (start, len), w),
     );
-    let back = T::narrow(w.scale.recip());
     let base = c * layout.half + start;
     let (m, xs, r) = (
         mass.at(layout, face, base, len),
@@ -353,16 +324,13 @@ fn operator_run<T: Real, W: Real, const RESIDUAL: bool, const IN_PLACE: bool>(
     let out = &mut out[base..][..len];
     let [n0, n1, n2, n3] = near;
     let [w0, w1, w2, w3] = weights;
-    // Each weight in `T`: `f32` widened exactly, or the value itself.
-    let at = |w: &[W], i: usize| T::narrow(w[i].widen());
     for i in 0..len {
         let xi = xs[i];
         let mut sum = m[i] * xi;
-        sum += at(w0, i) * (xi - n0[i]);
-        sum += at(w1, i) * (xi - n1[i]);
-        sum += at(w2, i) * (xi - n2[i]);
-        sum += at(w3, i) * (xi - n3[i]);
-        let sum = if RESIDUAL { sum * back } else { sum };
+        sum += w0[i] * (xi - n0[i]);
+        sum += w1[i] * (xi - n1[i]);
+        sum += w2[i] * (xi - n2[i]);
+        sum += w3[i] * (xi - n3[i]);
         let b = if IN_PLACE {
             out[i]
         } else if RESIDUAL {
@@ -905,14 +873,13 @@ pub(super) fn update_direction<T: Real>(back: f64, z: &[T], beta: Option<f64>, p
     }
 }
 
-/// `x += step·p`, `r −= step_q·q`, and returns `r·r`, summed as [`dot`] sums: each
+/// `x += step·p`, `r −= step·q`, and returns `r·r`, summed as [`dot`] sums: each
 /// lane's `r` squared as it is made (one pass over `r`, where the dot read it back), `x`
 /// in a pass of its own (with both updated in one loop the compiler could not tell them
-/// apart and kept it scalar). (`step_q` is `step` but where `q` is held scaled:
-/// [`Scaled`].)
+/// apart and kept it scalar).
 #[inline(always)]
 pub(super) fn update_and_norm2(
-    (step, step_q): (f64, f64),
+    step: f64,
     p: &[f64],
     q: &[f64],
     x: &mut [f64],
@@ -924,9 +891,9 @@ pub(super) fn update_and_norm2(
     let main = r.len() - r.len() % LANES;
     let (r, r_tail) = r.split_at_mut(main);
     let (q, q_tail) = q.split_at(main);
-    let lanes = subtract_and_square_lanes(step_q, &q[..main], r);
+    let lanes = subtract_and_square_lanes(step, &q[..main], r);
     for (ri, qi) in r_tail.iter_mut().zip(q_tail) {
-        *ri -= step_q * qi;
+        *ri -= step * qi;
     }
     let tail: f64 = r_tail.iter().zip(r_tail.iter()).map(|(x, y)| x * y).sum();
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + tail
