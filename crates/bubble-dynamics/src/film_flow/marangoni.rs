@@ -187,8 +187,8 @@ impl FilmFlow {
         // The cells' areas, alike on every face to the bit: face 0's.
         let n = self.sides.n();
         let areas = MassTerm::EveryFace(&g.areas_sr()[..n * n]);
-        // The weights taken as their `f32` roundings (6e-8 of each at most): the solve's
-        // iterations then stream half the bytes ([`Weights::F32`]).
+        // The solve's last iterations may take the weights as their `f32` roundings (6e-8
+        // of each at most) on what the first leaves ([`Weights::F32`]).
         let report = self.hierarchy.solve_from_start_and_change(
             &mut s.work,
             (areas, Weights::F32(&s.weight), &s.rhs),
