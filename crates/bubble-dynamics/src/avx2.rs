@@ -447,10 +447,34 @@ fn coriolis_row_avx2(w: &[f64], z: [&[f64]; 2], u: [&[f64]; 3], out: [&mut [f64]
     }
 }
 
-/// [`coriolis_row`]'s terms of cells `x..x + 4` in AVX2 registers, from a group's
-/// weights `wq` ([`QUAD_WEIGHTS`]), the row's vertices `z` (bottom, top), its velocities
-/// `u` (bottom, left and right, top) and into its terms `out` (bottom, left, right, top),
-/// as [`coriolis_row`] lays them out.
+/// [`coriolis_row`]'s terms of cells `x..x + 4` in AVX2 registers ([`coriolis_terms`])
+/// into `out` (bottom, left, right, top), as [`coriolis_row`] lays them out.
+///
+/// # Safety
+/// As [`coriolis_terms`], and each of `out` holds `x + 4`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+pub(crate) unsafe fn coriolis_quad(
+    wq: *const f64,
+    z: [*const f64; 2],
+    u: [*const f64; 3],
+    out: [*mut f64; 4],
+    x: usize,
+) {
+    // SAFETY: the caller's promise.
+    unsafe {
+        let (terms, _) = coriolis_terms(wq, z, u, x);
+        for (o, t) in out.into_iter().zip(terms) {
+            std::arch::x86_64::_mm256_storeu_pd(o.add(x), t);
+        }
+    }
+}
+
+/// [`coriolis_row`]'s terms of cells `x..x + 4` in AVX2 registers (bottom, left, right,
+/// top), from a group's weights `wq` ([`QUAD_WEIGHTS`]), the row's vertices `z` (bottom,
+/// top) and its velocities `u` (bottom, left and right, top); and the cells' velocities
+/// it read (bottom, left, right, top), for a caller that moves those edges.
 ///
 /// # Safety
 /// The processor has AVX2; `wq` holds [`QUAD_WEIGHTS`] values, `z` and `u[1]` hold
@@ -458,18 +482,19 @@ fn coriolis_row_avx2(w: &[f64], z: [&[f64]; 2], u: [&[f64]; 3], out: [&mut [f64]
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline]
-pub(crate) unsafe fn coriolis_quad(
+pub(crate) unsafe fn coriolis_terms(
     wq: *const f64,
     [zb, zt]: [*const f64; 2],
     [ub, ux, ut]: [*const f64; 3],
-    [ob, ol, or, ot]: [*mut f64; 4],
     x: usize,
+) -> (
+    [std::arch::x86_64::__m256d; 4],
+    [std::arch::x86_64::__m256d; 4],
 ) {
     use std::arch::x86_64::{
-        _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_setzero_pd, _mm256_storeu_pd,
-        _mm256_sub_pd,
+        _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_setzero_pd, _mm256_sub_pd,
     };
-    // SAFETY: every load and store is in bounds (the caller's promise).
+    // SAFETY: every load is in bounds (the caller's promise).
     unsafe {
         let ld = |p: *const f64, at: usize| _mm256_loadu_pd(p.add(at));
         let (c0, c1, c2, c3) = (ld(zb, x), ld(zb, x + 1), ld(zt, x), ld(zt, x + 1));
@@ -486,14 +511,13 @@ pub(crate) unsafe fn coriolis_quad(
         });
         let t = |q: usize, side: usize| _mm256_mul_pd(p[q], v[side]);
         let (add, sub) = (_mm256_add_pd, _mm256_sub_pd);
-        let st = |o: *mut f64, r| _mm256_storeu_pd(o.add(x), r);
-        st(ob, add(add(t(0, 1), t(1, 2)), t(2, 3)));
-        st(ol, add(sub(t(3, 2), t(0, 0)), t(4, 3)));
-        st(or, sub(sub(t(5, 3), t(1, 0)), t(3, 1)));
-        st(
-            ot,
+        let terms = [
+            add(add(t(0, 1), t(1, 2)), t(2, 3)),
+            add(sub(t(3, 2), t(0, 0)), t(4, 3)),
+            sub(sub(t(5, 3), t(1, 0)), t(3, 1)),
             sub(sub(sub(_mm256_setzero_pd(), t(2, 0)), t(4, 1)), t(5, 2)),
-        );
+        ];
+        (terms, v)
     }
 }
 

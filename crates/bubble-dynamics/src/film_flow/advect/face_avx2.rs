@@ -3,14 +3,17 @@
 //! There each row sliced some twenty arrays again, checked their bounds and chose its
 //! starting velocities' and its destination's layouts: about 425 instructions a row, 19 M
 //! of the advection's 94 M over `film_profile 64 0 9.81`'s 40 steps. Here the face's
-//! arrays are checked once and each row's are its face's at fixed strides.
+//! arrays are checked once and each row's are its face's at fixed strides (85.1 M).
+//! Where `n` is a multiple of four, each group of four cells' terms moves the edges they
+//! complete as soon as they are taken ([`fused_row`]), where the row's terms were stored
+//! and read back by two more loops (82.5 M).
 
 use std::arch::x86_64::{
-    __m256d, _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_storeu_pd,
-    _mm256_sub_pd,
+    __m256d, _mm256_add_pd, _mm256_blend_pd, _mm256_cvtsd_f64, _mm256_loadu_pd, _mm256_mul_pd,
+    _mm256_permute4x64_pd, _mm256_set1_pd, _mm256_setzero_pd, _mm256_storeu_pd, _mm256_sub_pd,
 };
 
-use crate::avx2::{QUAD_WEIGHTS, coriolis_quad};
+use crate::avx2::{QUAD_WEIGHTS, coriolis_quad, coriolis_terms};
 
 use super::rk3_step;
 
@@ -177,7 +180,7 @@ pub(super) fn face_stage<const STAGE: u8, const GRAVITY: bool>(
 #[target_feature(enable = "avx2")]
 unsafe fn rows<const STAGE: u8, const GRAVITY: bool>(p: Plan, h: f64) {
     let n = p.n;
-    let (w, groups) = (n + 1, n.div_ceil(4));
+    let w = n + 1;
     // SAFETY (throughout): the offsets are those of local edges and vertices of one face,
     // of a row of `n + 1` cell terms, or of the face's `4n` border terms, within the
     // checked lengths: vertex row `j ≤ n` at `j (n + 1)`, X-edge row `y < n` at
@@ -193,33 +196,161 @@ unsafe fn rows<const STAGE: u8, const GRAVITY: bool>(p: Plan, h: f64) {
                 circulation_row(p, y + 1, out);
                 out.cast_const()
             };
-            let [rb, rl, rr, rt] = p.rate[y % 2];
-            let before_top = p.rate[(y + 1) % 2][3];
-            let (ux, uy) = (p.u.add(y * w), p.u.add(n * w + y * n));
-            let weights = p.coriolis.add(y * groups * QUAD_WEIGHTS);
-            let out = [rb, rl, rr, rt];
-            for g in 0..n / 4 {
-                let (z, u) = ([zb, zt], [uy, ux, uy.add(n)]);
-                coriolis_quad(weights.add(g * QUAD_WEIGHTS), z, u, out, 4 * g);
-            }
-            if n % 4 != 0 {
-                let (z, u) = ([zb, zt], [uy, ux, uy.add(n)]);
-                coriolis_quad(weights.add(n / 4 * QUAD_WEIGHTS), z, u, out, n - 4);
-            }
-            keep_border_rates(p, [rb, rl, rr, rt], y);
-            // The X-edges inside the face and the right border copy (the row's `n`),
-            // that copy's entry put back after (as `Stage::stage` does).
-            let k = y * w + 1;
-            let border_copy = *p.dst.add(k + n - 1);
-            let start = p.start.0.add(y * p.start.1);
-            move_run::<STAGE, GRAVITY>(p, h, k, start, [rr.cast_const(), rl.add(1)]);
-            *p.dst.add(k + n - 1) = border_copy;
-            if y > 0 {
-                let k = n * w + y * n;
-                let start = p.start.2.add((y - 1) * n);
-                move_run::<STAGE, GRAVITY>(p, h, k, start, [before_top.cast_const(), rb]);
+            // This row's cell terms (its tops read by the next row's Y-edges) and the row
+            // before's.
+            let (rate, before) = (p.rate[y % 2], p.rate[(y + 1) % 2]);
+            if n % 4 == 0 {
+                let (z, top) = ([zb, zt], (rate[3], before[3].cast_const()));
+                if y == 0 {
+                    fused_row::<STAGE, GRAVITY, false>(p, h, y, z, top);
+                } else {
+                    fused_row::<STAGE, GRAVITY, true>(p, h, y, z, top);
+                }
+            } else {
+                row_apart::<STAGE, GRAVITY>(p, h, y, [zb, zt], rate, before[3]);
             }
             zb = zt;
+        }
+    }
+}
+
+/// Row `y`'s cells' terms (`z` its bottom and top vertices' vorticity) and the moves of
+/// its X-edges and of the Y-edges below it (where `BELOW`, `y > 0`; `before_top` the row
+/// before's top terms), each group of four cells' terms moving those of its edges whose other cells'
+/// terms are in (the left ones of its cells and their bottoms) as soon as they are taken,
+/// where a row's terms were stored and read back by the moves (`n` a multiple of four):
+/// each X-edge's term of the cell on its left the group's right terms a lane on, the one
+/// before's last carried in. Its tops go to `top` (for the next row), or to the face's
+/// border terms on its last row, as its bottoms on its first and its first left and last
+/// right terms on each.
+///
+/// # Safety
+/// As [`rows`]: `y < n` (`BELOW` where `y > 0`), `n` a multiple of four, `top` and
+/// `before_top` hold `n`.
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn fused_row<const STAGE: u8, const GRAVITY: bool, const BELOW: bool>(
+    p: Plan,
+    h: f64,
+    y: usize,
+    z: [*const f64; 2],
+    (top, before_top): (*mut f64, *const f64),
+) {
+    let n = p.n;
+    let w = n + 1;
+    let (kx, ky) = (y * w, n * w + y * n);
+    // SAFETY: as [`rows`] says. X-edge `(i, y)`'s starting velocity is at `i − 1` of its
+    // run; the first group's lane 0 (the left border copy, put back after) takes lane 1's
+    // run, so that no run is read before its first.
+    unsafe {
+        let ld = |base: *const f64, at: usize| _mm256_loadu_pd(base.add(at));
+        let u = [p.u.add(ky), p.u.add(kx), p.u.add(ky + n)];
+        let weights = p.coriolis.add(y * (n / 4) * QUAD_WEIGHTS);
+        let (start_x, start_y) = (p.start.0.add(y * p.start.1), p.start.2);
+        let top = if y + 1 == n { p.border.add(3 * n) } else { top };
+        let border_copy = *p.dst.add(kx);
+        let moves = Moves::<STAGE, GRAVITY>::new(p, h);
+        // The group before's right terms, turned a lane on (its last in lane 0).
+        let mut carried = _mm256_setzero_pd();
+        for g in 0..n / 4 {
+            let x = 4 * g;
+            let ([b, l, r, t], [ub, ul, _, _]) =
+                coriolis_terms(weights.add(g * QUAD_WEIGHTS), z, u, x);
+            let turned = _mm256_permute4x64_pd::<0b10_01_00_11>(r);
+            let right_of_left = _mm256_blend_pd::<0b0001>(turned, carried);
+            carried = turned;
+            let start = || {
+                if g == 0 {
+                    _mm256_permute4x64_pd::<0b10_01_00_00>(ld(start_x, 0))
+                } else {
+                    ld(start_x, x - 1)
+                }
+            };
+            let x_edges = moves.lanes(kx + x, ul, start, _mm256_add_pd(right_of_left, l));
+            _mm256_storeu_pd(p.dst.add(kx + x), x_edges);
+            if BELOW {
+                let start = || ld(start_y, (y - 1) * n + x);
+                let rates = _mm256_add_pd(ld(before_top, x), b);
+                _mm256_storeu_pd(p.dst.add(ky + x), moves.lanes(ky + x, ub, start, rates));
+            } else {
+                _mm256_storeu_pd(p.border.add(x), b);
+            }
+            _mm256_storeu_pd(top.add(x), t);
+            if g == 0 {
+                *p.border.add(n + y) = _mm256_cvtsd_f64(l);
+            }
+        }
+        *p.border.add(2 * n + y) = _mm256_cvtsd_f64(carried);
+        *p.dst.add(kx) = border_copy;
+    }
+}
+
+/// Row `y`'s cells' terms into `rate` (bottom, left, right, top; `z` its bottom and top
+/// vertices' vorticity), its border cells' kept, then the moves of its X-edges and of the
+/// Y-edges below it (`y > 0`, `before_top` the row before's top terms) from those: `n`
+/// not a multiple of four, the last group of cells overlapping the one before.
+///
+/// # Safety
+/// As [`rows`]: `y < n`, each of `rate` and `before_top` holds `n + 1`.
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn row_apart<const STAGE: u8, const GRAVITY: bool>(
+    p: Plan,
+    h: f64,
+    y: usize,
+    z: [*const f64; 2],
+    [rb, rl, rr, rt]: [*mut f64; 4],
+    before_top: *const f64,
+) {
+    let n = p.n;
+    let (w, groups) = (n + 1, n.div_ceil(4));
+    // SAFETY: as [`rows`] says.
+    unsafe {
+        let (ux, uy) = (p.u.add(y * w), p.u.add(n * w + y * n));
+        let weights = p.coriolis.add(y * groups * QUAD_WEIGHTS);
+        let out = [rb, rl, rr, rt];
+        let u = [uy, ux, uy.add(n)];
+        for g in 0..n / 4 {
+            coriolis_quad(weights.add(g * QUAD_WEIGHTS), z, u, out, 4 * g);
+        }
+        if n % 4 != 0 {
+            coriolis_quad(weights.add(n / 4 * QUAD_WEIGHTS), z, u, out, n - 4);
+        }
+        keep_border_rates(p, out, y);
+        let moves = Moves::<STAGE, GRAVITY>::new(p, h);
+        // The X-edges inside the face and the right border copy (the row's `n`),
+        // that copy's entry put back after (as `Stage::stage` does).
+        let k = y * w + 1;
+        let border_copy = *p.dst.add(k + n - 1);
+        let start = p.start.0.add(y * p.start.1);
+        moves.run(k, start, [rr.cast_const(), rl.add(1)]);
+        *p.dst.add(k + n - 1) = border_copy;
+        if y > 0 {
+            let k = n * w + y * n;
+            let start = p.start.2.add((y - 1) * n);
+            moves.run(k, start, [before_top, rb]);
+        }
+    }
+}
+
+/// Keeps row `y`'s border cells' terms (`rate`: bottom, left, right, top) into the face's
+/// border terms, as `keep_border_rates` does.
+///
+/// # Safety
+/// As [`rows`]: `y < n`.
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn keep_border_rates(p: Plan, [rb, rl, rr, rt]: [*mut f64; 4], y: usize) {
+    let n = p.n;
+    // SAFETY: as [`rows`] says: the face's `4n` border terms, the row's `n`.
+    unsafe {
+        *p.border.add(n + y) = *rl;
+        *p.border.add(2 * n + y) = *rr.add(n - 1);
+        if y == 0 {
+            std::ptr::copy_nonoverlapping(rb, p.border, n);
+        }
+        if y == n - 1 {
+            std::ptr::copy_nonoverlapping(rt, p.border.add(3 * n), n);
         }
     }
 }
@@ -260,89 +391,93 @@ unsafe fn circulation_row(p: Plan, j: usize, out: *mut f64) {
     }
 }
 
-/// Keeps row `y`'s border cells' terms (`rate`: bottom, left, right, top) into the face's
-/// border terms, as `keep_border_rates` does.
-///
-/// # Safety
-/// As [`rows`]: `y < n`.
-#[target_feature(enable = "avx2")]
-#[inline]
-unsafe fn keep_border_rates(p: Plan, [rb, rl, rr, rt]: [*mut f64; 4], y: usize) {
-    let n = p.n;
-    // SAFETY: as [`rows`] says: the face's `4n` border terms, the row's `n`.
-    unsafe {
-        *p.border.add(n + y) = *rl;
-        *p.border.add(2 * n + y) = *rr.add(n - 1);
-        if y == 0 {
-            std::ptr::copy_nonoverlapping(rb, p.border, n);
-        }
-        if y == n - 1 {
-            std::ptr::copy_nonoverlapping(rt, p.border.add(3 * n), n);
-        }
-    }
-}
-
-/// `dst ← step(u, u0, (ra + rb)·s)` (plus gravity where `GRAVITY`) on the `n` local
-/// edges from `k`, as `move_edges` takes them: `u0` from `start`, the terms `ra` and `rb`
-/// from `terms`, `s` the edges' `1/(l d)`. Four edges an instruction, the last `n mod 4`
-/// one by one (each edge's entry of the destination may be its source: a chunk taken
-/// twice would move its edges twice).
-///
-/// # Safety
-/// As [`rows`]: the `n` edges from `k` are one row's, `start` holds `n` and `terms` `n`
-/// each.
-#[target_feature(enable = "avx2")]
-#[inline]
-unsafe fn move_run<const STAGE: u8, const GRAVITY: bool>(
+/// The edge moves of stage `STAGE` of [`rk3_step`] (plus gravity where `GRAVITY`), as
+/// `move_edges` takes them: `dst ← step(u, u0, (ra + rb)·s)`, `s` the edge's `1/(l d)`.
+#[derive(Clone, Copy)]
+struct Moves<const STAGE: u8, const GRAVITY: bool> {
+    /// The plan whose edges move.
     p: Plan,
+    /// The sub-step, s.
     h: f64,
-    k: usize,
-    start: *const f64,
-    [ra, rb]: [*const f64; 2],
-) {
-    let n = p.n;
-    let (g_dt, g, c) = p.gravity;
-    // SAFETY: as [`rows`] says, and the caller's promise.
-    unsafe {
-        let (u, dst, inv) = (p.u.add(k), p.dst.add(k), p.inverse_norm.add(k));
-        let c = c.wrapping_add(k);
-        let ld = |base: *const f64, i: usize| _mm256_loadu_pd(base.add(i));
-        let (hv, g_dtv, gv) = (_mm256_set1_pd(h), _mm256_set1_pd(g_dt), _mm256_set1_pd(g));
-        let whole = n / 4 * 4;
-        for i in (0..n / 4).map(|q| 4 * q) {
-            let r = _mm256_mul_pd(_mm256_add_pd(ld(ra, i), ld(rb, i)), ld(inv, i));
-            let mut v = step_lanes::<STAGE>(hv, ld(u, i), || ld(start, i), r);
-            if GRAVITY {
-                v = _mm256_add_pd(v, _mm256_mul_pd(g_dtv, _mm256_mul_pd(gv, ld(c, i))));
-            }
-            _mm256_storeu_pd(dst.add(i), v);
-        }
-        for i in whole..n {
-            let r = (*ra.add(i) + *rb.add(i)) * *inv.add(i);
-            let u0 = if STAGE == 1 { 0.0 } else { *start.add(i) };
-            let mut v = rk3_step::<STAGE>(h, *u.add(i), u0, r);
-            if GRAVITY {
-                v += g_dt * (g * *c.add(i));
-            }
-            *dst.add(i) = v;
-        }
-    }
+    /// `h`, gravity's step and `g` in each lane.
+    lanes: [__m256d; 3],
 }
 
-/// [`rk3_step`] on four edges: `u0` read only by the stages that take it.
-#[target_feature(enable = "avx2")]
-#[inline]
-fn step_lanes<const STAGE: u8>(
-    h: __m256d,
-    u: __m256d,
-    u0: impl FnOnce() -> __m256d,
-    r: __m256d,
-) -> __m256d {
-    let (add, mul, splat) = (_mm256_add_pd, _mm256_mul_pd, _mm256_set1_pd);
-    let moved = add(u, mul(h, r));
-    match STAGE {
-        1 => moved,
-        2 => add(mul(splat(0.75), u0()), mul(splat(0.25), moved)),
-        _ => add(mul(splat(1.0 / 3.0), u0()), mul(splat(2.0 / 3.0), moved)),
+impl<const STAGE: u8, const GRAVITY: bool> Moves<STAGE, GRAVITY> {
+    /// The moves of `p`'s edges over `h`.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn new(p: Plan, h: f64) -> Self {
+        let (g_dt, g, _) = p.gravity;
+        let lanes = [h, g_dt, g].map(|v| _mm256_set1_pd(v));
+        Self { p, h, lanes }
+    }
+
+    /// The moved velocities of local edges `k..k + 4`: `u` theirs, `start` their starting
+    /// ones (read only by the stages that take them), `rates` their terms' sums.
+    ///
+    /// # Safety
+    /// As [`rows`]: `k..k + 4` are a row's local edges.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    unsafe fn lanes(
+        self,
+        k: usize,
+        u: __m256d,
+        start: impl FnOnce() -> __m256d,
+        rates: __m256d,
+    ) -> __m256d {
+        let (add, mul, splat) = (_mm256_add_pd, _mm256_mul_pd, _mm256_set1_pd);
+        let [h, g_dt, g] = self.lanes;
+        // SAFETY: the caller's promise.
+        unsafe {
+            let r = mul(rates, _mm256_loadu_pd(self.p.inverse_norm.add(k)));
+            let moved = add(u, mul(h, r));
+            let v = match STAGE {
+                1 => moved,
+                2 => add(mul(splat(0.75), start()), mul(splat(0.25), moved)),
+                _ => add(mul(splat(1.0 / 3.0), start()), mul(splat(2.0 / 3.0), moved)),
+            };
+            if GRAVITY {
+                let c = _mm256_loadu_pd(self.p.gravity.2.add(k));
+                add(v, mul(g_dt, mul(g, c)))
+            } else {
+                v
+            }
+        }
+    }
+
+    /// The `n` local edges from `k` moved: `start` their starting velocities, `terms`
+    /// their two cells' terms. Four edges an instruction, the last `n mod 4` one by one
+    /// (each edge's entry of the destination may be its source: a chunk taken twice would
+    /// move its edges twice).
+    ///
+    /// # Safety
+    /// As [`rows`]: the `n` edges from `k` are one row's, `start` holds `n` and `terms`
+    /// `n` each.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    unsafe fn run(self, k: usize, start: *const f64, [ra, rb]: [*const f64; 2]) {
+        let (p, n) = (self.p, self.p.n);
+        // SAFETY: as [`rows`] says, and the caller's promise.
+        unsafe {
+            let (u, dst) = (p.u.add(k), p.dst.add(k));
+            let ld = |base: *const f64, i: usize| _mm256_loadu_pd(base.add(i));
+            for i in (0..n / 4).map(|q| 4 * q) {
+                let rates = _mm256_add_pd(ld(ra, i), ld(rb, i));
+                let v = self.lanes(k + i, ld(u, i), || ld(start, i), rates);
+                _mm256_storeu_pd(dst.add(i), v);
+            }
+            let (g_dt, g, c) = p.gravity;
+            for i in n / 4 * 4..n {
+                let r = (*ra.add(i) + *rb.add(i)) * *p.inverse_norm.add(k + i);
+                let u0 = if STAGE == 1 { 0.0 } else { *start.add(i) };
+                let mut v = rk3_step::<STAGE>(self.h, *u.add(i), u0, r);
+                if GRAVITY {
+                    v += g_dt * (g * *c.add(k + i));
+                }
+                *dst.add(i) = v;
+            }
+        }
     }
 }
