@@ -128,6 +128,8 @@ struct SeamTerms {
     grid_edge: u32,
     /// [`AdvectionGeometry::inverse_norm`] of the grid's edge.
     inverse_norm: f64,
+    /// The face of the first copy.
+    first_face: u32,
 }
 
 /// An irregular cell's reconstruction weights, its sides in the grid's order.
@@ -216,6 +218,7 @@ impl AdvectionGeometry {
                     signs: e.cells.map(|(_, _, k)| rows.sign(k as usize)),
                     grid_edge: rows.edge[e.cells[0].2 as usize],
                     inverse_norm: inverse_norm(&edges[rows.edge[e.cells[0].2 as usize] as usize]),
+                    first_face: e.cells[0].2 / rows.edges_per_face() as u32,
                 }
             })
             .collect();
@@ -683,14 +686,7 @@ impl Stage<'_> {
             let io = (src, dst, u0, vorticity, border);
             self.face_rows(f, io, buffers, gravity, &step);
         }
-        self.move_seam_edges(src, dst, u0, &w.border_rate, &step);
-        if let Some(gravity) = gravity {
-            for e in &self.geo.seams {
-                let ([first, second], [sa, sb]) = (e.edges.map(|k| k as usize), e.signs);
-                gravity.add_to(first, &mut dst[first]);
-                dst[second] = dst[first] * sa * sb;
-            }
-        }
+        self.move_seam_edges(src, dst, u0, &w.border_rate, &step, gravity);
         if next {
             rows.seam_circulation(dst, &mut w.vorticity, self.scale, |z, ia| z * ia);
         }
@@ -827,7 +823,10 @@ impl Stage<'_> {
     }
 
     /// The edges on the faces' borders: each from its two cells' terms in `border`, both
-    /// copies (`dst ← step(src, u0, rate)` as in [`Self::stage`]).
+    /// copies (`dst ← step(src, u0, rate)` as in [`Self::stage`]); where `gravity` is
+    /// given, it is added to the first copy, and the second made the first's in its
+    /// orientation (as [`FaceRows::add_gravity`] leaves them), in the same pass, where a
+    /// pass of its own read every seam's copies again (and found its face by a division).
     #[inline(always)]
     fn move_seam_edges(
         self,
@@ -836,15 +835,25 @@ impl Stage<'_> {
         u0: Start,
         border: &[f64],
         step: &impl Fn(f64, f64, f64) -> f64,
+        gravity: Option<&AxisGravity>,
     ) {
+        let epf = self.rows.edges_per_face();
         for e in &self.geo.seams {
             let ([ia, ib], [sa, sb]) = (e.slots.map(|i| i as usize), e.signs);
             let r = (sa * border[ia] + sb * border[ib]) * e.inverse_norm;
-            for (k, sign) in [(e.edges[0] as usize, sa), (e.edges[1] as usize, sb)] {
-                let start = u0.at(dst, k, (e.grid_edge as usize, sign));
-                let from = src.map_or(dst[k], |s| s[k]);
-                dst[k] = step(from, start, sign * r);
-            }
+            let [ka, kb] = e.edges.map(|k| k as usize);
+            let (at_a, at_b) = ((e.grid_edge as usize, sa), (e.grid_edge as usize, sb));
+            let (start_a, start_b) = (u0.at(dst, ka, at_a), u0.at(dst, kb, at_b));
+            let (from_a, from_b) = src.map_or((dst[ka], dst[kb]), |s| (s[ka], s[kb]));
+            let (first, second) = (step(from_a, start_a, sa * r), step(from_b, start_b, sb * r));
+            (dst[ka], dst[kb]) = match gravity {
+                None => (first, second),
+                Some(gravity) => {
+                    let first = first
+                        + gravity.term(e.first_face as usize, ka - e.first_face as usize * epf);
+                    (first, first * sa * sb)
+                }
+            };
         }
     }
 }
