@@ -38,12 +38,10 @@ pub(crate) fn with_avx2<R>(f: impl FnOnce() -> R) -> R {
 
 /// Whether the processor has AVX2 and [`with_avx2`] would use it: for kernels that
 /// take their own AVX2 path inside it.
+#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 pub(crate) fn has_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    return std::arch::is_x86_feature_detected!("avx2") && !portable_only();
-    #[cfg(not(target_arch = "x86_64"))]
-    false
+    std::arch::is_x86_feature_detected!("avx2") && !portable_only()
 }
 
 /// `f()` compiled with AVX2 (what `f` inlines is compiled so too).

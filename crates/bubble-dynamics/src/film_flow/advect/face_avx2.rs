@@ -215,14 +215,14 @@ unsafe fn rows<const STAGE: u8, const GRAVITY: bool>(p: Plan, h: f64) {
 }
 
 /// Row `y`'s cells' terms (`z` its bottom and top vertices' vorticity) and the moves of
-/// its X-edges and of the Y-edges below it (where `BELOW`, `y > 0`; `before_top` the row
-/// before's top terms), each group of four cells' terms moving those of its edges whose other cells'
-/// terms are in (the left ones of its cells and their bottoms) as soon as they are taken,
-/// where a row's terms were stored and read back by the moves (`n` a multiple of four):
-/// each X-edge's term of the cell on its left the group's right terms a lane on, the one
-/// before's last carried in. Its tops go to `top` (for the next row), or to the face's
-/// border terms on its last row, as its bottoms on its first and its first left and last
-/// right terms on each.
+/// its X-edges and, where `BELOW` (`y > 0`), of the Y-edges below it (`before_top` the
+/// row before's top terms), `n` a multiple of four. Each group of four cells moves its
+/// cells' left and bottom edges as soon as its terms are taken, where a row's terms were
+/// stored and read back by two loops of moves: an X-edge's other term, the right one of
+/// the cell on its left, is the group's right terms a lane on, the group before's last
+/// carried into lane 0. The row's tops go to `top` (for the next row's Y-edges), or to
+/// the face's border terms on its last row, as its bottoms do on its first and its first
+/// left and last right terms on every row.
 ///
 /// # Safety
 /// As [`rows`]: `y < n` (`BELOW` where `y > 0`), `n` a multiple of four, `top` and
