@@ -36,6 +36,14 @@ pub(crate) fn with_avx2<R>(f: impl FnOnce() -> R) -> R {
     f()
 }
 
+/// Whether the processor has AVX2 and [`with_avx2`] would use it: for kernels that
+/// take their own AVX2 path inside it.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) fn has_avx2() -> bool {
+    std::arch::is_x86_feature_detected!("avx2") && !portable_only()
+}
+
 /// `f()` compiled with AVX2 (what `f` inlines is compiled so too).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
@@ -419,51 +427,95 @@ pub(crate) fn coriolis_row(w: &[f64], z: [&[f64]; 2], u: [&[f64]; 3], out: [&mut
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn coriolis_row_avx2(w: &[f64], z: [&[f64]; 2], u: [&[f64]; 3], out: [&mut [f64]; 4]) {
-    use std::arch::x86_64::{
-        _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_setzero_pd, _mm256_storeu_pd,
-        _mm256_sub_pd,
-    };
     let n = u[0].len();
-    let ([zb, zt], [ub, ux, ut]) = (z.map(<[f64]>::as_ptr), u.map(<[f64]>::as_ptr));
-    let [ob, ol, or, ot] = out.map(<[f64]>::as_mut_ptr);
-    let quad = |wq: *const f64, x: usize| {
-        // SAFETY: `x + 4 ≤ n` (`n ≥ 4`), the slices are as long as `coriolis_row` checked
-        // (`n + 1` where read at `x + 1`) and `wq` starts a group's `QUAD_WEIGHTS` within
-        // `w` (the caller's): every load and store is in bounds.
-        unsafe {
-            let ld = |p: *const f64, at: usize| _mm256_loadu_pd(p.wrapping_add(at));
-            let (c0, c1, c2, c3) = (ld(zb, x), ld(zb, x + 1), ld(zt, x), ld(zt, x + 1));
-            let z = [
-                _mm256_add_pd(c0, c1),
-                _mm256_add_pd(c0, c2),
-                _mm256_add_pd(c1, c3),
-                _mm256_add_pd(c2, c3),
-            ];
-            let v = [ld(ub, x), ld(ux, x), ld(ux, x + 1), ld(ut, x)];
-            let p: [_; 6] = std::array::from_fn(|q| {
-                let [i, o] = PAIRS[q];
-                _mm256_mul_pd(ld(wq, 4 * q), _mm256_add_pd(z[i], z[o]))
-            });
-            let t = |q: usize, side: usize| _mm256_mul_pd(p[q], v[side]);
-            let (add, sub) = (_mm256_add_pd, _mm256_sub_pd);
-            let st = |o: *mut f64, r| _mm256_storeu_pd(o.wrapping_add(x), r);
-            st(ob, add(add(t(0, 1), t(1, 2)), t(2, 3)));
-            st(ol, add(sub(t(3, 2), t(0, 0)), t(4, 3)));
-            st(or, sub(sub(t(5, 3), t(1, 0)), t(3, 1)));
-            st(
-                ot,
-                sub(sub(sub(_mm256_setzero_pd(), t(2, 0)), t(4, 1)), t(5, 2)),
-            );
-        }
-    };
+    let (z, u) = (z.map(<[f64]>::as_ptr), u.map(<[f64]>::as_ptr));
+    let out = out.map(<[f64]>::as_mut_ptr);
     // Each group's weights from the row's base: `w` holds `⌈n/4⌉` groups' (checked by
     // `coriolis_row`).
     let groups = n / 4;
     for g in 0..groups {
-        quad(w.as_ptr().wrapping_add(g * QUAD_WEIGHTS), 4 * g);
+        // SAFETY: `4g + 4 ≤ n`, the slices are as long as `coriolis_row` checked and
+        // group `g`'s weights are within `w`.
+        unsafe { coriolis_quad(w.as_ptr().wrapping_add(g * QUAD_WEIGHTS), z, u, out, 4 * g) };
     }
     if n % 4 != 0 {
-        quad(w.as_ptr().wrapping_add(groups * QUAD_WEIGHTS), n - 4);
+        // SAFETY: as above, for the last four cells (`n ≥ 4`) and the last group.
+        let wq = w.as_ptr().wrapping_add(groups * QUAD_WEIGHTS);
+        unsafe { coriolis_quad(wq, z, u, out, n - 4) };
+    }
+}
+
+/// [`coriolis_row`]'s terms of cells `x..x + 4` in AVX2 registers ([`coriolis_terms`])
+/// into `out` (bottom, left, right, top), as [`coriolis_row`] lays them out.
+///
+/// # Safety
+/// As [`coriolis_terms`], and each of `out` holds `x + 4`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+pub(crate) unsafe fn coriolis_quad(
+    wq: *const f64,
+    z: [*const f64; 2],
+    u: [*const f64; 3],
+    out: [*mut f64; 4],
+    x: usize,
+) {
+    // SAFETY: the caller's promise.
+    unsafe {
+        let (terms, _) = coriolis_terms(wq, z, u, x);
+        for (o, t) in out.into_iter().zip(terms) {
+            std::arch::x86_64::_mm256_storeu_pd(o.add(x), t);
+        }
+    }
+}
+
+/// [`coriolis_row`]'s terms of cells `x..x + 4` in AVX2 registers (bottom, left, right,
+/// top), from a group's weights `wq` ([`QUAD_WEIGHTS`]), the row's vertices `z` (bottom,
+/// top) and its velocities `u` (bottom, left and right, top); and the cells' velocities
+/// it read (bottom, left, right, top), for a caller that moves those edges.
+///
+/// # Safety
+/// The processor has AVX2; `wq` holds [`QUAD_WEIGHTS`] values, `z` and `u[1]` hold
+/// `x + 5` and the others `x + 4`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+pub(crate) unsafe fn coriolis_terms(
+    wq: *const f64,
+    [zb, zt]: [*const f64; 2],
+    [ub, ux, ut]: [*const f64; 3],
+    x: usize,
+) -> (
+    [std::arch::x86_64::__m256d; 4],
+    [std::arch::x86_64::__m256d; 4],
+) {
+    use std::arch::x86_64::{
+        _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_setzero_pd, _mm256_sub_pd,
+    };
+    // SAFETY: every load is in bounds (the caller's promise).
+    unsafe {
+        let ld = |p: *const f64, at: usize| _mm256_loadu_pd(p.add(at));
+        let (c0, c1, c2, c3) = (ld(zb, x), ld(zb, x + 1), ld(zt, x), ld(zt, x + 1));
+        let z = [
+            _mm256_add_pd(c0, c1),
+            _mm256_add_pd(c0, c2),
+            _mm256_add_pd(c1, c3),
+            _mm256_add_pd(c2, c3),
+        ];
+        let v = [ld(ub, x), ld(ux, x), ld(ux, x + 1), ld(ut, x)];
+        let p: [_; 6] = std::array::from_fn(|q| {
+            let [i, o] = PAIRS[q];
+            _mm256_mul_pd(ld(wq, 4 * q), _mm256_add_pd(z[i], z[o]))
+        });
+        let t = |q: usize, side: usize| _mm256_mul_pd(p[q], v[side]);
+        let (add, sub) = (_mm256_add_pd, _mm256_sub_pd);
+        let terms = [
+            add(add(t(0, 1), t(1, 2)), t(2, 3)),
+            add(sub(t(3, 2), t(0, 0)), t(4, 3)),
+            sub(sub(t(5, 3), t(1, 0)), t(3, 1)),
+            sub(sub(sub(_mm256_setzero_pd(), t(2, 0)), t(4, 1)), t(5, 2)),
+        ];
+        (terms, v)
     }
 }
 

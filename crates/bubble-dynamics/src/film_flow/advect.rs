@@ -34,6 +34,9 @@
 //! film energy at about (ω dt)² a step: 3.3 % of a 5 rad/s rotation's rate in 0.2 s of
 //! 1/240 s steps (`tests/film_flow_advection.rs`).
 
+#[cfg(target_arch = "x86_64")]
+mod face_avx2;
+
 use glam::DVec3;
 
 use crate::avx2::{PAIRS, QUAD_WEIGHTS, coriolis_row, quad_starts, with_avx2};
@@ -41,6 +44,8 @@ use crate::avx2::{PAIRS, QUAD_WEIGHTS, coriolis_row, quad_starts, with_avx2};
 use super::compare::larger;
 use super::face_rows::{AxisGravity, FaceRows, SIDES, Side, face_order};
 use super::grid::CubeSphere;
+#[cfg(target_arch = "x86_64")]
+use face_avx2::{FaceInputs, FaceStart};
 
 /// Largest fraction of the narrowest dual edge the fastest cell may cross in a sub-step.
 /// SSP-RK3 damps (never amplifies) a rotation of `ω·sub_dt < √3`; the vorticity at the
@@ -123,6 +128,8 @@ struct SeamTerms {
     grid_edge: u32,
     /// [`AdvectionGeometry::inverse_norm`] of the grid's edge.
     inverse_norm: f64,
+    /// The face of the first copy.
+    first_face: u32,
 }
 
 /// An irregular cell's reconstruction weights, its sides in the grid's order.
@@ -211,6 +218,7 @@ impl AdvectionGeometry {
                     signs: e.cells.map(|(_, _, k)| rows.sign(k as usize)),
                     grid_edge: rows.edge[e.cells[0].2 as usize],
                     inverse_norm: inverse_norm(&edges[rows.edge[e.cells[0].2 as usize] as usize]),
+                    first_face: e.cells[0].2 / rows.edges_per_face() as u32,
                 }
             })
             .collect();
@@ -486,25 +494,59 @@ fn ssp_rk3(
 ) {
     let on = Stage { rows, geo, scale };
     // The stages' faces in alternate directions, the first in reverse ([`face_order`]).
-    let step1 = |u, _, r| u + h * r;
-    let step2 = |u, u0, r| 0.75 * u0 + 0.25 * (u + h * r);
-    // Stage 3: each edge's starting velocity read before it is replaced. ⅓ as a
-    // multiplication: a division took several times as long.
-    let step3 = |u, u0, r| (1.0 / 3.0) * u0 + (2.0 / 3.0) * (u + h * r);
     match stage {
         Ok(grid) => {
-            on.stage(None, u, Start::Dst, w, (true, true, None), step1);
-            on.stage(None, u, Start::Grid(grid), w, (true, false, None), step2);
-            on.stage(None, u, Start::Grid(grid), w, (next, true, gravity), step3);
+            on.stage::<1>(None, u, Start::Dst, w, (true, true, None), h);
+            on.stage::<2>(None, u, Start::Grid(grid), w, (true, false, None), h);
+            on.stage::<3>(None, u, Start::Grid(grid), w, (next, true, gravity), h);
         }
         Err(stage) => {
             // Stage 1 (what `stage` held is passed over) ignores the starting velocities:
             // given `u`'s, the rows may move the border copies too (see `Stage::stage`).
-            on.stage(Some(u), stage, Start::Rows(u), w, (true, true, None), step1);
+            on.stage::<1>(Some(u), stage, Start::Rows(u), w, (true, true, None), h);
             // Stage 2, `u₁` into `u₂` where it is.
-            on.stage(None, stage, Start::Rows(u), w, (true, false, None), step2);
+            on.stage::<2>(None, stage, Start::Rows(u), w, (true, false, None), h);
             // Stage 3, onto `u`.
-            on.stage(Some(stage), u, Start::Dst, w, (next, true, gravity), step3);
+            on.stage::<3>(Some(stage), u, Start::Dst, w, (next, true, gravity), h);
+        }
+    }
+}
+
+/// Stage `STAGE` (1, 2 or 3) of [`ssp_rk3`] over `h` on one edge: its velocity `u` moved
+/// at its rate `r`, then (stages 2 and 3) weighed with its starting velocity `u0`. Stage
+/// 3 takes ⅓ as a multiplication: a division took several times as long.
+#[inline(always)]
+fn rk3_step<const STAGE: u8>(h: f64, u: f64, u0: f64, r: f64) -> f64 {
+    match STAGE {
+        1 => u + h * r,
+        2 => 0.75 * u0 + 0.25 * (u + h * r),
+        _ => (1.0 / 3.0) * u0 + (2.0 / 3.0) * (u + h * r),
+    }
+}
+
+/// [`face_avx2::face_stage`] of stage `STAGE` over `h`, with gravity where `at` gives it,
+/// into `dst` and `border`, the rows' buffers (vertex rows, cell terms) those given.
+///
+/// # Safety
+/// The processor has AVX2.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn face_stage<const STAGE: u8>(
+    at: &FaceInputs,
+    h: f64,
+    dst: &mut [f64],
+    border: &mut [f64],
+    (z, rate): (&mut [Vec<f64>; 2], &mut [[Vec<f64>; 4]; 2]),
+) {
+    let z = z.each_mut().map(|r| &mut r[..]);
+    let [[b0, l0, r0, t0], [b1, l1, r1, t1]] = rate;
+    let rate = [b0, l0, r0, t0, b1, l1, r1, t1].map(|r| &mut r[..]);
+    // SAFETY: the processor has AVX2 (the caller's promise).
+    unsafe {
+        if at.gravity.is_some() {
+            face_avx2::face_stage::<STAGE, true>(at, h, dst, border, z, rate);
+        } else {
+            face_avx2::face_stage::<STAGE, false>(at, h, dst, border, z, rate);
         }
     }
 }
@@ -582,7 +624,8 @@ struct Stage<'a> {
 
 impl Stage<'_> {
     /// One stage, in one pass over each face's rows: `dst ← step(src, u0, rate)` on every
-    /// local edge (`src` the edge's entry of `dst` before it is written where `None`: the
+    /// local edge, `step` stage `STAGE` of [`rk3_step`] over `h` (`src` the edge's entry
+    /// of `dst` before it is written where `None`: the
     /// stage moves the edges where they are), the rate the rotation term `−ζ (k×u)·n` of
     /// `src` (with its vorticity
     /// on the faces' borders in `w.vorticity`) summed over the edge's two cells (the
@@ -604,77 +647,141 @@ impl Stage<'_> {
     /// row `y` moves X-edge row `y` and Y-edge row `y` (a face reads no other face's
     /// edges, and its border vertices' vorticity is kept from the stage before), so a
     /// stage may move the edges where they are.
+    ///
+    /// Each face's rows in one call in AVX2 registers where the processor has it
+    /// ([`face_avx2`]), row by row in portable code else ([`Self::face_rows`]): the same
+    /// bits.
     #[inline(always)]
-    fn stage(
+    fn stage<const STAGE: u8>(
         self,
         src: Option<&[f64]>,
         dst: &mut [f64],
         u0: Start,
         w: &mut StageWork,
         (next, reverse, gravity): (bool, bool, Option<&AxisGravity>),
-        step: impl Fn(f64, f64, f64) -> f64,
+        h: f64,
     ) {
         let (rows, n) = (self.rows, self.rows.n);
         let (epf, vpf) = (rows.edges_per_face(), rows.vertices_per_face());
-        let (vorticity, border) = (&w.vorticity, &mut w.border_rate);
-        let [even, odd] = &mut w.row_rate;
-        let [z_even, z_odd] = &mut w.vertex_rows;
+        let step = |u, u0, r| rk3_step::<STAGE>(h, u, u0, r);
+        #[cfg(target_arch = "x86_64")]
+        let fast = n >= 4 && crate::avx2::has_avx2();
         for f in face_order(reverse) {
             // The face's own parts, sliced once (a row's offsets are then the face's rows',
             // from 0), where each row sliced the whole arrays again: 2.7 M of the
             // advection's 99 M instructions over film_profile 64 0 9.81's 40 steps.
             let face = f * epf..(f + 1) * epf;
             let (dst, src) = (&mut dst[face.clone()], src.map(|s| &s[face.clone()]));
-            let vorticity = &vorticity[f * vpf..][..vpf];
-            let border = &mut border[f * 4 * n..][..4 * n];
+            let vorticity = &w.vorticity[f * vpf..][..vpf];
+            let border = &mut w.border_rate[f * 4 * n..][..4 * n];
             let u0 = u0.face(f * epf..(f + 1) * epf);
-            self.vertex_row(src.unwrap_or(dst), vorticity, 0, z_even);
-            for y in 0..n {
-                let (rate, before, z, z_next) = if y % 2 == 0 {
-                    (&mut *even, &*odd, &*z_even, &mut *z_odd)
-                } else {
-                    (&mut *odd, &*even, &*z_odd, &mut *z_even)
-                };
-                let from = src.unwrap_or(dst);
-                self.vertex_row(from, vorticity, y + 1, z_next);
-                self.cell_row(from, [z, z_next], y, rate);
-                keep_border_rates(border, rate, n, y);
-                let [_, left, right, _] = &*rate;
-                // The X-edges inside the face: cell (i − 1, y)'s right side and (i, y)'s left.
-                // The row runs on through the right border copy, n edges, which vectorise
-                // without the scalar tail of n − 1: that copy's entry of `dst` (which the
-                // seam pass may read, as the source or the start) is put back after.
-                let k = y * (n + 1) + 1..(y + 1) * (n + 1);
-                let border_copy = dst[k.end - 1];
-                let u0x = u0.run(rows, (f, y, true), k.clone());
-                let srcx = src.map(|s| &s[k.clone()]);
-                let at = (f, k.start);
-                let rates = (&right[..], &left[1..], &self.geo.inverse_norm[k.start..]);
-                move_edges(&mut dst[k.clone()], srcx, u0x, rates, &step, gravity, at);
-                dst[k.end - 1] = border_copy;
-                if y == 0 {
-                    continue;
-                }
-                // The Y-edges below: cell (x, y − 1)'s top and (x, y)'s bottom.
-                let k = n * (n + 1) + y * n..n * (n + 1) + (y + 1) * n;
-                let (top, bottom) = (&before[Side::Top as usize], &rate[Side::Bottom as usize]);
-                let u0y = u0.run(rows, (f, y, false), k.clone());
-                let srcy = src.map(|s| &s[k.clone()]);
-                let at = (f, k.start);
-                let rates = (&top[..], &bottom[..], &self.geo.inverse_norm[k.start..]);
-                move_edges(&mut dst[k], srcy, u0y, rates, &step, gravity, at);
+            let buffers = (&mut w.vertex_rows, &mut w.row_rate);
+            #[cfg(target_arch = "x86_64")]
+            if fast {
+                let at = self.face_inputs(f, src, u0, vorticity, gravity);
+                // SAFETY: the processor has AVX2 (`has_avx2`).
+                unsafe { face_stage::<STAGE>(&at, h, dst, border, buffers) };
+                continue;
             }
+            let io = (src, dst, u0, vorticity, border);
+            self.face_rows(f, io, buffers, gravity, &step);
         }
-        self.move_seam_edges(src, dst, u0, &w.border_rate, &step);
-        if let Some(gravity) = gravity {
-            for e in &self.geo.seams {
-                let ([first, second], [sa, sb]) = (e.edges.map(|k| k as usize), e.signs);
-                gravity.add_to(first, &mut dst[first]);
-                dst[second] = dst[first] * sa * sb;
-            }
-        }
+        self.move_seam_edges(src, dst, u0, &w.border_rate, &step, gravity);
         if next {
             rows.seam_circulation(dst, &mut w.vorticity, self.scale, |z, ia| z * ia);
+        }
+    }
+
+    /// Face `f`'s rows of a stage ([`Self::stage`]) in portable code: `src`, `dst` and
+    /// `u0` the face's alone, `vorticity` its kept border vertices' and `border` its
+    /// border terms.
+    #[inline(always)]
+    #[allow(clippy::type_complexity)] // the face's parts, as the stage slices them
+    fn face_rows(
+        self,
+        f: usize,
+        (src, dst, u0, vorticity, border): (Option<&[f64]>, &mut [f64], Start, &[f64], &mut [f64]),
+        (z_rows, rate_rows): (&mut [Vec<f64>; 2], &mut [[Vec<f64>; 4]; 2]),
+        gravity: Option<&AxisGravity>,
+        step: &impl Fn(f64, f64, f64) -> f64,
+    ) {
+        let (rows, n) = (self.rows, self.rows.n);
+        let [even, odd] = rate_rows;
+        let [z_even, z_odd] = z_rows;
+        self.vertex_row(src.unwrap_or(dst), vorticity, 0, z_even);
+        for y in 0..n {
+            let (rate, before, z, z_next) = if y % 2 == 0 {
+                (&mut *even, &*odd, &*z_even, &mut *z_odd)
+            } else {
+                (&mut *odd, &*even, &*z_odd, &mut *z_even)
+            };
+            let from = src.unwrap_or(dst);
+            self.vertex_row(from, vorticity, y + 1, z_next);
+            self.cell_row(from, [z, z_next], y, rate);
+            keep_border_rates(border, rate, n, y);
+            let [_, left, right, _] = &*rate;
+            // The X-edges inside the face: cell (i − 1, y)'s right side and (i, y)'s left.
+            // The row runs on through the right border copy, n edges, which vectorise
+            // without the scalar tail of n − 1: that copy's entry of `dst` (which the
+            // seam pass may read, as the source or the start) is put back after.
+            let k = y * (n + 1) + 1..(y + 1) * (n + 1);
+            let border_copy = dst[k.end - 1];
+            let u0x = u0.run(rows, (f, y, true), k.clone());
+            let srcx = src.map(|s| &s[k.clone()]);
+            let at = (f, k.start);
+            let rates = (&right[..], &left[1..], &self.geo.inverse_norm[k.start..]);
+            move_edges(&mut dst[k.clone()], srcx, u0x, rates, step, gravity, at);
+            dst[k.end - 1] = border_copy;
+            if y == 0 {
+                continue;
+            }
+            // The Y-edges below: cell (x, y − 1)'s top and (x, y)'s bottom.
+            let k = n * (n + 1) + y * n..n * (n + 1) + (y + 1) * n;
+            let (top, bottom) = (&before[Side::Top as usize], &rate[Side::Bottom as usize]);
+            let u0y = u0.run(rows, (f, y, false), k.clone());
+            let srcy = src.map(|s| &s[k.clone()]);
+            let at = (f, k.start);
+            let rates = (&top[..], &bottom[..], &self.geo.inverse_norm[k.start..]);
+            move_edges(&mut dst[k], srcy, u0y, rates, step, gravity, at);
+        }
+    }
+
+    /// What [`face_stage`] reads of face `f` (`src` and `u0` the face's alone, `kept` its
+    /// border vertices' vorticity) and of face 0's constants.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn face_inputs<'a>(
+        self,
+        f: usize,
+        src: Option<&'a [f64]>,
+        u0: Start<'a>,
+        kept: &'a [f64],
+        gravity: Option<&AxisGravity<'a>>,
+    ) -> FaceInputs<'a>
+    where
+        Self: 'a,
+    {
+        let (rows, n) = (self.rows, self.rows.n);
+        let epf = rows.edges_per_face();
+        let start = match u0 {
+            Start::Dst => FaceStart::Dst,
+            Start::Rows(u0) => FaceStart::Rows(u0),
+            // (`n ≥ 2`: a grid of one cell a face reads no runs.)
+            Start::Grid(grid) => FaceStart::Grid {
+                x: &grid[rows.grid_x_run(f, 0)..],
+                y: &grid[rows.grid_y_run(f, 1)..],
+            },
+        };
+        FaceInputs {
+            n,
+            src,
+            start,
+            kept,
+            dual_length: &rows.dual_length,
+            scale: self.scale,
+            coriolis: &self.geo.coriolis,
+            inverse_norm: &self.geo.inverse_norm,
+            gravity: gravity.map(|g| g.row(f, 0, epf)),
         }
     }
 
@@ -716,7 +823,10 @@ impl Stage<'_> {
     }
 
     /// The edges on the faces' borders: each from its two cells' terms in `border`, both
-    /// copies (`dst ← step(src, u0, rate)` as in [`Self::stage`]).
+    /// copies (`dst ← step(src, u0, rate)` as in [`Self::stage`]); where `gravity` is
+    /// given, it is added to the first copy, and the second made the first's in its
+    /// orientation (as [`FaceRows::add_gravity`] leaves them), in the same pass, where a
+    /// pass of its own read every seam's copies again (and found its face by a division).
     #[inline(always)]
     fn move_seam_edges(
         self,
@@ -725,15 +835,25 @@ impl Stage<'_> {
         u0: Start,
         border: &[f64],
         step: &impl Fn(f64, f64, f64) -> f64,
+        gravity: Option<&AxisGravity>,
     ) {
+        let epf = self.rows.edges_per_face();
         for e in &self.geo.seams {
             let ([ia, ib], [sa, sb]) = (e.slots.map(|i| i as usize), e.signs);
             let r = (sa * border[ia] + sb * border[ib]) * e.inverse_norm;
-            for (k, sign) in [(e.edges[0] as usize, sa), (e.edges[1] as usize, sb)] {
-                let start = u0.at(dst, k, (e.grid_edge as usize, sign));
-                let from = src.map_or(dst[k], |s| s[k]);
-                dst[k] = step(from, start, sign * r);
-            }
+            let [ka, kb] = e.edges.map(|k| k as usize);
+            let (at_a, at_b) = ((e.grid_edge as usize, sa), (e.grid_edge as usize, sb));
+            let (start_a, start_b) = (u0.at(dst, ka, at_a), u0.at(dst, kb, at_b));
+            let (from_a, from_b) = src.map_or((dst[ka], dst[kb]), |s| (s[ka], s[kb]));
+            let (first, second) = (step(from_a, start_a, sa * r), step(from_b, start_b, sb * r));
+            (dst[ka], dst[kb]) = match gravity {
+                None => (first, second),
+                Some(gravity) => {
+                    let first = first
+                        + gravity.term(e.first_face as usize, ka - e.first_face as usize * epf);
+                    (first, first * sa * sb)
+                }
+            };
         }
     }
 }
@@ -1055,11 +1175,15 @@ mod tests {
         assert!(change.abs() < 1e-4, "energy changed by {change:+.3e}");
     }
 
-    /// The advection with AVX2 gives the portable code's bits: at n = 5 (a row of cells
-    /// in two overlapping groups of four) and 16, a rotation with a rough field on it.
+    /// The advection with AVX2 (the face kernel, `face_avx2`) gives the portable code's
+    /// bits: at n = 4 (one group of four cells a row), 5 (two overlapping groups, rows of
+    /// edges one past whole chunks of four), 7 and 16, a rotation with a rough field on
+    /// it, through the stage buffer and from the grid's numbering (its starting
+    /// velocities read there), with gravity added by the last stage and without.
     #[test]
     fn the_avx2_advection_gives_the_portable_bits() {
-        for n in [5, 16] {
+        use super::super::flow::FilmGradient;
+        for n in [4, 5, 7, 16] {
             let grid = CubeSphere::new(n);
             let rows = FaceRows::new(&grid);
             let geo = AdvectionGeometry::new(&grid, &rows);
@@ -1070,33 +1194,33 @@ mod tests {
                         + ((e * 7919) % 1000) as f64 * 1e-5
                 })
                 .collect();
-            let run = |portable: bool| {
-                crate::avx2::set_portable_only(portable);
-                let mut u = Vec::new();
-                rows.to_rows(&field, &mut u);
-                advect_momentum(
-                    &rows,
-                    &geo,
-                    0.01,
-                    1.0 / 60.0,
-                    &mut u,
-                    None,
-                    None,
-                    &mut AdvectionScratch::default(),
+            let g = DVec3::NEG_Y * 9.81;
+            let gravity = rows.gravity(&grid, FilmGradient::TwoPoint, g, 1.0 / 60.0);
+            let along = gravity.along_axes().expect("gravity along an axis");
+            for (from_grid, with_gravity) in [(false, false), (true, false), (true, true)] {
+                let run = |portable: bool| {
+                    crate::avx2::set_portable_only(portable);
+                    let mut u = Vec::new();
+                    rows.to_rows(&field, &mut u);
+                    let from = from_grid.then_some(&field[..]);
+                    let g = with_gravity.then_some(&along);
+                    let s = &mut AdvectionScratch::default();
+                    advect_momentum(&rows, &geo, 0.01, 1.0 / 60.0, &mut u, from, g, s);
+                    crate::avx2::set_portable_only(false);
+                    u
+                };
+                let (fast, plain) = (run(false), run(true));
+                let what = format!("n {n}, from the grid {from_grid}, gravity {with_gravity}");
+                assert!(
+                    fast != run_unchanged(&rows, &field),
+                    "{what}: the field moved"
                 );
-                crate::avx2::set_portable_only(false);
-                u
-            };
-            let (fast, plain) = (run(false), run(true));
-            assert!(
-                fast != run_unchanged(&rows, &field),
-                "n {n}: the field moved"
-            );
-            let differ = fast
-                .iter()
-                .zip(&plain)
-                .filter(|(a, b)| a.to_bits() != b.to_bits());
-            assert_eq!(differ.count(), 0, "n {n}: edges differ");
+                let differ = fast
+                    .iter()
+                    .zip(&plain)
+                    .filter(|(a, b)| a.to_bits() != b.to_bits());
+                assert_eq!(differ.count(), 0, "{what}: edges differ");
+            }
         }
     }
 
@@ -1169,7 +1293,9 @@ mod tests {
     /// the bits of one that reads them apart, and so does one over the faces in reverse
     /// order, or one that reads its starting velocities in the grid's numbering, the kept
     /// border vorticity too: no row reads an edge that a row before it has moved, and a
-    /// row's run through its right border copy leaves it as it was. At n = 5 and 16.
+    /// row's run through its right border copy leaves it as it was. Each case with AVX2
+    /// (the face kernel, `face_avx2`) and without, against the portable stage apart. At
+    /// n = 5 and 16.
     #[test]
     fn a_stage_in_place_or_in_reverse_is_the_stage_apart() {
         for n in [5, 16] {
@@ -1182,8 +1308,7 @@ mod tests {
             );
             let mut u0_grid = vec![0.0; grid.edges().len()];
             rows.to_grid(&u0, &mut u0_grid);
-            let step = |u: f64, u0: f64, r: f64| 0.75 * u0 + 0.25 * (u + 0.01 * r);
-            let run = |in_place: bool, reverse: bool, from_grid: bool| {
+            let run = |in_place: bool, reverse: bool, from_grid: bool, portable: bool| {
                 let (mut w, scale) = stage_work(&rows, &src);
                 let on = Stage {
                     rows: &rows,
@@ -1201,17 +1326,22 @@ mod tests {
                 } else {
                     Start::Rows(&u0)
                 };
-                on.stage(from, &mut dst, start, &mut w, (true, reverse, None), step);
+                crate::avx2::set_portable_only(portable);
+                on.stage::<2>(from, &mut dst, start, &mut w, (true, reverse, None), 0.01);
+                crate::avx2::set_portable_only(false);
                 (dst, w.vorticity)
             };
-            let apart = run(false, false, false);
+            let apart = run(false, false, false, true);
             assert_ne!(apart.0, src, "n {n}: nothing moved");
-            let cases = [(true, false), (false, true), (true, true)];
+            let cases = [(false, false), (true, false), (false, true), (true, true)];
             let cases = cases.map(|(a, b)| (a, b, false)).into_iter();
-            for (in_place, reverse, from_grid) in cases.chain([(true, true, true)]) {
-                let (dst, vorticity) = run(in_place, reverse, from_grid);
+            let cases = cases.chain([(true, true, true)]);
+            let cases = cases.flat_map(|c| [(c, true), (c, false)]).skip(1);
+            for ((in_place, reverse, from_grid), portable) in cases {
+                let (dst, vorticity) = run(in_place, reverse, from_grid, portable);
                 let what = format!(
-                    "n {n}, in place {in_place}, reverse {reverse}, from the grid {from_grid}"
+                    "n {n}, in place {in_place}, reverse {reverse}, from the grid {from_grid}, \
+                     portable {portable}"
                 );
                 for (name, got, want) in
                     [("edges", dst, &apart.0), ("vorticity", vorticity, &apart.1)]

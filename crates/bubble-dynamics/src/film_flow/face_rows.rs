@@ -735,12 +735,12 @@ impl<'a> AxisGravity<'a> {
         (self.dt_s, g, &c[from..from + len])
     }
 
-    /// `u += dt·(g·c)` for local edge `k` (of any face).
+    /// `dt·(g·c)` of face `f`'s local edge `k` (counted from the face's first): what
+    /// the edge's `u` gains.
     #[inline(always)]
-    pub(crate) fn add_to(&self, k: usize, u: &mut f64) {
-        let epf = self.terms[0].1.len();
-        let (g, c) = self.terms[k / epf];
-        *u += self.dt_s * (g * c[k % epf]);
+    pub(crate) fn term(&self, f: usize, k: usize) -> f64 {
+        let (g, c) = self.terms[f];
+        self.dt_s * (g * c[k])
     }
 }
 
