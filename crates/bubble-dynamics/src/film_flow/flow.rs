@@ -384,8 +384,14 @@ impl FilmFlow {
         // edge of `u` anew.
         s.u_start.resize(self.u_m_per_s.len(), 0.0);
         std::mem::swap(&mut s.u_start, &mut self.u_m_per_s);
+        // The surfactant's transport and the temperature's read the starting velocities
+        // and their own field alone: here, where the last step's thickness transport
+        // has just read those velocities ([`Self::transport_surfactant`]).
+        let fastest = self.grid.fastest_crossing(&s.u_start);
+        self.transport_surfactant(&mut s, dt_s, fastest);
         let up = up_from(forcing.g_eff_m_per_s2);
-        self.exchange_heat(&s.u_start, (&mut s.cell, &mut s.spread), dt_s, up);
+        let start = (&s.u_start[..], fastest);
+        self.exchange_heat(start, (&mut s.cell, &mut s.spread), dt_s, up);
         self.momentum_explicit(&mut s, dt_s, forcing);
         self.air_shear(&mut s, dt_s, forcing.air_m_per_s);
         if let Some(m) = &self.meniscus {

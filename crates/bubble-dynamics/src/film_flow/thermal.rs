@@ -179,11 +179,13 @@ pub(super) fn up_from(g_eff_m_per_s2: DVec3) -> DVec3 {
 impl FilmFlow {
     /// Moves the temperature with the surfaces' starting velocity (upwind, in sub-steps
     /// of at most a quarter of a cell an edge), then relaxes it towards the air's,
-    /// implicitly per cell.
+    /// implicitly per cell. `fastest` is the velocity's
+    /// [`CubeSphere::fastest_crossing`](super::grid::CubeSphere::fastest_crossing), which
+    /// the surfactant's transport takes too.
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     pub(super) fn exchange_heat(
         &mut self,
-        u_start: &[f64],
+        (u_start, fastest): (&[f64], f64),
         scratch: (&mut Vec<f64>, &mut Vec<f64>),
         dt_s: f64,
         up: DVec3,
@@ -191,7 +193,7 @@ impl FilmFlow {
         if self.temperature_k.is_empty() {
             return;
         }
-        self.advect_temperature(u_start, scratch, dt_s);
+        self.advect_temperature((u_start, fastest), scratch, dt_s);
         let (th, rho) = (self.params.thermal, self.params.density_kg_per_m3);
         let centres = &self.grid.face_geometry().centre;
         let (theta, h) = (&mut self.temperature_k, &self.h_m);
@@ -201,16 +203,17 @@ impl FilmFlow {
         );
     }
 
-    /// `∂θ/∂t + u·∇θ = 0`, upwind: each cell takes `(θ_up − θ)` times what flows in.
+    /// `∂θ/∂t + u·∇θ = 0`, upwind: each cell takes `(θ_up − θ)` times what flows in, in
+    /// sub-steps from `fastest`, `u`'s fastest crossing.
     /// The faces' cells read face 0's lengths and inverse areas (the same on every face,
     /// [`super::face_geometry`]), the rim the grid's lengths and its own inverse areas.
     fn advect_temperature(
         &mut self,
-        u: &[f64],
+        (u, fastest): (&[f64], f64),
         (before, x_u): (&mut Vec<f64>, &mut Vec<f64>),
         dt_s: f64,
     ) {
-        let courant = self.grid.fastest_crossing(u) * dt_s / self.params.radius_m;
+        let courant = fastest * dt_s / self.params.radius_m;
         if courant == 0.0 {
             return;
         }
