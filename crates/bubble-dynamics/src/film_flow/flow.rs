@@ -187,7 +187,8 @@ pub(super) struct Scratch {
     pub(super) cell: Vec<f64>,
     pub(super) cell2: Vec<f64>,
     pub(super) vertex: Vec<f64>,
-    pub(super) weight: Vec<f64>,
+    /// The Marangoni system's edge weights, rounded to `f32` where they are made.
+    pub(super) weight: Vec<f32>,
     pub(super) u_start: Vec<f64>,
     pub(super) stiffness: Vec<f64>,
     /// The thickness transport's limited rises ([`Rises`]).

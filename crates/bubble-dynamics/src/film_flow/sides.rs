@@ -145,12 +145,12 @@ pub(crate) trait EdgeBlock: Copy {
     fn count(&self) -> usize;
     /// A per-edge array's values along the block, `count()` long.
     #[inline(always)]
-    fn values<'a>(&self, per_edge: &'a [f64]) -> &'a [f64] {
+    fn values<'a, T>(&self, per_edge: &'a [T]) -> &'a [T] {
         &per_edge[self.first()..self.first() + self.count()]
     }
     /// A per-edge array's values along the block, to write.
     #[inline(always)]
-    fn values_mut<'a>(&self, per_edge: &'a mut [f64]) -> &'a mut [f64] {
+    fn values_mut<'a, T>(&self, per_edge: &'a mut [T]) -> &'a mut [T] {
         &mut per_edge[self.first()..self.first() + self.count()]
     }
     /// A grid constant's values along the block, `count()` long: a run's from face 0's

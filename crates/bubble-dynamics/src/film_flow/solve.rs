@@ -4,10 +4,12 @@
 //!
 //! The conjugate gradients run in `f64`, the V-cycle in `f32` (see [`Work`]: a
 //! preconditioner need only be a fixed map near `M⁻¹`, and the V-cycle's `f32` rounding
-//! is far below its own error as an inverse). Where the weights are given as their
-//! `f32` roundings (`Weights::F32`), the conjugate gradients' last iterations, once
-//! the residual is within `F32_FROM_TOLERANCES` tolerances of the goal, run in `f32`
-//! but for `x` (`Hierarchy::iterate_in_f32`).
+//! is far below its own error as an inverse). Where the weights are given as `f32`
+//! values (`Weights::F32`, as the Marangoni step rounds them where it makes them), the
+//! V-cycle's finest copy, scaled by a power of two, holds them exactly: the conjugate
+//! gradients' `f64` passes read it widened (no `f64` copy of the weights is made), and
+//! their last iterations, once the residual is within `F32_FROM_TOLERANCES` tolerances
+//! of the goal, run in `f32` but for `x` (`Hierarchy::iterate_in_f32`).
 //!
 //! Every level is held in a padded, colour-split layout (`layout`): each face ringed by
 //! halo copies of its neighbours' cells, and the cells split by parity into two arrays,
@@ -21,9 +23,9 @@
 //!
 //! The solve is bound by memory traffic (at n = 64 a field of the finest level is
 //! 220 kB in `f64`, the L2 1 MB), so each pass is counted: an iteration of the conjugate
-//! gradients streams the weights once (the operator's product `q`; the V-cycle's `f32`
-//! copy where the caller lets it take the weights as their `f32` roundings, as the
-//! Marangoni step does: [`Weights::F32`]), `x`, `r` and `p` once each, and writes `q` and
+//! gradients streams the weights once (the operator's product `q`; in `f32`, the
+//! V-cycle's copy, where they are given as `f32` values, as the Marangoni step gives
+//! them: [`Weights::F32`]), `x`, `r` and `p` once each, and writes `q` and
 //! the V-cycle's right-hand side (an `f32` iteration streams `x` in `f64` and the rest in
 //! `f32`, its residual the V-cycle's right-hand side itself). The preconditioned
 //! residual `z` is never held in `f64` (`r·z` is summed from the V-cycle's own numbers,
@@ -53,10 +55,11 @@ use super::grid::CubeSphere;
 use super::sides::{BOTTOM, CellSides, LEFT, RIGHT, TOP};
 use crate::avx2::with_avx2;
 use kernels::{
-    LevelField, NOT_A_CELL, Stencil, add_widened, correct, direction_from_f64, dot, dot_f32,
-    gather_row, operator, refresh, refresh_all, refresh_from_other, relax, relax_from_zero,
-    residuals_in_place, restrict, restrict_field, rounded_level, scatter_row, scatter_run,
-    subtract_scaled, update_and_norm2, update_direction, update_direction_f32, widened_dot,
+    LevelField, NOT_A_CELL, Stencil, Weighted, add_widened, correct, direction_from_f64, dot,
+    dot_f32, gather_row, operator, refresh, refresh_all, refresh_from_other, relax,
+    relax_from_zero, residuals_in_place, restrict, restrict_field, rounded_level, scatter_row,
+    scatter_run, subtract_scaled, update_and_norm2, update_direction, update_direction_f32,
+    widened_dot,
 };
 use layout::Layout;
 use sparse::{Factor, Pattern};
@@ -79,7 +82,8 @@ trait Real:
     fn narrow(x: f64) -> Self;
     /// `even[k] = values[2k]` and `odd[k] = values[2k + 1]` over a leading run of the
     /// values, where this precision has a vectorised copy for it
-    /// ([`deinterleave_f64`](crate::avx2::deinterleave_f64)); returns how many values
+    /// ([`deinterleave_f64`](crate::avx2::deinterleave_f64),
+    /// [`deinterleave_f32`](crate::avx2::deinterleave_f32)); returns how many values
     /// that was (none by default: the caller's own loop takes them all).
     #[inline(always)]
     fn deinterleave(_values: &[Self], _even: &mut [Self], _odd: &mut [Self]) -> usize {
@@ -119,6 +123,10 @@ impl Real for f32 {
     fn narrow(x: f64) -> Self {
         x as f32
     }
+    #[inline(always)]
+    fn deinterleave(values: &[Self], even: &mut [Self], odd: &mut [Self]) -> usize {
+        crate::avx2::deinterleave_f32(values, even, odd)
+    }
 }
 
 /// The face size a grid of `n` coarsens to: halved while even and above
@@ -144,7 +152,7 @@ const COARSEST_FACE: usize = 2;
 
 /// How many tolerances above the goal the conjugate gradients' residual may be when they
 /// go on in `f32` ([`Hierarchy::iterate_in_f32`], where the weights are given as `f32`
-/// roundings). Each `f32` iteration's product `α M p` is rounded, the operator's sums of
+/// values). Each `f32` iteration's product `α M p` is rounded, the operator's sums of
 /// differences to about `c·ε` of the residual it removes (`ε` = 6e-8; `c` measured about
 /// 3 over `film_profile 64 0 9.81`'s steps, but 12 for the first iteration from a start,
 /// which therefore stays in `f64`: its product in `f32` would have left the tracked
@@ -152,8 +160,9 @@ const COARSEST_FACE: usize = 2;
 /// track falls from the true one by about `c·ε·2¹⁶ ≈ 0.01` tolerances at most. Measured
 /// against the true residual formed afresh in `f64` over `film_profile`'s 20 first
 /// steps: at most 2.8e-9 of the start's residual (3 thousandths of the 1e-6 tolerance)
-/// at n = 64, 4.3e-10 at 128, 1.3e-8 at 32 (where the system is the `f64` weights' and
-/// the `f32` iterations apply their roundings); driven through the normal gradient, 5e-4
+/// at n = 64, 4.3e-10 at 128, 1.3e-8 at 32 (measured while the system was the `f64`
+/// weights' and the `f32` iterations applied their roundings, which only added to the
+/// gap: now both read the same `f32` values); driven through the normal gradient, 5e-4
 /// of each solve's tolerance (its defect corrections' included). Over the 40 steps, at
 /// the same 126 PCG iterations (164 at 32): 640.2 → 625.5 M instructions and 14.16 →
 /// 13.08 M LL misses at n = 64, 183.4 → 178.5 M and 1.95 → 1.82 M misses at 32 (with
@@ -202,6 +211,9 @@ pub struct Hierarchy {
     /// RIGHT or TOP entries and the halo's (the rest of a face row's weights are a slice
     /// of the grid's edges).
     seam_weights: [Vec<[u32; 2]>; 2],
+    /// The first cell's four sides' edges (LEFT, RIGHT, BOTTOM, TOP), whose weights set
+    /// the V-cycle's scale ([`Work::scale`]) before the weights are put in the layout.
+    first_edges: [u32; 4],
     /// The coarsest level's elimination order and factor pattern (its direct solve).
     coarsest: Pattern,
 }
@@ -223,7 +235,7 @@ pub struct Hierarchy {
 /// answer's accuracy does not depend on the preconditioner's; `r·z`, which only weighs
 /// the directions, is summed in `f64` from the V-cycle's `f32` right-hand side and
 /// answer (`Hierarchy::precondition`). (The last iterations, where the weights are
-/// given as `f32` roundings, run in `f32` but for `x`: `Hierarchy::iterate_in_f32`
+/// given as `f32` values, run in `f32` but for `x`: `Hierarchy::iterate_in_f32`
 /// says why the residual they track stays the true one to a few hundredths of the
 /// tolerance.) `f32`'s narrower range is
 /// kept away from: the system enters the V-cycle scaled by a power of two that brings
@@ -232,20 +244,27 @@ pub struct Hierarchy {
 /// so which cell sets it changes no result), so no system or residual underflows or
 /// overflows in it: `f32` spans 2^±126, and a film's diagonal entries lie within a few
 /// powers of ten of one another (the cells' areas within 5.2×, their thickness floor
-/// [`H_FLOOR_M`](super::flow::H_FLOOR_M) keeping the weights finite).
+/// [`H_FLOOR_M`](super::flow::H_FLOOR_M) keeping the weights finite). So weights given
+/// as `f32` values stay exact, scaled, in the V-cycle's copy (a power of two moves an
+/// `f32` exactly while it stays within 2^±126).
 ///
 /// Every field here is in its level's split layout (`layout`); a field's cells outside
 /// the faces stay zero where the conjugate gradients' dot products would see them.
 #[derive(Clone, Debug, Default)]
 pub struct Work {
     /// Per level, the mass term ([`NOT_A_CELL`] outside the cells) and the edge weights
-    /// ([`Stencil`]) in `f64`: the finest level's the conjugate gradients' operator (but
-    /// in their `f32` iterations, [`Hierarchy::iterate_in_f32`]), the others what the
-    /// V-cycle's are rounded from.
+    /// ([`Stencil`]) in `f64`: the finest level's the conjugate gradients' operator, the
+    /// others what the V-cycle's are rounded from. Where the weights are given as `f32`
+    /// values ([`Work::weights_f32`]) the finest level has no `f64` weights: its
+    /// V-cycle copy holds them exactly, and is read in their stead.
     mass: Vec<Vec<f64>>,
     stencil: Vec<Stencil<f64>>,
-    /// Whether the weights were given as [`Weights::F32`].
-    weights_rounded: bool,
+    /// Whether the weights were given as [`Weights::F32`] (and there is a V-cycle to
+    /// hold them): the finest level's weights are then [`Work::stencil32`]'s alone.
+    weights_f32: bool,
+    /// [`Weights::F32`]'s weights widened, where the finest level is the coarsest (its
+    /// direct solve reads `f64` weights, and there is no V-cycle copy to read).
+    widened: Vec<f64>,
     /// Whether the finest level's mass term (in `f64` and `f32`) is held per face
     /// ([`LevelField`]): the system's faces are alike to the bit, as the grid's cell
     /// areas are.
@@ -258,7 +277,8 @@ pub struct Work {
     /// The power of two the V-cycle's system is scaled by (1 where there is one level).
     scale: f64,
     /// Per level but the coarsest, in `f32` and scaled by [`Work::scale`]: the mass
-    /// term, the inverse diagonal (zero outside the cells) and the edge weights.
+    /// term, the inverse diagonal (zero outside the cells) and the edge weights (the
+    /// finest level's exact where they were given as `f32` values: [`Work::weights_f32`]).
     mass32: Vec<Vec<f32>>,
     inv_diag: Vec<Vec<f32>>,
     stencil32: Vec<Stencil<f32>>,
@@ -296,6 +316,26 @@ impl Work {
             per_face: k == 0 && self.mass_per_face,
         }
     }
+
+    /// The finest level's weights as the conjugate gradients read them: in `f64`, or the
+    /// V-cycle's `f32` copy, scaled by [`Work::scale`] ([`Work::weights_f32`]).
+    fn fine_weights(&self) -> FineWeights<'_> {
+        if self.weights_f32 {
+            FineWeights::F32((&self.stencil32[0], self.scale))
+        } else {
+            FineWeights::F64((&self.stencil[0], 1.0))
+        }
+    }
+}
+
+/// The finest level's weights as the conjugate gradients' `f64` passes read them
+/// ([`Work::fine_weights`]).
+#[derive(Clone, Copy)]
+enum FineWeights<'a> {
+    /// The `f64` weights.
+    F64(Weighted<'a, f64, f64>),
+    /// The V-cycle's `f32` copy, scaled (exact: the weights were given as `f32` values).
+    F32(Weighted<'a, f32, f64>),
 }
 
 /// A system's mass term `α` as [`Hierarchy::solve_from_start_and_change`] is given it.
@@ -313,13 +353,12 @@ pub(crate) enum MassTerm<'a> {
 pub(crate) enum Weights<'a> {
     /// Any `f64` values.
     F64(&'a [f64]),
-    /// Weights whose `f32` roundings (each within 6e-8 of itself) the conjugate
-    /// gradients' last iterations may apply ([`Hierarchy::iterate_in_f32`]): the system
-    /// solved is still the `f64` weights' (the start's residual and the first iteration
-    /// read them, [`Hierarchy::start_residuals`]), and the rounding acts only on what is
-    /// left after the first iteration, so the residual the iterations track stays within
-    /// a few hundredths of the tolerance of the true one.
-    F32(&'a [f64]),
+    /// `f32` values: the system solved is theirs, exactly. The V-cycle's copy, scaled by
+    /// a power of two, holds them exactly, so the conjugate gradients' `f64` passes (the
+    /// starts' residuals, the first iterations) read it widened and no `f64` copy is
+    /// made ([`Work::weights_f32`]), and their last iterations run in `f32`
+    /// ([`Hierarchy::iterate_in_f32`]) on the same numbers.
+    F32(&'a [f32]),
 }
 
 /// Where [`Hierarchy::solve_prepared_from`] starts.
@@ -370,6 +409,7 @@ impl Hierarchy {
         Self {
             levels,
             seam_weights,
+            first_edges: sides.edge[0],
             coarsest,
         }
     }
@@ -619,12 +659,12 @@ impl Hierarchy {
     }
 
     /// Whether the conjugate gradients, at a residual `relative` to the start's, go on
-    /// in `f32` ([`Hierarchy::iterate_in_f32`]): where the weights may be read rounded
-    /// ([`Work::weights_rounded`]) and the residual is within [`F32_FROM_TOLERANCES`]
-    /// tolerances of the goal.
+    /// in `f32` ([`Hierarchy::iterate_in_f32`]): where the weights were given as `f32`
+    /// values ([`Work::weights_f32`]; there is then a V-cycle) and the residual is within
+    /// [`F32_FROM_TOLERANCES`] tolerances of the goal.
     #[inline(always)]
     fn continues_in_f32(&self, work: &Work, relative: f64, limits: SolveLimits) -> bool {
-        work.weights_rounded
+        work.weights_f32
             && self.levels.len() > 1
             && relative <= F32_FROM_TOLERANCES * limits.tolerance
     }
@@ -670,7 +710,8 @@ impl Hierarchy {
                 values: &work.mass32[0],
                 per_face: work.mass_per_face,
             };
-            operator::<f32, false>(fine, mass, &work.stencil32[0], &[], &p32, &mut q32);
+            let w = (&work.stencil32[0], 1.0);
+            operator::<f32, f32, false>(fine, mass, w, &[], &p32, &mut q32);
             // `p·M p = back²/scale · p'·q'`.
             let pq = dot_f32(&p32, &q32) * back * (back / scale);
             let usable = pq > 0.0 && pq.is_finite();
@@ -704,34 +745,42 @@ impl Hierarchy {
         work.p32 = p32;
     }
 
-    /// `q = M p` on the finest level, with the `f64` weights (as
-    /// [`Hierarchy::start_residuals`]).
+    /// `q = M p` on the finest level, with the system's own weights (as
+    /// [`Hierarchy::start_residuals`]: [`Work::fine_weights`]).
     #[inline(always)]
     fn apply(&self, work: &Work, p: &[f64], q: &mut [f64]) {
-        let w = &work.stencil[0];
-        operator::<f64, false>(&self.levels[0], work.mass_term(0), w, &[], p, q);
+        let (fine, mass) = (&self.levels[0], work.mass_term(0));
+        match work.fine_weights() {
+            FineWeights::F64(w) => operator::<f64, f64, false>(fine, mass, w, &[], p, q),
+            FineWeights::F32(w) => operator::<f64, f32, false>(fine, mass, w, &[], p, q),
+        }
     }
 
-    /// The starts' residuals in place ([`residuals_in_place`]) on the finest level, with
-    /// the `f64` weights always, whatever the iterations that follow read: the system
-    /// solved is the one given.
+    /// The starts' residuals in place ([`residuals_in_place`]) on the finest level, in
+    /// `f64`, with the system's own weights: the `f64` ones, or, where the weights were
+    /// given as `f32` values, the V-cycle's copy, which holds them exactly
+    /// ([`Work::fine_weights`]). Either way the system solved is the one given, the one
+    /// the caller's velocity correction applies.
     ///
-    /// Why not the weights' `f32` copy, where they are given as [`Weights::F32`] (as the
-    /// solve did from 64 cells a face, to stream half the bytes): a start's residual is
-    /// `b − M x₀` for the whole surfactant `x₀`, and the rounded weights' `M x₀` is off by
-    /// about 6e-8 of `L x₀`, which in a stiff step dwarfs the residual, the step's
-    /// change. The system solved was then the rounded weights', while the velocity
-    /// correction moves Γ with the `f64` ones: each step's answer carried a grid-scale
-    /// error some 9× the step's own change, alternating from step to step (on
-    /// `film_profile 64 0 9.81`'s film, each step's change −0.37 correlated with the
-    /// last's, its roughness `Σ_edges (Δc)²/(2Σc²)` 2.4 against 0.06), the tolerance was
-    /// judged against a start's residual swollen by it, and the guess never paid. The
-    /// first iteration applies the `f64` weights too ([`Hierarchy::apply`]): the `f32`
-    /// iterations' rounded weights then act on what is left after it, 2000× smaller.
+    /// Why that matters: a start's residual is `b − M x₀` for the whole surfactant `x₀`,
+    /// and where it was taken with the `f32` roundings of `f64` weights (as the solve did
+    /// from 64 cells a face, to stream half the bytes), `M x₀` was off by about 6e-8 of
+    /// `L x₀`, which in a stiff step dwarfs the residual, the step's change. The system
+    /// solved was then the rounded weights', while the velocity correction moved Γ with
+    /// the `f64` ones: each step's answer carried a grid-scale error some 9× the step's
+    /// own change, alternating from step to step (on `film_profile 64 0 9.81`'s film,
+    /// each step's change −0.37 correlated with the last's, its roughness
+    /// `Σ_edges (Δc)²/(2Σc²)` 2.4 against 0.06), the tolerance was judged against a
+    /// start's residual swollen by it, and the guess never paid. The Marangoni step now
+    /// rounds its weights to `f32` where it makes them ([`Weights::F32`]), so the solve
+    /// and the correction read the same numbers.
     #[inline(always)]
     fn start_residuals(&self, work: &Work, starts: [Option<&[f64]>; 2], out: [&mut [f64]; 2]) {
         let (fine, mass) = (&self.levels[0], work.mass_term(0));
-        residuals_in_place(fine, (mass, &work.stencil[0]), starts, out);
+        match work.fine_weights() {
+            FineWeights::F64(w) => residuals_in_place(fine, (mass, w), starts, out),
+            FineWeights::F32(w) => residuals_in_place(fine, (mass, w), starts, out),
+        }
     }
 
     /// [`Hierarchy::prepare_mass`] of a mass term given per cell.
@@ -740,32 +789,41 @@ impl Hierarchy {
     }
 
     /// Restricts the system's numbers to every level, and rounds them to `f32` for the
-    /// V-cycle (see [`Work`]); notes whether the conjugate gradients may iterate in `f32`
-    /// ([`Work::weights_rounded`]).
+    /// V-cycle (see [`Work`]); notes whether the weights were given as `f32` values
+    /// ([`Work::weights_f32`]: then put straight into the V-cycle's finest copy, scaled,
+    /// with no `f64` copy, and the conjugate gradients may iterate in `f32`).
     ///
     /// # Panics
     /// If the mass term's length does not match the finest level (its cells, or a face's).
     fn prepare_mass(&self, work: &mut Work, alpha: MassTerm, weight: Weights) {
-        let (weight, rounded) = match weight {
-            Weights::F64(w) => (w, false),
-            Weights::F32(w) => (w, true),
-        };
-        work.weights_rounded = rounded;
         let m = self.levels[0].m;
         let len = match alpha {
             MassTerm::Cells(a) => a.len() / 6,
             MassTerm::EveryFace(a) => a.len(),
         };
         assert_eq!(len, m * m, "system size mismatch");
+        let one_level = self.levels.len() == 1;
+        work.weights_f32 = matches!(weight, Weights::F32(_)) && !one_level;
+        let mut widened = std::mem::take(&mut work.widened);
+        let weight = match weight {
+            Weights::F32(w) if one_level => {
+                widened.clear();
+                widened.extend(w.iter().map(|&v| f64::from(v)));
+                Weights::F64(&widened)
+            }
+            given => given,
+        };
         with_avx2(
             #[inline(always)]
             || self.prepare_here(work, alpha, weight),
         );
+        work.widened = widened;
     }
 
-    /// [`Hierarchy::prepare_mass`]'s work, inlined into the AVX2 build where there is one.
+    /// [`Hierarchy::prepare_mass`]'s work, inlined into the AVX2 build where there is one
+    /// (`f32` weights only where there is a V-cycle to hold them).
     #[inline(always)]
-    fn prepare_here(&self, work: &mut Work, alpha: MassTerm, weight: &[f64]) {
+    fn prepare_here(&self, work: &mut Work, alpha: MassTerm, weight: Weights) {
         let count = self.levels.len();
         work.mass.resize(count, Vec::new());
         work.stencil.resize(count, Stencil::default());
@@ -773,24 +831,29 @@ impl Hierarchy {
         work.correction.resize(count, Vec::new());
         for (k, level) in self.levels.iter().enumerate() {
             sized(&mut work.mass[k], level.len(), NOT_A_CELL);
-            for w in &mut work.stencil[k] {
-                sized(w, level.len(), 0.0);
+            if k > 0 || !work.weights_f32 {
+                for w in &mut work.stencil[k] {
+                    sized(w, level.len(), 0.0);
+                }
             }
             work.residual[k].resize(level.len(), 0.0);
             work.correction[k].resize(level.len(), 0.0);
         }
-        self.fine_numbers(work, alpha, weight);
-        // One level: the direct solve is the whole preconditioner, in `f64`, unscaled.
-        work.scale = if count == 1 {
-            1.0
-        } else {
-            let fine = &self.levels[0];
-            let w = &work.stencil[0];
-            let [w0, w1, w2, w3] = fine.side_weights(0).map(|(field, p)| w[field][p]);
-            let first = work.mass[0][fine.position[0] as usize];
-            let diagonal = first + w0 + w1 + w2 + w3;
-            power_of_two_below(diagonal).recip()
-        };
+        self.size_the_v_cycles_fields(work);
+        work.scale = self.scale_of(alpha, weight);
+        self.fine_mass(work, alpha);
+        match weight {
+            Weights::F64(w) => {
+                let (out, row) = (&mut work.stencil[0], &mut work.row64);
+                self.fine_weights(w, out, row, |v| v);
+            }
+            Weights::F32(w) => {
+                let (out, row) = (&mut work.stencil32[0], &mut work.row);
+                // A power of two (in `f32`'s range: see `Work`): each product exact.
+                let scale = work.scale as f32;
+                self.fine_weights(w, out, row, |v| scale * v);
+            }
+        }
         // Each level rounded as soon as it is made, while its numbers are in cache.
         self.round_for_the_v_cycle(work, 0);
         for k in 1..count {
@@ -803,7 +866,13 @@ impl Hierarchy {
             };
             restrict_field(fine, fine_mass, coarse, &mut rest[0], &mut work.row64);
             let (done, rest) = work.stencil.split_at_mut(k);
-            kernels::restrict_weights(fine, &done[k - 1], coarse, &mut rest[0], &mut work.row64);
+            let row = &mut work.row64;
+            if k == 1 && work.weights_f32 {
+                let w = (&work.stencil32[0], work.scale);
+                kernels::restrict_weights(fine, w, coarse, &mut rest[0], row);
+            } else {
+                kernels::restrict_weights(fine, (&done[k - 1], 1.0), coarse, &mut rest[0], row);
+            }
             self.round_for_the_v_cycle(work, k);
         }
         let last = count - 1;
@@ -813,16 +882,34 @@ impl Hierarchy {
         self.coarsest.factor(level, system, work.scale, factor);
     }
 
-    /// The finest level's mass term (face 0's alone where the system's faces are
-    /// alike: [`Work::mass_per_face`]) and weights from the grid's cells and edges, a face
-    /// row at a time: a row's RIGHT weights but the last and its TOP weights (but the top
-    /// row's) are a slice of the grid's edges ([`inside_a_face`]); then the entries that
-    /// hold seam edges ([`Hierarchy::seam_weights`]).
+    /// The power of two the V-cycle's system is scaled by ([`Work::scale`]): the one
+    /// that brings the first cell's diagonal entry, its mass term plus its four side
+    /// weights, to `[1, 2)`; 1 where there is one level (the direct solve is the whole
+    /// preconditioner, in `f64`, unscaled).
+    fn scale_of(&self, alpha: MassTerm, weight: Weights) -> f64 {
+        if self.levels.len() == 1 {
+            return 1.0;
+        }
+        let first = match alpha {
+            MassTerm::Cells(a) | MassTerm::EveryFace(a) => a[0],
+        };
+        let side = |k: usize| {
+            let e = self.first_edges[k] as usize;
+            match weight {
+                Weights::F64(w) => w[e],
+                Weights::F32(w) => f64::from(w[e]),
+            }
+        };
+        let diagonal = first + side(0) + side(1) + side(2) + side(3);
+        power_of_two_below(diagonal).recip()
+    }
+
+    /// The finest level's mass term from the grid's cells, a face row at a time (face
+    /// 0's alone where the system's faces are alike: [`Work::mass_per_face`]).
     #[inline(always)]
-    fn fine_numbers(&self, work: &mut Work, alpha: MassTerm, weight: &[f64]) {
+    fn fine_mass(&self, work: &mut Work, alpha: MassTerm) {
         let fine = &self.levels[0];
         let n = fine.m;
-        let [right, top] = &mut work.stencil[0];
         // Checked where the caller does not say so: a pass over every face's values.
         let alike = match alpha {
             MassTerm::Cells(a) => faces_alike(a),
@@ -830,31 +917,72 @@ impl Hierarchy {
         };
         work.mass_per_face = self.levels.len() > 1 && fine.faces_alike() && alike;
         let mass_faces = if work.mass_per_face { 1 } else { 6 };
+        for face in 0..mass_faces {
+            for y in 0..n {
+                let alpha_row = match alpha {
+                    MassTerm::Cells(a) => &a[(face * n + y) * n..][..n],
+                    MassTerm::EveryFace(a) => &a[y * n..][..n],
+                };
+                scatter_row(fine, face, y, alpha_row, &mut work.mass[0]);
+            }
+        }
+    }
+
+    /// The finest level's weights from the grid's edges into `out`, each as `put` gives
+    /// it, a face row at a time: a row's RIGHT weights but the last and its TOP weights
+    /// (but the top row's) are a slice of the grid's edges ([`inside_a_face`]), put into
+    /// `row` and scattered from there; then the entries that hold seam edges
+    /// ([`Hierarchy::seam_weights`]). The entries no cell reads are left as they are
+    /// (zero: no pass writes them).
+    #[inline(always)]
+    fn fine_weights<W: Copy, T: Real>(
+        &self,
+        weight: &[W],
+        out: &mut Stencil<T>,
+        row: &mut Vec<T>,
+        put: impl Fn(W) -> T,
+    ) {
+        let fine = &self.levels[0];
+        let n = fine.m;
+        row.resize(n, T::ZERO);
+        let [right, top] = out;
         for face in 0..6 {
             for y in 0..n {
-                if face < mass_faces {
-                    let alpha_row = match alpha {
-                        MassTerm::Cells(a) => &a[(face * n + y) * n..][..n],
-                        MassTerm::EveryFace(a) => &a[y * n..][..n],
-                    };
-                    scatter_row(fine, face, y, alpha_row, &mut work.mass[0]);
-                }
                 // The last cell's RIGHT entry is a seam's, written below: the run stops
                 // before it.
                 let (xs, first) = inside_a_face(n, face, y, RIGHT);
                 if !xs.is_empty() {
                     let at = fine.padded_at(face, y + 1, 1 + xs.start);
-                    scatter_run(fine, at, &weight[first..][..xs.len()], right);
+                    let values = &weight[first..][..xs.len()];
+                    put_run(fine, at, (values, &put), row, right);
                 }
                 let (xs, first) = inside_a_face(n, face, y, TOP);
                 if !xs.is_empty() {
-                    scatter_row(fine, face, y, &weight[first..][..n], top);
+                    let at = fine.padded_at(face, y + 1, 1);
+                    put_run(fine, at, (&weight[first..][..n], &put), row, top);
                 }
             }
         }
         for (field, seams) in [right, top].into_iter().zip(&self.seam_weights) {
             for &[p, e] in seams {
-                field[p as usize] = weight[e as usize];
+                field[p as usize] = put(weight[e as usize]);
+            }
+        }
+    }
+
+    /// The V-cycle's fields of every level but the coarsest at their lengths (a level's
+    /// weights set to zero where its length changes: the entries no cell reads stay so).
+    fn size_the_v_cycles_fields(&self, work: &mut Work) {
+        let smoothed = self.levels.len() - 1;
+        work.mass32.resize(smoothed, Vec::new());
+        work.inv_diag.resize(smoothed, Vec::new());
+        work.stencil32.resize(smoothed, Stencil::default());
+        for (k, level) in self.levels[..smoothed].iter().enumerate() {
+            let n = level.len();
+            work.mass32[k].resize(n, 0.0);
+            work.inv_diag[k].resize(n, 0.0);
+            for w in &mut work.stencil32[k] {
+                sized(w, n, 0.0);
             }
         }
     }
@@ -862,33 +990,27 @@ impl Hierarchy {
     /// Level `k`'s numbers scaled by [`Work::scale`] and rounded to `f32`, the inverse
     /// diagonal summed in `f64` from the unrounded numbers and rounded once (zero outside
     /// the cells: [`rounded_level`]); nothing for the coarsest level, solved directly.
+    /// The finest level's weights, where they were given as `f32` values, are in the
+    /// V-cycle's copy already ([`Work::weights_f32`]): its diagonal is summed from it.
     #[inline(always)]
     fn round_for_the_v_cycle(&self, work: &mut Work, k: usize) {
         let (scale, smoothed) = (work.scale, self.levels.len() - 1);
         if k >= smoothed {
             return;
         }
-        work.mass32.resize(smoothed, Vec::new());
-        work.inv_diag.resize(smoothed, Vec::new());
-        work.stencil32.resize(smoothed, Stencil::default());
         let level = &self.levels[k];
-        let n = level.len();
-        work.mass32[k].resize(n, 0.0);
-        work.inv_diag[k].resize(n, 0.0);
-        for w in &mut work.stencil32[k] {
-            w.resize(n, 0.0);
-        }
         let mass = LevelField {
             values: &work.mass[k],
             per_face: k == 0 && work.mass_per_face,
         };
-        rounded_level(
-            level,
-            scale,
-            (mass, &work.stencil[k]),
-            (&mut work.mass32[k], &mut work.stencil32[k]),
-            &mut work.inv_diag[k],
-        );
+        let (mass32, inv_diag) = (&mut work.mass32[k], &mut work.inv_diag[k]);
+        if k == 0 && work.weights_f32 {
+            let w = &work.stencil32[0];
+            rounded_level(level, scale, (mass, w), (mass32, None), inv_diag);
+        } else {
+            let (w, w32) = (&work.stencil[k], Some(&mut work.stencil32[k]));
+            rounded_level(level, scale, (mass, w), (mass32, w32), inv_diag);
+        }
     }
 
     /// `z` = the preconditioner applied to the conjugate gradients' residual `r`, whose
@@ -975,7 +1097,7 @@ impl Hierarchy {
                     values: &work.mass32[k],
                     per_face: k == 0 && work.mass_per_face,
                 };
-                operator::<f32, true>(level, mass, w, r, z, &mut d);
+                operator::<f32, f32, true>(level, mass, (w, 1.0), r, z, &mut d);
                 let mut rc = std::mem::take(&mut work.residual[k + 1]);
                 restrict(level, &d, coarse, &mut rc, &mut work.row);
                 work.operator = d;
@@ -1043,6 +1165,23 @@ fn seam_weights(fine: &Layout, sides: &CellSides) -> [Vec<[u32; 2]>; 2] {
         s.sort_unstable();
     }
     seams
+}
+
+/// `values`, each as `put` gives it (put in `row` first), at padded indices from `first`
+/// on ([`scatter_run`]).
+#[inline(always)]
+fn put_run<W: Copy, T: Real>(
+    layout: &Layout,
+    first: usize,
+    (values, put): (&[W], &impl Fn(W) -> T),
+    row: &mut [T],
+    out: &mut [T],
+) {
+    let row = &mut row[..values.len()];
+    for (r, v) in row.iter_mut().zip(values) {
+        *r = put(*v);
+    }
+    scatter_run(layout, first, row, out);
 }
 
 /// Whether every face's values (a sixth of `values` each) are face 0's, to the bit
@@ -1342,7 +1481,8 @@ mod tests {
     fn start_and_change_solve_alike(n: usize) {
         let (grid, h, alpha, weight, b) = stiff_system(n, |c| (2.0 * c.x - c.y * c.z).sin());
         // `f32` values, so that they can be given as such too.
-        let weight: Vec<f64> = weight.iter().map(|&w| f64::from(w as f32)).collect();
+        let weight32: Vec<f32> = weight.iter().map(|&w| w as f32).collect();
+        let weight: Vec<f64> = weight32.iter().map(|&w| f64::from(w)).collect();
         let limits = SolveLimits {
             tolerance: 1e-9,
             max_iterations: 50,
@@ -1366,7 +1506,7 @@ mod tests {
         let far: Vec<f64> = near.iter().map(|v| 1e3 * v).collect();
         let face = MassTerm::EveryFace(&alpha[..n * n]);
         let changes = [Some(&near), Some(&far), None];
-        let weights = [Weights::F64(&weight), Weights::F32(&weight)];
+        let weights = [Weights::F64(&weight), Weights::F32(&weight32)];
         for ((mass, change), weights) in [MassTerm::Cells(&alpha), face]
             .into_iter()
             .flat_map(|m| changes.map(|c| (m, c)))
@@ -1466,6 +1606,98 @@ mod tests {
         }
     }
 
+    /// Weights given as `f32` values ([`Weights::F32`]) make the system their values
+    /// given as `f64`s make, to the bit, though the finest level's weights are then held
+    /// only in the V-cycle's scaled `f32` copy: the scale, every level's V-cycle numbers
+    /// (mass term, inverse diagonal, weights), the coarse levels' `f64` numbers, the
+    /// coarsest level's factor, and the conjugate gradients' product and starts'
+    /// residuals on the finest level (read from the copy: [`Work::fine_weights`]); at
+    /// n = 64 and 16 (the mass term held per face), 6 (the faces' mass terms differ, held
+    /// whole) and 3 (one level: the weights widened), with AVX2 and without.
+    #[test]
+    fn weights_given_as_f32_values_make_their_f64_values_system() {
+        let bits32 = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for (n, portable) in [64, 16, 6, 3]
+            .into_iter()
+            .flat_map(|n| [(n, false), (n, true)])
+        {
+            crate::avx2::set_portable_only(portable);
+            let (grid, h, alpha, weight, b) = stiff_system(n, |c| (2.0 * c.x - c.y * c.z).sin());
+            let alpha: Vec<f64> = if n == 6 {
+                let bump = |c: usize| 1.0 + 0.1 * (c % 5) as f64;
+                alpha.iter().enumerate().map(|(c, a)| a * bump(c)).collect()
+            } else {
+                alpha
+            };
+            let weight32: Vec<f32> = weight.iter().map(|&w| w as f32).collect();
+            let weight: Vec<f64> = weight32.iter().map(|&w| f64::from(w)).collect();
+            let (mut wide, mut narrow) = (Work::default(), Work::default());
+            h.prepare_mass(&mut wide, MassTerm::Cells(&alpha), Weights::F64(&weight));
+            h.prepare_mass(
+                &mut narrow,
+                MassTerm::Cells(&alpha),
+                Weights::F32(&weight32),
+            );
+            let levels = h.levels.len();
+            assert_eq!(narrow.weights_f32, levels > 1, "n {n}");
+            assert_eq!(narrow.mass_per_face, n == 64 || n == 16, "n {n}");
+            assert_eq!(wide.scale.to_bits(), narrow.scale.to_bits(), "n {n}");
+            for k in 0..levels - 1 {
+                let (a, b) = (&wide, &narrow);
+                assert_eq!(
+                    bits32(&a.mass32[k]),
+                    bits32(&b.mass32[k]),
+                    "n {n} level {k}"
+                );
+                assert_eq!(
+                    bits32(&a.inv_diag[k]),
+                    bits32(&b.inv_diag[k]),
+                    "n {n} level {k}"
+                );
+                for f in [RIGHT_W, TOP_W] {
+                    let (a, b) = (&a.stencil32[k][f], &b.stencil32[k][f]);
+                    assert_eq!(bits32(a), bits32(b), "n {n} level {k} field {f}");
+                }
+            }
+            for k in usize::from(levels > 1)..levels {
+                assert_eq!(
+                    bits(&wide.mass[k]),
+                    bits(&narrow.mass[k]),
+                    "n {n} level {k}"
+                );
+                for f in [RIGHT_W, TOP_W] {
+                    let (a, b) = (&wide.stencil[k][f], &narrow.stencil[k][f]);
+                    assert_eq!(bits(a), bits(b), "n {n} level {k} field {f}");
+                }
+            }
+            let factor = |w: &Work| format!("{:?}", w.coarse_factor);
+            assert_eq!(factor(&wide), factor(&narrow), "n {n}");
+            let fine = &h.levels[0];
+            let field = |k: usize| -> Vec<f64> {
+                let values: Vec<f64> = (0..grid.cells())
+                    .map(|c| ((c * k) % 11) as f64 / 3.0 + alpha[c])
+                    .collect();
+                let mut split = Vec::new();
+                to_split(fine, &values, &mut split);
+                refresh_all(fine, &mut split);
+                split
+            };
+            let (x, guess) = (field(37), field(53));
+            let operated = |work: &Work| {
+                let mut q = vec![f64::NAN; fine.len()];
+                with_avx2(|| h.apply(work, &x, &mut q));
+                let (mut r, mut s) = (Vec::new(), vec![f64::NAN; fine.len()]);
+                to_split(fine, &b, &mut r);
+                let starts = [Some(&x[..]), Some(&guess[..])];
+                with_avx2(|| h.start_residuals(work, starts, [&mut r, &mut s]));
+                [q, r, s].map(|v| bits(&v))
+            };
+            assert_eq!(operated(&wide), operated(&narrow), "n {n}");
+            crate::avx2::set_portable_only(false);
+        }
+    }
+
     /// [`each_level_holds_the_grids_numbers_at_its_cells`] for one system.
     fn holds_the_grids_numbers(h: &Hierarchy, work: &Work, alpha: &[f64], weight: &[f64]) {
         let fine = &h.levels[0];
@@ -1552,21 +1784,22 @@ mod tests {
     }
 
     /// The conjugate gradients' `f32` iterations ([`Hierarchy::iterate_in_f32`], for
-    /// weights given as [`Weights::F32`]) end where the true residual of the `f64`
-    /// weights' system, formed afresh from the answer, meets the tolerance: it differs
-    /// from the residual the iterations tracked (and report) by a twentieth of the
-    /// tolerance at most; at n = 64 and 32, from a start that reaches the `f32` iterations
-    /// after one iteration, from one that reaches them later, and from one near the
-    /// answer (`regression`: where a start's residual was taken with the rounded weights,
-    /// the solve answered their system, off by their rounding times the whole field:
-    /// this test's true residuals then missed the tracked ones by 0.4 of the tolerance,
-    /// and the film's answers carried a grid-scale error); and with AVX2 as without, to
-    /// the bit.
+    /// weights given as [`Weights::F32`]) end where the true residual of the given
+    /// weights' system, formed afresh in `f64` from the answer straight from the grid's
+    /// edges, meets the tolerance: it differs from the residual the iterations tracked
+    /// (and report) by a twentieth of the tolerance at most; at n = 64 and 32, from a
+    /// start that reaches the `f32` iterations after one iteration, from one that
+    /// reaches them later, and from one near the answer (where a start's residual is a
+    /// small part of `M x₀`: a start's residual taken with any other numbers than the
+    /// system's, as when it was taken with the `f32` roundings of `f64` weights, answers
+    /// another system, and this test's true residuals then missed the tracked ones by
+    /// 0.4 of the tolerance); and with AVX2 as without, to the bit.
     #[test]
     fn the_f32_iterations_meet_the_tolerance_on_the_true_residual() {
         for n in [64, 32] {
             let (grid, h, alpha, weight, b) = stiff_system(n, |c| (2.0 * c.x - c.y * c.z).sin());
-            let system_weights = &weight;
+            let weight32: Vec<f32> = weight.iter().map(|&w| w as f32).collect();
+            let weight: Vec<f64> = weight32.iter().map(|&w| f64::from(w)).collect();
             let limits = SolveLimits {
                 tolerance: 1e-6,
                 max_iterations: 50,
@@ -1581,7 +1814,7 @@ mod tests {
                     crate::avx2::set_portable_only(portable);
                     let mut work = Work::default();
                     let mut x = vec![f64::NAN; grid.cells()];
-                    let system = (MassTerm::Cells(&alpha), Weights::F32(&weight), &b[..]);
+                    let system = (MassTerm::Cells(&alpha), Weights::F32(&weight32), &b[..]);
                     let report = h.solve_from_start_and_change(
                         &mut work,
                         system,
@@ -1591,7 +1824,7 @@ mod tests {
                     );
                     crate::avx2::set_portable_only(false);
                     assert!(!work.p32.is_empty(), "n {n}: no f32 iterations, {report:?}");
-                    let mx = grid_apply(&grid, &alpha, system_weights, &x);
+                    let mx = grid_apply(&grid, &alpha, &weight, &x);
                     let left: f64 = b.iter().zip(&mx).map(|(b, m)| (b - m) * (b - m)).sum();
                     let relative = left.sqrt() / report.start_residual;
                     let tolerance = limits.tolerance;
@@ -1650,11 +1883,12 @@ mod tests {
         }
     }
 
-    /// The split layout's scatters and gathers (their `f64` chunks copied by AVX2
-    /// shuffles where the processor has it, [`Real::deinterleave`]) put each value at its
-    /// padded index's position and read it back, with and without AVX2: runs of every
-    /// length from 0 to 40 from both colours' first cells, and whole fields at face sizes
-    /// with odd and even rows.
+    /// The split layout's scatters and gathers (their `f64` chunks, and the scatters'
+    /// `f32` ones, copied by AVX2 shuffles where the processor has it,
+    /// [`Real::deinterleave`]) put each value at its padded index's position and read it
+    /// back, with and without AVX2: runs of every length from 0 to 40 from both colours'
+    /// first cells, in `f64` and `f32`, and whole fields at face sizes with odd and even
+    /// rows.
     #[test]
     fn scatters_and_gathers_put_each_value_at_its_position() {
         for portable in [false, true] {
@@ -1671,6 +1905,11 @@ mod tests {
                             expected[layout.index(first + j)] = *v;
                         }
                         assert_eq!(out, expected, "n {n} first {first} len {len}");
+                        let narrow: Vec<f32> = values.iter().map(|&v| v as f32).collect();
+                        let mut out32 = vec![-1.0f32; layout.len()];
+                        scatter_run(layout, first, &narrow, &mut out32);
+                        let expected32: Vec<f32> = expected.iter().map(|&v| v as f32).collect();
+                        assert_eq!(out32, expected32, "f32: n {n} first {first} len {len}");
                     }
                 }
                 let cells = 6 * n * n;
@@ -1712,7 +1951,7 @@ mod tests {
             let none = vec![0.0; fine.len()];
             let mut out = vec![f64::NAN; fine.len()];
             let (mass, w) = (work.mass_term(0), &work.stencil[0]);
-            operator::<f64, false>(fine, mass, w, &none, &xs, &mut out);
+            operator::<f64, f64, false>(fine, mass, (w, 1.0), &none, &xs, &mut out);
             let expected = grid_apply(&grid, &alpha, &weight, &x);
             for (c, &p) in fine.position.iter().enumerate() {
                 let err = (out[p as usize] - expected[c]).abs();
@@ -1751,13 +1990,13 @@ mod tests {
             let (mass, w) = (work.mass_term(0), &work.stencil[0]);
             let plain = |start: &[f64]| {
                 let mut out = vec![f64::NAN; fine.len()];
-                operator::<f64, true>(fine, mass, w, &b, start, &mut out);
+                operator::<f64, f64, true>(fine, mass, (w, 1.0), &b, start, &mut out);
                 out
             };
             let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
             for guess in [Some(&g[..]), None] {
                 let (mut r, mut q) = (b.clone(), vec![f64::NAN; fine.len()]);
-                let system = (mass, w);
+                let system = (mass, (w, 1.0));
                 residuals_in_place(fine, system, [Some(&x[..]), guess], [&mut r, &mut q]);
                 assert_eq!(bits(&r), bits(&plain(&x)), "n {n}");
                 if let Some(g) = guess {

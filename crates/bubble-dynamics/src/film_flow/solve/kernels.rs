@@ -18,6 +18,48 @@ use crate::avx2::{
 /// ([`Layout::side_weights`]); zero wherever no cell reads them.
 pub(super) type Stencil<T> = [Vec<T>; 2];
 
+/// A stencil's weight as a pass in precision `T` reads it: `f64` and `f32` weights in
+/// their own precision, and `f32` weights widened (exactly) into `f64`. The only `f32`
+/// weights an `f64` pass reads are the V-cycle's finest ones where the system's weights
+/// were given as `f32` values (the conjugate gradients then hold no `f64` copy): those
+/// are held scaled by the V-cycle's power of two ([`WeightIn::SCALED`]).
+pub(super) trait WeightIn<T>: Copy {
+    /// Whether the weights are held scaled by a power of two `s` that the pass's mass
+    /// term is not: the pass then scales the mass term by `s` and its sums back by
+    /// `1/s`, each step exact, so that it gives the bits of the unscaled weights' pass.
+    const SCALED: bool;
+    /// The weight in `T`.
+    fn read(self) -> T;
+}
+
+impl WeightIn<f64> for f64 {
+    const SCALED: bool = false;
+    #[inline(always)]
+    fn read(self) -> f64 {
+        self
+    }
+}
+
+impl WeightIn<f32> for f32 {
+    const SCALED: bool = false;
+    #[inline(always)]
+    fn read(self) -> f32 {
+        self
+    }
+}
+
+impl WeightIn<f64> for f32 {
+    const SCALED: bool = true;
+    #[inline(always)]
+    fn read(self) -> f64 {
+        f64::from(self)
+    }
+}
+
+/// A level's edge weights as the operator reads them: the stencil, and the power of two
+/// it is held scaled by where [`WeightIn::SCALED`] (unread otherwise).
+pub(super) type Weighted<'a, W, T> = (&'a Stencil<W>, T);
+
 /// The mass term's value at the positions that hold no cell: negative, where a cell's
 /// is not (a mass term), so the operator can tell them apart and give them zero (their
 /// weight entries hold seam weights, and their values a halo copy).
@@ -206,15 +248,15 @@ pub(super) fn relax_from_zero<T: Real>(layout: &Layout, inv_diag: &[T], r: &[T],
 /// a block at a time ([`BLOCK`]): each weight entry is read once, by its cell and by the
 /// neighbour across the edge, while it is in L2.
 #[inline(always)]
-pub(super) fn operator<T: Real, const RESIDUAL: bool>(
+pub(super) fn operator<T: Real, W: WeightIn<T>, const RESIDUAL: bool>(
     layout: &Layout,
     mass: LevelField<T>,
-    w: &Stencil<T>,
+    w: Weighted<W, T>,
     r: &[T],
     x: &[T],
     out: &mut [T],
 ) {
-    operator_blocks::<T, RESIDUAL>(layout, (mass, w, r), &mut [(Some(x), out)]);
+    operator_blocks::<T, W, RESIDUAL>(layout, (mass, w, r), &mut [(Some(x), out)]);
 }
 
 /// `out = b − (diag(mass) + L_w) x` for each start `x` given ([`operator`]'s residual),
@@ -223,9 +265,9 @@ pub(super) fn operator<T: Real, const RESIDUAL: bool>(
 /// own is written), in one pass over the system: each block's numbers are read once for
 /// every start, and `b` needs no field of its own.
 #[inline(always)]
-pub(super) fn residuals_in_place<T: Real>(
+pub(super) fn residuals_in_place<T: Real, W: WeightIn<T>>(
     layout: &Layout,
-    (mass, w): (LevelField<T>, &Stencil<T>),
+    (mass, w): (LevelField<T>, Weighted<W, T>),
     [x_a, x_b]: [Option<&[T]>; 2],
     [a, b_out]: [&mut [T]; 2],
 ) {
@@ -242,12 +284,12 @@ pub(super) fn residuals_in_place<T: Real>(
             let at = (face, start, len);
             if let Some(x) = x_b {
                 for c in 0..2 {
-                    operator_run::<T, true, false>(layout, c, at, (mass, w, &*a), x, b_out);
+                    operator_run::<T, W, true, false>(layout, c, at, (mass, w, &*a), x, b_out);
                 }
             }
             if let Some(x) = x_a {
                 for c in 0..2 {
-                    operator_run::<T, true, true>(layout, c, at, (mass, w, &[]), x, a);
+                    operator_run::<T, W, true, true>(layout, c, at, (mass, w, &[]), x, a);
                 }
             }
         },
@@ -267,9 +309,9 @@ fn zero_outside<T: Real>(layout: &Layout, range: std::ops::Range<usize>, out: &m
 /// zeroed outside the cells), both colours a block at a time: each block's numbers are
 /// read once for every start.
 #[inline(always)]
-fn operator_blocks<T: Real, const RESIDUAL: bool>(
+fn operator_blocks<T: Real, W: WeightIn<T>, const RESIDUAL: bool>(
     layout: &Layout,
-    (mass, w, r): (LevelField<T>, &Stencil<T>, &[T]),
+    (mass, w, r): (LevelField<T>, Weighted<W, T>, &[T]),
     pairs: &mut [(Option<&[T]>, &mut [T])],
 ) {
     let range = both_sweeps(layout);
@@ -286,7 +328,7 @@ fn operator_blocks<T: Real, const RESIDUAL: bool>(
                 let Some(x) = x else { continue };
                 for c in 0..2 {
                     let at = (face, start, len);
-                    operator_run::<T, RESIDUAL, false>(layout, c, at, (mass, w, r), x, out);
+                    operator_run::<T, W, RESIDUAL, false>(layout, c, at, (mass, w, r), x, out);
                 }
             }
         },
@@ -295,13 +337,15 @@ fn operator_blocks<T: Real, const RESIDUAL: bool>(
 
 /// [`operator`] at the `len` positions from `start` of colour `c`, of face `face`; the
 /// residual's `b` read from `out` itself where `IN_PLACE` (`r` then unread, as it is
-/// for the product, `RESIDUAL` false).
+/// for the product, `RESIDUAL` false). Weights held scaled by `s` ([`WeightIn::SCALED`])
+/// are summed with the mass term times `s` and the sum taken back by `1/s`: `s` a power
+/// of two, each product and sum is `s` times the unscaled one's, to the bit.
 #[inline(always)]
-fn operator_run<T: Real, const RESIDUAL: bool, const IN_PLACE: bool>(
+fn operator_run<T: Real, W: WeightIn<T>, const RESIDUAL: bool, const IN_PLACE: bool>(
     layout: &Layout,
     c: usize,
     (face, start, len): (usize, usize, usize),
-    (mass, w, r): (LevelField<T>, &Stencil<T>, &[T]),
+    (mass, (w, scale), r): (LevelField<T>, Weighted<W, T>, &[T]),
     x: &[T],
     out: &mut [T],
 ) {
@@ -324,13 +368,17 @@ fn operator_run<T: Real, const RESIDUAL: bool, const IN_PLACE: bool>(
     let out = &mut out[base..][..len];
     let [n0, n1, n2, n3] = near;
     let [w0, w1, w2, w3] = weights;
+    let (to, back) = (scale, T::narrow(1.0 / scale.widen()));
     for i in 0..len {
         let xi = xs[i];
-        let mut sum = m[i] * xi;
-        sum += w0[i] * (xi - n0[i]);
-        sum += w1[i] * (xi - n1[i]);
-        sum += w2[i] * (xi - n2[i]);
-        sum += w3[i] * (xi - n3[i]);
+        let mut sum = if W::SCALED { m[i] * to } else { m[i] } * xi;
+        sum += w0[i].read() * (xi - n0[i]);
+        sum += w1[i].read() * (xi - n1[i]);
+        sum += w2[i].read() * (xi - n2[i]);
+        sum += w3[i].read() * (xi - n3[i]);
+        if W::SCALED {
+            sum = sum * back;
+        }
         let b = if IN_PLACE {
             out[i]
         } else if RESIDUAL {
@@ -345,16 +393,19 @@ fn operator_run<T: Real, const RESIDUAL: bool, const IN_PLACE: bool>(
 }
 
 /// A level's numbers scaled by `scale` and rounded to `f32` for the V-cycle (`mass32`,
-/// `w32`), and its inverse diagonal `1/(scale·d)`, `d` the mass term plus the four side
-/// weights summed in `f64` (LEFT to TOP) and rounded once; zero outside the cells. One
-/// pass over the level's numbers, both colours a block at a time ([`operator`]); a
-/// mass term held `per_face` is rounded on face 0 alone, and read so.
+/// and the weights into `w32` where it is given), and its inverse diagonal
+/// `1/(scale·d)`, `d` the mass term plus the four side weights summed in `f64` (LEFT to
+/// TOP) and rounded once; zero outside the cells. One pass over the level's numbers,
+/// both colours a block at a time ([`operator`]); a mass term held `per_face` is
+/// rounded on face 0 alone, and read so. Weights held scaled already
+/// ([`WeightIn::SCALED`]: the V-cycle's own, `w32` then not given) are summed with the
+/// mass term times `scale`, `scale·d` to the bit.
 #[inline(always)]
-pub(super) fn rounded_level(
+pub(super) fn rounded_level<W: WeightIn<f64>>(
     layout: &Layout,
     scale: f64,
-    (mass, w): (LevelField<f64>, &Stencil<f64>),
-    (mass32, w32): (&mut [f32], &mut Stencil<f32>),
+    (mass, w): (LevelField<f64>, &Stencil<W>),
+    (mass32, mut w32): (&mut [f32], Option<&mut Stencil<f32>>),
     inv_diag: &mut [f32],
 ) {
     let range = both_sweeps(layout);
@@ -363,8 +414,7 @@ pub(super) fn rounded_level(
         let start = c * half;
         for part in [start..start + range.start, start + range.end..start + half] {
             round_run(scale, part.clone(), mass.values, mass32);
-            round_run(scale, part.clone(), &w[RIGHT_W], &mut w32[RIGHT_W]);
-            round_run(scale, part.clone(), &w[TOP_W], &mut w32[TOP_W]);
+            round_weights(scale, part.clone(), w, w32.as_deref_mut());
             inv_diag[part].fill(0.0);
         }
     }
@@ -379,29 +429,50 @@ pub(super) fn rounded_level(
                 if !mass.per_face || face == 0 {
                     round_run(scale, own.clone(), mass.values, mass32);
                 }
-                round_run(scale, own.clone(), &w[RIGHT_W], &mut w32[RIGHT_W]);
-                round_run(scale, own.clone(), &w[TOP_W], &mut w32[TOP_W]);
+                round_weights(scale, own.clone(), w, w32.as_deref_mut());
                 let [w0, w1, w2, w3] = side_weights(layout, c, (start, len), w);
                 let m = mass.at(layout, face, own.start, len);
                 let inv_diag = &mut inv_diag[own];
                 for i in 0..len {
-                    let d = m[i] + w0[i] + w1[i] + w2[i] + w3[i];
+                    let (mi, ws) = (m[i], [w0[i], w1[i], w2[i], w3[i]].map(W::read));
+                    let first = if W::SCALED { mi * scale } else { mi };
+                    let d = first + ws[0] + ws[1] + ws[2] + ws[3];
                     // Zero outside the cells, by a select, so the loop vectorises (a
                     // halo cell's sum of seam weights, or a division by zero's
                     // infinity, is dropped, not trapped).
-                    let inv = (1.0 / (scale * d)) as f32;
-                    inv_diag[i] = if m[i] >= 0.0 && d > 0.0 { inv } else { 0.0 };
+                    let inv = (1.0 / if W::SCALED { d } else { scale * d }) as f32;
+                    inv_diag[i] = if mi >= 0.0 && d > 0.0 { inv } else { 0.0 };
                 }
             }
         },
     );
 }
 
+/// Both weight fields' `range` scaled and rounded into `w32` ([`round_run`]), where it
+/// is given.
+#[inline(always)]
+fn round_weights<W: WeightIn<f64>>(
+    scale: f64,
+    range: std::ops::Range<usize>,
+    w: &Stencil<W>,
+    w32: Option<&mut Stencil<f32>>,
+) {
+    if let Some(w32) = w32 {
+        round_run(scale, range.clone(), &w[RIGHT_W], &mut w32[RIGHT_W]);
+        round_run(scale, range, &w[TOP_W], &mut w32[TOP_W]);
+    }
+}
+
 /// `out[range] = scale·values[range]` rounded to `f32`.
 #[inline(always)]
-fn round_run(scale: f64, range: std::ops::Range<usize>, values: &[f64], out: &mut [f32]) {
+fn round_run<W: WeightIn<f64>>(
+    scale: f64,
+    range: std::ops::Range<usize>,
+    values: &[W],
+    out: &mut [f32],
+) {
     for (o, v) in out[range.clone()].iter_mut().zip(&values[range]) {
-        *o = (scale * v) as f32;
+        *o = (scale * v.read()) as f32;
     }
 }
 
@@ -595,14 +666,18 @@ fn split_row<T: Real>(row: &[T], even: &mut [T], odd: &mut [T]) {
 /// neighbours'. A seam edge held on both of its faces sums the same two numbers on
 /// each (in either order, the same bits), so the coarse matrix stays symmetric to the
 /// bit.
+///
+/// Fine weights held scaled by `scale` ([`WeightIn::SCALED`]) are halved by
+/// `0.5/scale`, a power of two: the same bits as the unscaled weights' halves.
 #[inline(always)]
-pub(super) fn restrict_weights(
+pub(super) fn restrict_weights<W: WeightIn<f64>>(
     fine: &Layout,
-    fine_w: &Stencil<f64>,
+    (fine_w, scale): Weighted<W, f64>,
     coarse: &Layout,
     out: &mut Stencil<f64>,
     row: &mut Vec<f64>,
 ) {
+    let half = if W::SCALED { 0.5 / scale } else { 0.5 };
     let m = coarse.m;
     row.resize(m + 1, 0.0);
     // A run of one colour's entries of the fine level from padded `(row, col)`: every
@@ -616,7 +691,7 @@ pub(super) fn restrict_weights(
         for y in 0..m {
             let a = run(RIGHT_W, face, (2 * y + 1, 0), m + 1);
             let b = run(RIGHT_W, face, (2 * y + 2, 0), m + 1);
-            half_sums(a, b, &mut row[..m + 1]);
+            half_sums(half, a, b, &mut row[..m + 1]);
             let first = coarse.padded_at(face, y + 1, 0);
             scatter_run(coarse, first, &row[..m + 1], &mut out[RIGHT_W]);
         }
@@ -625,18 +700,18 @@ pub(super) fn restrict_weights(
         for y in 0..m + 1 {
             let a = run(TOP_W, face, (2 * y, 1), m);
             let b = run(TOP_W, face, (2 * y, 2), m);
-            half_sums(a, b, &mut row[..m]);
+            half_sums(half, a, b, &mut row[..m]);
             let first = coarse.padded_at(face, y, 1);
             scatter_run(coarse, first, &row[..m], &mut out[TOP_W]);
         }
     }
 }
 
-/// `out[x] = a[x]/2 + b[x]/2`.
+/// `out[x] = half·a[x] + half·b[x]` (`half` ½, or ½ over the weights' scale).
 #[inline(always)]
-fn half_sums(a: &[f64], b: &[f64], out: &mut [f64]) {
+fn half_sums<W: WeightIn<f64>>(half: f64, a: &[W], b: &[W], out: &mut [f64]) {
     for ((o, a), b) in out.iter_mut().zip(a).zip(b) {
-        *o = 0.5 * a + 0.5 * b;
+        *o = half * a.read() + half * b.read();
     }
 }
 
