@@ -9,6 +9,12 @@
 //! the portable build (SSE2) give the same bits; AVX2 has four `f64` lanes an instruction
 //! where SSE2 has two. Tests switch AVX2 off on their thread ([`set_portable_only`]) and
 //! compare the two.
+//!
+//! The explicit SIMD of the crate lives here: the dot products' and Coriolis rows' lanes
+//! below, and [`advect_face`], an advection stage's face in AVX2 registers.
+
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod advect_face;
 
 #[cfg(test)]
 thread_local! {

@@ -34,9 +34,6 @@
 //! film energy at about (ω dt)² a step: 3.3 % of a 5 rad/s rotation's rate in 0.2 s of
 //! 1/240 s steps (`tests/film_flow_advection.rs`).
 
-#[cfg(target_arch = "x86_64")]
-mod face_avx2;
-
 use glam::DVec3;
 
 use crate::avx2::{PAIRS, QUAD_WEIGHTS, coriolis_row, quad_starts, with_avx2};
@@ -45,7 +42,7 @@ use super::compare::larger;
 use super::face_rows::{AxisGravity, FaceRows, SIDES, Side, face_order};
 use super::grid::CubeSphere;
 #[cfg(target_arch = "x86_64")]
-use face_avx2::{FaceInputs, FaceStart};
+use crate::avx2::advect_face::{self, FaceInputs, FaceStart};
 
 /// Largest fraction of the narrowest dual edge the fastest cell may cross in a sub-step.
 /// SSP-RK3 damps (never amplifies) a rotation of `ω·sub_dt < √3`; the vorticity at the
@@ -516,7 +513,7 @@ fn ssp_rk3(
 /// at its rate `r`, then (stages 2 and 3) weighed with its starting velocity `u0`. Stage
 /// 3 takes ⅓ as a multiplication: a division took several times as long.
 #[inline(always)]
-fn rk3_step<const STAGE: u8>(h: f64, u: f64, u0: f64, r: f64) -> f64 {
+pub(crate) fn rk3_step<const STAGE: u8>(h: f64, u: f64, u0: f64, r: f64) -> f64 {
     match STAGE {
         1 => u + h * r,
         2 => 0.75 * u0 + 0.25 * (u + h * r),
@@ -524,7 +521,7 @@ fn rk3_step<const STAGE: u8>(h: f64, u: f64, u0: f64, r: f64) -> f64 {
     }
 }
 
-/// [`face_avx2::face_stage`] of stage `STAGE` over `h`, with gravity where `at` gives it,
+/// [`advect_face::face_stage`] of stage `STAGE` over `h`, with gravity where `at` gives it,
 /// into `dst` and `border`, the rows' buffers (vertex rows, cell terms) those given.
 ///
 /// # Safety
@@ -544,9 +541,9 @@ unsafe fn face_stage<const STAGE: u8>(
     // SAFETY: the processor has AVX2 (the caller's promise).
     unsafe {
         if at.gravity.is_some() {
-            face_avx2::face_stage::<STAGE, true>(at, h, dst, border, z, rate);
+            advect_face::face_stage::<STAGE, true>(at, h, dst, border, z, rate);
         } else {
-            face_avx2::face_stage::<STAGE, false>(at, h, dst, border, z, rate);
+            advect_face::face_stage::<STAGE, false>(at, h, dst, border, z, rate);
         }
     }
 }
@@ -649,7 +646,7 @@ impl Stage<'_> {
     /// stage may move the edges where they are.
     ///
     /// Each face's rows in one call in AVX2 registers where the processor has it
-    /// ([`face_avx2`]), row by row in portable code else ([`Self::face_rows`]): the same
+    /// ([`advect_face`]), row by row in portable code else ([`Self::face_rows`]): the same
     /// bits.
     #[inline(always)]
     fn stage<const STAGE: u8>(
@@ -1175,7 +1172,7 @@ mod tests {
         assert!(change.abs() < 1e-4, "energy changed by {change:+.3e}");
     }
 
-    /// The advection with AVX2 (the face kernel, `face_avx2`) gives the portable code's
+    /// The advection with AVX2 (the face kernel, `advect_face`) gives the portable code's
     /// bits: at n = 4 (one group of four cells a row), 5 (two overlapping groups, rows of
     /// edges one past whole chunks of four), 7 and 16, a rotation with a rough field on
     /// it, through the stage buffer and from the grid's numbering (its starting
@@ -1294,7 +1291,7 @@ mod tests {
     /// order, or one that reads its starting velocities in the grid's numbering, the kept
     /// border vorticity too: no row reads an edge that a row before it has moved, and a
     /// row's run through its right border copy leaves it as it was. Each case with AVX2
-    /// (the face kernel, `face_avx2`) and without, against the portable stage apart. At
+    /// (the face kernel, `advect_face`) and without, against the portable stage apart. At
     /// n = 5 and 16.
     #[test]
     fn a_stage_in_place_or_in_reverse_is_the_stage_apart() {

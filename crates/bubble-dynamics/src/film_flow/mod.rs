@@ -2,13 +2,13 @@
 //! than the particle mesh, moved by gravity, Marangoni stress, the sheet's viscosity,
 //! drainage, the air's shear and evaporation (docs/dynamics.md, "Film flow").
 
-mod advect;
+pub(crate) mod advect;
 mod burst;
 mod capillary;
 mod cell_map;
 mod compare;
 mod face_geometry;
-mod face_rows;
+pub(crate) mod face_rows;
 mod flow;
 mod fluxes;
 pub mod grid;

@@ -13,39 +13,39 @@ use std::arch::x86_64::{
     _mm256_permute4x64_pd, _mm256_set1_pd, _mm256_setzero_pd, _mm256_storeu_pd, _mm256_sub_pd,
 };
 
-use crate::avx2::{QUAD_WEIGHTS, coriolis_quad, coriolis_terms};
+use super::{QUAD_WEIGHTS, coriolis_quad, coriolis_terms};
 
-use super::rk3_step;
+use crate::film_flow::advect::rk3_step;
 
 /// What one face's part of a stage reads: the face's own values, and face 0's constants,
-/// which every face reads ([`FaceRows`](super::FaceRows) says why).
-pub(super) struct FaceInputs<'a> {
+/// which every face reads ([`FaceRows`](crate::film_flow::face_rows::FaceRows) says why).
+pub(crate) struct FaceInputs<'a> {
     /// Cells along a side of the face (at least 4).
-    pub(super) n: usize,
+    pub(crate) n: usize,
     /// The face's edge velocities the stage moves, where they are not its destination's
     /// (per local edge of the face).
-    pub(super) src: Option<&'a [f64]>,
+    pub(crate) src: Option<&'a [f64]>,
     /// Where the face's starting velocities are.
-    pub(super) start: FaceStart<'a>,
+    pub(crate) start: FaceStart<'a>,
     /// The vorticity of the face's border vertices, per local vertex of the face (the
     /// inner ones' unread).
-    pub(super) kept: &'a [f64],
+    pub(crate) kept: &'a [f64],
     /// Face 0's dual lengths, per local edge.
-    pub(super) dual_length: &'a [f64],
+    pub(crate) dual_length: &'a [f64],
     /// Face 0's `1/(A R)`, per local vertex.
-    pub(super) scale: &'a [f64],
+    pub(crate) scale: &'a [f64],
     /// Face 0's Coriolis weights, by rows of cells.
-    pub(super) coriolis: &'a [f64],
+    pub(crate) coriolis: &'a [f64],
     /// Face 0's `1/(l d)`, per local edge.
-    pub(super) inverse_norm: &'a [f64],
+    pub(crate) inverse_norm: &'a [f64],
     /// Where the stage adds gravity: the step, s, `g` along the face's axis, m/s², and face
     /// 0's gradient component along it, per local edge.
-    pub(super) gravity: Option<(f64, f64, &'a [f64])>,
+    pub(crate) gravity: Option<(f64, f64, &'a [f64])>,
 }
 
 /// Where a face's stage reads each edge's starting velocity.
 #[derive(Clone, Copy)]
-pub(super) enum FaceStart<'a> {
+pub(crate) enum FaceStart<'a> {
     /// The destination's entry, before it is written.
     Dst,
     /// These, per local edge of the face.
@@ -99,7 +99,7 @@ struct Plan {
 /// If `n < 4`, gravity is given or not against `GRAVITY`, or a slice is short of the
 /// face's.
 #[target_feature(enable = "avx2")]
-pub(super) fn face_stage<const STAGE: u8, const GRAVITY: bool>(
+pub(crate) fn face_stage<const STAGE: u8, const GRAVITY: bool>(
     at: &FaceInputs<'_>,
     h: f64,
     dst: &mut [f64],
