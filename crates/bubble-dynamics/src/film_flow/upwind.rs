@@ -150,7 +150,9 @@ fn limiter(h: f64, nb: [f64; 4], rise: [f64; 4]) -> f64 {
     } else {
         (down_room, down_rise)
     };
-    larger(smaller(room / rise, 1.0), 0.0)
+    // No maximum with 0: `room` is `hi − h` or `h − lo`, ≥ +0 (`hi` and `lo` take `h`
+    // in), and `rise` > 0 or 1, so the quotient is ≥ +0 or NaN, which the minimum makes 1.
+    smaller(room / rise, 1.0)
 }
 
 /// The limited rises: the rim's, kept for the sub-step (the seams' volumes read them),
