@@ -132,26 +132,29 @@ fn limiter(h: f64, nb: [f64; 4], rise: [f64; 4]) -> f64 {
     // that way); the smaller by a cross-multiplication, then one division where there
     // were two: `(lo − h)/down` is `(h − lo)/(−down)` exactly.
     //
-    // Up, `(hi − h)/0` where nothing rises (`up` is then +0, never NaN), not 1/1: the
-    // comparison below then never takes it (`≥ 0 < +0` fails), where 1/1 was taken only
-    // with the down fraction above 1, whose quotient is then ≥ 1 and the factor 1 all the
-    // same; so the same bits, without a compare and two blends a vector
-    // (`tests::the_limiter_is_the_plain_least_room_over_rise`). Down has no such
-    // shortcut: the comparison's tie goes to it.
+    // Where nothing rises a way, not 1/1 but a fraction that gives the same bits with
+    // fewer blends (`tests::the_limiter_is_the_plain_least_room_over_rise`):
+    // - up, `(hi − h)/0` (`up` is then +0, never NaN): the comparison below never takes
+    //   it (`≥ 0 < +0` fails), where 1/1 was taken only with the down fraction above 1,
+    //   whose quotient is then ≥ 1 and the factor 1 all the same (a compare and two
+    //   blends a vector fewer);
+    // - down, `1/0` (`0 − down` is +0, where `−down` is −0): the up fraction is then
+    //   taken wherever something rises, whose factor is its quotient where it is below 1
+    //   (as when 1/1 was taken over it) and 1 elsewhere; where nothing rises either way,
+    //   `1/0` is taken and the factor is 1 (a blend a vector fewer). Its room `h − lo`
+    //   would not do: at a cell that is its neighbours' lowest, `0/0` would be taken
+    //   over the up fraction (the comparison's tie goes to down).
     let (up_room, up_rise) = (hi - h, up);
-    let (down_room, down_rise) = if down < 0.0 {
-        (h - lo, -down)
-    } else {
-        (1.0, 1.0)
-    };
+    let down_room = if down < 0.0 { h - lo } else { 1.0 };
+    let down_rise = 0.0 - down;
     let up_first = up_room * down_rise < down_room * up_rise;
     let (room, rise) = if up_first {
         (up_room, up_rise)
     } else {
         (down_room, down_rise)
     };
-    // No maximum with 0: `room` is `hi − h` or `h − lo`, ≥ +0 (`hi` and `lo` take `h`
-    // in), and `rise` > 0 or 1, so the quotient is ≥ +0 or NaN, which the minimum makes 1.
+    // No maximum with 0: `room` is `hi − h`, `h − lo` or 1, ≥ +0 (`hi` and `lo` take `h`
+    // in), and `rise` ≥ +0, so the quotient is ≥ +0 or NaN, which the minimum makes 1.
     smaller(room / rise, 1.0)
 }
 
