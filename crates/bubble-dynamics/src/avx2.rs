@@ -586,6 +586,7 @@ pub(crate) unsafe fn coriolis_terms(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bits::differing_bits;
 
     /// A repeatable number in `[-0.5, 0.5)` for `i`.
     fn rough(i: usize) -> f64 {
@@ -625,11 +626,8 @@ mod tests {
             let (w, z, u) = row_inputs(n, n);
             let (fast, plain) = (run_row(&w, &z, &u, false), run_row(&w, &z, &u, true));
             assert!(plain.iter().any(|&r| r != 0.0), "n {n}: no terms");
-            let differ = fast
-                .iter()
-                .zip(&plain)
-                .filter(|(a, b)| a.to_bits() != b.to_bits());
-            assert_eq!(differ.count(), 0, "n {n}: terms differ");
+            let differ = differing_bits(&fast, &plain);
+            assert_eq!(differ, 0, "n {n}: terms differ");
         }
     }
 

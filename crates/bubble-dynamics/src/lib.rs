@@ -23,6 +23,8 @@
 //! ```
 
 mod avx2;
+#[cfg(test)]
+mod bits;
 mod bubble;
 mod collide;
 mod collider;

@@ -1043,6 +1043,7 @@ fn largest_magnitude(values: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bits::differing_bits;
 
     fn rotation_about_z(grid: &CubeSphere, omega: f64) -> Vec<f64> {
         grid.edges()
@@ -1212,11 +1213,8 @@ mod tests {
                     fast != run_unchanged(&rows, &field),
                     "{what}: the field moved"
                 );
-                let differ = fast
-                    .iter()
-                    .zip(&plain)
-                    .filter(|(a, b)| a.to_bits() != b.to_bits());
-                assert_eq!(differ.count(), 0, "{what}: edges differ");
+                let differ = differing_bits(&fast, &plain);
+                assert_eq!(differ, 0, "{what}: edges differ");
             }
         }
     }
@@ -1343,11 +1341,8 @@ mod tests {
                 for (name, got, want) in
                     [("edges", dst, &apart.0), ("vorticity", vorticity, &apart.1)]
                 {
-                    let differ = got
-                        .iter()
-                        .zip(want)
-                        .filter(|(a, b)| a.to_bits() != b.to_bits());
-                    assert_eq!(differ.count(), 0, "{what}: {name} differ");
+                    let differ = differing_bits(&got, want);
+                    assert_eq!(differ, 0, "{what}: {name} differ");
                 }
             }
         }
@@ -1439,11 +1434,8 @@ mod tests {
                 };
                 let (through, from_grid) = (run(false), run(true));
                 assert_ne!(through, start, "n {n}, radius {radius}: nothing moved");
-                let differ = through
-                    .iter()
-                    .zip(&from_grid)
-                    .filter(|(a, b)| a.to_bits() != b.to_bits());
-                assert_eq!(differ.count(), 0, "n {n}, radius {radius}: edges differ");
+                let differ = differing_bits(&through, &from_grid);
+                assert_eq!(differ, 0, "n {n}, radius {radius}: edges differ");
             }
         }
     }
@@ -1482,12 +1474,9 @@ mod tests {
                     };
                     let (fused, apart) = (run(true), run(false));
                     assert_ne!(fused, start, "n {n}, radius {radius}: nothing moved");
-                    let differ = fused
-                        .iter()
-                        .zip(&apart)
-                        .filter(|(a, b)| a.to_bits() != b.to_bits());
+                    let differ = differing_bits(&fused, &apart);
                     let what = format!("n {n}, radius {radius}, from grid {from_grid}, g {g}");
-                    assert_eq!(differ.count(), 0, "{what}: edges differ");
+                    assert_eq!(differ, 0, "{what}: edges differ");
                 }
             }
         }

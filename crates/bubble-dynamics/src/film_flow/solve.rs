@@ -1277,6 +1277,7 @@ fn power_of_two_below(x: f64) -> f64 {
 mod tests {
     use super::layout::{RIGHT_W, TOP_W};
     use super::*;
+    use crate::bits::differing_bits;
     use crate::film_flow::grid::parent_cell;
 
     /// `(diag(alpha) + L_w) x` in the grid's own numbering, straight from its edges.
@@ -1342,11 +1343,8 @@ mod tests {
             let (fast, fast_report) = solve_on_this_thread(n, false);
             let (plain, plain_report) = solve_on_this_thread(n, true);
             assert_eq!(fast_report, plain_report, "n {n}");
-            let differ = fast
-                .iter()
-                .zip(&plain)
-                .filter(|(a, b)| a.to_bits() != b.to_bits());
-            assert_eq!(differ.count(), 0, "n {n}: cells differ");
+            let differ = differing_bits(&fast, &plain);
+            assert_eq!(differ, 0, "n {n}: cells differ");
             assert!(fast_report.iterations >= 2, "n {n}: {fast_report:?}");
         }
     }
@@ -1537,12 +1535,9 @@ mod tests {
                 "n {n}, face 0's mass term: {face}, f32: {f32s}"
             );
             assert!(report.iterations >= 1, "{report:?}");
-            let differ = x
-                .iter()
-                .zip(&plain)
-                .filter(|(a, b)| a.to_bits() != b.to_bits());
+            let differ = differing_bits(&x, &plain);
             let change = change.map(|c| c[0]);
-            assert_eq!(differ.count(), 0, "change {change:?}, f32: {f32s}");
+            assert_eq!(differ, 0, "change {change:?}, f32: {f32s}");
         }
     }
 

@@ -879,6 +879,7 @@ pub(super) fn viscous_bound(g: &CubeSphere) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use crate::bits::differing_bits;
     use std::sync::Arc;
 
     use glam::DVec3;
@@ -960,11 +961,8 @@ mod tests {
                     let what =
                         format!("n {n}, weights {weights:?}, last {last}, reverse {reverse}");
                     for (name, got, want) in [("u", &got.0, &want.0), ("stage", &got.1, &want.1)] {
-                        let differ = got
-                            .iter()
-                            .zip(want)
-                            .filter(|(a, b)| a.to_bits() != b.to_bits());
-                        assert_eq!(differ.count(), 0, "{what}: {name} differs");
+                        let differ = differing_bits(got, want);
+                        assert_eq!(differ, 0, "{what}: {name} differs");
                     }
                 }
             }
@@ -1074,12 +1072,9 @@ mod tests {
                 };
                 f.viscous_step_to_grid(&mut start.clone(), &mut v, nu, dt, first_reverse);
                 assert_ne!(want, rough, "n {n}: nothing moved");
-                let differ = want
-                    .iter()
-                    .zip(&v.stage)
-                    .filter(|(a, b)| a.to_bits() != b.to_bits());
+                let differ = differing_bits(&want, &v.stage);
                 let what = format!("n {n}, {substeps} sub-steps, first reverse {first_reverse}");
-                assert_eq!(differ.count(), 0, "{what}: edges differ");
+                assert_eq!(differ, 0, "{what}: edges differ");
             }
         }
     }
