@@ -272,11 +272,7 @@ const PAIRS_CHUNK: usize = 8;
 /// face row's cells to its two colours); copies, so the same bits either way.
 #[inline(always)]
 pub(crate) fn deinterleave_f64(values: &[f64], even: &mut [f64], odd: &mut [f64]) -> usize {
-    let half = PAIRS_CHUNK / 2;
-    let chunks = (values.len() / PAIRS_CHUNK)
-        .min(even.len() / half)
-        .min(odd.len() / half);
-    let done = chunks * PAIRS_CHUNK;
+    let done = whole_chunks(PAIRS_CHUNK, values.len(), [even.len(), odd.len()]);
     let (values, even, odd) = (&values[..done], &mut even[..done / 2], &mut odd[..done / 2]);
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && !portable_only() {
@@ -284,13 +280,30 @@ pub(crate) fn deinterleave_f64(values: &[f64], even: &mut [f64], odd: &mut [f64]
         unsafe { deinterleave_f64_avx2(values, even, odd) };
         return done;
     }
+    deinterleave_portable(PAIRS_CHUNK, values, even, odd);
+    done
+}
+
+/// How many leading values fill whole chunks of `chunk` in a run of `len` and, at half
+/// a chunk each, in both halves `halves` long: what the (de)interleaves take.
+#[inline(always)]
+fn whole_chunks(chunk: usize, len: usize, halves: [usize; 2]) -> usize {
+    let half = chunk / 2;
+    let chunks = (len / chunk).min(halves[0] / half).min(halves[1] / half);
+    chunks * chunk
+}
+
+/// The deinterleaves' portable loop over `values` cut to whole chunks of `chunk`:
+/// `even[k] = values[2k]`, `odd[k] = values[2k + 1]`.
+#[inline(always)]
+fn deinterleave_portable<T: Copy>(chunk: usize, values: &[T], even: &mut [T], odd: &mut [T]) {
+    let half = chunk / 2;
     let halves = even.chunks_exact_mut(half).zip(odd.chunks_exact_mut(half));
-    for (v, (e, o)) in values.chunks_exact(PAIRS_CHUNK).zip(halves) {
+    for (v, (e, o)) in values.chunks_exact(chunk).zip(halves) {
         for k in 0..half {
             (e[k], o[k]) = (v[2 * k], v[2 * k + 1]);
         }
     }
-    done
 }
 
 /// [`deinterleave_f64`]'s chunks in AVX2 registers (the slices cut to whole chunks).
@@ -326,11 +339,7 @@ const PAIRS_CHUNK_F32: usize = 16;
 /// a value); copies, so the same bits either way.
 #[inline(always)]
 pub(crate) fn deinterleave_f32(values: &[f32], even: &mut [f32], odd: &mut [f32]) -> usize {
-    let half = PAIRS_CHUNK_F32 / 2;
-    let chunks = (values.len() / PAIRS_CHUNK_F32)
-        .min(even.len() / half)
-        .min(odd.len() / half);
-    let done = chunks * PAIRS_CHUNK_F32;
+    let done = whole_chunks(PAIRS_CHUNK_F32, values.len(), [even.len(), odd.len()]);
     let (values, even, odd) = (&values[..done], &mut even[..done / 2], &mut odd[..done / 2]);
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && !portable_only() {
@@ -338,12 +347,7 @@ pub(crate) fn deinterleave_f32(values: &[f32], even: &mut [f32], odd: &mut [f32]
         unsafe { deinterleave_f32_avx2(values, even, odd) };
         return done;
     }
-    let halves = even.chunks_exact_mut(half).zip(odd.chunks_exact_mut(half));
-    for (v, (e, o)) in values.chunks_exact(PAIRS_CHUNK_F32).zip(halves) {
-        for k in 0..half {
-            (e[k], o[k]) = (v[2 * k], v[2 * k + 1]);
-        }
-    }
+    deinterleave_portable(PAIRS_CHUNK_F32, values, even, odd);
     done
 }
 
@@ -381,10 +385,7 @@ fn deinterleave_f32_avx2(values: &[f32], even: &mut [f32], odd: &mut [f32]) {
 #[inline(always)]
 pub(crate) fn interleave_f64(even: &[f64], odd: &[f64], out: &mut [f64]) -> usize {
     let half = PAIRS_CHUNK / 2;
-    let chunks = (out.len() / PAIRS_CHUNK)
-        .min(even.len() / half)
-        .min(odd.len() / half);
-    let done = chunks * PAIRS_CHUNK;
+    let done = whole_chunks(PAIRS_CHUNK, out.len(), [even.len(), odd.len()]);
     let (even, odd, out) = (&even[..done / 2], &odd[..done / 2], &mut out[..done]);
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && !portable_only() {
