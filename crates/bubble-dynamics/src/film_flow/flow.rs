@@ -612,6 +612,7 @@ impl FilmFlow {
         let shared = Shared {
             gather: &mut s.gather,
             seam_ends: &mut s.seam_ends,
+            laplacian: &mut s.cell,
         };
         let scratch = (&mut s.capillary, shared);
         smooth_thickness(&self.grid, sides, c, (dt_s, thin), h, scratch)
