@@ -607,3 +607,13 @@ fn capillary_smoothing_of_a_thick_pooled_film_stays_bounded_and_conserves_liquid
         "the pool's edge stayed sharp: {before:e} → {after:e} m"
     );
 }
+
+#[test]
+fn capillary_smoothing_joined_to_the_transport_decays_at_the_thin_film_rate() {
+    // The l = 4 bump of the test above in steps short enough for the smoothing to take
+    // one sub-step a step, which then joins the thickness transport's (capillary::Term):
+    // the same rate within the same bound (19.73/s either way, against 20.83/s).
+    let (measured, expected) = capillary_decay(16, 4, 50e-6, 1e-6, 10_000);
+    eprintln!("joined capillary l = 4: decay {measured:.4}/s, expected {expected:.4}/s");
+    assert_rel("joined capillary decay l = 4", measured, expected, 0.10);
+}

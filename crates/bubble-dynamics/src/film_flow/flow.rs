@@ -17,7 +17,9 @@ use glam::DVec3;
 
 use super::advect::{AdvectionGeometry, AdvectionScratch, advect_momentum};
 use super::burst::{BurstParams, BurstState, Hole};
-use super::capillary::{Capillary, CapillaryScratch, Shared, smooth_thickness};
+use super::capillary::{
+    Capillary, CapillaryScratch, Mobility, Shared, one_substep, smooth_thickness,
+};
 use super::compare::larger;
 use super::face_geometry::{EdgeVector, FaceGeometry};
 use super::face_rows::FaceRows;
@@ -211,7 +213,7 @@ pub(super) struct Scratch {
     /// The Marangoni system's right-hand side, then the surfactant the step ends with.
     pub(super) rhs: Vec<f64>,
     advect: AdvectionScratch,
-    capillary: CapillaryScratch,
+    pub(super) capillary: CapillaryScratch,
     /// The cell-by-cell gathers' buffers ([`GatherScratch`]).
     pub(super) gather: GatherScratch,
     /// The seam edges' end values for the edge passes ([`SeamEnds`]).
@@ -399,10 +401,14 @@ impl FilmFlow {
             m.hold(&mut self.u_m_per_s, &mut s.drag);
         }
         let report = self.marangoni_implicit(&mut s, dt_s);
-        self.transport_thickness(&mut s, dt_s, forcing.g_eff_m_per_s2);
+        // The smoothing joins the transport's sub-step where each takes one
+        // ([`capillary::Term`]: the splitting and its stability), else runs after it.
+        let capillary = self.capillary_term(&mut s, dt_s);
+        let g_eff = forcing.g_eff_m_per_s2;
+        let joined = self.transport_thickness(&mut s, (dt_s, g_eff), capillary);
         // A uniform evaporation joins the smoothing's last apply, where it has one.
-        let thin = self.uniform_evaporation(dt_s);
-        if !self.capillary_smoothing(&mut s, dt_s, thin) {
+        let thin = self.uniform_evaporation(dt_s).filter(|_| !joined);
+        if joined || !self.capillary_smoothing(&mut s, dt_s, thin) {
             self.evaporate(dt_s);
         }
         self.feed_meniscus(dt_s);
@@ -591,21 +597,40 @@ impl FilmFlow {
         self.meniscus.is_none()
     }
 
+    /// The capillary smoothing's one sub-step from the thickness the transport starts
+    /// from, its Laplacian into `s.capillary` (module `capillary`); `None` without
+    /// drainage, where the step cannot see it, or where it takes more sub-steps.
+    #[inline(never)] // its own frame in a profile (perf report names the step's parts)
+    fn capillary_term(&mut self, s: &mut Scratch, dt_s: f64) -> Option<(Mobility, f64)> {
+        let c = self.capillary()?;
+        let buffers = (&mut s.capillary, &mut s.gather, &mut s.seam_ends);
+        let grid = (&*self.grid, &*self.sides);
+        one_substep(grid, c, dt_s, &self.h_m, buffers)
+    }
+
+    /// The smoothing's parameters; `None` without drainage (immobile liquid between the
+    /// surfaces) or surface tension.
+    fn capillary(&self) -> Option<Capillary> {
+        let p = &self.params;
+        let mu = p.drainage_viscosity_pa_s;
+        if !(mu.is_finite() && mu > 0.0 && p.burst.sigma_n_per_m > 0.0) {
+            return None;
+        }
+        Some(Capillary {
+            sigma_n_per_m: p.burst.sigma_n_per_m,
+            drainage_viscosity_pa_s: mu,
+            radius_m: p.radius_m,
+        })
+    }
+
     /// The capillary pressure's flow relative to the surfaces (module `capillary`); none
     /// without drainage (immobile liquid between the surfaces). Where `thin`, its last
     /// apply thins every cell by it too (kept ≥ 0, as [`Self::evaporate`]): returns
     /// whether it did.
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn capillary_smoothing(&mut self, s: &mut Scratch, dt_s: f64, thin: Option<f64>) -> bool {
-        let p = &self.params;
-        let mu = p.drainage_viscosity_pa_s;
-        if !(mu.is_finite() && mu > 0.0 && p.burst.sigma_n_per_m > 0.0) {
+        let Some(c) = self.capillary() else {
             return false;
-        }
-        let c = Capillary {
-            sigma_n_per_m: p.burst.sigma_n_per_m,
-            drainage_viscosity_pa_s: mu,
-            radius_m: p.radius_m,
         };
         let sides = &self.sides;
         let h = &mut self.h_m;

@@ -11,6 +11,7 @@
 
 use glam::DVec3;
 
+use super::capillary::{Mobility, Term};
 use super::compare::larger;
 use super::face_geometry::FaceGeometry;
 use super::flow::{FilmFlow, Scratch};
@@ -33,8 +34,17 @@ impl FilmFlow {
     /// Courant number read the velocities, thicknesses and normals again (14 k cache lines
     /// a step at n = 64) for the one sub-step a film in the optics' range takes; and the
     /// thickness copied aside in case (0.2 MB a step) cost as much.
+    ///
+    /// Where `capillary` (the smoothing's one sub-step, its Laplacian in
+    /// `s.capillary`), the one sub-step takes the smoothing's volumes too ([`Term`]):
+    /// returns whether it did (not where the Courant number asks for more sub-steps).
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
-    pub(super) fn transport_thickness(&mut self, s: &mut Scratch, dt_s: f64, g_eff: DVec3) {
+    pub(super) fn transport_thickness(
+        &mut self,
+        s: &mut Scratch,
+        (dt_s, g_eff): (f64, DVec3),
+        capillary: Option<(Mobility, f64)>,
+    ) -> bool {
         let p = self.params;
         let drain = if p.drainage_viscosity_pa_s.is_finite() && p.drainage_viscosity_pa_s > 0.0 {
             p.density_kg_per_m3 / (3.0 * p.drainage_viscosity_pa_s)
@@ -42,18 +52,19 @@ impl FilmFlow {
             0.0
         };
         let drain = Drain { drain, g_eff };
-        let courant = self.upwind_substep(s, dt_s, drain, true) * dt_s / p.radius_m;
+        let courant = self.upwind_substep(s, dt_s, drain, Some(capillary)) * dt_s / p.radius_m;
         // A cell drains through at most two edges of a smooth flow: 2·courant per step, kept
         // within one sub-step's content; the outflow limit guards the rest.
         let substeps = (2.0 * courant).ceil().clamp(1.0, f64::from(MAX_SUBSTEPS)) as u32;
         if substeps == 1 {
             std::mem::swap(&mut self.h_m, &mut s.cell);
-            return;
+            return capillary.is_some();
         }
         let h_dt = dt_s / f64::from(substeps);
         for _ in 0..substeps {
-            self.upwind_substep(s, h_dt, drain, false);
+            self.upwind_substep(s, h_dt, drain, None);
         }
+        false
     }
 
     /// One transport of `h` over `dt_s`: second-order upwind (the upwind cell's
@@ -61,9 +72,18 @@ impl FilmFlow {
     /// midpoint and clamped between the two cells' values), outflow-limited: one limited
     /// apply of the [`upwind::Volumes`], band by band. Where `courant`, out of place into
     /// `s.cell` (`h_m` unchanged), returning the fastest edge's characteristic speed over
-    /// its smaller cell's width ([`Fastest`]); else in place, returning 0.
+    /// its smaller cell's width ([`Fastest`]), and the capillary [`Term`] where given;
+    /// else in place, returning 0.
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
-    fn upwind_substep(&mut self, s: &mut Scratch, dt_s: f64, drain: Drain, courant: bool) -> f64 {
+    fn upwind_substep(
+        &mut self,
+        s: &mut Scratch,
+        dt_s: f64,
+        drain: Drain,
+        courant: Option<Option<(Mobility, f64)>>,
+    ) -> f64 {
+        let capillary = courant.flatten();
+        let courant = courant.is_some();
         let mut fastest = Fastest {
             speed: std::mem::take(&mut s.edge2),
             fastest: 0.0,
@@ -80,6 +100,7 @@ impl FilmFlow {
             rises: &mut s.rises,
             seam_ends: &mut s.seam_ends,
             fastest: courant.then_some(&mut fastest),
+            capillary: capillary.map(|c| Term::new(&s.capillary.laplacian, c)),
         };
         let (sides, grid, gather) = (&self.sides, &self.grid, &mut s.gather);
         if courant {
@@ -217,16 +238,16 @@ mod tests {
             g_eff,
         };
         let mut taken = film.clone();
-        taken.transport_thickness(&mut Scratch::default(), dt_s, g_eff);
+        taken.transport_thickness(&mut Scratch::default(), (dt_s, g_eff), None);
         // The Courant number from a sub-step of its own, then the sub-steps from the start.
         let fastest = film
             .clone()
-            .upwind_substep(&mut Scratch::default(), dt_s, drain, true);
+            .upwind_substep(&mut Scratch::default(), dt_s, drain, Some(None));
         let substeps = (2.0 * fastest * dt_s / params.radius_m).ceil() as u32;
         assert!(substeps > 1, "{substeps} sub-step: the test is idle");
         let mut s = Scratch::default();
         for _ in 0..substeps {
-            film.upwind_substep(&mut s, dt_s / f64::from(substeps), drain, false);
+            film.upwind_substep(&mut s, dt_s / f64::from(substeps), drain, None);
         }
         let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&taken.h_m), bits(&film.h_m));

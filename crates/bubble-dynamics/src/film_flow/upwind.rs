@@ -20,6 +20,7 @@
 
 use std::ops::Range;
 
+use super::capillary::Term;
 use super::compare::{larger, smaller};
 use super::face_geometry::FaceGeometry;
 use super::fluxes::{BAND, EdgeValues};
@@ -417,6 +418,8 @@ pub(crate) struct Volumes<'a> {
     pub(crate) seam_ends: &'a mut SeamEnds,
     /// Where the Courant number is taken alongside, its fastest edge so far.
     pub(crate) fastest: Option<&'a mut Fastest>,
+    /// Where the capillary smoothing joins the sub-step, its volumes' term.
+    pub(crate) capillary: Option<Term<'a>>,
 }
 
 impl EdgeValues for Volumes<'_> {
@@ -428,6 +431,17 @@ impl EdgeValues for Volumes<'_> {
         let fastest = self.fastest.as_deref_mut();
         let fastest = fastest.map(|f| (f, seams.len));
         volumes_block(seams, h_ends, rises, (self.fg, self.speeds), (out, fastest));
+        if let Some(term) = &self.capillary {
+            let [ha, hb] = h_ends;
+            let (l, per_d) = (
+                seams.constant(&self.fg.length),
+                seams.constant(&self.fg.inverse_dual_length),
+            );
+            for i in 0..seams.len {
+                let ends = seams.ends(i, term.laplacian);
+                out[i] += term.volume([ha[i], hb[i]], ends, [l[i], per_d[i]]);
+            }
+        }
     }
 
     #[inline(always)]
@@ -458,6 +472,9 @@ impl EdgeValues for Volumes<'_> {
             (self.fg, self.speeds),
             (out, fastest.map(|f| (f, edges))),
         );
+        if let Some(term) = &self.capillary {
+            capillary_block(term, run, [ha, hb], self.fg, out);
+        }
     }
 }
 
@@ -492,6 +509,28 @@ fn volumes_block(
                 }
             },
         ),
+    }
+}
+
+/// A block's capillary volumes ([`Term`]) added to its volumes in `out`.
+#[inline(always)]
+fn capillary_block(
+    term: &Term,
+    run: EdgeRun,
+    [ha, hb]: [&[f64]; 2],
+    fg: &FaceGeometry,
+    out: &mut [f64],
+) {
+    let len = run.count();
+    let (la, lb) = run.ends(term.laplacian);
+    let (l, per_d) = (
+        run.constant(&fg.length),
+        run.constant(&fg.inverse_dual_length),
+    );
+    let (ha, hb, la, lb) = (&ha[..len], &hb[..len], &la[..len], &lb[..len]);
+    let (l, per_d, out) = (&l[..len], &per_d[..len], &mut out[..len]);
+    for i in 0..len {
+        out[i] += term.volume([ha[i], hb[i]], [la[i], lb[i]], [l[i], per_d[i]]);
     }
 }
 
@@ -635,6 +674,7 @@ mod tests {
                 rises: &mut rises,
                 seam_ends: &mut seam_ends,
                 fastest: Some(&mut fastest),
+                capillary: None,
             };
             let mut kept = Kept {
                 pass: volumes,
