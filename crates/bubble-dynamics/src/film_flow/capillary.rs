@@ -54,10 +54,6 @@ pub(crate) struct CapillaryScratch {
     /// The grid's Laplacian ∞-norm on the unit sphere and the cell count it is for (it
     /// depends on the grid alone).
     laplacian_norm: Option<(usize, f64)>,
-    /// The thickness's Laplacian per cell, per m, where the smoothing joins the
-    /// thickness transport ([`Term`]: the transport's out-of-place sub-step writes
-    /// `Scratch::cell`).
-    pub(crate) laplacian: Vec<f64>,
 }
 
 /// Buffers the smoothing shares with the step's other passes: the gathers', the seams'
@@ -159,8 +155,8 @@ fn plan(
 /// Why: the smoothing's own limited apply, a second pass over the thickness after the
 /// transport's, cost about 30 M instructions over `film_profile 64 0 9.81`'s 40 steps;
 /// joined, the term costs the transport about 10 M, and the step went from 581.8 M to
-/// 564.7 M instructions (its LL misses from 11.00 M to 11.22 M: the Laplacian is
-/// written, and read by the transport, from a buffer of its own).
+/// 564.5 M instructions (its LL misses from 11.00 M to 11.13 M: the Laplacian, a pass of
+/// its own before the transport, is read back by the transport partly from beyond L2).
 /// The splitting: the transport and the smoothing both take their rates from the
 /// thickness at the step's start (an unsplit forward Euler step of their sum) where the
 /// smoothing took the transported thickness (Lie splitting); both are first order in
@@ -180,24 +176,19 @@ pub(crate) struct Term<'a> {
 }
 
 /// The smoothing's one sub-step over `dt_s` as a [`Term`]'s mobility and step over R²,
-/// its Laplacian into `s.laplacian`; `None` where the step cannot see it or it takes
-/// more than one sub-step.
+/// its Laplacian into `shared.laplacian`; `None` where the step cannot see it or it
+/// takes more than one sub-step.
 pub(crate) fn one_substep(
     (grid, sides): (&CubeSphere, &CellSides),
     c: Capillary,
     dt_s: f64,
     h_m: &[f64],
-    (s, gather, seam_ends): (&mut CapillaryScratch, &mut GatherScratch, &mut SeamEnds),
+    (s, shared): (&mut CapillaryScratch, Shared),
 ) -> Option<(Mobility, f64)> {
     let (substeps, mobility, sub_dt) = plan(grid, c, dt_s, h_m, s)?;
     if substeps != 1 {
         return None;
     }
-    let shared = Shared {
-        gather,
-        seam_ends,
-        laplacian: &mut s.laplacian,
-    };
     laplacian(grid, sides, c.radius_m, h_m, shared);
     Some((mobility, sub_dt / (c.radius_m * c.radius_m)))
 }

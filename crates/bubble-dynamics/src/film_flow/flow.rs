@@ -213,7 +213,7 @@ pub(super) struct Scratch {
     /// The Marangoni system's right-hand side, then the surfactant the step ends with.
     pub(super) rhs: Vec<f64>,
     advect: AdvectionScratch,
-    pub(super) capillary: CapillaryScratch,
+    capillary: CapillaryScratch,
     /// The cell-by-cell gathers' buffers ([`GatherScratch`]).
     pub(super) gather: GatherScratch,
     /// The seam edges' end values for the edge passes ([`SeamEnds`]).
@@ -598,12 +598,21 @@ impl FilmFlow {
     }
 
     /// The capillary smoothing's one sub-step from the thickness the transport starts
-    /// from, its Laplacian into `s.capillary` (module `capillary`); `None` without
-    /// drainage, where the step cannot see it, or where it takes more sub-steps.
+    /// from, its Laplacian into `s.cell2` (module `capillary`); `None` without drainage,
+    /// where the step cannot see it, or where it takes more sub-steps.
+    ///
+    /// Why `s.cell2`: the Marangoni step has just read the surfactant the step started
+    /// with from it (swapped there), so it is spent and partly in cache, where a buffer
+    /// of the smoothing's own was written cold.
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn capillary_term(&mut self, s: &mut Scratch, dt_s: f64) -> Option<(Mobility, f64)> {
         let c = self.capillary()?;
-        let buffers = (&mut s.capillary, &mut s.gather, &mut s.seam_ends);
+        let shared = Shared {
+            gather: &mut s.gather,
+            seam_ends: &mut s.seam_ends,
+            laplacian: &mut s.cell2,
+        };
+        let buffers = (&mut s.capillary, shared);
         let grid = (&*self.grid, &*self.sides);
         one_substep(grid, c, dt_s, &self.h_m, buffers)
     }

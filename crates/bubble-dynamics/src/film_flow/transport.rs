@@ -36,7 +36,7 @@ impl FilmFlow {
     /// thickness copied aside in case (0.2 MB a step) cost as much.
     ///
     /// Where `capillary` (the smoothing's one sub-step, its Laplacian in
-    /// `s.capillary`), the one sub-step takes the smoothing's volumes too ([`Term`]):
+    /// `s.cell2`), the one sub-step takes the smoothing's volumes too ([`Term`]):
     /// returns whether it did (not where the Courant number asks for more sub-steps).
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     pub(super) fn transport_thickness(
@@ -100,7 +100,7 @@ impl FilmFlow {
             rises: &mut s.rises,
             seam_ends: &mut s.seam_ends,
             fastest: courant.then_some(&mut fastest),
-            capillary: capillary.map(|c| Term::new(&s.capillary.laplacian, c)),
+            capillary: capillary.map(|c| Term::new(&s.cell2, c)),
         };
         let (sides, grid, gather) = (&self.sides, &self.grid, &mut s.gather);
         if courant {
