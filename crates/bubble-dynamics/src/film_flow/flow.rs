@@ -29,6 +29,7 @@ use super::meniscus::MeniscusState;
 use super::sides::{CellSides, EdgeBlock, SeamEnds};
 use super::solve::{Hierarchy, SolveReport, Work};
 use super::thermal::{ThermalParams, up_from};
+use super::transport::Joined;
 use super::upwind::{Rises, UpwindGeometry};
 use super::viscosity::{ViscousScratch, viscous_bound};
 use crate::avx2::with_avx2;
@@ -403,12 +404,16 @@ impl FilmFlow {
         let report = self.marangoni_implicit(&mut s, dt_s);
         // The smoothing joins the transport's sub-step where each takes one
         // ([`capillary::Term`]: the splitting and its stability), else runs after it.
-        let capillary = self.capillary_term(&mut s, dt_s);
-        let g_eff = forcing.g_eff_m_per_s2;
-        let joined = self.transport_thickness(&mut s, (dt_s, g_eff), capillary);
         // A uniform evaporation joins the smoothing's last apply, where it has one.
-        let thin = self.uniform_evaporation(dt_s).filter(|_| !joined);
-        if joined || !self.capillary_smoothing(&mut s, dt_s, thin) {
+        let thin = self.uniform_evaporation(dt_s);
+        let capillary = self.capillary_term(&mut s, dt_s);
+        let joined = capillary.map(|capillary| Joined { capillary, thin });
+        let g_eff = forcing.g_eff_m_per_s2;
+        if self.transport_thickness(&mut s, (dt_s, g_eff), joined) {
+            if thin.is_none() {
+                self.evaporate(dt_s);
+            }
+        } else if !self.capillary_smoothing(&mut s, dt_s, thin) {
             self.evaporate(dt_s);
         }
         self.feed_meniscus(dt_s);

@@ -529,6 +529,41 @@ impl Moved for Thinned<'_> {
     }
 }
 
+/// An [`OutOfPlace`] field whose new values are each then thinned by `by`, kept ≥ 0 (as
+/// [`Thinned`]).
+///
+/// Why: where the capillary smoothing joins the thickness transport's out-of-place
+/// sub-step, the uniform evaporation joins it too, as it joined the smoothing's last
+/// apply (a pass of its own over the thickness otherwise).
+pub(crate) struct ThinnedOutOfPlace<'a> {
+    /// The values before and after.
+    pub(crate) moved: OutOfPlace<'a>,
+    /// What each new value loses.
+    pub(crate) by: f64,
+}
+
+impl Moved for ThinnedOutOfPlace<'_> {
+    #[inline(always)]
+    fn before(&self) -> &[f64] {
+        self.moved.before
+    }
+
+    #[inline(always)]
+    fn add(&mut self, at: usize, len: usize, gain: impl Fn(usize) -> f64) {
+        let by = self.by;
+        let m = &mut self.moved;
+        let (x, out) = (&m.before[at..at + len], &mut m.after[at..at + len]);
+        for i in 0..len {
+            out[i] = (x[i] + gain(i) - by).max(0.0);
+        }
+    }
+
+    #[inline(always)]
+    fn set(&mut self, c: usize, value: f64) {
+        self.moved.after[c] = (value - self.by).max(0.0);
+    }
+}
+
 /// [`apply_limited`] on a [`Moved`] field: in place, or out of place.
 // Inlined into the callers, so `pass` compiles into the AVX2 closure.
 #[inline(always)]
@@ -1070,6 +1105,15 @@ mod tests {
             apply_limited_to(&sides, &grid, pass, 0.3, thinned, &mut scratch);
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&got), bits(&want), "n = {n}");
+            // Out of place, every value written (NaN before).
+            let mut after = vec![f64::NAN; values.len()];
+            let moved = OutOfPlace {
+                before: &values,
+                after: &mut after,
+            };
+            let thinned = &mut ThinnedOutOfPlace { moved, by };
+            apply_limited_to(&sides, &grid, pass, 0.3, thinned, &mut scratch);
+            assert_eq!(bits(&after), bits(&want), "n = {n}, out of place");
         }
     }
 

@@ -15,10 +15,20 @@ use super::capillary::{Mobility, Term};
 use super::compare::larger;
 use super::face_geometry::FaceGeometry;
 use super::flow::{FilmFlow, Scratch};
-use super::fluxes::{OutOfPlace, apply_limited, apply_limited_to};
+use super::fluxes::{OutOfPlace, ThinnedOutOfPlace, apply_limited, apply_limited_to};
 use super::grid::dot_at;
 use super::sides::EdgeBlock;
 use super::upwind;
+
+/// What the transport's first sub-step joins: the capillary smoothing's one sub-step
+/// (its [`Term`]'s mobility and step over R²) and, with it, the uniform evaporation.
+#[derive(Clone, Copy)]
+pub(super) struct Joined {
+    /// The smoothing's term.
+    pub(super) capillary: (Mobility, f64),
+    /// The uniform evaporation, m, where there is one.
+    pub(super) thin: Option<f64>,
+}
 
 /// Most sub-steps one thickness transport takes.
 const MAX_SUBSTEPS: u32 = 64;
@@ -35,15 +45,16 @@ impl FilmFlow {
     /// a step at n = 64) for the one sub-step a film in the optics' range takes; and the
     /// thickness copied aside in case (0.2 MB a step) cost as much.
     ///
-    /// Where `capillary` (the smoothing's one sub-step, its Laplacian in
-    /// `s.cell2`), the one sub-step takes the smoothing's volumes too ([`Term`]):
-    /// returns whether it did (not where the Courant number asks for more sub-steps).
+    /// Where `joined` (the smoothing's one sub-step, its Laplacian in `s.cell2`), the
+    /// one sub-step takes the smoothing's volumes too ([`Term`]), and thins every cell by
+    /// the uniform evaporation where there is one: returns whether it did (not where the
+    /// Courant number asks for more sub-steps).
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     pub(super) fn transport_thickness(
         &mut self,
         s: &mut Scratch,
         (dt_s, g_eff): (f64, DVec3),
-        capillary: Option<(Mobility, f64)>,
+        joined: Option<Joined>,
     ) -> bool {
         let p = self.params;
         let drain = if p.drainage_viscosity_pa_s.is_finite() && p.drainage_viscosity_pa_s > 0.0 {
@@ -52,13 +63,13 @@ impl FilmFlow {
             0.0
         };
         let drain = Drain { drain, g_eff };
-        let courant = self.upwind_substep(s, dt_s, drain, Some(capillary)) * dt_s / p.radius_m;
+        let courant = self.upwind_substep(s, dt_s, drain, Some(joined)) * dt_s / p.radius_m;
         // A cell drains through at most two edges of a smooth flow: 2·courant per step, kept
         // within one sub-step's content; the outflow limit guards the rest.
         let substeps = (2.0 * courant).ceil().clamp(1.0, f64::from(MAX_SUBSTEPS)) as u32;
         if substeps == 1 {
             std::mem::swap(&mut self.h_m, &mut s.cell);
-            return capillary.is_some();
+            return joined.is_some();
         }
         let h_dt = dt_s / f64::from(substeps);
         for _ in 0..substeps {
@@ -80,9 +91,9 @@ impl FilmFlow {
         s: &mut Scratch,
         dt_s: f64,
         drain: Drain,
-        courant: Option<Option<(Mobility, f64)>>,
+        courant: Option<Option<Joined>>,
     ) -> f64 {
-        let capillary = courant.flatten();
+        let joined = courant.flatten();
         let courant = courant.is_some();
         let mut fastest = Fastest {
             speed: std::mem::take(&mut s.edge2),
@@ -100,18 +111,24 @@ impl FilmFlow {
             rises: &mut s.rises,
             seam_ends: &mut s.seam_ends,
             fastest: courant.then_some(&mut fastest),
-            capillary: capillary.map(|c| Term::new(&s.cell2, c)),
+            capillary: joined.map(|j| Term::new(&s.cell2, j.capillary)),
         };
         let (sides, grid, gather) = (&self.sides, &self.grid, &mut s.gather);
         if courant {
             // Every cell of `after` is written: its length, not a fill.
             s.cell.resize(self.h_m.len(), 0.0);
             let after = &mut s.cell[..];
-            let h = &mut OutOfPlace {
+            let moved = OutOfPlace {
                 before: &self.h_m,
                 after,
             };
-            apply_limited_to(sides, grid, &mut volumes, 1.0, h, gather);
+            match joined.and_then(|j| j.thin) {
+                None => apply_limited_to(sides, grid, &mut volumes, 1.0, &mut { moved }, gather),
+                Some(by) => {
+                    let h = &mut ThinnedOutOfPlace { moved, by };
+                    apply_limited_to(sides, grid, &mut volumes, 1.0, h, gather);
+                }
+            }
         } else {
             apply_limited(sides, grid, &mut volumes, 1.0, &mut self.h_m, gather);
         }
