@@ -239,11 +239,13 @@ impl FaceRows {
 
     /// The grid's edge values `grid` (in the grid's orientation) into `rows` (each copy
     /// in its own): each face's inner edges are runs of the grid's ([`FaceLayout`](super::grid::FaceLayout), checked
-    /// in [`Self::new`]), copied; the copies on the faces' borders one by one.
+    /// in [`Self::new`]), copied, the faces in reverse order ([`face_order`]: the
+    /// advection's first stage runs them forward); the copies on the faces' borders one
+    /// by one.
     pub(crate) fn to_rows(&self, grid: &[f64], rows: &mut Vec<f64>) {
         // Every entry is written: the buffer needs its length, not a fill.
         rows.resize(self.edge.len(), 0.0);
-        self.for_each_inner_run(face_order(false), |local, at| {
+        self.for_each_inner_run(face_order(true), |local, at| {
             rows[local.clone()].copy_from_slice(&grid[at..at + local.len()]);
         });
         for &k in &self.border_edges {
