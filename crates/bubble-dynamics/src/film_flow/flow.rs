@@ -485,12 +485,12 @@ impl FilmFlow {
             &mut s.advect,
         );
         // Whether the last pass over the rows ended on face 5 ([`face_order`]), where the
-        // next should start: the advection's last stage ends on face 0, a gravity pass of
-        // its own (or the rows taken anew after the thermal stress) on face 5.
-        let mut after_face_5 = false;
+        // next should start: the advection's last stage ends on face 5, and so does a
+        // gravity pass of its own; the rows taken anew after the thermal stress end on
+        // face 0.
+        let mut after_face_5 = true;
         if let (Some(gravity), None) = (&gravity, &along) {
             self.rows.add_gravity(u, gravity);
-            after_face_5 = true;
         }
         match self.params.gradient {
             FilmGradient::TwoPoint => {
@@ -498,7 +498,7 @@ impl FilmFlow {
                     self.rows.to_grid(u, &mut self.u_m_per_s);
                     self.thermal_stress(dt_s, &mut s.vertex);
                     self.rows.to_rows(&self.u_m_per_s, u);
-                    after_face_5 = true;
+                    after_face_5 = false;
                 }
                 // (A grid of one cell a face has no inner edges to keep in the grid's
                 // numbering.)

@@ -35,10 +35,17 @@ pub(super) struct ViscousScratch {
     /// on the faces' borders only (every copy); the inner ones are taken row by row into
     /// [`Self::window`].
     vorticity: Vec<f64>,
-    /// Per cell, in the padded layout (`FaceRows::padded_cell`): the divergence on the
-    /// unit sphere (m/s per rad) of the cells on the faces' borders, and in the halo of
-    /// the cells across them; the inner ones are taken row by row into [`Self::window`].
+    /// Per cell, in the padded layout (`FaceRows::padded_cell`): 4 times the divergence
+    /// on the unit sphere (m/s per rad) of the cells on the faces' borders, and in the
+    /// halo of the cells across them ([`Self::inverse_areas_4`] says why); the inner ones
+    /// are taken row by row into [`Self::window`].
     divergence: Vec<f64>,
+    /// Per cell of face 0, which every face reads ([`FaceRows`] says why): 4 times its
+    /// inverse area, per sr. The divergences are kept 4 times over, so that their
+    /// differences are the stress's `4 grad div` without a multiplication an edge: a
+    /// power of 2 scales a product exactly (short of the subnormals), so the bits are
+    /// those of `4 · ((a − b) · id)`.
+    inverse_areas_4: Vec<f64>,
     /// The rows of vertices and cells a face's edge rows read ([`Window`]).
     window: Window,
     /// Per face, per border of it (its left and right X-edge columns, its bottom and top
@@ -61,7 +68,8 @@ pub(super) struct ViscousScratch {
 struct Window {
     /// Vertex rows `j` at `j mod 2`, `n + 1` each.
     vertex: [Vec<f64>; 2],
-    /// Padded cell rows `p` at `p mod 2`, `n + 2` each (the halo at both ends).
+    /// Padded cell rows `p` at `p mod 2`, `n + 2` each (the halo at both ends): 4 times
+    /// the cells' divergences ([`ViscousScratch::inverse_areas_4`]).
     cell: [Vec<f64>; 2],
 }
 
@@ -143,8 +151,8 @@ impl FilmFlow {
     }
 
     /// A stage's set-up, the same for both of its passes: the border cells' vorticity
-    /// and divergence from `u`, the stage's [`Blend`], and face 0's cells' inverse areas,
-    /// which every face reads ([`FaceRows`] says why).
+    /// and divergence from `u` (with [`ViscousScratch::inverse_areas_4`], taken here the
+    /// first time), and the stage's [`Blend`].
     #[inline(always)]
     fn stage_set_up(
         &self,
@@ -153,19 +161,22 @@ impl FilmFlow {
         nu: f64,
         dt_s: f64,
         (mu, nu_prev): (f64, f64),
-    ) -> (Blend, &[f64]) {
+    ) -> Blend {
         let n = self.rows.n;
-        border_fields(&self.grid, &self.rows, u, v);
+        if v.inverse_areas_4.len() != n * n {
+            let ia = &self.grid.inverse_areas_per_sr()[..n * n];
+            v.inverse_areas_4 = ia.iter().map(|a| 4.0 * a).collect();
+        }
+        border_fields(&self.rows, u, v);
         v.window.prepare(n);
         // Vorticity and divergence per R (of the unit sphere's), and each difference of
         // them per R again: every term of the stress carries 1/R², taken once here.
         let r = self.params.radius_m;
-        let blend = Blend {
+        Blend {
             rate: dt_s * nu / (r * r),
             mu,
             nu_prev,
-        };
-        (blend, &self.grid.inverse_areas_per_sr()[..n * n])
+        }
     }
 
     /// [`Self::viscous_stage`] with the stage before last in the grid's numbering
@@ -181,7 +192,7 @@ impl FilmFlow {
         (last, reverse): (bool, bool),
     ) {
         let rows = &self.rows;
-        let (blend, ia) = self.stage_set_up(u, v, nu, dt_s, (mu, nu_prev));
+        let blend = self.stage_set_up(u, v, nu, dt_s, (mu, nu_prev));
         let n = rows.n;
         let (epf, vpf, cpf) = rows.per_face();
         let ViscousScratch {
@@ -190,6 +201,7 @@ impl FilmFlow {
             divergence,
             window,
             border_prev,
+            inverse_areas_4: ia,
             ..
         } = v;
         // The grid's inner X-edges, then its inner Y-edges, `m` a face (`FaceLayout`).
@@ -238,13 +250,14 @@ impl FilmFlow {
         (last, reverse): (bool, bool),
     ) {
         let rows = &self.rows;
-        let (blend, ia) = self.stage_set_up(u, v, nu, dt_s, (mu, nu_prev));
+        let blend = self.stage_set_up(u, v, nu, dt_s, (mu, nu_prev));
         let (epf, vpf, cpf) = rows.per_face();
         let ViscousScratch {
             stage,
             vorticity,
             divergence,
             window,
+            inverse_areas_4: ia,
             ..
         } = v;
         // Each case its own loops: a test of the case per edge cost the reads and writes
@@ -276,20 +289,22 @@ struct Blend {
 }
 
 impl Blend {
-    /// One edge: the stage before last `y_prev` read where `BLEND` (else the stage, the
-    /// first, is a plain forward-Euler step), and replaced by the edge's `u` on entry where
-    /// `KEEP` (a stage follows). Where `INTO` (the last stage, not `KEEP`), the new value
-    /// goes to `y_prev`, `u` left as it is ([`FilmFlow::viscous_step_to_grid`]).
+    /// One edge, from its `curl curl` and its `4 grad div` (the divergences are kept 4
+    /// times over, [`ViscousScratch::inverse_areas_4`]): the stage before last `y_prev`
+    /// read where `BLEND` (else the stage, the first, is a plain forward-Euler step), and
+    /// replaced by the edge's `u` on entry where `KEEP` (a stage follows). Where `INTO`
+    /// (the last stage, not `KEEP`), the new value goes to `y_prev`, `u` left as it is
+    /// ([`FilmFlow::viscous_step_to_grid`]).
     #[inline(always)]
     fn step<const BLEND: bool, const KEEP: bool, const INTO: bool>(
         self,
         u: &mut f64,
         y_prev: &mut f64,
         curl_curl: f64,
-        grad_div: f64,
+        grad_div_4: f64,
     ) {
         let y = *u;
-        let change = self.rate * (4.0 * grad_div - curl_curl + 2.0 * y);
+        let change = self.rate * (grad_div_4 - curl_curl + 2.0 * y);
         let new = if BLEND {
             self.mu * y + self.nu_prev * *y_prev + change
         } else {
@@ -453,8 +468,8 @@ impl Blend {
         let (il, id, inner) = (&il[..=n], &id[..=n], &mut inner[..n]);
         let [into, from] = [&cells[1..], cells];
         let curl_curl = (head[0] - tail[0]) * il[0];
-        let grad_div = (into[0] - from[0]) * id[0];
-        self.step::<BLEND, KEEP, INTO>(&mut u[0], left, curl_curl, grad_div);
+        let grad_div_4 = (into[0] - from[0]) * id[0];
+        self.step::<BLEND, KEEP, INTO>(&mut u[0], left, curl_curl, grad_div_4);
         let kept = (u[n], inner[n - 1]);
         self.row::<BLEND, KEEP, INTO>(
             &mut u[1..],
@@ -465,8 +480,8 @@ impl Blend {
         );
         (u[n], inner[n - 1]) = kept;
         let curl_curl = (head[n] - tail[n]) * il[n];
-        let grad_div = (into[n] - from[n]) * id[n];
-        self.step::<BLEND, KEEP, INTO>(&mut u[n], right, curl_curl, grad_div);
+        let grad_div_4 = (into[n] - from[n]) * id[n];
+        self.step::<BLEND, KEEP, INTO>(&mut u[n], right, curl_curl, grad_div_4);
     }
 
     /// Y-edge row `y < n` (`u` and `y_prev`) as [`Self::row`] takes it, and in the same
@@ -537,8 +552,8 @@ impl Blend {
             let into = d * ia[x];
             out[x] = into;
             let curl_curl = (head[x] - tail[x]) * il[x];
-            let grad_div = (into - from[x]) * id[x];
-            self.step::<BLEND, KEEP, INTO>(&mut u[x], &mut y_prev[x], curl_curl, grad_div);
+            let grad_div_4 = (into - from[x]) * id[x];
+            self.step::<BLEND, KEEP, INTO>(&mut u[x], &mut y_prev[x], curl_curl, grad_div_4);
         }
     }
 
@@ -568,8 +583,8 @@ impl Blend {
             metric,
         );
         let curl_curl = (head[n] - tail[n]) * il[n];
-        let grad_div = (into[n] - from[n]) * id[n];
-        self.step::<BLEND, KEEP, false>(&mut u[n], &mut y_prev[n], curl_curl, grad_div);
+        let grad_div_4 = (into[n] - from[n]) * id[n];
+        self.step::<BLEND, KEEP, false>(&mut u[n], &mut y_prev[n], curl_curl, grad_div_4);
     }
 
     /// A row of edges: the vorticities at their `[head, tail]`, the divergences of the
@@ -591,8 +606,8 @@ impl Blend {
         let (il, id) = (&il[..len], &id[..len]);
         for i in 0..len {
             let curl_curl = (head[i] - tail[i]) * il[i];
-            let grad_div = (into[i] - from[i]) * id[i];
-            self.step::<BLEND, KEEP, INTO>(&mut u[i], &mut y_prev[i], curl_curl, grad_div);
+            let grad_div_4 = (into[i] - from[i]) * id[i];
+            self.step::<BLEND, KEEP, INTO>(&mut u[i], &mut y_prev[i], curl_curl, grad_div_4);
         }
     }
 }
@@ -758,8 +773,9 @@ impl Window {
 }
 
 /// The vorticity at the vertices on the faces' borders into `v.vorticity` (each copy),
-/// and the divergence of the cells on the faces' borders into `v.divergence`, its halo
-/// too, of the edge velocities `u` (in the rows), on the unit sphere (m/s per rad): what
+/// and 4 times the divergence ([`ViscousScratch::inverse_areas_4`]) of the cells on the
+/// faces' borders into `v.divergence`, its halo too, of the edge velocities `u` (in the
+/// rows), on the unit sphere (m/s per rad): what
 /// a face's rows read of the other faces' edges, taken before any face's edges move. A
 /// cell's divergence sums its edges' `±u l` in the local order
 /// ([`SIDES`](super::face_rows::SIDES)), `+` where the local normal points out of it (its
@@ -767,16 +783,16 @@ impl Window {
 /// too ([`FaceRows::irregular_cells`]), which taken apart in the grid's order cost a tenth
 /// of the viscous step, for sums that differ only in rounding.
 #[inline(always)]
-fn border_fields(grid: &CubeSphere, rows: &FaceRows, u: &[f64], v: &mut ViscousScratch) {
+fn border_fields(rows: &FaceRows, u: &[f64], v: &mut ViscousScratch) {
     let vorticity = &mut v.vorticity;
     vorticity.resize(rows.vertices(), 0.0);
     rows.seam_circulation(u, vorticity, &rows.vertex_inverse_area, |z, ia| z * ia);
     let n = rows.n;
     let divergence = &mut v.divergence;
     divergence.resize(6 * rows.padded_cells_per_face(), 0.0);
-    // Face 0's cells' inverse areas, which every face reads ([`FaceRows`] says why;
-    // `face_rows::tests::every_faces_constants_are_face_0s` checks them).
-    let ia = &grid.inverse_areas_per_sr()[..n * n];
+    // Face 0's cells' inverse areas (4 times over), which every face reads ([`FaceRows`]
+    // says why; `face_rows::tests::every_faces_constants_are_face_0s` checks them).
+    let ia = &v.inverse_areas_4[..n * n];
     let (epf, cpf, pw) = (rows.edges_per_face(), rows.padded_cells_per_face(), n + 2);
     let faces = u.chunks_exact(epf).zip(divergence.chunks_exact_mut(cpf));
     for (u, out) in faces {
