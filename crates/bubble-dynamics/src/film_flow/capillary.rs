@@ -89,10 +89,9 @@ pub(crate) fn smooth_thickness(
     h_m: &mut [f64],
     (s, shared): (&mut CapillaryScratch, Shared),
 ) -> bool {
-    let Some(plan) = plan(grid, c, dt_s, h_m, s) else {
+    let Some(((substeps, mobility, sub_dt), _)) = plan(grid, c, dt_s, h_m, s) else {
         return false; // a smoothing the step cannot see (every film of the optics' range)
     };
-    let (substeps, mobility, sub_dt) = plan;
     for k in 0..substeps {
         let thin = thin.filter(|_| k + 1 == substeps);
         let shared = Shared {
@@ -113,14 +112,16 @@ pub(crate) fn smooth_thickness(
 }
 
 /// The sub-steps a smoothing of `h_m` over `dt_s` takes, their mobility and their
-/// length; `None` where the step cannot see it (a rate under 1e-3 a step).
+/// length, and the share of one sub-step's stability bound the whole step would take
+/// (`rate·dt/`[`STABLE_RATE_DT`]); `None` where the step cannot see it (a rate under
+/// 1e-3 a step).
 fn plan(
     grid: &CubeSphere,
     c: Capillary,
     dt_s: f64,
     h_m: &[f64],
     s: &mut CapillaryScratch,
-) -> Option<(u32, Mobility, f64)> {
+) -> Option<((u32, Mobility, f64), f64)> {
     // h³/(3μ_d) times σ/2 (the pressure's factor), per m³ of h³.
     let per_cubed = 0.5 * c.sigma_n_per_m / (3.0 * c.drainage_viscosity_pa_s);
     // Gershgorin: |∇·(M∇)| ≤ max M · |∇²| and |∇²| ≤ 2 max Σ l/(d A R²).
@@ -144,7 +145,8 @@ fn plan(
     let sub_dt = dt_s / substeps;
     // Cap the mobility where the sub-steps cannot resolve the rate.
     let cap = max_mobility * (STABLE_RATE_DT / (rate * sub_dt)).min(1.0);
-    Some((substeps as u32, Mobility { per_cubed, cap }, sub_dt))
+    let plan = (substeps as u32, Mobility { per_cubed, cap }, sub_dt);
+    Some((plan, rate * dt_s / STABLE_RATE_DT))
 }
 
 /// The smoothing as one more term of the thickness transport's volumes over the step
@@ -161,11 +163,16 @@ fn plan(
 /// The splitting: the transport and the smoothing both take their rates from the
 /// thickness at the step's start (an unsplit forward Euler step of their sum) where the
 /// smoothing took the transported thickness (Lie splitting); both are first order in
-/// time. Stability: forward Euler of the sum is stable where each part's is: the
-/// capillary part under its Gershgorin bound (`rate·dt ≤` [`STABLE_RATE_DT`], the one
-/// sub-step's condition), the transport's under its Courant bound (its one sub-step's),
-/// and the shared outflow limit keeps every cell ≥ 0 whatever they sum to. Where
-/// either needs more sub-steps, the two run apart as before.
+/// time. Stability: a forward Euler step of a sum `A + B` over `dt` is the convex
+/// combination `θ·(1 + (dt/θ)A) + (1 − θ)·(1 + (dt/(1 − θ))B)`, so it is stable where
+/// each part's forward Euler step is over its stretched step, that is where the two
+/// parts' shares of their own bounds sum to at most 1 (the strong-stability-preserving
+/// argument): the smoothing's share `rate·dt/`[`STABLE_RATE_DT`] plus the transport's
+/// `2·courant` (its one sub-step's condition is `2·courant ≤ 1`). Each part alone under
+/// its bound does not make the sum stable, so the transport joins the term only there
+/// (`transport::joins`), and the shared outflow limit keeps every cell ≥ 0 whatever
+/// they sum to. Elsewhere, or where either needs more sub-steps, the two run apart as
+/// before.
 #[derive(Clone, Copy)]
 pub(crate) struct Term<'a> {
     /// The thickness's Laplacian per cell, per m.
@@ -177,21 +184,22 @@ pub(crate) struct Term<'a> {
 }
 
 /// The smoothing's one sub-step over `dt_s` as a [`Term`]'s mobility and step over R²,
-/// its Laplacian into `shared.laplacian`; `None` where the step cannot see it or it
-/// takes more than one sub-step.
+/// with the share of its stability bound it takes ([`plan`]), its Laplacian into
+/// `shared.laplacian`; `None` where the step cannot see it or it takes more than one
+/// sub-step.
 pub(crate) fn one_substep(
     (grid, sides): (&CubeSphere, &CellSides),
     c: Capillary,
     dt_s: f64,
     h_m: &[f64],
     (s, shared): (&mut CapillaryScratch, Shared),
-) -> Option<(Mobility, f64)> {
-    let (substeps, mobility, sub_dt) = plan(grid, c, dt_s, h_m, s)?;
+) -> Option<((Mobility, f64), f64)> {
+    let ((substeps, mobility, sub_dt), share) = plan(grid, c, dt_s, h_m, s)?;
     if substeps != 1 {
         return None;
     }
     laplacian(grid, sides, c.radius_m, h_m, shared);
-    Some((mobility, sub_dt / (c.radius_m * c.radius_m)))
+    Some(((mobility, sub_dt / (c.radius_m * c.radius_m)), share))
 }
 
 impl<'a> Term<'a> {

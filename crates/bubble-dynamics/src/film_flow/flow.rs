@@ -407,7 +407,11 @@ impl FilmFlow {
         // A uniform evaporation joins the smoothing's last apply, where it has one.
         let thin = self.uniform_evaporation(dt_s);
         let capillary = self.capillary_term(&mut s, dt_s);
-        let joined = capillary.map(|capillary| Joined { capillary, thin });
+        let joined = capillary.map(|(capillary, share)| Joined {
+            capillary,
+            share,
+            thin,
+        });
         let g_eff = forcing.g_eff_m_per_s2;
         if self.transport_thickness(&mut s, (dt_s, g_eff), joined) {
             if thin.is_none() {
@@ -610,7 +614,7 @@ impl FilmFlow {
     /// with from it (swapped there), so it is spent and partly in cache, where a buffer
     /// of the smoothing's own was written cold.
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
-    fn capillary_term(&mut self, s: &mut Scratch, dt_s: f64) -> Option<(Mobility, f64)> {
+    fn capillary_term(&mut self, s: &mut Scratch, dt_s: f64) -> Option<((Mobility, f64), f64)> {
         let c = self.capillary()?;
         let shared = Shared {
             gather: &mut s.gather,
@@ -816,6 +820,55 @@ mod tests {
     /// The drag left to the Marangoni step's edge pass gives the bits of the drag taken
     /// in a pass of its own, as with a meniscus ([`Drag`]), with either gradient, in a
     /// wind and in still air ([`AirShear::drag_in_still_air`]).
+    /// Where the capillary smoothing's share of its stability bound and the transport's
+    /// Courant share sum past 1, the transport does not take the smoothing's term
+    /// ([`super::transport::joins`]): the thickness is the transport's and then the
+    /// smoothing's apart, to the bit; with a small share the two join, and the thickness
+    /// differs from the split one (a different splitting).
+    #[test]
+    fn a_smoothing_that_would_overdraw_the_joined_step_runs_after_the_transport() {
+        let mut params = FlowParams {
+            drainage_viscosity_pa_s: 1e-6,
+            ..FlowParams::water_film(0.05)
+        };
+        params.thermal.bottom_warming_k = 0.0;
+        let mut start = test_film(params);
+        let mut s = std::mem::take(&mut start.scratch);
+        // A step the smoothing takes in one sub-step (its share, `rate·dt/1.8`, ≤ 1).
+        let (dt0, share) = (1..12)
+            .map(|k| 10f64.powi(-k))
+            .find_map(|dt| Some((dt, start.capillary_term(&mut s, dt)?.1)))
+            .expect("a step of one smoothing sub-step");
+        let split_and_joined = |target: f64, courant: f64| {
+            let dt = dt0 * target / share;
+            // A uniform speed at `courant` of the narrowest cell's width a step.
+            let width = start.params.radius_m * 0.7 * std::f64::consts::FRAC_PI_2 / 12.0;
+            let mut f = start.clone();
+            f.set_velocity(|d| DVec3::Y.cross(d).normalize_or_zero() * courant * width / dt);
+            let (mut joined, mut apart) = (f.clone(), f);
+            let g = DVec3::ZERO;
+            let mut s = Scratch::default();
+            let (term, share) = joined.capillary_term(&mut s, dt).expect("one sub-step");
+            assert!((share - target).abs() < 1e-9 * target, "share {share}");
+            let join = Joined {
+                capillary: term,
+                share,
+                thin: None,
+            };
+            let took = joined.transport_thickness(&mut s, (dt, g), Some(join));
+            let mut s = Scratch::default();
+            assert!(!apart.transport_thickness(&mut s, (dt, g), None));
+            if !took {
+                joined.capillary_smoothing(&mut Scratch::default(), dt, None);
+            }
+            apart.capillary_smoothing(&mut s, dt, None);
+            (took, joined.h_m == apart.h_m)
+        };
+        // 0.9 + 2·0.1: past 1, apart; 0.1 + 2·0.1: joined.
+        assert_eq!(split_and_joined(0.9, 0.1), (false, true));
+        assert_eq!(split_and_joined(0.1, 0.1), (true, false));
+    }
+
     #[test]
     fn the_drag_left_to_the_marangoni_pass_gives_the_drag_pass_bits() {
         let airs = [DVec3::new(0.3, 0.0, 0.1), DVec3::ZERO];

@@ -26,8 +26,19 @@ use super::upwind;
 pub(super) struct Joined {
     /// The smoothing's term.
     pub(super) capillary: (Mobility, f64),
+    /// The share of its stability bound the smoothing's one sub-step takes
+    /// (its `rate·dt` over the smoothing's `STABLE_RATE_DT`): see [`joins`].
+    pub(super) share: f64,
     /// The uniform evaporation, m, where there is one.
     pub(super) thin: Option<f64>,
+}
+
+/// Whether the transport's one sub-step at `courant` takes the capillary smoothing's
+/// whose share of its own stability bound is `share` ([`Joined::share`]): where the two
+/// shares, the transport's `2·courant`, sum to at most 1, the forward Euler step of the
+/// sum is a convex combination of stable steps of each ([`super::capillary::Term`]).
+pub(super) fn joins(share: f64, courant: f64) -> bool {
+    share + 2.0 * courant <= 1.0
 }
 
 /// Most sub-steps one thickness transport takes.
@@ -68,8 +79,14 @@ impl FilmFlow {
         // within one sub-step's content; the outflow limit guards the rest.
         let substeps = (2.0 * courant).ceil().clamp(1.0, f64::from(MAX_SUBSTEPS)) as u32;
         if substeps == 1 {
+            let joins = joined.is_some_and(|j| joins(j.share, courant));
+            if joined.is_some() && !joins {
+                // The sum would overdraw the step's stability: the transport alone, again
+                // from `h_m` (untouched), and the smoothing after it.
+                self.upwind_substep(s, dt_s, drain, Some(None));
+            }
             std::mem::swap(&mut self.h_m, &mut s.cell);
-            return joined.is_some();
+            return joins;
         }
         let h_dt = dt_s / f64::from(substeps);
         for _ in 0..substeps {
