@@ -932,8 +932,8 @@ impl Hierarchy {
     /// it, a face row at a time: a row's RIGHT weights but the last and its TOP weights
     /// (but the top row's) are a slice of the grid's edges ([`inside_a_face`]), put into
     /// `row` and scattered from there; then the entries that hold seam edges
-    /// ([`Hierarchy::seam_weights`]). The entries no cell reads are left as they are
-    /// (zero: no pass writes them).
+    /// ([`Hierarchy::seam_weights`]), over whatever the runs left there. The entries no
+    /// cell reads are left as they are (zero: no pass writes them).
     #[inline(always)]
     fn fine_weights<W: Copy, T: Real>(
         &self,
@@ -948,13 +948,13 @@ impl Hierarchy {
         let [right, top] = out;
         for face in 0..6 {
             for y in 0..n {
-                // The last cell's RIGHT entry is a seam's, written below: the run stops
-                // before it.
+                // The last cell's RIGHT entry is a seam's, written below: the run takes
+                // the next edge there (the grid's edges run on past a row's last
+                // x-edge), so it is whole chunks long, with no remainder a pair at a time.
                 let (xs, first) = inside_a_face(n, face, y, RIGHT);
                 if !xs.is_empty() {
                     let at = fine.padded_at(face, y + 1, 1 + xs.start);
-                    let values = &weight[first..][..xs.len()];
-                    put_run(fine, at, (values, &put), row, right);
+                    put_run(fine, at, (&weight[first..][..n], &put), row, right);
                 }
                 let (xs, first) = inside_a_face(n, face, y, TOP);
                 if !xs.is_empty() {
