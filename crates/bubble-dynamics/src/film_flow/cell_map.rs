@@ -35,7 +35,7 @@ impl CellMap {
         Self { cells }
     }
 
-    /// Σ_k w_k·values[vertex_k] at every cell.
+    /// `Σ_k w_k·values[vertex_k]` at every cell.
     pub fn interpolate(&self, triangles: &[[u32; 3]], values: &[f64], out: &mut Vec<f64>) {
         out.clear();
         out.extend(self.cells.iter().map(|&(t, w)| {

@@ -25,7 +25,7 @@
 //! 220 kB in `f64`, the L2 1 MB), so each pass is counted: an iteration of the conjugate
 //! gradients streams the weights once (the operator's product `q`; in `f32`, the
 //! V-cycle's copy, where they are given as `f32` values, as the Marangoni step gives
-//! them: [`Weights::F32`]), `x`, `r` and `p` once each, and writes `q` and
+//! them: `Weights::F32`), `x`, `r` and `p` once each, and writes `q` and
 //! the V-cycle's right-hand side (an `f32` iteration streams `x` in `f64` and the rest in
 //! `f32`, its residual the V-cycle's right-hand side itself). The preconditioned
 //! residual `z` is never held in `f64` (`r·z` is summed from the V-cycle's own numbers,
@@ -244,7 +244,7 @@ pub struct Hierarchy {
 /// so which cell sets it changes no result), so no system or residual underflows or
 /// overflows in it: `f32` spans 2^±126, and a film's diagonal entries lie within a few
 /// powers of ten of one another (the cells' areas within 5.2×, their thickness floor
-/// [`H_FLOOR_M`](super::flow::H_FLOOR_M) keeping the weights finite). So weights given
+/// (the flow's `H_FLOOR_M`) keeping the weights finite). So weights given
 /// as `f32` values stay exact, scaled, in the V-cycle's copy (a power of two moves an
 /// `f32` exactly while it stays within 2^±126).
 ///
@@ -394,7 +394,8 @@ pub struct SolveReport {
 }
 
 impl Hierarchy {
-    /// Halves the grid while its face size stays even and above [`COARSEST_FACE`].
+    /// Halves the grid while its face size stays even and above the coarsest level's
+    /// (`COARSEST_FACE`, 2).
     pub fn new(grid: &CubeSphere) -> Self {
         let sides = CellSides::new(grid);
         let mut levels = vec![Layout::of_grid(&sides)];
