@@ -159,7 +159,7 @@ fn plan(
 /// joined, the term costs the transport about 10 M, and the step went from 581.8 M to
 /// 564.5 M instructions (its LL misses from 11.00 M to 11.13 M: the Laplacian, a pass of
 /// its own before the transport, is read back by the transport partly from beyond L2),
-/// 562.0 M with the uniform evaporation joined too (`fluxes::ThinnedOutOfPlace`).
+/// 562.0 M with the uniform evaporation joined too (`fluxes::Thinned`, out of place).
 /// The splitting: the transport and the smoothing both take their rates from the
 /// thickness at the step's start (an unsplit forward Euler step of their sum) where the
 /// smoothing took the transported thickness (Lie splitting); both are first order in

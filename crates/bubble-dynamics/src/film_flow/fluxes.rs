@@ -432,15 +432,28 @@ pub(crate) fn apply_limited(
 }
 
 /// The field a limited apply moves: changed in place (`[f64]`), or read from one slice
-/// and written into another ([`OutOfPlace`]).
+/// and written into another ([`OutOfPlace`]), either thinned as it is written
+/// ([`Thinned`]).
 pub(crate) trait Moved {
     /// The values before the apply: the apply reads none it has changed.
     fn before(&self) -> &[f64];
-    /// Cells `at`'s new values (`len` of them): each its value before plus `gain(i)`,
-    /// `i` counted from `at`.
-    fn add(&mut self, at: usize, len: usize, gain: impl Fn(usize) -> f64);
+    /// Cells `at`'s new values (`len` of them): each `then` of its value before plus
+    /// `gain(i)`, `i` counted from `at`.
+    fn add_then(
+        &mut self,
+        at: usize,
+        len: usize,
+        gain: impl Fn(usize) -> f64,
+        then: impl Fn(f64) -> f64,
+    );
     /// Cell `c`'s new value.
     fn set(&mut self, c: usize, value: f64);
+
+    /// Cells `at`'s new values (`len` of them): each its value before plus `gain(i)`.
+    #[inline(always)]
+    fn add(&mut self, at: usize, len: usize, gain: impl Fn(usize) -> f64) {
+        self.add_then(at, len, gain, |v| v);
+    }
 }
 
 impl Moved for [f64] {
@@ -450,9 +463,15 @@ impl Moved for [f64] {
     }
 
     #[inline(always)]
-    fn add(&mut self, at: usize, len: usize, gain: impl Fn(usize) -> f64) {
+    fn add_then(
+        &mut self,
+        at: usize,
+        len: usize,
+        gain: impl Fn(usize) -> f64,
+        then: impl Fn(f64) -> f64,
+    ) {
         for (i, x) in self[at..at + len].iter_mut().enumerate() {
-            *x += gain(i);
+            *x = then(*x + gain(i));
         }
     }
 
@@ -483,10 +502,16 @@ impl Moved for OutOfPlace<'_> {
     }
 
     #[inline(always)]
-    fn add(&mut self, at: usize, len: usize, gain: impl Fn(usize) -> f64) {
+    fn add_then(
+        &mut self,
+        at: usize,
+        len: usize,
+        gain: impl Fn(usize) -> f64,
+        then: impl Fn(f64) -> f64,
+    ) {
         let (x, out) = (&self.before[at..at + len], &mut self.after[at..at + len]);
         for i in 0..len {
-            out[i] = x[i] + gain(i);
+            out[i] = then(x[i] + gain(i));
         }
     }
 
@@ -496,71 +521,44 @@ impl Moved for OutOfPlace<'_> {
     }
 }
 
-/// A field a limited apply changes in place, each new value then thinned by `by` and
-/// kept ≥ 0 (`(x − by).max(0)`, as a pass of its own would after the apply).
+/// A field (in place or [`OutOfPlace`]) a limited apply moves, each new value then
+/// thinned by `by` and kept ≥ 0 (`(x − by).max(0)`, as a pass of its own would after
+/// the apply).
 ///
 /// Why: the film's uniform evaporation was a pass of its own over the thickness right
 /// after the capillary smoothing's last apply (1.7 M instructions over 40 steps at
-/// n = 64); inside the apply's gather it costs a subtraction and a maximum a cell.
-pub(crate) struct Thinned<'a> {
+/// n = 64); inside the apply's gather it costs a subtraction and a maximum a cell. Where
+/// the smoothing joins the thickness transport's out-of-place sub-step, the evaporation
+/// rides in that apply.
+pub(crate) struct Thinned<'a, M: Moved + ?Sized> {
     /// The values.
-    pub(crate) values: &'a mut [f64],
+    pub(crate) values: &'a mut M,
     /// What each new value loses.
     pub(crate) by: f64,
 }
 
-impl Moved for Thinned<'_> {
+impl<M: Moved + ?Sized> Moved for Thinned<'_, M> {
     #[inline(always)]
     fn before(&self) -> &[f64] {
+        self.values.before()
+    }
+
+    #[inline(always)]
+    fn add_then(
+        &mut self,
+        at: usize,
+        len: usize,
+        gain: impl Fn(usize) -> f64,
+        then: impl Fn(f64) -> f64,
+    ) {
+        let by = self.by;
         self.values
-    }
-
-    #[inline(always)]
-    fn add(&mut self, at: usize, len: usize, gain: impl Fn(usize) -> f64) {
-        let by = self.by;
-        for (i, x) in self.values[at..at + len].iter_mut().enumerate() {
-            *x = (*x + gain(i) - by).max(0.0);
-        }
+            .add_then(at, len, gain, |v| then((v - by).max(0.0)));
     }
 
     #[inline(always)]
     fn set(&mut self, c: usize, value: f64) {
-        self.values[c] = (value - self.by).max(0.0);
-    }
-}
-
-/// An [`OutOfPlace`] field whose new values are each then thinned by `by`, kept ≥ 0 (as
-/// [`Thinned`]).
-///
-/// Why: where the capillary smoothing joins the thickness transport's out-of-place
-/// sub-step, the uniform evaporation joins it too, as it joined the smoothing's last
-/// apply (a pass of its own over the thickness otherwise).
-pub(crate) struct ThinnedOutOfPlace<'a> {
-    /// The values before and after.
-    pub(crate) moved: OutOfPlace<'a>,
-    /// What each new value loses.
-    pub(crate) by: f64,
-}
-
-impl Moved for ThinnedOutOfPlace<'_> {
-    #[inline(always)]
-    fn before(&self) -> &[f64] {
-        self.moved.before
-    }
-
-    #[inline(always)]
-    fn add(&mut self, at: usize, len: usize, gain: impl Fn(usize) -> f64) {
-        let by = self.by;
-        let m = &mut self.moved;
-        let (x, out) = (&m.before[at..at + len], &mut m.after[at..at + len]);
-        for i in 0..len {
-            out[i] = (x[i] + gain(i) - by).max(0.0);
-        }
-    }
-
-    #[inline(always)]
-    fn set(&mut self, c: usize, value: f64) {
-        self.moved.after[c] = (value - self.by).max(0.0);
+        self.values.set(c, (value - self.by).max(0.0));
     }
 }
 
@@ -1099,7 +1097,7 @@ mod tests {
             want.iter_mut().for_each(|x| *x = (*x - by).max(0.0));
             let mut got = values.clone();
             let thinned = &mut Thinned {
-                values: &mut got,
+                values: &mut got[..],
                 by,
             };
             apply_limited_to(&sides, &grid, pass, 0.3, thinned, &mut scratch);
@@ -1107,11 +1105,11 @@ mod tests {
             assert_eq!(bits(&got), bits(&want), "n = {n}");
             // Out of place, every value written (NaN before).
             let mut after = vec![f64::NAN; values.len()];
-            let moved = OutOfPlace {
+            let moved = &mut OutOfPlace {
                 before: &values,
                 after: &mut after,
             };
-            let thinned = &mut ThinnedOutOfPlace { moved, by };
+            let thinned = &mut Thinned { values: moved, by };
             apply_limited_to(&sides, &grid, pass, 0.3, thinned, &mut scratch);
             assert_eq!(bits(&after), bits(&want), "n = {n}, out of place");
         }

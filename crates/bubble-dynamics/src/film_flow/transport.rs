@@ -15,7 +15,7 @@ use super::capillary::{Mobility, Term};
 use super::compare::larger;
 use super::face_geometry::FaceGeometry;
 use super::flow::{FilmFlow, Scratch};
-use super::fluxes::{OutOfPlace, ThinnedOutOfPlace, apply_limited, apply_limited_to};
+use super::fluxes::{OutOfPlace, Thinned, apply_limited, apply_limited_to};
 use super::grid::dot_at;
 use super::sides::EdgeBlock;
 use super::upwind;
@@ -135,14 +135,14 @@ impl FilmFlow {
             // Every cell of `after` is written: its length, not a fill.
             s.cell.resize(self.h_m.len(), 0.0);
             let after = &mut s.cell[..];
-            let moved = OutOfPlace {
+            let moved = &mut OutOfPlace {
                 before: &self.h_m,
                 after,
             };
             match joined.and_then(|j| j.thin) {
-                None => apply_limited_to(sides, grid, &mut volumes, 1.0, &mut { moved }, gather),
+                None => apply_limited_to(sides, grid, &mut volumes, 1.0, moved, gather),
                 Some(by) => {
-                    let h = &mut ThinnedOutOfPlace { moved, by };
+                    let h = &mut Thinned { values: moved, by };
                     apply_limited_to(sides, grid, &mut volumes, 1.0, h, gather);
                 }
             }
