@@ -33,6 +33,16 @@ pub(super) struct Joined {
     pub(super) thin: Option<f64>,
 }
 
+/// How [`FilmFlow::upwind_substep`] runs.
+#[derive(Clone, Copy)]
+enum Substep {
+    /// The first: out of place into `s.cell`, taking the Courant number, with the
+    /// smoothing joined where given.
+    First(Option<Joined>),
+    /// One of several after it, in place.
+    Another,
+}
+
 /// Whether the transport's one sub-step at `courant` takes the capillary smoothing's
 /// whose share of its own stability bound is `share` ([`Joined::share`]): where the two
 /// shares, the transport's `2·courant`, sum to at most 1, the forward Euler step of the
@@ -74,7 +84,8 @@ impl FilmFlow {
             0.0
         };
         let drain = Drain { drain, g_eff };
-        let courant = self.upwind_substep(s, dt_s, drain, Some(joined)) * dt_s / p.radius_m;
+        let courant =
+            self.upwind_substep(s, dt_s, drain, Substep::First(joined)) * dt_s / p.radius_m;
         // A cell drains through at most two edges of a smooth flow: 2·courant per step, kept
         // within one sub-step's content; the outflow limit guards the rest.
         let substeps = (2.0 * courant).ceil().clamp(1.0, f64::from(MAX_SUBSTEPS)) as u32;
@@ -83,14 +94,14 @@ impl FilmFlow {
             if joined.is_some() && !joins {
                 // The sum would overdraw the step's stability: the transport alone, again
                 // from `h_m` (untouched), and the smoothing after it.
-                self.upwind_substep(s, dt_s, drain, Some(None));
+                self.upwind_substep(s, dt_s, drain, Substep::First(None));
             }
             std::mem::swap(&mut self.h_m, &mut s.cell);
             return joins;
         }
         let h_dt = dt_s / f64::from(substeps);
         for _ in 0..substeps {
-            self.upwind_substep(s, h_dt, drain, None);
+            self.upwind_substep(s, h_dt, drain, Substep::Another);
         }
         false
     }
@@ -98,20 +109,22 @@ impl FilmFlow {
     /// One transport of `h` over `dt_s`: second-order upwind (the upwind cell's
     /// Green–Gauss gradient, limited to its neighbours' range, carried to the edge
     /// midpoint and clamped between the two cells' values), outflow-limited: one limited
-    /// apply of the [`upwind::Volumes`], band by band. Where `courant`, out of place into
-    /// `s.cell` (`h_m` unchanged), returning the fastest edge's characteristic speed over
-    /// its smaller cell's width ([`Fastest`]), and the capillary [`Term`] where given;
-    /// else in place, returning 0.
+    /// apply of the [`upwind::Volumes`], band by band. The first ([`Substep::First`]) out
+    /// of place into `s.cell` (`h_m` unchanged), returning the fastest edge's
+    /// characteristic speed over its smaller cell's width ([`Fastest`]), with the
+    /// capillary [`Term`] where given; another in place, returning 0.
     #[inline(never)] // its own frame in a profile (perf report names the step's parts)
     fn upwind_substep(
         &mut self,
         s: &mut Scratch,
         dt_s: f64,
         drain: Drain,
-        courant: Option<Option<Joined>>,
+        substep: Substep,
     ) -> f64 {
-        let joined = courant.flatten();
-        let courant = courant.is_some();
+        let (courant, joined) = match substep {
+            Substep::First(joined) => (true, joined),
+            Substep::Another => (false, None),
+        };
         let mut fastest = Fastest {
             speed: std::mem::take(&mut s.edge2),
             fastest: 0.0,
@@ -274,14 +287,14 @@ mod tests {
         let mut taken = film.clone();
         taken.transport_thickness(&mut Scratch::default(), (dt_s, g_eff), None);
         // The Courant number from a sub-step of its own, then the sub-steps from the start.
-        let fastest = film
-            .clone()
-            .upwind_substep(&mut Scratch::default(), dt_s, drain, Some(None));
+        let fastest =
+            film.clone()
+                .upwind_substep(&mut Scratch::default(), dt_s, drain, Substep::First(None));
         let substeps = (2.0 * fastest * dt_s / params.radius_m).ceil() as u32;
         assert!(substeps > 1, "{substeps} sub-step: the test is idle");
         let mut s = Scratch::default();
         for _ in 0..substeps {
-            film.upwind_substep(&mut s, dt_s / f64::from(substeps), drain, None);
+            film.upwind_substep(&mut s, dt_s / f64::from(substeps), drain, Substep::Another);
         }
         let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&taken.h_m), bits(&film.h_m));
