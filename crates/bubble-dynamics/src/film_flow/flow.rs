@@ -817,9 +817,6 @@ mod tests {
         f
     }
 
-    /// The drag left to the Marangoni step's edge pass gives the bits of the drag taken
-    /// in a pass of its own, as with a meniscus ([`Drag`]), with either gradient, in a
-    /// wind and in still air ([`AirShear::drag_in_still_air`]).
     /// Where the capillary smoothing's share of its stability bound and the transport's
     /// Courant share sum past 1, the transport does not take the smoothing's term
     /// ([`super::transport::joins`]): the thickness is the transport's and then the
@@ -869,6 +866,9 @@ mod tests {
         assert_eq!(split_and_joined(0.1, 0.1), (true, false));
     }
 
+    /// The drag left to the Marangoni step's edge pass gives the bits of the drag taken
+    /// in a pass of its own, as with a meniscus ([`Drag`]), with either gradient, in a
+    /// wind and in still air ([`AirShear::drag_in_still_air`]).
     #[test]
     fn the_drag_left_to_the_marangoni_pass_gives_the_drag_pass_bits() {
         let airs = [DVec3::new(0.3, 0.0, 0.1), DVec3::ZERO];
