@@ -192,13 +192,13 @@ pub(crate) fn one_substep(
     c: Capillary,
     dt_s: f64,
     h_m: &[f64],
-    (s, shared): (&mut CapillaryScratch, Shared),
+    (s, mut shared): (&mut CapillaryScratch, Shared),
 ) -> Option<((Mobility, f64), f64)> {
     let ((substeps, mobility, sub_dt), share) = plan(grid, c, dt_s, h_m, s)?;
     if substeps != 1 {
         return None;
     }
-    laplacian(grid, sides, c.radius_m, h_m, shared);
+    laplacian(grid, sides, c.radius_m, h_m, &mut shared);
     Some(((mobility, sub_dt / (c.radius_m * c.radius_m)), share))
 }
 
@@ -217,6 +217,34 @@ impl<'a> Term<'a> {
     #[inline(always)]
     pub(crate) fn volume(&self, h: [f64; 2], lap: [f64; 2], [l, per_d]: [f64; 2]) -> f64 {
         volume((self.mobility, self.per_length), h, lap, [l, per_d])
+    }
+
+    /// The volumes over a block of edges with thicknesses and Laplacians `[ha, hb, la,
+    /// lb]` at their ends: into `out` (the smoothing's own pass), or added to the
+    /// transport's volumes there (`ADD`: the joined sub-step).
+    #[inline(always)]
+    pub(crate) fn block<const ADD: bool>(
+        &self,
+        fg: &FaceGeometry,
+        run: impl EdgeBlock,
+        [ha, hb, la, lb]: [&[f64]; 4],
+        out: &mut [f64],
+    ) {
+        let len = run.count();
+        let (l, per_d) = (
+            run.constant(&fg.length),
+            run.constant(&fg.inverse_dual_length),
+        );
+        let (ha, hb, la, lb) = (&ha[..len], &hb[..len], &la[..len], &lb[..len]);
+        let (l, per_d, out) = (&l[..len], &per_d[..len], &mut out[..len]);
+        for i in 0..len {
+            let v = self.volume([ha[i], hb[i]], [la[i], lb[i]], [l[i], per_d[i]]);
+            if ADD {
+                out[i] += v;
+            } else {
+                out[i] = v;
+            }
+        }
     }
 }
 
@@ -252,10 +280,10 @@ fn substep(
     mobility: Mobility,
     (dt_s, thin): (f64, Option<f64>),
     h_m: &mut [f64],
-    shared: Shared,
+    mut shared: Shared,
 ) {
     let fg = grid.face_geometry();
-    let shared = laplacian(grid, sides, radius_m, h_m, shared);
+    laplacian(grid, sides, radius_m, h_m, &mut shared);
     substep_apply(
         (grid, fg, sides),
         radius_m,
@@ -266,15 +294,14 @@ fn substep(
     );
 }
 
-/// The thickness's Laplacian per cell, per m, into `shared.laplacian`; gives back the
-/// shared buffers.
-fn laplacian<'a>(
+/// The thickness's Laplacian per cell, per m, into `shared.laplacian`.
+fn laplacian(
     grid: &CubeSphere,
     sides: &CellSides,
     radius_m: f64,
     h_m: &[f64],
-    shared: Shared<'a>,
-) -> (&'a mut GatherScratch, &'a mut SeamEnds, &'a mut Vec<f64>) {
+    shared: &mut Shared,
+) {
     let fg = grid.face_geometry();
     // ∇²h as the net inflow of the differences `(h_b − h_a) l/d` (their sum out of a
     // cell, with the sign of an inflow: a cell below its neighbours gains), over the
@@ -289,7 +316,7 @@ fn laplacian<'a>(
     // Every entry is written below: the buffer needs its length, not a fill.
     let laplacian = &mut *shared.laplacian;
     laplacian.resize(h_m.len(), 0.0);
-    net_inflow(sides, pass, shared.gather, |_, face, rows, inflow| {
+    net_inflow(sides, pass, &mut *shared.gather, |_, face, rows, inflow| {
         let cells = rows.start * n..rows.end * n;
         let (per_area, first) = (&per_area[cells.clone()], face * n * n + cells.start);
         let lap = &mut laplacian[first..first + cells.len()];
@@ -297,7 +324,6 @@ fn laplacian<'a>(
             *lap = inflow * (per_area * per_r2);
         }
     });
-    (shared.gather, shared.seam_ends, shared.laplacian)
 }
 
 /// The sub-step's limited apply of the volumes from the Laplacian in `laplacian`
@@ -308,8 +334,13 @@ fn substep_apply(
     mobility: Mobility,
     (dt_s, thin): (f64, Option<f64>),
     h_m: &mut [f64],
-    (gather, seam_ends, laplacian): (&mut GatherScratch, &mut SeamEnds, &mut Vec<f64>),
+    shared: Shared,
 ) {
+    let Shared {
+        gather,
+        seam_ends,
+        laplacian,
+    } = shared;
     // Volume from a to b over the sub-step, per R² (m·sr): the flux runs down the
     // pressure −(σ/2)∇²h, i.e. up the gradient of ∇²h (the ½σ is in the mobility), so
     // out of a bump, whose top has the lowest ∇²h.
@@ -321,9 +352,7 @@ fn substep_apply(
     // second). At the donor's, a thin cell gives at its own slow rate.
     let mut volumes = Volumes {
         fg,
-        mobility,
-        per_length: dt_s / (radius_m * radius_m),
-        laplacian: &laplacian[..],
+        term: Term::new(&laplacian[..], (mobility, dt_s / (radius_m * radius_m))),
         seam_ends,
     };
     // Each donor gives at most half its content: h stays ≥ 0.
@@ -384,12 +413,8 @@ fn differences_block(
 struct Volumes<'a> {
     /// The grid's constants.
     fg: &'a FaceGeometry,
-    /// Each edge's mobility from its donor's thickness.
-    mobility: Mobility,
-    /// The sub-step over `R²`.
-    per_length: f64,
-    /// The thickness's Laplacian per cell, per m.
-    laplacian: &'a [f64],
+    /// The mobility, the sub-step over `R²` and the thickness's Laplacian.
+    term: Term<'a>,
     /// The seams' ends.
     seam_ends: &'a mut SeamEnds,
 }
@@ -397,57 +422,22 @@ struct Volumes<'a> {
 impl EdgeValues for Volumes<'_> {
     #[inline(always)]
     fn seams(&mut self, seams: Seams, h: &[f64], out: &mut [f64]) {
-        let [[ha, hb], [la, lb]] = self.seam_ends.gather_many(seams, [h, self.laplacian]);
-        volumes_block(
-            (self.fg, self.mobility, self.per_length),
-            seams,
-            [ha, hb, la, lb],
-            out,
-        );
+        let lap = self.term.laplacian;
+        let [[ha, hb], [la, lb]] = self.seam_ends.gather_many(seams, [h, lap]);
+        self.term
+            .block::<false>(self.fg, seams, [ha, hb, la, lb], out);
     }
 
     #[inline(always)]
     fn run(&mut self, run: EdgeRun, _rows: Range<usize>, h: &[f64], out: &mut [f64]) {
         let run = run.padded(out.len(), h.len());
-        let ((ha, hb), (la, lb)) = (run.ends(h), run.ends(self.laplacian));
-        volumes_block(
-            (self.fg, self.mobility, self.per_length),
-            run,
-            [ha, hb, la, lb],
-            out,
-        );
+        let ((ha, hb), (la, lb)) = (run.ends(h), run.ends(self.term.laplacian));
+        self.term
+            .block::<false>(self.fg, run, [ha, hb, la, lb], out);
     }
 }
 
-/// The volumes over a block of edges with thicknesses and Laplacians `[ha, hb, la, lb]`
-/// at their ends, into `out` (the grid's constants, the mobility and the sub-step over
-/// R², [`Volumes`]).
-#[inline(always)]
-fn volumes_block(
-    (fg, mobility, per_length): (&FaceGeometry, Mobility, f64),
-    run: impl EdgeBlock,
-    [ha, hb, la, lb]: [&[f64]; 4],
-    out: &mut [f64],
-) {
-    let len = run.count();
-    let (l, per_d) = (
-        run.constant(&fg.length),
-        run.constant(&fg.inverse_dual_length),
-    );
-    let (ha, hb, la, lb) = (&ha[..len], &hb[..len], &la[..len], &lb[..len]);
-    let out = &mut out[..len];
-    for i in 0..len {
-        let lengths = [l[i], per_d[i]];
-        out[i] = volume(
-            (mobility, per_length),
-            [ha[i], hb[i]],
-            [la[i], lb[i]],
-            lengths,
-        );
-    }
-}
-
-/// The volume across an edge ([`volumes_block`]), from its ends' thicknesses and
+/// The volume across an edge ([`Term::block`]), from its ends' thicknesses and
 /// Laplacians, its length and inverse dual length.
 #[inline(always)]
 fn volume(

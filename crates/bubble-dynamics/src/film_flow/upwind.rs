@@ -473,7 +473,8 @@ impl EdgeValues for Volumes<'_> {
             (out, fastest.map(|f| (f, edges))),
         );
         if let Some(term) = &self.capillary {
-            capillary_block(term, run, [ha, hb], self.fg, out);
+            let (la, lb) = run.ends(term.laplacian);
+            term.block::<true>(self.fg, run, [ha, hb, la, lb], out);
         }
     }
 }
@@ -509,28 +510,6 @@ fn volumes_block(
                 }
             },
         ),
-    }
-}
-
-/// A block's capillary volumes ([`Term`]) added to its volumes in `out`.
-#[inline(always)]
-fn capillary_block(
-    term: &Term,
-    run: EdgeRun,
-    [ha, hb]: [&[f64]; 2],
-    fg: &FaceGeometry,
-    out: &mut [f64],
-) {
-    let len = run.count();
-    let (la, lb) = run.ends(term.laplacian);
-    let (l, per_d) = (
-        run.constant(&fg.length),
-        run.constant(&fg.inverse_dual_length),
-    );
-    let (ha, hb, la, lb) = (&ha[..len], &hb[..len], &la[..len], &lb[..len]);
-    let (l, per_d, out) = (&l[..len], &per_d[..len], &mut out[..len]);
-    for i in 0..len {
-        out[i] += term.volume([ha[i], hb[i]], [la[i], lb[i]], [l[i], per_d[i]]);
     }
 }
 
