@@ -7,7 +7,13 @@
 //! For a change meant to move only rounding: with `FILM_STATE_DUMP=dir` set, each swirl
 //! film's fields are also written to `dir` (raw little-endian `f64`s), and
 //! `film_state_hash compare dir_a dir_b` prints each field's largest difference between
-//! two builds' dumps, relative to the field's largest magnitude.
+//! two builds' dumps, relative to the field's largest magnitude, and its rms difference
+//! relative to the field's rms.
+//!
+//! Two settings measure what such a difference is worth against the film's own
+//! sensitivity and the step's own error (docs/performance.md, "Fifteenth round"):
+//! `FILM_START_NUDGE=ε` scales the swirl films' starting rotation by `1 + ε`, and
+//! `FILM_STEP_SPLIT=k` takes each 1/60 s step as `k` steps of 1/(60 k) s.
 
 #[path = "../benches/common/swirl_film.rs"]
 mod swirl_film;
@@ -73,14 +79,32 @@ fn compare(a: &str, b: &str) {
                 .iter()
                 .zip(&y)
                 .fold(0.0, |m: f64, (p, q)| m.max((p - q).abs()));
-            let relative = if largest > 0.0 {
-                worst / largest
-            } else {
-                worst
+            let rms = |v: &mut dyn Iterator<Item = f64>| -> f64 {
+                let (sum, count) = v.fold((0.0, 0usize), |(s, c), d| (s + d * d, c + 1));
+                (sum / count.max(1) as f64).sqrt()
             };
-            println!("film {index} {field}: largest difference {relative:.3e} of its largest");
+            let rms_difference = rms(&mut x.iter().zip(&y).map(|(p, q)| p - q));
+            let rms_field = rms(&mut x.iter().copied());
+            let of = |d: f64, scale: f64| if scale > 0.0 { d / scale } else { d };
+            println!(
+                "film {index} {field}: largest difference {:.3e} of its largest, \
+                 rms difference {:.3e} of its rms",
+                of(worst, largest),
+                of(rms_difference, rms_field)
+            );
         }
     }
+}
+
+/// The environment's setting `name` as a number, else `default`.
+///
+/// # Panics
+/// If the setting is there but not a number.
+fn setting(name: &str, default: f64) -> f64 {
+    std::env::var(name).map_or(default, |v| {
+        v.parse()
+            .unwrap_or_else(|_| panic!("{name}={v} is not a number"))
+    })
 }
 
 fn main() {
@@ -105,10 +129,12 @@ fn main() {
             air_m_per_s: DVec3::new(air, 0.0, 0.1),
         };
         let mut f = swirl_film(n, warming_k, FilmGradient::TwoPoint);
-        f.set_velocity(|d| DVec3::new(0.0, 0.02, 0.01).cross(d));
+        let nudge = 1.0 + setting("FILM_START_NUDGE", 0.0);
+        f.set_velocity(|d| DVec3::new(0.0, 0.02 * nudge, 0.01).cross(d));
         let mut h = Fnv(0xcbf2_9ce4_8422_2325);
-        for _ in 0..steps {
-            let r = f.step(1.0 / 60.0, &forcing);
+        let split = setting("FILM_STEP_SPLIT", 1.0) as usize;
+        for _ in 0..steps * split {
+            let r = f.step(1.0 / (60.0 * split as f64), &forcing);
             h.add(u64::from(r.iterations));
             h.add(r.relative_residual.to_bits());
         }

@@ -7,8 +7,8 @@
 //! The loops it runs are IEEE additions and multiplications in a fixed order: no fused
 //! multiply-add is enabled and the compiler reorders no floating-point sum, so AVX2 and
 //! the portable build (SSE2) give the same bits; AVX2 has four `f64` lanes an instruction
-//! where SSE2 has two. Tests switch AVX2 off on their thread ([`set_portable_only`]) and
-//! compare the two.
+//! where SSE2 has two. Tests switch AVX2 off on their thread (`set_portable_only`, a
+//! test-only function) and compare the two.
 //!
 //! The explicit SIMD of the crate lives here: the dot products' and Coriolis rows' lanes
 //! below, and [`advect_face`], an advection stage's face in AVX2 registers.

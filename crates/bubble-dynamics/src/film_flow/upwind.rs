@@ -9,9 +9,10 @@
 //!    midpoint, its Green–Gauss gradient in its tangent plane dotted with the reach,
 //!    Barth–Jespersen limited) and the seams' volumes;
 //! 2. then, row by row on all the faces together, the row's limited rises
-//!    ([`row_rises`]) and its edges' volumes, each part upwind along its own
-//!    characteristic, which the rows' cells gather a row or two behind (each donor's
-//!    factor that keeps its outflow within its budget, each cell's gathered volumes).
+//!    ([`band_rises`], a band of rows at a time) and its edges' volumes, each part
+//!    upwind along its own characteristic, which the rows' cells gather a row or two
+//!    behind (each donor's factor that keeps its outflow within its budget, each cell's
+//!    gathered volumes).
 //!
 //! Why by rows: the rises were four per-cell arrays (0.8 MB at n = 64) and the volumes a
 //! per-edge one (0.4 MB), each written out and read back from beyond the core's 1 MB L2;
@@ -52,7 +53,7 @@ pub(crate) struct UpwindGeometry {
     rim_rise: [[Vec<f64>; 4]; 4],
 }
 
-/// The rim's thicknesses and rises in the rim's order ([`limited_rises`]).
+/// The rim's thicknesses and rises in the rim's order ([`rim_rises`]).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct RimRises {
     /// A face's rim cells' thicknesses.
