@@ -3,7 +3,9 @@
 //! film, for profiling with perf; `normal` drives it through the normal gradient;
 //! `FILM_STEPS` sets the number of steps, 40 unless set; `FILM_REPEATS` runs those steps
 //! that many times, each from a copy of the same starting film, so a profile of a small
-//! grid is not dominated by building it).
+//! grid is not dominated by building it; `FILM_EVICT_MB` writes a buffer of that many MB
+//! before each step, outside its timing, so that the step finds the caches as a scene's
+//! rendering leaves them: cold).
 
 #[path = "../benches/common/swirl_film.rs"]
 mod swirl_film;
@@ -27,15 +29,26 @@ fn main() {
     let start = swirl_film(n, arg(4, 0.0), gradient);
     let count = |name: &str, d: usize| std::env::var(name).map_or(d, |s| s.parse().expect(name));
     let (steps, repeats) = (count("FILM_STEPS", 40), count("FILM_REPEATS", 1));
+    let mut evict = vec![0u8; count("FILM_EVICT_MB", 0) << 20];
     for _ in 0..repeats {
         let mut f = start.clone();
-        run(&mut f, steps, &forcing);
+        run(&mut f, steps, &forcing, &mut evict);
     }
 }
 
-/// Steps `f` `steps` times, printing each step's figures.
-fn run(f: &mut bubble_dynamics::film_flow::FilmFlow, steps: usize, forcing: &Forcing) {
+/// Steps `f` `steps` times, printing each step's figures; writes every cache line of
+/// `evict` before each step.
+fn run(
+    f: &mut bubble_dynamics::film_flow::FilmFlow,
+    steps: usize,
+    forcing: &Forcing,
+    evict: &mut [u8],
+) {
     for k in 0..steps {
+        for (i, b) in evict.iter_mut().enumerate().step_by(64) {
+            *b = b.wrapping_add(i as u8);
+        }
+        std::hint::black_box(&mut *evict);
         let t = std::time::Instant::now();
         let r = f.step(1.0 / 60.0, forcing);
         let hmin = f.thickness_m().iter().cloned().fold(1.0, f64::min);
