@@ -30,6 +30,7 @@ mod collide;
 mod collider;
 mod dynamics;
 mod error;
+mod exp;
 mod film;
 pub mod film_flow;
 pub mod geometry;

@@ -450,9 +450,15 @@ impl FilmFlow {
             return;
         }
         let th = self.params.thermal;
-        for (h, theta) in self.h_m.iter_mut().zip(&self.temperature_k) {
-            *h = (*h - evaporated * th.evaporation_factor(*theta)).max(0.0);
-        }
+        // One exponential a cell, vectorised (`crate::exp`).
+        with_avx2(
+            #[inline(always)]
+            || {
+                for (h, theta) in self.h_m.iter_mut().zip(&self.temperature_k) {
+                    *h = (*h - evaporated * th.evaporation_factor(*theta)).max(0.0);
+                }
+            },
+        );
     }
 
     /// `u ← u + dt (−u·∇u + g_t + thermal Marangoni + viscous)`.
