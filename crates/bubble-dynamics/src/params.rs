@@ -167,6 +167,10 @@ pub struct BubbleParams {
     /// Density of the film liquid, kg/m³.
     pub film_density_kg_per_m3: f64,
     /// Effective viscosity of the lubrication drainage flux, Pa·s (see docs/dynamics.md).
+    /// The default, 5e-8, is the per-vertex film's, which stands for its surfaces sliding
+    /// too; a flowing film (`film_grid` > 0) moves its surfaces itself, and scene files
+    /// give it 1e-6 (at 5e-8 it drains into a thick pool and its steps slow about
+    /// tenfold).
     pub drainage_viscosity_pa_s: f64,
     /// Thickness below which the film ruptures, nm.
     pub rupture_thickness_nm: f64,
