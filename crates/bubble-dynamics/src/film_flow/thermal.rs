@@ -92,7 +92,7 @@ impl ThermalParams {
 
     /// The evaporation rate of film `excess_k` warmer than the ambient over the
     /// ambient's (Clausius–Clapeyron), its exponential within 2 ulps
-    /// ([`crate::exp::exp`], which a loop over cells vectorises).
+    /// (the crate's own `exp`, which a loop over cells vectorises).
     #[inline]
     pub fn evaporation_factor(&self, excess_k: f64) -> f64 {
         let per_kelvin_inverse =
