@@ -178,6 +178,9 @@ pub struct FilmFlow {
     /// to the start): set to [`GUESS_REST`] when a solve's guess did not beat its
     /// start. Part of the film's state, so a copy steps on as the original does.
     pub(super) guess_wait: u32,
+    /// The sub-steps the last thickness transport took: the next one's first guess
+    /// (`FilmFlow::last_count_holds`).
+    pub(super) transport_substeps: u32,
     scratch: Scratch,
 }
 
@@ -259,6 +262,7 @@ impl FilmFlow {
             },
             surfactant_change: Vec::new(),
             guess_wait: 0,
+            transport_substeps: 1,
             hierarchy,
             grid,
             scratch: Scratch::default(),
