@@ -305,16 +305,23 @@ mod tests {
     use crate::film_flow::FlowParams;
     use crate::film_flow::flow::test_film;
 
-    /// A film whose Courant number asks for several sub-steps takes them all from the
-    /// thickness it started from: the speculative single sub-step's is put back.
-    #[test]
-    fn a_fast_film_takes_its_sub_steps_from_its_starting_thickness() {
+    /// A draining film turning at 3 rad/s, fast enough for several sub-steps a 1/60 s
+    /// step, and its parameters.
+    fn fast_film() -> (FlowParams, FilmFlow) {
         let params = FlowParams {
             drainage_viscosity_pa_s: 1e-6,
             ..FlowParams::water_film(0.05)
         };
         let mut film = test_film(params);
         film.set_velocity(|d| DVec3::Y.cross(d) * 3.0);
+        (params, film)
+    }
+
+    /// A film whose Courant number asks for several sub-steps takes them all from the
+    /// thickness it started from: the speculative single sub-step's is put back.
+    #[test]
+    fn a_fast_film_takes_its_sub_steps_from_its_starting_thickness() {
+        let (params, mut film) = fast_film();
         let (dt_s, g_eff) = (1.0 / 60.0, DVec3::new(0.0, -9.81, 0.0));
         let drain = Drain {
             drain: params.density_kg_per_m3 / (3.0 * params.drainage_viscosity_pa_s),
@@ -341,12 +348,7 @@ mod tests {
     /// count the Courant number asks for taken from the start), and unknown.
     #[test]
     fn the_last_sub_step_count_as_a_guess_gives_the_same_bits() {
-        let params = FlowParams {
-            drainage_viscosity_pa_s: 1e-6,
-            ..FlowParams::water_film(0.05)
-        };
-        let mut film = test_film(params);
-        film.set_velocity(|d| DVec3::Y.cross(d) * 3.0);
+        let (_, film) = fast_film();
         let step = (1.0 / 60.0, DVec3::new(0.0, -9.81, 0.0));
         let mut unknown = film.clone();
         unknown.transport_thickness(&mut Scratch::default(), step, None);
