@@ -179,7 +179,7 @@ pub struct FilmFlow {
     /// start. Part of the film's state, so a copy steps on as the original does.
     pub(super) guess_wait: u32,
     /// The sub-steps the last thickness transport took: the next one's first guess
-    /// (`FilmFlow::last_count_holds`).
+    /// (`FilmFlow::take_last_count`).
     pub(super) transport_substeps: u32,
     scratch: Scratch,
 }

@@ -91,8 +91,16 @@ impl FilmFlow {
             0.0
         };
         let drain = Drain { drain, g_eff };
-        if self.transport_substeps > 1 && self.last_count_holds(s, (dt_s, drain)) {
-            return false;
+        if self.transport_substeps > 1 {
+            match self.take_last_count(s, (dt_s, drain)) {
+                None => return false,
+                Some(asked) if asked > 1 => {
+                    self.substeps_from_start(s, (dt_s, drain), asked);
+                    return false;
+                }
+                // One sub-step: over the whole step, as below, where the smoothing may join.
+                Some(_) => {}
+            }
         }
         let courant =
             self.upwind_substep(s, dt_s, drain, Substep::First(joined)) * dt_s / p.radius_m;
@@ -108,17 +116,23 @@ impl FilmFlow {
             std::mem::swap(&mut self.h_m, &mut s.cell);
             return joins;
         }
+        self.substeps_from_start(s, (dt_s, drain), substeps);
+        false
+    }
+
+    /// `substeps` sub-steps of the transport over `dt_s`, in place from `h_m`.
+    fn substeps_from_start(&mut self, s: &mut Scratch, (dt_s, drain): (f64, Drain), substeps: u32) {
         let h_dt = dt_s / f64::from(substeps);
         for _ in 0..substeps {
             self.upwind_substep(s, h_dt, drain, Substep::Another);
         }
-        false
     }
 
     /// Where the last transport took several sub-steps: the first of as many again, out of
     /// place, taking the Courant number; where that asks for the same count, the rest of
-    /// them in place, and `true`. Else `false`, `h_m` untouched, and the count the
-    /// Courant number asks for noted for [`FilmFlow::transport_thickness`]'s own start.
+    /// them in place, and `None`. Else the count the Courant number asks for (noted as the
+    /// last), `h_m` untouched: [`FilmFlow::transport_thickness`] then takes that many from
+    /// the start, or its one sub-step over the whole step.
     ///
     /// Why: that start takes its first sub-step over the whole step to learn the Courant
     /// number, and a film that needs several sub-steps then throws it away; a film's flow
@@ -126,20 +140,20 @@ impl FilmFlow {
     /// (`dome`'s film needed 2–3 sub-steps in 358 of its 360 steps over 6 s). The speeds
     /// that make the Courant number do not depend on the sub-step's length, and both
     /// ways take the same sub-steps from the same thickness: the same bits.
-    fn last_count_holds(&mut self, s: &mut Scratch, (dt_s, drain): (f64, Drain)) -> bool {
+    fn take_last_count(&mut self, s: &mut Scratch, (dt_s, drain): (f64, Drain)) -> Option<u32> {
         let last = self.transport_substeps;
         let h_dt = dt_s / f64::from(last);
         let speed = self.upwind_substep(s, h_dt, drain, Substep::First(None));
         let substeps = substeps_at(speed * dt_s / self.params.radius_m);
         self.transport_substeps = substeps;
         if substeps != last {
-            return false;
+            return Some(substeps);
         }
         std::mem::swap(&mut self.h_m, &mut s.cell);
         for _ in 1..substeps {
             self.upwind_substep(s, h_dt, drain, Substep::Another);
         }
-        true
+        None
     }
 
     /// One transport of `h` over `dt_s`: second-order upwind (the upwind cell's
@@ -302,6 +316,7 @@ pub(crate) fn edge_speed(u: f64, c: f64, ha: f64, hb: f64, per_area: f64) -> f64
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bits::differing_bits;
     use crate::film_flow::FlowParams;
     use crate::film_flow::flow::test_film;
 
@@ -339,8 +354,7 @@ mod tests {
         for _ in 0..substeps {
             film.upwind_substep(&mut s, dt_s / f64::from(substeps), drain, Substep::Another);
         }
-        let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
-        assert_eq!(bits(&taken.h_m), bits(&film.h_m));
+        assert_eq!(differing_bits(&taken.h_m, &film.h_m), 0);
     }
 
     /// The last transport's sub-step count, taken as the next one's first guess, changes
@@ -354,12 +368,12 @@ mod tests {
         unknown.transport_thickness(&mut Scratch::default(), step, None);
         let substeps = unknown.transport_substeps;
         assert!(substeps > 2, "{substeps} sub-steps: the test is idle");
-        let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
         for guess in [substeps, substeps - 1, substeps + 1] {
             let mut guessed = film.clone();
             guessed.transport_substeps = guess;
             guessed.transport_thickness(&mut Scratch::default(), step, None);
-            assert_eq!(bits(&guessed.h_m), bits(&unknown.h_m), "guess {guess}");
+            let differ = differing_bits(&guessed.h_m, &unknown.h_m);
+            assert_eq!(differ, 0, "guess {guess}: {differ} cells differ");
             assert_eq!(guessed.transport_substeps, substeps, "guess {guess}");
         }
     }
