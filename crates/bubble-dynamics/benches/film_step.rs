@@ -9,13 +9,16 @@
 //! solve takes more iterations on it than on the swirl film (docs/performance.md,
 //! "Fifteenth round").
 
+#[path = "common/scene_film.rs"]
+mod scene_film;
 #[path = "common/swirl_film.rs"]
 mod swirl_film;
 
-use bubble_dynamics::film_flow::{FilmFlow, FilmGradient, Forcing};
-use bubble_dynamics::{BubbleParams, Collider, DVec3, World, WorldParams};
+use bubble_dynamics::DVec3;
+use bubble_dynamics::film_flow::{FilmGradient, Forcing};
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 
+use scene_film::scene_film;
 use swirl_film::swirl_film;
 
 fn bench_film_step(c: &mut Criterion) {
@@ -56,36 +59,6 @@ fn bench_film_step(c: &mut Criterion) {
         )
     });
     group.finish();
-}
-
-/// The film of `crowd`'s first bubble with a grid of 64, one second after it was
-/// dropped onto the ground.
-fn scene_film() -> FilmFlow {
-    let bubble = BubbleParams {
-        center_m: DVec3::new(-0.240, 0.0692, -0.210),
-        radius_m: 0.0267,
-        mean_thickness_nm: 600.0,
-        subdivisions: 3,
-        film_grid: 64,
-        seed: 1,
-        // A scene file's default for a flowing film (`bubbles`' `scene::to_dynamics`):
-        // the library's 5e-8 is the per-vertex film's, under which a flowing film drains
-        // into a thick pool and its steps run about ten times longer.
-        drainage_viscosity_pa_s: 1e-6,
-        ..BubbleParams::default()
-    };
-    let params = WorldParams {
-        colliders: vec![Collider::ground(0.0)],
-        ..WorldParams::default()
-    };
-    let mut world = World::try_new(params, vec![bubble]).expect("crowd's first bubble");
-    world
-        .advance(1.0)
-        .expect("one second of crowd's first bubble");
-    world.bubbles()[0]
-        .film_flow()
-        .expect("a film grid of 64")
-        .clone()
 }
 
 criterion_group! {

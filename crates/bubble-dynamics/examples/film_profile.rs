@@ -5,8 +5,11 @@
 //! that many times, each from a copy of the same starting film, so a profile of a small
 //! grid is not dominated by building it; `FILM_EVICT_MB` writes a buffer of that many MB
 //! before each step, outside its timing, so that the step finds the caches as a scene's
-//! rendering leaves them: cold).
+//! rendering leaves them: cold; `FILM_SCENE=1` steps `film_step/scene_n64`'s film, a
+//! scene's, in place of the bench's, `n` and the warming then unused).
 
+#[path = "../benches/common/scene_film.rs"]
+mod scene_film;
 #[path = "../benches/common/swirl_film.rs"]
 mod swirl_film;
 
@@ -26,8 +29,12 @@ fn main() {
         Some("normal") => FilmGradient::Normal,
         _ => FilmGradient::TwoPoint,
     };
-    let start = swirl_film(n, arg(4, 0.0), gradient);
     let count = |name: &str, d: usize| std::env::var(name).map_or(d, |s| s.parse().expect(name));
+    let start = if count("FILM_SCENE", 0) == 1 {
+        scene_film::scene_film()
+    } else {
+        swirl_film(n, arg(4, 0.0), gradient)
+    };
     let (steps, repeats) = (count("FILM_STEPS", 40), count("FILM_REPEATS", 1));
     let mut evict = vec![0u8; count("FILM_EVICT_MB", 0) << 20];
     for _ in 0..repeats {
