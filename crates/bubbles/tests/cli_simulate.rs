@@ -332,3 +332,42 @@ fn scene_file_runs_and_divergence_exits_1_naming_step_and_bubble() {
     );
     assert!(out.stdout.is_empty(), "half a report was printed");
 }
+
+/// `docs/scenes/ten64.toml`, the ten-film bench the performance notes measure with, is
+/// what its header says: `crowd`'s first ten bubbles as they are there (the same shapes
+/// to the bit, and the same mean thickness: the finer grid samples the same streaks at
+/// other points, so their extremes differ), each with a film grid of 64.
+#[test]
+fn the_ten_film_bench_scene_is_crowds_first_ten_bubbles_with_grids_of_64() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/scenes/ten64.toml");
+    let path = path.to_str().expect("a UTF-8 path");
+    let ten = json(&[path, "--seconds", "0", "--json"]);
+    let crowd = json(&["crowd", "--seconds", "0", "--json"]);
+    let (ten, crowd) = (
+        ten["bubbles"].as_array().expect("bubbles"),
+        crowd["bubbles"].as_array().expect("bubbles"),
+    );
+    assert_eq!(ten.len(), 10);
+    for (i, (a, b)) in ten.iter().zip(crowd).enumerate() {
+        for key in ["center_m", "radius_m", "volume_m3"] {
+            assert_eq!(a[key], b[key], "bubble {i}: {key}");
+        }
+        let mean = |v: &Value| num(&v["thickness_nm"]["mean"]);
+        assert_rel(
+            &format!("bubble {i}'s mean thickness"),
+            mean(a),
+            mean(b),
+            1e-12,
+        );
+    }
+    let text = std::fs::read_to_string(path).expect("the scene file");
+    let scene: toml::Table = text.parse().expect("the scene is TOML");
+    let bubbles = scene["bubbles"].as_array().expect("[[bubbles]]");
+    for (i, b) in bubbles.iter().enumerate() {
+        assert_eq!(
+            b["film_grid"].as_integer(),
+            Some(64),
+            "bubble {i}'s film_grid"
+        );
+    }
+}
