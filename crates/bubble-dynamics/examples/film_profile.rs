@@ -6,7 +6,7 @@
 //! grid is not dominated by building it; `FILM_EVICT_MB` writes a buffer of that many MB
 //! before each step, outside its timing, so that the step finds the caches as a scene's
 //! rendering leaves them: cold; `FILM_SCENE=1` steps `film_step/scene_n64`'s film, a
-//! scene's, in place of the bench's, `n` and the warming then unused).
+//! scene's, in place of the bench's, `n`, the warming and the gradient then unused).
 
 #[path = "../benches/common/scene_film.rs"]
 mod scene_film;
